@@ -1,0 +1,291 @@
+#include "gltf_doc.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+
+struct GltfDoc {
+    tinygltf::Model model;
+    int scene = -1;
+};
+
+namespace {
+
+void set_error(char *err, size_t size, const std::string &text)
+{
+    std::string line = text;
+    for (char &c : line)
+        if (c == '\n' || c == '\r')
+            c = ' ';
+    while (!line.empty() && line.back() == ' ')
+        line.pop_back();
+    std::snprintf(err, size, "%s", line.c_str());
+}
+
+// ptr never looks at textures: skip decoding every embedded image.
+bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
+                const unsigned char *, int, void *)
+{
+    return true;
+}
+
+bool in_range(int index, size_t count) { return index >= 0 && size_t(index) < count; }
+
+// tinygltf leaves most cross-references unchecked; check every one ptr
+// follows, so the C side can index without looking.
+std::string check_indices(const tinygltf::Model &m)
+{
+    const size_t nodes = m.nodes.size();
+    for (size_t i = 0; i < nodes; i++) {
+        const tinygltf::Node &n = m.nodes[i];
+        if (n.mesh != -1 && !in_range(n.mesh, m.meshes.size()))
+            return "node " + std::to_string(i) + " refers to mesh " + std::to_string(n.mesh) +
+                   ", which does not exist";
+        if (n.camera != -1 && !in_range(n.camera, m.cameras.size()))
+            return "node " + std::to_string(i) + " refers to camera " +
+                   std::to_string(n.camera) + ", which does not exist";
+        for (int child : n.children)
+            if (!in_range(child, nodes))
+                return "node " + std::to_string(i) + " has child " + std::to_string(child) +
+                       ", which does not exist";
+        if (!(n.matrix.empty() || n.matrix.size() == 16) ||
+            !(n.rotation.empty() || n.rotation.size() == 4) ||
+            !(n.scale.empty() || n.scale.size() == 3) ||
+            !(n.translation.empty() || n.translation.size() == 3))
+            return "node " + std::to_string(i) + " has a transform of the wrong length";
+    }
+    for (size_t i = 0; i < m.meshes.size(); i++) {
+        for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
+            if (p.material != -1 && !in_range(p.material, m.materials.size()))
+                return "mesh " + std::to_string(i) + " refers to material " +
+                       std::to_string(p.material) + ", which does not exist";
+            auto pos = p.attributes.find("POSITION");
+            if (pos != p.attributes.end() && !in_range(pos->second, m.accessors.size()))
+                return "mesh " + std::to_string(i) + " refers to accessor " +
+                       std::to_string(pos->second) + ", which does not exist";
+        }
+    }
+    for (size_t s = 0; s < m.scenes.size(); s++)
+        for (int root : m.scenes[s].nodes)
+            if (!in_range(root, nodes))
+                return "scene " + std::to_string(s) + " refers to node " + std::to_string(root) +
+                       ", which does not exist";
+    if (m.defaultScene != -1 && !in_range(m.defaultScene, m.scenes.size()))
+        return "default scene " + std::to_string(m.defaultScene) + " does not exist";
+    return "";
+}
+
+bool is_binary_gltf(const char *path, bool *readable)
+{
+    std::ifstream file(path, std::ios::binary);
+    *readable = bool(file);
+    char magic[4] = { 0, 0, 0, 0 };
+    file.read(magic, 4);
+    return file.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+}
+
+const tinygltf::Value *object_member(const tinygltf::Value &object, const char *key)
+{
+    // Get(key) asserts on a non-object.
+    if (!object.IsObject() || !object.Has(key))
+        return nullptr;
+    return &object.Get(key);
+}
+
+bool number_member(const tinygltf::Value &object, const char *key, double *out)
+{
+    const tinygltf::Value *v = object_member(object, key);
+    if (!v || !v->IsNumber())
+        return false;
+    *out = v->GetNumberAsDouble();
+    return true;
+}
+
+// A number inside material.extensions[extension][key].
+bool extension_number(const tinygltf::ExtensionMap &extensions, const char *extension,
+                      const char *key, double *out)
+{
+    auto it = extensions.find(extension);
+    return it != extensions.end() && number_member(it->second, key, out);
+}
+
+template <size_t N>
+void copy_or(double (&dst)[N], const std::vector<double> &src, const double (&fallback)[N])
+{
+    for (size_t i = 0; i < N; i++)
+        dst[i] = src.size() == N ? src[i] : fallback[i];
+}
+
+} // namespace
+
+extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
+                                  int *unreadable)
+{
+    *unreadable = 0;
+    try {
+        bool readable = false;
+        bool binary = is_binary_gltf(path, &readable);
+        if (!readable) {
+            *unreadable = 1;
+            set_error(err, err_size, std::string(path) + ": " + std::strerror(errno));
+            return nullptr;
+        }
+        auto doc = std::make_unique<GltfDoc>();
+        tinygltf::TinyGLTF loader;
+        loader.SetImageLoader(skip_image, nullptr);
+        std::string error, warning;
+        bool ok = binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
+                         : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path);
+        if (!ok) {
+            set_error(err, err_size, std::string(path) + ": " +
+                                         (error.empty() ? "not a valid glTF file" : error));
+            return nullptr;
+        }
+        std::string fault = check_indices(doc->model);
+        if (!fault.empty()) {
+            set_error(err, err_size, std::string(path) + ": " + fault);
+            return nullptr;
+        }
+        const tinygltf::Model &m = doc->model;
+        doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
+        return doc.release();
+    } catch (const std::exception &e) {
+        set_error(err, err_size, std::string(path) + ": " + e.what());
+    } catch (...) {
+        set_error(err, err_size, std::string(path) + ": unexpected error while parsing");
+    }
+    return nullptr;
+}
+
+extern "C" void gltf_doc_free(GltfDoc *doc) { delete doc; }
+
+extern "C" size_t gltf_doc_node_count(const GltfDoc *d) { return d->model.nodes.size(); }
+extern "C" size_t gltf_doc_mesh_count(const GltfDoc *d) { return d->model.meshes.size(); }
+extern "C" size_t gltf_doc_material_count(const GltfDoc *d) { return d->model.materials.size(); }
+extern "C" size_t gltf_doc_camera_count(const GltfDoc *d) { return d->model.cameras.size(); }
+
+extern "C" void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *out)
+{
+    static const double identity[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+    static const double zero3[3] = { 0, 0, 0 }, one3[3] = { 1, 1, 1 };
+    static const double unit_quat[4] = { 0, 0, 0, 1 };
+    const tinygltf::Node &n = doc->model.nodes[index];
+    *out = GltfNode{};
+    out->name = n.name.c_str();
+    out->mesh = n.mesh;
+    out->camera = n.camera;
+    out->children = n.children.data();
+    out->child_count = n.children.size();
+    out->has_matrix = n.matrix.size() == 16;
+    copy_or(out->matrix, n.matrix, identity);
+    copy_or(out->translation, n.translation, zero3);
+    copy_or(out->rotation, n.rotation, unit_quat);
+    copy_or(out->scale, n.scale, one3);
+    out->has_radius = number_member(n.extras, "radius", &out->radius);
+}
+
+extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
+{
+    const tinygltf::Mesh &mesh = doc->model.meshes[index];
+    *out = GltfMesh{};
+    out->name = mesh.name.c_str();
+    out->material = mesh.primitives.empty() ? -1 : mesh.primitives[0].material;
+    out->has_bounds = !mesh.primitives.empty();
+    for (int k = 0; k < 3; k++) {
+        out->min[k] = HUGE_VAL;
+        out->max[k] = -HUGE_VAL;
+    }
+    for (const tinygltf::Primitive &p : mesh.primitives) {
+        auto pos = p.attributes.find("POSITION");
+        if (pos == p.attributes.end()) {
+            out->has_bounds = 0;
+            continue;
+        }
+        const tinygltf::Accessor &a = doc->model.accessors[size_t(pos->second)];
+        if (a.minValues.size() != 3 || a.maxValues.size() != 3) {
+            out->has_bounds = 0;
+            continue;
+        }
+        for (size_t k = 0; k < 3; k++) {
+            out->min[k] = std::min(out->min[k], a.minValues[k]);
+            out->max[k] = std::max(out->max[k], a.maxValues[k]);
+        }
+    }
+}
+
+extern "C" void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *out)
+{
+    static const double white[4] = { 1, 1, 1, 1 }, black3[3] = { 0, 0, 0 };
+    const tinygltf::Material &m = doc->model.materials[index];
+    const tinygltf::PbrMetallicRoughness &pbr = m.pbrMetallicRoughness;
+    *out = GltfMaterial{};
+    out->name = m.name.c_str();
+    copy_or(out->base_color, pbr.baseColorFactor, white);
+    out->metallic = pbr.metallicFactor;
+    out->roughness = pbr.roughnessFactor;
+    copy_or(out->emissive, m.emissiveFactor, black3);
+    out->emissive_strength = 1.0;
+    extension_number(m.extensions, "KHR_materials_emissive_strength", "emissiveStrength",
+                     &out->emissive_strength);
+    out->transmission = 0.0;
+    extension_number(m.extensions, "KHR_materials_transmission", "transmissionFactor",
+                     &out->transmission);
+    out->ior = 1.5;
+    extension_number(m.extensions, "KHR_materials_ior", "ior", &out->ior);
+    out->has_texture = pbr.baseColorTexture.index >= 0 ||
+                       pbr.metallicRoughnessTexture.index >= 0 ||
+                       m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0 ||
+                       m.emissiveTexture.index >= 0;
+}
+
+extern "C" void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *out)
+{
+    const tinygltf::Camera &c = doc->model.cameras[index];
+    *out = GltfCamera{};
+    out->name = c.name.c_str();
+    out->perspective = c.type == "perspective";
+    out->yfov = c.perspective.yfov;
+    out->aspect_ratio = c.perspective.aspectRatio;
+    out->has_aperture = number_member(c.extras, "aperture", &out->aperture);
+    out->has_focus_distance = number_member(c.extras, "focus_distance", &out->focus_distance);
+}
+
+extern "C" int gltf_doc_scene(const GltfDoc *doc, GltfScene *out)
+{
+    *out = GltfScene{};
+    if (doc->scene < 0)
+        return 0;
+    const tinygltf::Scene &s = doc->model.scenes[size_t(doc->scene)];
+    out->roots = s.nodes.data();
+    out->root_count = s.nodes.size();
+    if (const tinygltf::Value *sky = object_member(s.extras, "sky")) {
+        if (sky->IsString()) {
+            out->sky_name = sky->Get<std::string>().c_str();
+        } else if (sky->IsArray() && sky->ArrayLen() == 3 && sky->Get(0).IsNumber() &&
+                   sky->Get(1).IsNumber() && sky->Get(2).IsNumber()) {
+            out->has_sky_rgb = 1;
+            for (int k = 0; k < 3; k++)
+                out->sky_rgb[k] = sky->Get(k).GetNumberAsDouble();
+        } else {
+            out->sky_invalid = 1;
+        }
+    }
+    if (const tinygltf::Value *res = object_member(s.extras, "resolution")) {
+        if (res->IsArray() && res->ArrayLen() == 2 && res->Get(0).IsInt() &&
+            res->Get(1).IsInt()) {
+            out->has_resolution = 1;
+            out->resolution[0] = res->Get(0).GetNumberAsInt();
+            out->resolution[1] = res->Get(1).GetNumberAsInt();
+        } else {
+            out->resolution_invalid = 1;
+        }
+    }
+    return 1;
+}

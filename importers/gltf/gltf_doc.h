@@ -1,0 +1,93 @@
+/* A glTF document as plain C data: the parts of tinygltf's model that ptr
+ * maps onto its scene, with indices checked. Everything about the scene
+ * conventions lives in gltf_import.c; this layer only reads the file. */
+#ifndef PTR_GLTF_DOC_H
+#define PTR_GLTF_DOC_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct GltfDoc GltfDoc;
+
+typedef struct GltfNode {
+    const char *name;
+    int mesh;   /* -1 if none */
+    int camera; /* -1 if none */
+    const int *children;
+    size_t child_count;
+    int has_matrix;
+    double matrix[16]; /* column-major, as glTF stores it */
+    double translation[3], rotation[4] /* x, y, z, w */, scale[3];
+    int has_radius;    /* extras.radius */
+    double radius;
+} GltfNode;
+
+typedef struct GltfMesh {
+    const char *name;
+    int has_bounds;    /* every primitive has POSITION with min and max */
+    double min[3], max[3]; /* union over the primitives */
+    int material;      /* first primitive's material, -1 if none */
+} GltfMesh;
+
+typedef struct GltfMaterial {
+    const char *name;
+    double base_color[4];
+    double metallic, roughness;
+    double emissive[3];
+    double emissive_strength;   /* KHR_materials_emissive_strength, default 1 */
+    double transmission;        /* KHR_materials_transmission, default 0 */
+    double ior;                 /* KHR_materials_ior, default 1.5 */
+    int has_texture;
+} GltfMaterial;
+
+typedef struct GltfCamera {
+    const char *name;
+    int perspective;
+    double yfov;         /* radians */
+    double aspect_ratio; /* 0 if not given */
+    int has_aperture, has_focus_distance; /* extras */
+    double aperture, focus_distance;
+} GltfCamera;
+
+/* The default scene (`scene`, else scene 0) and its extras. */
+typedef struct GltfScene {
+    const int *roots;
+    size_t root_count;
+    const char *sky_name;   /* extras.sky as a string, or NULL */
+    int has_sky_rgb;        /* extras.sky as [r, g, b] */
+    double sky_rgb[3];
+    int sky_invalid;        /* extras.sky present but neither */
+    int has_resolution;     /* extras.resolution: [width, height] */
+    int resolution[2];
+    int resolution_invalid; /* extras.resolution present but not two integers */
+} GltfScene;
+
+/* Loads .gltf or .glb (chosen by the file's first bytes). Returns NULL and
+ * writes one line to err on failure; *unreadable is set when the file could
+ * not be read at all (as opposed to read and found malformed). Warnings from
+ * the parser are ignored: ptr reports what it drops itself. */
+GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size, int *unreadable);
+void gltf_doc_free(GltfDoc *doc);
+
+size_t gltf_doc_node_count(const GltfDoc *doc);
+size_t gltf_doc_mesh_count(const GltfDoc *doc);
+size_t gltf_doc_material_count(const GltfDoc *doc);
+size_t gltf_doc_camera_count(const GltfDoc *doc);
+
+/* Index arguments must be below the matching count; every index the
+ * structures hold has been checked to be in range when the file loaded. */
+void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *node);
+void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *mesh);
+void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *material);
+void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *camera);
+/* Returns 0 if the file has no scene at all. */
+int gltf_doc_scene(const GltfDoc *doc, GltfScene *scene);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PTR_GLTF_DOC_H */

@@ -1,0 +1,74 @@
+#include "importer.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "importer_internal.h"
+
+typedef PtrResult (*ImportFn)(const char *, const PtrImportOptions *, PtrScene *,
+                              PtrWarnings *, PtrError *);
+
+static const struct {
+    const char *extension;
+    ImportFn import;
+} importers[] = {
+    { ".gltf", ptr_import_gltf },
+    { ".glb", ptr_import_gltf },
+};
+
+void ptr_warn(PtrWarnings *warnings, const char *fmt, ...)
+{
+    char line[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    char **grown = realloc(warnings->lines, (warnings->count + 1) * sizeof *grown);
+    if (!grown)
+        return; /* a warning lost to memory exhaustion is not worth failing for */
+    warnings->lines = grown;
+    grown[warnings->count] = strdup(line);
+    if (grown[warnings->count])
+        warnings->count++;
+}
+
+void ptr_warnings_free(PtrWarnings *warnings)
+{
+    for (size_t i = 0; i < warnings->count; i++)
+        free(warnings->lines[i]);
+    free(warnings->lines);
+    warnings->lines = NULL;
+    warnings->count = 0;
+}
+
+PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
+                           PtrScene *scene, PtrWarnings *warnings, PtrError *err)
+{
+    ptr_scene_init(scene);
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return ptr_error_set(err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path, strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return ptr_error_set(err, PTR_ERR_SCENE_UNREADABLE, "%s: is a directory, not a scene file",
+                             path);
+
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (dot && (!slash || dot > slash)) {
+        for (size_t i = 0; i < sizeof importers / sizeof importers[0]; i++) {
+            if (strcasecmp(dot, importers[i].extension))
+                continue;
+            PtrResult r = importers[i].import(path, options, scene, warnings, err);
+            if (r != PTR_OK)
+                ptr_scene_free(scene);
+            return r;
+        }
+    }
+    return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                         "%s: unknown scene format (expected .gltf or .glb)", path);
+}

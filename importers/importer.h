@@ -1,0 +1,33 @@
+/* Scene files in, one PtrScene out. The importer chosen by the file's
+ * extension follows docs/scenes.md; everything it could not represent is
+ * reported as a warning naming the object. */
+#ifndef PTR_IMPORTER_H
+#define PTR_IMPORTER_H
+
+#include <stddef.h>
+
+#include "result.h"
+#include "scene.h"
+
+typedef struct PtrImportOptions {
+    const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
+} PtrImportOptions;
+
+typedef struct PtrWarnings {
+    char **lines;
+    size_t count;
+} PtrWarnings;
+
+/* Reads path into scene (which the call initialises). On failure the scene
+ * is left empty and err holds one line naming the file and the problem:
+ * PTR_ERR_SCENE_UNREADABLE if it could not be read, PTR_ERR_SCENE_INVALID if
+ * it was read and is wrong. Warnings are appended to warnings either way. */
+PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
+                           PtrScene *scene, PtrWarnings *warnings, PtrError *err);
+
+/* Appends a printf-formatted warning line. */
+void ptr_warn(PtrWarnings *warnings, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+void ptr_warnings_free(PtrWarnings *warnings);
+
+#endif /* PTR_IMPORTER_H */

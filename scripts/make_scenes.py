@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Writes a glTF scene (.gltf with an embedded buffer, or .glb) from a neutral
+JSON scene description (the format of shared/bench-scenes/*.json).
+
+Every sphere is a node that instances one shared unit UV sphere (bounds exactly
+[-1, 1]^3) with translation = centre and uniform scale = radius, so ptr's
+import (docs/scenes.md) recovers the centre and radius exactly, and other glTF
+viewers show round spheres. The camera node looks from `lookfrom` towards
+`lookat`; depth of field is carried in the camera's extras.
+
+Usage: make_scenes.py INPUT.json OUTPUT.gltf|OUTPUT.glb
+"""
+import base64
+import json
+import math
+import struct
+import sys
+
+SEGMENTS, RINGS = 32, 16  # multiples of 4 and 2: the bounds are exactly +-1
+
+
+def unit_sphere():
+    """Positions (also the normals) and triangle indices of a UV sphere."""
+    verts = [(0.0, 1.0, 0.0)]
+    for ring in range(1, RINGS):
+        theta = math.pi * ring / RINGS
+        y = 0.0 if 2 * ring == RINGS else math.cos(theta)
+        s = math.sin(theta)
+        for seg in range(SEGMENTS):
+            phi = 2.0 * math.pi * seg / SEGMENTS
+            quarter = 4 * seg % SEGMENTS == 0  # exact +-1 where the bounds are
+            x = s * (round(math.cos(phi)) if quarter else math.cos(phi))
+            z = s * (round(math.sin(phi)) if quarter else math.sin(phi))
+            verts.append((x, y, z))
+    verts.append((0.0, -1.0, 0.0))
+    bottom = len(verts) - 1
+
+    def ring_vertex(ring, seg):
+        return 1 + (ring - 1) * SEGMENTS + seg % SEGMENTS
+
+    tris = []
+    for seg in range(SEGMENTS):
+        tris.append((0, ring_vertex(1, seg + 1), ring_vertex(1, seg)))
+        tris.append((bottom, ring_vertex(RINGS - 1, seg), ring_vertex(RINGS - 1, seg + 1)))
+    for ring in range(1, RINGS - 1):
+        for seg in range(SEGMENTS):
+            a, b = ring_vertex(ring, seg), ring_vertex(ring, seg + 1)
+            c, d = ring_vertex(ring + 1, seg), ring_vertex(ring + 1, seg + 1)
+            tris += [(a, b, d), (a, d, c)]
+    return verts, tris
+
+
+def normalize(v):
+    n = math.sqrt(sum(x * x for x in v))
+    return [x / n for x in v]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def look_rotation(lookfrom, lookat, vup):
+    """Quaternion (x, y, z, w) turning a camera that looks down -Z with +Y up
+    to look from `lookfrom` at `lookat`."""
+    w = normalize([f - t for f, t in zip(lookfrom, lookat)])
+    u = normalize(cross(vup, w))
+    v = cross(w, u)
+    m = [[u[0], v[0], w[0]], [u[1], v[1], w[1]], [u[2], v[2], w[2]]]  # columns u, v, w
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0:
+        s = 0.5 / math.sqrt(trace + 1.0)
+        q = [(m[2][1] - m[1][2]) * s, (m[0][2] - m[2][0]) * s, (m[1][0] - m[0][1]) * s, 0.25 / s]
+    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2])
+        q = [0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]
+    elif m[1][1] > m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2])
+        q = [(m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
+        q = [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s]
+    return normalize(q)
+
+
+def gltf_material(sphere):
+    kind = sphere["material"]
+    if kind == "lambertian":
+        return {"pbrMetallicRoughness": {"baseColorFactor": sphere["albedo"] + [1.0],
+                                         "metallicFactor": 0.0, "roughnessFactor": 1.0}}
+    if kind == "metal":
+        return {"pbrMetallicRoughness": {"baseColorFactor": sphere["albedo"] + [1.0],
+                                         "metallicFactor": 1.0,
+                                         "roughnessFactor": sphere.get("fuzz", 0.0)}}
+    if kind == "dielectric":
+        return {"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+                                         "metallicFactor": 0.0, "roughnessFactor": 0.0},
+                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                               "KHR_materials_ior": {"ior": sphere["ior"]}}}
+    raise SystemExit(f"unknown material kind {kind!r}")
+
+
+def build(desc):
+    verts, tris = unit_sphere()
+    positions = b"".join(struct.pack("<3f", *v) for v in verts)
+    indices = b"".join(struct.pack("<3H", *t) for t in tris)
+    indices += b"\0" * (-len(indices) % 4)
+    blob = positions + indices
+
+    materials, material_index, meshes, nodes = [], {}, [], []
+    for i, sphere in enumerate(desc["spheres"]):
+        mat = gltf_material(sphere)
+        key = json.dumps(mat, sort_keys=True)
+        if key not in material_index:
+            material_index[key] = len(materials)
+            materials.append(dict(mat, name=f"{sphere['material']}.{len(materials):03d}"))
+            meshes.append({"name": f"Sphere.{len(meshes):03d}",
+                           "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 0},
+                                           "indices": 1, "material": material_index[key]}]})
+        r = sphere["radius"]
+        nodes.append({"name": f"Sphere.{i:03d}", "mesh": material_index[key],
+                      "translation": sphere["center"], "scale": [r, r, r]})
+
+    cam = desc["camera"]
+    width, height = desc["image"]["width"], desc["image"]["height"]
+    nodes.append({"name": "Camera", "camera": 0,
+                  "translation": cam["lookfrom"],
+                  "rotation": look_rotation(cam["lookfrom"], cam["lookat"], cam["vup"])})
+    camera = {"name": "Camera", "type": "perspective",
+              "perspective": {"yfov": math.radians(cam["vfov_deg"]),
+                              "aspectRatio": width / height, "znear": 0.001},
+              "extras": {"aperture": cam["aperture"], "focus_distance": cam["focus_dist"]}}
+
+    doc = {
+        "asset": {"version": "2.0", "generator": "ptr scripts/make_scenes.py"},
+        "scene": 0,
+        "scenes": [{"name": desc["name"], "nodes": list(range(len(nodes))),
+                    "extras": {"sky": desc["sky"]["type"], "resolution": [width, height]}}],
+        "nodes": nodes,
+        "cameras": [camera],
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": len(verts), "type": "VEC3",
+             "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3 * len(tris), "type": "SCALAR"},
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": len(positions), "target": 34962},
+            {"buffer": 0, "byteOffset": len(positions), "byteLength": 6 * len(tris),
+             "target": 34963},
+        ],
+        "buffers": [{"byteLength": len(blob)}],
+    }
+    if any(s["material"] == "dielectric" for s in desc["spheres"]):
+        doc["extensionsUsed"] = ["KHR_materials_transmission", "KHR_materials_ior"]
+    return doc, blob
+
+
+def write_gltf(doc, blob, path):
+    doc["buffers"][0]["uri"] = ("data:application/octet-stream;base64," +
+                                base64.b64encode(blob).decode("ascii"))
+    with open(path, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+
+
+def write_glb(doc, blob, path):
+    text = json.dumps(doc, separators=(",", ":")).encode()
+    text += b" " * (-len(text) % 4)
+    blob += b"\0" * (-len(blob) % 4)
+    total = 12 + 8 + len(text) + 8 + len(blob)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<4sII", b"glTF", 2, total))
+        f.write(struct.pack("<I4s", len(text), b"JSON") + text)
+        f.write(struct.pack("<I4s", len(blob), b"BIN\0") + blob)
+
+
+def main():
+    if len(sys.argv) != 3:
+        raise SystemExit(__doc__)
+    with open(sys.argv[1]) as f:
+        desc = json.load(f)
+    doc, blob = build(desc)
+    if sys.argv[2].endswith(".glb"):
+        write_glb(doc, blob, sys.argv[2])
+    else:
+        write_gltf(doc, blob, sys.argv[2])
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,290 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "importer.h"
+#include "isect.h"
+#include "output.h"
+#include "render.h"
+#include "version.h"
+
+enum {
+    DEFAULT_SAMPLES = 100,
+    DEFAULT_MAX_DEPTH = 50,
+    DEFAULT_WIDTH = 800,
+    MAX_SIZE = 1 << 16,
+    MAX_THREADS = 1024,
+};
+
+typedef struct Options {
+    const char *scene_path;
+    const char *output_path;
+    const char *camera_name;
+    uint32_t samples;
+    uint64_t seed;
+    int width, height; /* 0: from the scene */
+    int max_depth;
+    int threads;
+    int has_sky;
+    PtrSky sky;
+    PtrKernel kernel;
+    int half;
+    int quiet;
+} Options;
+
+enum {
+    OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
+    OPT_SKY, OPT_C, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_HELP, OPT_VERSION,
+};
+
+static const struct option long_options[] = {
+    { "output", required_argument, NULL, 'o' },
+    { "samples", required_argument, NULL, OPT_SAMPLES },
+    { "width", required_argument, NULL, OPT_WIDTH },
+    { "height", required_argument, NULL, OPT_HEIGHT },
+    { "threads", required_argument, NULL, OPT_THREADS },
+    { "seed", required_argument, NULL, OPT_SEED },
+    { "max-depth", required_argument, NULL, OPT_MAX_DEPTH },
+    { "sky", required_argument, NULL, OPT_SKY },
+    { "camera", required_argument, NULL, OPT_CAMERA },
+    { "c", no_argument, NULL, OPT_C },
+    { "half", no_argument, NULL, OPT_HALF },
+    { "quiet", no_argument, NULL, OPT_QUIET },
+    { "help", no_argument, NULL, OPT_HELP },
+    { "version", no_argument, NULL, OPT_VERSION },
+    { NULL, 0, NULL, 0 },
+};
+
+static void print_help(FILE *out)
+{
+    fprintf(out,
+        "Usage: ptr SCENE -o OUTPUT [options]\n"
+        "Renders a scene of spheres (.gltf, .glb) with a path tracer.\n"
+        "\n"
+        "  -o, --output FILE     image to write; the extension picks the format:\n"
+        "                        .exr (scene-linear float), .png/.jpg/.tif (8-bit sRGB)\n"
+        "      --samples N       samples per pixel (default %d)\n"
+        "      --width W         image width; with only one of width/height the other\n"
+        "      --height H        follows the camera's aspect ratio (default: the scene's\n"
+        "                        resolution, else %d wide)\n"
+        "      --threads N       render threads, 0 for one per CPU (default 0)\n"
+        "      --seed S          random seed (default 1); the image depends only on it,\n"
+        "                        never on the thread count\n"
+        "      --max-depth D     rays per path at most (default %d)\n"
+        "      --sky SKY         gradient, black or R,G,B (overrides the scene's sky)\n"
+        "      --camera NAME     the glTF camera (node or camera name) to render through\n"
+        "      --c               use the portable C intersector\n"
+        "      --half            store .exr pixels as half floats\n"
+        "      --quiet           no statistics line\n"
+        "      --help            this text\n"
+        "      --version         version and intersector\n"
+        "\n"
+        "Exit codes:\n",
+        DEFAULT_SAMPLES, DEFAULT_WIDTH, DEFAULT_MAX_DEPTH);
+    for (int r = PTR_OK; r <= PTR_ERR_NOMEM; r++)
+        fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
+                ptr_result_description((PtrResult)r));
+}
+
+/* A whole decimal number in [lo, hi], nothing else. */
+static int parse_uint(const char *text, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    if (*text < '0' || *text > '9')
+        return 0;
+    errno = 0;
+    char *end;
+    unsigned long long v = strtoull(text, &end, 10);
+    if (errno || *end || v < lo || v > hi)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int usage_error(const char *option, const char *value, const char *expected)
+{
+    fprintf(stderr, "ptr: %s: '%s' is not %s (see ptr --help)\n", option, value, expected);
+    return ptr_result_exit_code(PTR_ERR_USAGE);
+}
+
+/* Returns -1 to go on rendering, else the exit code to return. */
+static int parse_options(int argc, char **argv, Options *o)
+{
+    *o = (Options){
+        .samples = DEFAULT_SAMPLES, .seed = 1, .max_depth = DEFAULT_MAX_DEPTH,
+        .kernel = PTR_KERNEL_AUTO,
+    };
+    optind = 0; /* glibc: restart scanning, so the parser can run more than once */
+    opterr = 0;
+    int c;
+    uint64_t v;
+    while ((c = getopt_long(argc, argv, ":o:", long_options, NULL)) != -1) {
+        const char *name = long_options[0].name;
+        for (const struct option *lo = long_options; lo->name; lo++)
+            if (lo->val == c)
+                name = lo->name;
+        char option[64];
+        snprintf(option, sizeof option, "--%s", name);
+        switch (c) {
+        case 'o': o->output_path = optarg; break;
+        case OPT_SAMPLES:
+            if (!parse_uint(optarg, 1, 1u << 30, &v))
+                return usage_error(option, optarg, "a whole number from 1 to 2^30");
+            o->samples = (uint32_t)v;
+            break;
+        case OPT_WIDTH:
+        case OPT_HEIGHT:
+            if (!parse_uint(optarg, 1, MAX_SIZE, &v))
+                return usage_error(option, optarg, "a whole number from 1 to 65536");
+            *(c == OPT_WIDTH ? &o->width : &o->height) = (int)v;
+            break;
+        case OPT_THREADS:
+            if (!parse_uint(optarg, 0, MAX_THREADS, &v))
+                return usage_error(option, optarg, "a whole number from 0 to 1024");
+            o->threads = (int)v;
+            break;
+        case OPT_SEED:
+            if (!parse_uint(optarg, 0, UINT64_MAX, &v))
+                return usage_error(option, optarg, "a whole number from 0 to 2^64-1");
+            o->seed = v;
+            break;
+        case OPT_MAX_DEPTH:
+            if (!parse_uint(optarg, 1, 100000, &v))
+                return usage_error(option, optarg, "a whole number from 1 to 100000");
+            o->max_depth = (int)v;
+            break;
+        case OPT_SKY:
+            if (!ptr_sky_parse(optarg, &o->sky))
+                return usage_error(option, optarg, "gradient, black or R,G,B (not negative)");
+            o->has_sky = 1;
+            break;
+        case OPT_CAMERA: o->camera_name = optarg; break;
+        case OPT_C: o->kernel = PTR_KERNEL_C; break;
+        case OPT_HALF: o->half = 1; break;
+        case OPT_QUIET: o->quiet = 1; break;
+        case OPT_HELP: print_help(stdout); return 0;
+        case OPT_VERSION: {
+            PtrIsectTable table;
+            ptr_isect_init(&table, PTR_KERNEL_AUTO);
+            printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
+            return 0;
+        }
+        case ':':
+            fprintf(stderr, "ptr: %s needs a value (see ptr --help)\n", argv[optind - 1]);
+            return ptr_result_exit_code(PTR_ERR_USAGE);
+        default:
+            fprintf(stderr, "ptr: unknown option '%s' (see ptr --help)\n", argv[optind - 1]);
+            return ptr_result_exit_code(PTR_ERR_USAGE);
+        }
+    }
+    if (optind >= argc || !o->output_path || argc - optind > 1) {
+        fprintf(stderr, "ptr: %s (usage: ptr SCENE -o OUTPUT [options]; see ptr --help)\n",
+                optind >= argc ? "no scene file given"
+                : !o->output_path ? "no output file given (-o)" : "more than one scene given");
+        return ptr_result_exit_code(PTR_ERR_USAGE);
+    }
+    o->scene_path = argv[optind];
+    return -1;
+}
+
+/* Width and height: the command line's, else the scene's, filling a missing
+ * one from the camera's aspect ratio (else the scene's, else 16:9). */
+static void choose_size(const Options *o, const PtrScene *scene, int *width, int *height)
+{
+    float aspect = scene->camera.aspect > 0.0f ? scene->camera.aspect
+                   : scene->width > 0          ? (float)scene->width / (float)scene->height
+                                               : 16.0f / 9.0f;
+    int w = o->width, h = o->height;
+    if (!w && !h && scene->width > 0) {
+        w = scene->width;
+        h = scene->height;
+    }
+    if (!w && !h)
+        w = DEFAULT_WIDTH;
+    if (!h)
+        h = (int)lroundf((float)w / aspect);
+    if (!w)
+        w = (int)lroundf((float)h * aspect);
+    *width = w < 1 ? 1 : w > MAX_SIZE ? MAX_SIZE : w;
+    *height = h < 1 ? 1 : h > MAX_SIZE ? MAX_SIZE : h;
+}
+
+static int fail(const PtrError *err)
+{
+    fprintf(stderr, "ptr: %s\n", err->message);
+    return ptr_result_exit_code(err->code);
+}
+
+int ptr_cli_main(int argc, char **argv)
+{
+    Options o;
+    int code = parse_options(argc, argv, &o);
+    if (code >= 0)
+        return code;
+
+    PtrError err = { 0 };
+    if (ptr_output_check(o.output_path, &err) != PTR_OK)
+        return fail(&err);
+
+    PtrIsectTable isect;
+    if (!ptr_isect_init(&isect, o.kernel)) {
+        ptr_error_set(&err, PTR_ERR_USAGE, "the requested intersector is not available here");
+        return fail(&err);
+    }
+
+    PtrScene scene;
+    PtrWarnings warnings = { 0 };
+    PtrImportOptions import_options = { .camera_name = o.camera_name };
+    PtrResult res = ptr_import_scene(o.scene_path, &import_options, &scene, &warnings, &err);
+    for (size_t i = 0; i < warnings.count; i++)
+        fprintf(stderr, "ptr: warning: %s\n", warnings.lines[i]);
+    ptr_warnings_free(&warnings);
+    if (res != PTR_OK)
+        return fail(&err);
+    if (o.has_sky)
+        scene.sky = o.sky;
+
+    PtrRenderSettings settings = {
+        .samples = o.samples, .seed = o.seed, .max_depth = o.max_depth, .threads = o.threads,
+    };
+    choose_size(&o, &scene, &settings.width, &settings.height);
+    float *rgb = malloc((size_t)settings.width * (size_t)settings.height * 3 * sizeof *rgb);
+    PtrRenderStats stats = { 0 };
+    if (!rgb)
+        res = ptr_error_set(&err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
+                            o.output_path, settings.width, settings.height);
+    else
+        res = ptr_render(&scene, &isect, &settings, rgb, &stats, &err);
+    if (res == PTR_ERR_SCENE_INVALID) {
+        /* The renderer does not know where the scene came from. */
+        char message[sizeof err.message];
+        memcpy(message, err.message, sizeof message);
+        ptr_error_set(&err, res, "%s: %s", o.scene_path, message);
+    }
+    if (res == PTR_OK) {
+        PtrOutputInfo info = {
+            .scene_path = o.scene_path, .kernel = isect.name, .samples = o.samples,
+            .seed = o.seed, .max_depth = o.max_depth, .render_seconds = stats.seconds,
+            .half = o.half,
+        };
+        res = ptr_output_write(o.output_path, settings.width, settings.height, rgb, &info, &err);
+    }
+    free(rgb);
+    ptr_scene_free(&scene);
+    if (res != PTR_OK)
+        return fail(&err);
+    if (!o.quiet)
+        fprintf(stderr,
+                "ptr: %s: %dx%d, %" PRIu32 " spp, %d threads, %s intersector: %.3f s, "
+                "%.2f Mrays/s (%" PRIu64 " rays)\n",
+                o.output_path, settings.width, settings.height, o.samples, stats.threads,
+                isect.name, stats.seconds,
+                stats.seconds > 0 ? (double)stats.rays / stats.seconds * 1e-6 : 0.0,
+                stats.rays);
+    return 0;
+}

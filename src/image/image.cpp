@@ -1,0 +1,164 @@
+#include "image.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace {
+
+void set_error(char *err, size_t size, const std::string &text)
+{
+    if (!err || size == 0)
+        return;
+    std::string line = text;
+    for (char &c : line)
+        if (c == '\n' || c == '\r')
+            c = ' ';
+    while (!line.empty() && line.back() == ' ')
+        line.pop_back();
+    std::snprintf(err, size, "%s", line.c_str());
+}
+
+OIIO::TypeDesc pixel_type(PtrPixelFormat format)
+{
+    switch (format) {
+    case PTR_PIXEL_UINT8: return OIIO::TypeDesc::UINT8;
+    case PTR_PIXEL_HALF: return OIIO::TypeDesc::HALF;
+    case PTR_PIXEL_FLOAT: break;
+    }
+    return OIIO::TypeDesc::FLOAT;
+}
+
+/* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
+ * and keeping the extension for tools that look at it. */
+std::string temporary_name(const std::string &path)
+{
+    size_t slash = path.rfind('/');
+    size_t base = slash == std::string::npos ? 0 : slash + 1;
+    size_t dot = path.rfind('.');
+    if (dot == std::string::npos || dot < base)
+        dot = path.size();
+    return path.substr(0, base) + "." + path.substr(base, dot - base) + ".ptr-" +
+           std::to_string(getpid()) + path.substr(dot);
+}
+
+} // namespace
+
+struct PtrImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb;
+    std::map<std::string, std::string> attrs;
+};
+
+extern "C" int ptr_image_can_write(const char *path)
+{
+    try {
+        return OIIO::ImageOutput::create(path) != nullptr;
+    } catch (...) {
+        return 0;
+    }
+}
+
+extern "C" int ptr_image_write(const char *path, int width, int height, const float *rgb,
+                               PtrPixelFormat format, const PtrImageAttr *attrs,
+                               size_t attr_count, char *err, size_t err_size)
+{
+    std::string tmp;
+    try {
+        // The writer is chosen from the real name; the temporary name only
+        // receives the bytes.
+        auto out = OIIO::ImageOutput::create(path);
+        if (!out) {
+            set_error(err, err_size, std::string(path) + ": no image format for this extension");
+            return -1;
+        }
+        OIIO::ImageSpec spec(width, height, 3, pixel_type(format));
+        for (size_t i = 0; i < attr_count; i++) {
+            const PtrImageAttr &a = attrs[i];
+            switch (a.type) {
+            case PTR_ATTR_INT: spec.attribute(a.name, a.int_value); break;
+            case PTR_ATTR_FLOAT: spec.attribute(a.name, a.float_value); break;
+            case PTR_ATTR_STRING: spec.attribute(a.name, a.string_value); break;
+            }
+        }
+        tmp = temporary_name(path);
+        if (!out->open(tmp, spec)) {
+            set_error(err, err_size, std::string(path) + ": " + out->geterror());
+            std::remove(tmp.c_str());
+            return -1;
+        }
+        bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+        ok = out->close() && ok;
+        if (!ok) {
+            set_error(err, err_size, std::string(path) + ": " + out->geterror());
+            std::remove(tmp.c_str());
+            return -1;
+        }
+        if (std::rename(tmp.c_str(), path) != 0) {
+            set_error(err, err_size, std::string(path) + ": cannot replace file: " +
+                                         std::strerror(errno));
+            std::remove(tmp.c_str());
+            return -1;
+        }
+        return 0;
+    } catch (const std::exception &e) {
+        set_error(err, err_size, std::string(path) + ": " + e.what());
+    } catch (...) {
+        set_error(err, err_size, std::string(path) + ": unexpected error while writing");
+    }
+    if (!tmp.empty())
+        std::remove(tmp.c_str());
+    return -1;
+}
+
+extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size)
+{
+    try {
+        auto in = OIIO::ImageInput::open(path);
+        if (!in) {
+            set_error(err, err_size, std::string(path) + ": " + OIIO::geterror());
+            return nullptr;
+        }
+        const OIIO::ImageSpec &spec = in->spec();
+        std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+            set_error(err, err_size, std::string(path) + ": " + in->geterror());
+            return nullptr;
+        }
+        auto image = std::make_unique<PtrImage>();
+        image->width = spec.width;
+        image->height = spec.height;
+        size_t pixels = size_t(spec.width) * size_t(spec.height);
+        image->rgb.resize(pixels * 3);
+        for (size_t p = 0; p < pixels; p++)
+            for (int c = 0; c < 3; c++)
+                image->rgb[3 * p + size_t(c)] =
+                    all[p * size_t(spec.nchannels) + size_t(c < spec.nchannels ? c : 0)];
+        for (const OIIO::ParamValue &param : spec.extra_attribs)
+            image->attrs[param.name().string()] = param.get_string();
+        in->close();
+        return image.release();
+    } catch (const std::exception &e) {
+        set_error(err, err_size, std::string(path) + ": " + e.what());
+    } catch (...) {
+        set_error(err, err_size, std::string(path) + ": unexpected error while reading");
+    }
+    return nullptr;
+}
+
+extern "C" void ptr_image_free(PtrImage *image) { delete image; }
+extern "C" int ptr_image_width(const PtrImage *image) { return image->width; }
+extern "C" int ptr_image_height(const PtrImage *image) { return image->height; }
+extern "C" const float *ptr_image_pixels(const PtrImage *image) { return image->rgb.data(); }
+
+extern "C" const char *ptr_image_attr(const PtrImage *image, const char *name)
+{
+    auto it = image->attrs.find(name);
+    return it == image->attrs.end() ? nullptr : it->second.c_str();
+}

@@ -1,0 +1,57 @@
+/* Image files through OpenImageIO, behind a C interface. */
+#ifndef PTR_IMAGE_H
+#define PTR_IMAGE_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum PtrPixelFormat {
+    PTR_PIXEL_UINT8,
+    PTR_PIXEL_HALF,
+    PTR_PIXEL_FLOAT,
+} PtrPixelFormat;
+
+typedef enum PtrAttrType { PTR_ATTR_INT, PTR_ATTR_FLOAT, PTR_ATTR_STRING } PtrAttrType;
+
+/* One metadata entry of an image file's header. */
+typedef struct PtrImageAttr {
+    const char *name;
+    PtrAttrType type;
+    int int_value;
+    float float_value;
+    const char *string_value;
+} PtrImageAttr;
+
+/* Whether a writer exists for the file's extension. */
+int ptr_image_can_write(const char *path);
+
+/* Writes RGB float pixels (rows top to bottom), stored in the file as format.
+ * The file is created under a temporary name in the same directory and
+ * renamed over path only once complete, so an existing file is replaced by a
+ * whole new one or not at all. Returns 0 on success; otherwise fills err with
+ * one line and returns -1. */
+int ptr_image_write(const char *path, int width, int height, const float *rgb,
+                    PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
+                    char *err, size_t err_size);
+
+/* An image read back as float RGB (extra channels dropped, grey replicated). */
+typedef struct PtrImage PtrImage;
+
+PtrImage *ptr_image_read(const char *path, char *err, size_t err_size);
+void ptr_image_free(PtrImage *image);
+int ptr_image_width(const PtrImage *image);
+int ptr_image_height(const PtrImage *image);
+const float *ptr_image_pixels(const PtrImage *image);
+
+/* A header attribute as text (numbers formatted), or NULL if absent. The
+ * string lives as long as the image. */
+const char *ptr_image_attr(const PtrImage *image, const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PTR_IMAGE_H */

@@ -1,0 +1,58 @@
+/* Closest-hit queries of one ray against a run of spheres.
+ *
+ * The kernel sits behind a function-pointer table filled once at start-up:
+ * first with the portable C reference, then overridden by faster versions
+ * the CPU supports. Hot code makes one indirect call and never branches on the
+ * CPU. Every version returns exactly what the C reference returns.
+ */
+#ifndef PTR_ISECT_H
+#define PTR_ISECT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "scene.h"
+
+/* A ray with a unit direction; hits count only for tmin < t < tmax.
+ * Layout is fixed (32 bytes) because assembly kernels read it. */
+typedef struct PtrRay {
+    float org[3];
+    float tmin;
+    float dir[3];
+    float tmax;
+} PtrRay;
+
+typedef struct PtrHit {
+    float t;         /* ray->tmax on a miss */
+    uint32_t sphere; /* PTR_NO_HIT on a miss */
+} PtrHit;
+
+#define PTR_NO_HIT UINT32_MAX
+
+/* One signature for the pointer type, the C reference and every assembly
+ * version, so that they cannot drift apart. Writes *hit in every case and
+ * returns 1 on a hit, 0 on a miss. On equal distances the lowest index wins. */
+#define PTR_DECL_CLOSEST_HIT(name)                                            \
+    int name(const PtrRay *ray, const PtrSpheres *spheres, size_t count,      \
+             PtrHit *hit)
+
+typedef PTR_DECL_CLOSEST_HIT((*PtrClosestHitFn));
+
+typedef enum PtrKernel {
+    PTR_KERNEL_AUTO, /* the fastest this CPU supports */
+    PTR_KERNEL_C,    /* the portable reference */
+} PtrKernel;
+
+typedef struct PtrIsectTable {
+    PtrClosestHitFn closest_hit;
+    const char *name; /* which implementation closest_hit is, e.g. "c" */
+} PtrIsectTable;
+
+/* Fills the table for the requested kernel. Returns 0 if that kernel is not
+ * available on this machine. */
+int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel);
+
+/* The reference implementation. */
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c);
+
+#endif /* PTR_ISECT_H */

@@ -1,0 +1,189 @@
+#include "render.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "camera.h"
+#include "material.h"
+
+enum { TILE_SIZE = 16 };
+
+/* How far a new ray's origin is pushed off the surface, relative to the
+ * magnitude of the numbers that locate it. The hit point is re-projected onto
+ * the sphere first, leaving an error of a few ulps of |centre| + radius; the
+ * kernel's f.f - r^2 adds a few more. 2^-18 is 32 ulps of that magnitude, so
+ * the new origin is on the intended side of the surface at every scale. */
+#define SPAWN_OFFSET_SCALE 0x1.0p-18f
+
+static PtrRay spawn_ray(PtrVec3 centre, float radius, PtrVec3 outward_normal,
+                        PtrVec3 dir)
+{
+    float offset = SPAWN_OFFSET_SCALE * (v3_max_abs(centre) + radius);
+    if (v3_dot(dir, outward_normal) < 0.0f)
+        offset = -offset;
+    PtrVec3 o = v3_add(centre, v3_scale(outward_normal, radius + offset));
+    return (PtrRay){ { o.x, o.y, o.z }, 0.0f, { dir.x, dir.y, dir.z }, INFINITY };
+}
+
+PtrVec3 ptr_trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
+                       int max_depth, PtrRng *rng, uint64_t *rays)
+{
+    const PtrSpheres *spheres = &scene->spheres;
+    PtrVec3 radiance = v3_splat(0.0f);
+    PtrVec3 throughput = v3_splat(1.0f);
+
+    for (int depth = 0; depth < max_depth; depth++) {
+        PtrHit hit;
+        PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
+        ++*rays;
+        if (!isect->closest_hit(&ray, spheres, spheres->count, &hit)) {
+            radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
+            break;
+        }
+        const PtrMaterial *m = &scene->materials[spheres->material[hit.sphere]];
+        radiance = v3_add(radiance, v3_mul(throughput, m->emission));
+
+        PtrVec3 centre = ptr_sphere_centre(spheres, hit.sphere);
+        float radius = spheres->radius[hit.sphere];
+        PtrVec3 p = v3(ray.org[0], ray.org[1], ray.org[2]);
+        p = v3_madd(p, dir, hit.t);
+        PtrVec3 normal = v3_normalize(v3_sub(p, centre));
+
+        PtrVec3 out_dir, attenuation;
+        if (!ptr_scatter(m, dir, normal, rng, &out_dir, &attenuation))
+            break;
+        throughput = v3_mul(throughput, attenuation);
+        if (v3_max_comp(throughput) <= 0.0f)
+            break;
+        ray = spawn_ray(centre, radius, normal, out_dir);
+    }
+    return radiance;
+}
+
+typedef struct RenderJob {
+    const PtrScene *scene;
+    const PtrIsectTable *isect;
+    const PtrRenderSettings *settings;
+    PtrView view;
+    float *rgb;
+    int tiles_x, tile_count;
+    atomic_int next_tile;
+} RenderJob;
+
+typedef struct Worker {
+    RenderJob *job;
+    pthread_t thread;
+    uint64_t rays;
+} Worker;
+
+static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
+{
+    const PtrRenderSettings *s = job->settings;
+    uint64_t pixel = (uint64_t)y * (uint64_t)s->width + (uint64_t)x;
+    double sum[3] = { 0, 0, 0 };
+
+    for (uint32_t i = 0; i < s->samples; i++) {
+        PtrRng rng = ptr_rng_for_sample(s->seed, pixel, i);
+        float sx = ptr_rng_float(&rng), sy = ptr_rng_float(&rng);
+        float lens_r = sqrtf(ptr_rng_float(&rng));
+        float lens_phi = 2.0f * PTR_PI * ptr_rng_float(&rng);
+        PtrVec3 o, d;
+        ptr_view_ray(&job->view, x, y, sx, sy, lens_r * cosf(lens_phi),
+                     lens_r * sinf(lens_phi), &o, &d);
+        PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
+        PtrVec3 l = ptr_trace_path(job->scene, job->isect, ray, s->max_depth, &rng, rays);
+        sum[0] += l.x;
+        sum[1] += l.y;
+        sum[2] += l.z;
+    }
+    float *out = job->rgb + 3 * pixel;
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)(sum[c] / (double)s->samples);
+}
+
+static void *render_worker(void *arg)
+{
+    Worker *w = arg;
+    RenderJob *job = w->job;
+    const PtrRenderSettings *s = job->settings;
+    for (;;) {
+        int tile = atomic_fetch_add(&job->next_tile, 1);
+        if (tile >= job->tile_count)
+            break;
+        int x0 = (tile % job->tiles_x) * TILE_SIZE;
+        int y0 = (tile / job->tiles_x) * TILE_SIZE;
+        int x1 = x0 + TILE_SIZE < s->width ? x0 + TILE_SIZE : s->width;
+        int y1 = y0 + TILE_SIZE < s->height ? y0 + TILE_SIZE : s->height;
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++)
+                render_pixel(job, x, y, &w->rays);
+    }
+    return NULL;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int online_cpus(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
+}
+
+PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+                     const PtrRenderSettings *settings, float *rgb,
+                     PtrRenderStats *stats, PtrError *err)
+{
+    RenderJob job = {
+        .scene = scene, .isect = isect, .settings = settings, .rgb = rgb,
+    };
+    if (settings->samples == 0 || settings->max_depth < 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive and max depth not negative");
+    if (!ptr_view_init(&job.view, &scene->camera, settings->width, settings->height))
+        return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                             "camera is degenerate (look-from equals look-at, up along the view, "
+                             "field of view outside (0, 180) degrees, or bad focus distance/aperture)");
+    job.tiles_x = (settings->width + TILE_SIZE - 1) / TILE_SIZE;
+    int tiles_y = (settings->height + TILE_SIZE - 1) / TILE_SIZE;
+    job.tile_count = job.tiles_x * tiles_y;
+    atomic_init(&job.next_tile, 0);
+
+    int threads = settings->threads > 0 ? settings->threads : online_cpus();
+    if (threads > job.tile_count)
+        threads = job.tile_count;
+    Worker *workers = calloc((size_t)threads, sizeof *workers);
+    if (!workers)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate %d render threads", threads);
+
+    double start = now_seconds();
+    int started = 0;
+    for (; started < threads; started++) {
+        workers[started].job = &job;
+        /* The calling thread is a worker too, so that one thread costs no
+         * thread creation; if creation fails the rest share the work. */
+        if (started == 0)
+            continue;
+        if (pthread_create(&workers[started].thread, NULL, render_worker, &workers[started]))
+            break;
+    }
+    render_worker(&workers[0]);
+    uint64_t rays = workers[0].rays;
+    for (int i = 1; i < started; i++) {
+        pthread_join(workers[i].thread, NULL);
+        rays += workers[i].rays;
+    }
+    double seconds = now_seconds() - start;
+    free(workers);
+
+    if (stats)
+        *stats = (PtrRenderStats){ .seconds = seconds, .rays = rays, .threads = started };
+    return PTR_OK;
+}

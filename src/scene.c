@@ -1,0 +1,168 @@
+#include "scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ptr_scene_init(PtrScene *scene)
+{
+    memset(scene, 0, sizeof *scene);
+    scene->sky.kind = PTR_SKY_GRADIENT;
+    scene->camera = (PtrCamera){
+        .lookfrom = v3(0, 0, 0), .lookat = v3(0, 0, -1), .up = v3(0, 1, 0),
+        .vfov_deg = 90.0f, .aperture = 0.0f, .focus_distance = 1.0f,
+    };
+}
+
+static void spheres_free(PtrSpheres *s)
+{
+    free(s->cx);
+    free(s->cy);
+    free(s->cz);
+    free(s->radius);
+    free(s->material);
+    memset(s, 0, sizeof *s);
+}
+
+void ptr_scene_free(PtrScene *scene)
+{
+    spheres_free(&scene->spheres);
+    free(scene->materials);
+    ptr_scene_init(scene);
+}
+
+static float *aligned_floats(size_t n)
+{
+    return aligned_alloc(PTR_SPHERE_ALIGN, n * sizeof(float));
+}
+
+static PtrResult spheres_grow(PtrSpheres *s)
+{
+    size_t capacity = s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK;
+    if (capacity > SIZE_MAX / 2 / sizeof(float))
+        return PTR_ERR_NOMEM;
+
+    PtrSpheres grown = { 0 };
+    grown.cx = aligned_floats(capacity);
+    grown.cy = aligned_floats(capacity);
+    grown.cz = aligned_floats(capacity);
+    grown.radius = aligned_floats(capacity);
+    grown.material = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
+    if (!grown.cx || !grown.cy || !grown.cz || !grown.radius || !grown.material) {
+        spheres_free(&grown);
+        return PTR_ERR_NOMEM;
+    }
+    grown.count = s->count;
+    grown.capacity = capacity;
+    for (size_t i = 0; i < capacity; i++) {
+        int old = i < s->count;
+        grown.cx[i] = old ? s->cx[i] : 0.0f;
+        grown.cy[i] = old ? s->cy[i] : 0.0f;
+        grown.cz[i] = old ? s->cz[i] : 0.0f;
+        grown.radius[i] = old ? s->radius[i] : NAN;
+        grown.material[i] = old ? s->material[i] : 0;
+    }
+    spheres_free(s);
+    *s = grown;
+    return PTR_OK;
+}
+
+PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
+                               uint32_t material)
+{
+    PtrSpheres *s = &scene->spheres;
+    if (s->count == s->capacity) {
+        PtrResult r = spheres_grow(s);
+        if (r != PTR_OK)
+            return r;
+    }
+    size_t i = s->count++;
+    s->cx[i] = centre.x;
+    s->cy[i] = centre.y;
+    s->cz[i] = centre.z;
+    s->radius[i] = radius;
+    s->material[i] = material;
+    return PTR_OK;
+}
+
+PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
+                                 uint32_t *index)
+{
+    if (scene->material_count >= UINT32_MAX)
+        return PTR_ERR_NOMEM;
+    PtrMaterial *grown = realloc(scene->materials,
+                                 (scene->material_count + 1) * sizeof *grown);
+    if (!grown)
+        return PTR_ERR_NOMEM;
+    scene->materials = grown;
+    grown[scene->material_count] = *material;
+    *index = (uint32_t)scene->material_count++;
+    return PTR_OK;
+}
+
+PtrCamera ptr_camera_framing(const PtrSpheres *s)
+{
+    PtrVec3 lo = v3_splat(INFINITY), hi = v3_splat(-INFINITY);
+    for (size_t i = 0; i < s->count; i++) {
+        PtrVec3 c = ptr_sphere_centre(s, i);
+        float r = s->radius[i];
+        lo = v3(fminf(lo.x, c.x - r), fminf(lo.y, c.y - r), fminf(lo.z, c.z - r));
+        hi = v3(fmaxf(hi.x, c.x + r), fmaxf(hi.y, c.y + r), fmaxf(hi.z, c.z + r));
+    }
+    if (s->count == 0)
+        lo = hi = v3_splat(0.0f);
+
+    const float vfov_deg = 40.0f;
+    PtrVec3 centre = v3_scale(v3_add(lo, hi), 0.5f);
+    float bound = 0.5f * v3_length(v3_sub(hi, lo));
+    if (!(bound > 0.0f))
+        bound = 1.0f;
+    /* Far enough that the bounding sphere of the box fits the vertical field
+     * of view (and so the wider horizontal one too). */
+    float distance = bound / sinf(0.5f * vfov_deg * PTR_PI / 180.0f);
+    return (PtrCamera){
+        .lookfrom = v3_add(centre, v3(0, 0, distance)),
+        .lookat = centre,
+        .up = v3(0, 1, 0),
+        .vfov_deg = vfov_deg,
+        .aperture = 0.0f,
+        .focus_distance = distance,
+        .aspect = 0.0f,
+    };
+}
+
+PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
+{
+    switch (sky->kind) {
+    case PTR_SKY_GRADIENT: {
+        float a = 0.5f * (unit_dir.y + 1.0f);
+        return v3_add(v3_splat(1.0f - a), v3_scale(v3(0.5f, 0.7f, 1.0f), a));
+    }
+    case PTR_SKY_CONSTANT:
+        return sky->radiance;
+    case PTR_SKY_BLACK:
+        break;
+    }
+    return v3_splat(0.0f);
+}
+
+int ptr_sky_parse(const char *text, PtrSky *sky)
+{
+    if (!strcmp(text, "gradient")) {
+        *sky = (PtrSky){ .kind = PTR_SKY_GRADIENT };
+        return 1;
+    }
+    if (!strcmp(text, "black")) {
+        *sky = (PtrSky){ .kind = PTR_SKY_BLACK };
+        return 1;
+    }
+    float r, g, b;
+    char tail;
+    if (sscanf(text, "%f,%f,%f%c", &r, &g, &b, &tail) != 3)
+        return 0;
+    if (!isfinite(r) || !isfinite(g) || !isfinite(b) || r < 0 || g < 0 || b < 0)
+        return 0;
+    *sky = (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = v3(r, g, b) };
+    return 1;
+}
