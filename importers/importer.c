@@ -63,6 +63,8 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
         for (size_t i = 0; i < sizeof importers / sizeof importers[0]; i++) {
             if (strcasecmp(dot, importers[i].extension))
                 continue;
+            if (S_ISREG(st.st_mode) && st.st_size == 0)
+                return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
             PtrResult r = importers[i].import(path, options, scene, warnings, err);
             if (r != PTR_OK)
                 ptr_scene_free(scene);

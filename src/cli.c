@@ -12,6 +12,7 @@
 #include "isect.h"
 #include "output.h"
 #include "render.h"
+#include "scene_json.h"
 #include "version.h"
 
 enum {
@@ -36,11 +37,12 @@ typedef struct Options {
     PtrKernel kernel;
     int half;
     int quiet;
+    int dump_scene;
 } Options;
 
 enum {
     OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
-    OPT_SKY, OPT_C, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_HELP, OPT_VERSION,
+    OPT_SKY, OPT_C, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION,
 };
 
 static const struct option long_options[] = {
@@ -56,6 +58,7 @@ static const struct option long_options[] = {
     { "c", no_argument, NULL, OPT_C },
     { "half", no_argument, NULL, OPT_HALF },
     { "quiet", no_argument, NULL, OPT_QUIET },
+    { "dump-scene", no_argument, NULL, OPT_DUMP_SCENE },
     { "help", no_argument, NULL, OPT_HELP },
     { "version", no_argument, NULL, OPT_VERSION },
     { NULL, 0, NULL, 0 },
@@ -65,6 +68,7 @@ static void print_help(FILE *out)
 {
     fprintf(out,
         "Usage: ptr SCENE -o OUTPUT [options]\n"
+        "       ptr --dump-scene SCENE [--camera NAME] [--sky SKY]\n"
         "Renders a scene of spheres (.gltf, .glb) with a path tracer.\n"
         "\n"
         "  -o, --output FILE     image to write; the extension picks the format:\n"
@@ -82,6 +86,7 @@ static void print_help(FILE *out)
         "      --c               use the portable C intersector\n"
         "      --half            store .exr pixels as half floats\n"
         "      --quiet           no statistics line\n"
+        "      --dump-scene      print the imported scene as JSON and render nothing\n"
         "      --help            this text\n"
         "      --version         version and intersector\n"
         "\n"
@@ -167,6 +172,7 @@ static int parse_options(int argc, char **argv, Options *o)
         case OPT_C: o->kernel = PTR_KERNEL_C; break;
         case OPT_HALF: o->half = 1; break;
         case OPT_QUIET: o->quiet = 1; break;
+        case OPT_DUMP_SCENE: o->dump_scene = 1; break;
         case OPT_HELP: print_help(stdout); return 0;
         case OPT_VERSION: {
             PtrIsectTable table;
@@ -182,7 +188,7 @@ static int parse_options(int argc, char **argv, Options *o)
             return ptr_result_exit_code(PTR_ERR_USAGE);
         }
     }
-    if (optind >= argc || !o->output_path || argc - optind > 1) {
+    if (optind >= argc || (!o->output_path && !o->dump_scene) || argc - optind > 1) {
         fprintf(stderr, "ptr: %s (usage: ptr SCENE -o OUTPUT [options]; see ptr --help)\n",
                 optind >= argc ? "no scene file given"
                 : !o->output_path ? "no output file given (-o)" : "more than one scene given");
@@ -228,7 +234,7 @@ int ptr_cli_main(int argc, char **argv)
         return code;
 
     PtrError err = { 0 };
-    if (ptr_output_check(o.output_path, &err) != PTR_OK)
+    if (!o.dump_scene && ptr_output_check(o.output_path, &err) != PTR_OK)
         return fail(&err);
 
     PtrIsectTable isect;
@@ -243,11 +249,17 @@ int ptr_cli_main(int argc, char **argv)
     PtrResult res = ptr_import_scene(o.scene_path, &import_options, &scene, &warnings, &err);
     for (size_t i = 0; i < warnings.count; i++)
         fprintf(stderr, "ptr: warning: %s\n", warnings.lines[i]);
+    if (res == PTR_OK && o.has_sky)
+        scene.sky = o.sky;
+    if (res == PTR_OK && o.dump_scene)
+        ptr_scene_write_json(stdout, o.scene_path, &scene, &warnings);
     ptr_warnings_free(&warnings);
     if (res != PTR_OK)
         return fail(&err);
-    if (o.has_sky)
-        scene.sky = o.sky;
+    if (o.dump_scene) {
+        ptr_scene_free(&scene);
+        return 0;
+    }
 
     PtrRenderSettings settings = {
         .samples = o.samples, .seed = o.seed, .max_depth = o.max_depth, .threads = o.threads,

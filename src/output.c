@@ -1,11 +1,14 @@
 #include "output.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "image/image.h"
 #include "version.h"
@@ -21,6 +24,25 @@ PtrResult ptr_output_check(const char *path, PtrError *err)
     if (!ptr_image_can_write(path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);
+    /* The file is written beside its final name and renamed, so the folder
+     * must take new files. */
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    size_t len = slash ? (size_t)(slash - path) : 1;
+    if (len >= sizeof dir)
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
+    memcpy(dir, slash ? path : ".", len);
+    dir[len] = '\0';
+    if (slash && len == 0)
+        strcpy(dir, "/");
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: folder %s does not exist", path, dir);
+    if (access(dir, W_OK | X_OK) != 0)
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: cannot create files in %s: %s", path, dir,
+                             strerror(errno));
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: is a directory", path);
     return PTR_OK;
 }
 

@@ -17,7 +17,8 @@ typedef struct PtrOutputInfo {
 } PtrOutputInfo;
 
 /* Fails early, before any rendering, if no writer exists for the output's
- * extension. */
+ * extension (PTR_ERR_USAGE) or its folder cannot take the file
+ * (PTR_ERR_OUTPUT). */
 PtrResult ptr_output_check(const char *path, PtrError *err);
 
 /* Float formats (.exr, .hdr) keep scene-linear values; every other format is

@@ -1,0 +1,202 @@
+/* The command line end to end, in process: what the executable runs. */
+#include <dirent.h>
+#include <stdarg.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "image/image.h"
+#include "result.h"
+#include "test.h"
+
+#define SEED_SCENE PTR_SOURCE_DIR "/scenes/seed.gltf"
+#define FIXTURE(name) PTR_SOURCE_DIR "/tests/fixtures/" name
+
+static char tmpdir[64];
+
+static const char *tmp_path(const char *name)
+{
+    static char paths[8][256];
+    static int next;
+    char *p = paths[next++ % 8];
+    snprintf(p, 256, "%s/%s", tmpdir, name);
+    return p;
+}
+
+/* Runs ptr with a NULL-terminated argument list. */
+static int run(const char *first, ...)
+{
+    char *argv[32] = { "ptr", (char *)first };
+    int argc = 2;
+    va_list ap;
+    va_start(ap, first);
+    for (char *a; argc < 31 && (a = va_arg(ap, char *));)
+        argv[argc++] = a;
+    va_end(ap);
+    argv[argc] = NULL;
+    return ptr_cli_main(argc, argv);
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    fputs(text, f);
+    fclose(f);
+}
+
+static int file_is(const char *path, const char *text)
+{
+    char buf[256] = { 0 };
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    return n == strlen(text) && !memcmp(buf, text, n);
+}
+
+/* Files in the temporary folder: a failed write must leave no temporary. */
+static int file_count(void)
+{
+    DIR *d = opendir(tmpdir);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));)
+        n += e->d_name[0] != '.' || (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."));
+    closedir(d);
+    return n;
+}
+
+static void test_render_seed_exr(void)
+{
+    const char *out = tmp_path("seed.exr");
+    CHECK_INT(run(SEED_SCENE, "-o", out, "--samples", "8", "--width", "60", "--seed", "42",
+                  "--quiet", "--c", NULL), 0);
+    char err[256];
+    PtrImage *img = ptr_image_read(out, err, sizeof err);
+    CHECK(img != NULL);
+    if (!img)
+        return;
+    /* The scene's camera is square: the height follows the width. */
+    CHECK_INT(ptr_image_width(img), 60);
+    CHECK_INT(ptr_image_height(img), 60);
+    CHECK_STR(ptr_image_attr(img, "ptr:samples"), "8");
+    CHECK_STR(ptr_image_attr(img, "ptr:seed"), "42");
+    CHECK_STR(ptr_image_attr(img, "ptr:kernel"), "c");
+    CHECK(ptr_image_attr(img, "Software") && !strncmp(ptr_image_attr(img, "Software"), "ptr ", 4));
+    CHECK(ptr_image_attr(img, "ptr:render_seconds") != NULL);
+
+    const float *px = ptr_image_pixels(img);
+    /* Top centre looks 44 degrees up into the open gradient sky: with
+     * a = (1 + y) / 2 the radiance is (1 - a) + a * (0.5, 0.7, 1.0). Sub-pixel
+     * jitter moves y by less than 0.01. */
+    double y = sin(44.0 * 3.14159265358979 / 180.0), a = 0.5 * (1 + y);
+    const float *top = px + 3 * (0 * 60 + 30);
+    CHECK_NEAR(top[0], (1 - a) + a * 0.5, 0.01);
+    CHECK_NEAR(top[1], (1 - a) + a * 0.7, 0.01);
+    CHECK_NEAR(top[2], 1.0, 1e-6);
+    /* The centre is the blue diffuse sphere (albedo 0.1, 0.2, 0.5), lit by
+     * the sky and by the yellow ground, which carries no blue: still
+     * b > g > r, and darker than the sky that lights it. */
+    const float *centre = px + 3 * (30 * 60 + 30);
+    CHECK(centre[2] > centre[1] && centre[1] > 1.5f * centre[0]);
+    CHECK(centre[2] < 0.5f);
+    /* Bottom centre is the yellow ground (albedo 0.8, 0.8, 0): no blue. */
+    const float *ground = px + 3 * (59 * 60 + 30);
+    CHECK(ground[0] > 0.2f && ground[2] < 0.05f * ground[0]);
+    ptr_image_free(img);
+}
+
+static void test_png_and_options(void)
+{
+    const char *png = tmp_path("seed.png");
+    CHECK_INT(run(SEED_SCENE, "-o", png, "--samples", "2", "--width", "40", "--height", "20",
+                  "--sky", "black", "--threads", "1", "--max-depth", "5", "--quiet", NULL), 0);
+    char err[256];
+    PtrImage *img = ptr_image_read(png, err, sizeof err);
+    CHECK(img != NULL);
+    if (!img)
+        return;
+    CHECK_INT(ptr_image_width(img), 40);
+    CHECK_INT(ptr_image_height(img), 20);
+    /* A black sky lights nothing: every 8-bit value is 0. */
+    float max = 0;
+    for (int i = 0; i < 40 * 20 * 3; i++)
+        max = fmaxf(max, ptr_image_pixels(img)[i]);
+    CHECK_FLOAT_EQ(max, 0.0f);
+    ptr_image_free(img);
+
+    /* A constant sky of 0.5 seen directly encodes to sRGB 0.735 -> code 188. */
+    CHECK_INT(run(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
+                  "--camera", "Camera", "--quiet", NULL), 0);
+    img = ptr_image_read(png, err, sizeof err);
+    CHECK_NEAR(ptr_image_pixels(img)[0] * 255.0f, 188.0, 1e-3);
+    ptr_image_free(img);
+}
+
+static void test_bad_input(void)
+{
+    const char *out = tmp_path("keep.exr");
+    const char *keep = "an existing output file";
+    int ok_files;
+    struct {
+        PtrResult expected;
+        const char *args[8];
+    } cases[] = {
+        { PTR_ERR_SCENE_UNREADABLE, { FIXTURE("missing.gltf") } },
+        { PTR_ERR_SCENE_UNREADABLE, { FIXTURE("bad") } },
+        { PTR_ERR_SCENE_INVALID, { FIXTURE("bad/truncated.gltf") } },
+        { PTR_ERR_SCENE_INVALID, { FIXTURE("bad/garbage.glb") } },
+        { PTR_ERR_SCENE_INVALID, { PTR_SOURCE_DIR "/CMakeLists.txt" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--samples", "0" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--samples", "12x" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--width", "-3" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--sky", "0.1,0.2" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--seed", "18446744073709551616" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--no-such-option" } },
+        { PTR_ERR_SCENE_INVALID, { SEED_SCENE, "--camera", "NoSuchCamera" } },
+    };
+    write_file(out, keep);
+    ok_files = file_count();
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char *argv[12] = { "ptr", "-o", (char *)out, "--samples", "1", "--quiet" };
+        int argc = 6;
+        for (int k = 0; cases[i].args[k]; k++)
+            argv[argc++] = (char *)cases[i].args[k];
+        int code = ptr_cli_main(argc, argv);
+        CHECK_INT(code, ptr_result_exit_code(cases[i].expected));
+        if (code != ptr_result_exit_code(cases[i].expected))
+            fprintf(stderr, "  case %zu (%s %s)\n", i, cases[i].args[0],
+                    cases[i].args[1] ? cases[i].args[1] : "");
+        CHECK(file_is(out, keep));
+        CHECK_INT(file_count(), ok_files);
+    }
+
+    /* Output problems: unknown format, missing folder, a folder as output. */
+    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("x.unknown"), NULL),
+              ptr_result_exit_code(PTR_ERR_USAGE));
+    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("no/such/dir.exr"), NULL),
+              ptr_result_exit_code(PTR_ERR_OUTPUT));
+    mkdir(tmp_path("folder.exr"), 0755);
+    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("folder.exr"), "--samples", "1", NULL),
+              ptr_result_exit_code(PTR_ERR_OUTPUT));
+    rmdir(tmp_path("folder.exr"));
+    CHECK_INT(run(SEED_SCENE, NULL), ptr_result_exit_code(PTR_ERR_USAGE));
+    CHECK_INT(run("--help", NULL), 0);
+    CHECK_INT(run("--version", NULL), 0);
+    CHECK_INT(file_count(), ok_files);
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/ptr-test-cli-XXXXXX");
+    if (!mkdtemp(tmpdir))
+        return 1;
+    test_render_seed_exr();
+    test_png_and_options();
+    test_bad_input();
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "could not remove %s\n", tmpdir);
+    return test_report();
+}

@@ -1,0 +1,183 @@
+/* The glTF importer against fixtures whose spheres, materials and camera are
+ * worked out by hand from docs/scenes.md. */
+#include "importer.h"
+#include "test.h"
+
+#define FIXTURE(name) PTR_SOURCE_DIR "/tests/fixtures/" name
+
+static void check_sphere(const PtrScene *s, size_t i, float x, float y, float z, float r)
+{
+    CHECK(i < s->spheres.count);
+    if (i >= s->spheres.count)
+        return;
+    CHECK_NEAR(s->spheres.cx[i], x, 1e-5);
+    CHECK_NEAR(s->spheres.cy[i], y, 1e-5);
+    CHECK_NEAR(s->spheres.cz[i], z, 1e-5);
+    CHECK_NEAR(s->spheres.radius[i], r, 1e-6);
+}
+
+static const PtrMaterial *material_of(const PtrScene *s, size_t sphere)
+{
+    return &s->materials[s->spheres.material[sphere]];
+}
+
+static int has_warning(const PtrWarnings *w, const char *needle)
+{
+    int n = 0;
+    for (size_t i = 0; i < w->count; i++)
+        n += strstr(w->lines[i], needle) != NULL;
+    return n;
+}
+
+static void test_hierarchy(void)
+{
+    PtrScene s;
+    PtrWarnings w = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), NULL, &s, &w, &err), PTR_OK);
+
+    CHECK_INT(s.spheres.count, 7);
+    check_sphere(&s, 0, 12, 0, 0, 2);     /* parent TRS composed with the child's */
+    check_sphere(&s, 1, 12, 4, -2, 4);    /* rotated off-centre bounds */
+    check_sphere(&s, 2, 0, 5, 0, 0.5f);   /* matrix */
+    check_sphere(&s, 3, 0, 0, -3, 0.25f); /* extras.radius overrides the scale */
+    check_sphere(&s, 4, 0, 0, 0, 2);      /* non-uniform: the largest axis */
+    check_sphere(&s, 5, 0, -100, 0, 1);
+    check_sphere(&s, 6, 3, 3, 3, 1);
+
+    CHECK_INT(s.material_count, 5); /* Red is shared by spheres 0, 3 and 4 */
+    CHECK_INT(s.spheres.material[0], s.spheres.material[3]);
+    const PtrMaterial *red = material_of(&s, 0), *gold = material_of(&s, 1),
+                      *grey = material_of(&s, 2), *lamp = material_of(&s, 5),
+                      *glass = material_of(&s, 6);
+    CHECK_INT(red->kind, PTR_MATERIAL_DIFFUSE);
+    CHECK_FLOAT_EQ(red->albedo.y, 0.1f);
+    CHECK_INT(gold->kind, PTR_MATERIAL_METAL);
+    CHECK_FLOAT_EQ(gold->fuzz, 0.25f);
+    CHECK_FLOAT_EQ(gold->albedo.z, 0.3f);
+    CHECK_INT(grey->kind, PTR_MATERIAL_DIFFUSE); /* no material: Blender's grey */
+    CHECK_FLOAT_EQ(grey->albedo.x, 0.8f);
+    CHECK_INT(lamp->kind, PTR_MATERIAL_DIFFUSE);
+    CHECK_FLOAT_EQ(lamp->emission.x, 4.0f);
+    CHECK_FLOAT_EQ(lamp->emission.y, 2.0f);
+    CHECK_FLOAT_EQ(lamp->emission.z, 1.0f);
+    CHECK_INT(glass->kind, PTR_MATERIAL_DIELECTRIC); /* transmission beats metallic */
+    CHECK_FLOAT_EQ(glass->ior, 2.0f);                /* an integer in the JSON */
+    CHECK_FLOAT_EQ(glass->albedo.x, 0.9f);
+
+    CHECK_NEAR(s.camera.lookfrom.y, 1.0, 1e-6);
+    CHECK_NEAR(s.camera.lookfrom.z, 10.0, 1e-6);
+    CHECK_NEAR(s.camera.lookat.z, 2.0, 1e-5);
+    CHECK_NEAR(s.camera.up.y, 1.0, 1e-6);
+    CHECK_NEAR(s.camera.vfov_deg, 0.5 * 180 / 3.14159265358979, 1e-4);
+    CHECK_FLOAT_EQ(s.camera.aperture, 0.1f);
+    CHECK_FLOAT_EQ(s.camera.focus_distance, 8.0f);
+    CHECK_FLOAT_EQ(s.camera.aspect, 1.5f);
+
+    CHECK_INT(s.sky.kind, PTR_SKY_CONSTANT);
+    CHECK_FLOAT_EQ(s.sky.radiance.z, 0.4f);
+    CHECK_INT(s.width, 320);
+    CHECK_INT(s.height, 240);
+
+    CHECK_INT(w.count, 2);
+    CHECK_INT(has_warning(&w, "'Squashed' has a non-uniform scale"), 1);
+    CHECK_INT(has_warning(&w, "textures are ignored"), 1);
+    ptr_warnings_free(&w);
+    ptr_scene_free(&s);
+
+    /* --camera picks another camera by camera or node name. */
+    PtrImportOptions by_name = { .camera_name = "Other" };
+    CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), &by_name, &s, &w, &err), PTR_OK);
+    CHECK_NEAR(s.camera.lookfrom.x, 5.0, 1e-6);
+    CHECK_NEAR(s.camera.lookat.x, 4.0, 1e-6); /* turned to look down -X */
+    CHECK_NEAR(s.camera.lookat.z, 0.0, 1e-6);
+    CHECK_NEAR(s.camera.vfov_deg, 180 / 3.14159265358979, 1e-4);
+    ptr_warnings_free(&w);
+    ptr_scene_free(&s);
+
+    by_name.camera_name = "Nowhere";
+    CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), &by_name, &s, &w, &err),
+              PTR_ERR_SCENE_INVALID);
+    CHECK(strstr(err.message, "Nowhere") != NULL);
+    ptr_warnings_free(&w);
+}
+
+/* The binary container holds the same scene as the text one. */
+static void test_glb_matches_gltf(void)
+{
+    PtrScene a, b;
+    PtrWarnings w = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(PTR_SOURCE_DIR "/scenes/seed.gltf", NULL, &a, &w, &err), PTR_OK);
+    CHECK_INT(ptr_import_scene(FIXTURE("seed.glb"), NULL, &b, &w, &err), PTR_OK);
+    CHECK_INT(w.count, 0);
+    CHECK_INT(a.spheres.count, 4);
+    CHECK_INT(b.spheres.count, a.spheres.count);
+    size_t n = a.spheres.count * sizeof(float);
+    CHECK(!memcmp(a.spheres.cx, b.spheres.cx, n) && !memcmp(a.spheres.cy, b.spheres.cy, n) &&
+          !memcmp(a.spheres.cz, b.spheres.cz, n) && !memcmp(a.spheres.radius, b.spheres.radius, n));
+    CHECK_INT(b.material_count, a.material_count);
+    CHECK(!memcmp(a.materials, b.materials, a.material_count * sizeof *a.materials));
+    CHECK(!memcmp(&a.camera, &b.camera, sizeof a.camera));
+    ptr_scene_free(&a);
+    ptr_scene_free(&b);
+}
+
+/* No camera in the file: one that frames every sphere, looking down -Z. */
+static void test_automatic_camera(void)
+{
+    PtrScene s;
+    PtrWarnings w = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), NULL, &s, &w, &err), PTR_OK);
+    ptr_warnings_free(&w);
+    PtrCamera framed = ptr_camera_framing(&s.spheres);
+    CHECK_NEAR(framed.lookat.x, 0.5 * (-2 + 16), 1e-5); /* box: x in [-2, 16] */
+    CHECK_NEAR(framed.lookat.y, 0.5 * (-101 + 8), 1e-5);
+    CHECK_NEAR(framed.lookfrom.x, framed.lookat.x, 0);
+    CHECK(framed.lookfrom.z > framed.lookat.z);
+    ptr_scene_free(&s);
+}
+
+static void check_bad(const char *path, PtrResult expected, const char *needle)
+{
+    PtrScene s;
+    PtrWarnings w = { 0 };
+    PtrError err = { 0 };
+    PtrResult r = ptr_import_scene(path, NULL, &s, &w, &err);
+    CHECK_INT(r, expected);
+    if (r != expected)
+        fprintf(stderr, "  for %s: %s\n", path, err.message);
+    /* One line that names the file first, then the problem. */
+    CHECK(!strncmp(err.message, path, strlen(path)));
+    CHECK(strchr(err.message, '\n') == NULL);
+    if (needle && !strstr(err.message, needle))
+        TEST_FAIL_("'%s' not in \"%s\"", needle, err.message);
+    CHECK_INT(s.spheres.count, 0);
+    ptr_warnings_free(&w);
+    ptr_scene_free(&s);
+}
+
+static void test_bad_input(void)
+{
+    check_bad(FIXTURE("does-not-exist.gltf"), PTR_ERR_SCENE_UNREADABLE, "No such file");
+    check_bad(FIXTURE("bad"), PTR_ERR_SCENE_UNREADABLE, "directory");
+    check_bad(FIXTURE("bad/truncated.gltf"), PTR_ERR_SCENE_INVALID, NULL);
+    check_bad(FIXTURE("bad/empty.gltf"), PTR_ERR_SCENE_INVALID, NULL);
+    check_bad(FIXTURE("bad/garbage.glb"), PTR_ERR_SCENE_INVALID, NULL);
+    check_bad(FIXTURE("bad/bad_mesh_index.gltf"), PTR_ERR_SCENE_INVALID, "mesh 5");
+    check_bad(FIXTURE("bad/cycle.gltf"), PTR_ERR_SCENE_INVALID, "cycle");
+    check_bad(FIXTURE("bad/zero_scale.gltf"), PTR_ERR_SCENE_INVALID, "'Flat'");
+    check_bad(FIXTURE("bad/no_bounds.gltf"), PTR_ERR_SCENE_INVALID, "bounds");
+    check_bad(FIXTURE("bad/bad_sky.gltf"), PTR_ERR_SCENE_INVALID, "sky");
+    check_bad(PTR_SOURCE_DIR "/CMakeLists.txt", PTR_ERR_SCENE_INVALID, "unknown scene format");
+}
+
+int main(void)
+{
+    test_hierarchy();
+    test_glb_matches_gltf();
+    test_automatic_camera();
+    test_bad_input();
+    return test_report();
+}

@@ -1,0 +1,115 @@
+/* Scattering: energy, reflection laws, Fresnel and total internal reflection. */
+#include "material.h"
+#include "test.h"
+
+static void test_schlick(void)
+{
+    /* Normal incidence: ((n1 - n2) / (n1 + n2))^2 = 0.04 for glass in air. */
+    CHECK_NEAR(ptr_schlick(1.0f, 1.0f / 1.5f), 0.04, 1e-7);
+    CHECK_NEAR(ptr_schlick(1.0f, 1.5f), 0.04, 1e-7);
+    CHECK_FLOAT_EQ(ptr_schlick(0.0f, 1.0f / 1.5f), 1.0f); /* grazing: all reflected */
+    CHECK_FLOAT_EQ(ptr_schlick(1.0f, 1.0f), 0.0f);        /* no interface */
+}
+
+static int is_unit(PtrVec3 v) { return fabs(v3_length(v) - 1.0) < 1e-5; }
+
+static void test_energy_and_directions(void)
+{
+    PtrRng rng = ptr_rng_for_sample(3, 0, 0);
+    PtrVec3 n = v3(0, 1, 0);
+    const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.9f, 0.5f, 0.1f) };
+    const PtrMaterial metal = { .kind = PTR_MATERIAL_METAL, .albedo = v3(1, 0.8f, 0.6f),
+                                .fuzz = 0.3f };
+    const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1), .ior = 1.5f };
+    const PtrMaterial *all[] = { &diffuse, &metal, &glass };
+
+    int bad_dir = 0, gained = 0, wrong_side = 0;
+    double cos_sum = 0;
+    const int n_samples = 200000;
+    for (int i = 0; i < n_samples; i++) {
+        PtrVec3 in = v3_normalize(v3(ptr_rng_float(&rng) - 0.5f, -ptr_rng_float(&rng) - 0.01f,
+                                     ptr_rng_float(&rng) - 0.5f));
+        for (int m = 0; m < 3; m++) {
+            PtrVec3 out, att;
+            if (!ptr_scatter(all[m], in, n, &rng, &out, &att))
+                continue;
+            bad_dir += !is_unit(out);
+            gained += att.x > all[m]->albedo.x || att.y > all[m]->albedo.y ||
+                      att.z > all[m]->albedo.z;
+            if (m < 2)
+                wrong_side += v3_dot(out, n) <= 0.0f;
+            if (m == 0)
+                cos_sum += v3_dot(out, n);
+        }
+    }
+    CHECK_INT(bad_dir, 0);
+    CHECK_INT(gained, 0);
+    CHECK_INT(wrong_side, 0);
+    /* Lambertian: E[cos theta] = 2/3, standard deviation sqrt(1/2 - 4/9) = 0.236;
+     * the standard error over 2e5 samples is 5.3e-4; 5 sigma is 2.7e-3. */
+    CHECK_NEAR(cos_sum / n_samples, 2.0 / 3.0, 2.7e-3);
+}
+
+static void test_mirror(void)
+{
+    PtrRng rng = ptr_rng_for_sample(4, 0, 0);
+    const PtrMaterial mirror = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(0.7f) };
+    PtrVec3 in = v3_normalize(v3(1, -2, 0.5f)), out, att;
+    CHECK(ptr_scatter(&mirror, in, v3(0, 1, 0), &rng, &out, &att));
+    CHECK_NEAR(out.x, in.x, 1e-6);
+    CHECK_NEAR(out.y, -in.y, 1e-6);
+    CHECK_NEAR(out.z, in.z, 1e-6);
+    CHECK_FLOAT_EQ(att.y, 0.7f);
+
+    /* A heavily fuzzed metal at grazing incidence absorbs what points inward. */
+    const PtrMaterial rough = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(1), .fuzz = 1 };
+    PtrVec3 grazing = v3_normalize(v3(1, -0.05f, 0));
+    int absorbed = 0;
+    for (int i = 0; i < 1000; i++)
+        absorbed += !ptr_scatter(&rough, grazing, v3(0, 1, 0), &rng, &out, &att);
+    CHECK(absorbed > 100 && absorbed < 900);
+}
+
+static void test_dielectric(void)
+{
+    PtrRng rng = ptr_rng_for_sample(5, 0, 0);
+    const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1), .ior = 1.5f };
+    PtrVec3 outward = v3(0, 1, 0), out, att;
+
+    /* From inside, beyond the critical angle asin(1/1.5) = 41.8 degrees, every
+     * ray is reflected back inside. */
+    float theta = 45.0f * PTR_PI / 180.0f;
+    PtrVec3 inside = v3(sinf(theta), cosf(theta), 0); /* travelling outward */
+    int reflected = 0;
+    for (int i = 0; i < 1000; i++) {
+        ptr_scatter(&glass, inside, outward, &rng, &out, &att);
+        reflected += out.y < 0 && fabsf(out.x - inside.x) < 1e-6f;
+    }
+    CHECK_INT(reflected, 1000);
+
+    /* From outside at 30 degrees, refracted rays obey Snell's law, and the
+     * share reflected is Schlick's reflectance (binomial, 5 sigma). */
+    theta = 30.0f * PTR_PI / 180.0f;
+    PtrVec3 in = v3(sinf(theta), -cosf(theta), 0);
+    int refracted = 0, snell_ok = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; i++) {
+        ptr_scatter(&glass, in, outward, &rng, &out, &att);
+        if (out.y < 0) {
+            refracted++;
+            snell_ok += fabsf(out.x - sinf(theta) / 1.5f) < 1e-6f;
+        }
+    }
+    CHECK_INT(snell_ok, refracted);
+    double r = ptr_schlick(cosf(theta), 1.0f / 1.5f);
+    CHECK_NEAR((double)(n - refracted) / n, r, 5 * sqrt(r * (1 - r) / n));
+}
+
+int main(void)
+{
+    test_schlick();
+    test_energy_and_directions();
+    test_mirror();
+    test_dielectric();
+    return test_report();
+}
