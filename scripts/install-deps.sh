@@ -1,0 +1,8 @@
+#!/bin/sh
+# Installs what ptr builds and tests with, from Debian 12's packages.
+set -eu
+run() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
+run apt-get update -qq
+DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends \
+    build-essential cmake pkg-config python3 \
+    libopenimageio-dev libtinygltf-dev >/dev/null
