@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cpu.h"
 #include "importer.h"
 #include "isect.h"
 #include "output.h"
@@ -42,7 +43,7 @@ typedef struct Options {
 
 enum {
     OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
-    OPT_SKY, OPT_C, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION,
+    OPT_SKY, OPT_C, OPT_ASM, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION,
 };
 
 static const struct option long_options[] = {
@@ -56,6 +57,9 @@ static const struct option long_options[] = {
     { "sky", required_argument, NULL, OPT_SKY },
     { "camera", required_argument, NULL, OPT_CAMERA },
     { "c", no_argument, NULL, OPT_C },
+    { "asm", no_argument, NULL, OPT_ASM },
+    { "cpumask", required_argument, NULL, OPT_CPUMASK },
+    { "print-dispatch", no_argument, NULL, OPT_PRINT_DISPATCH },
     { "half", no_argument, NULL, OPT_HALF },
     { "quiet", no_argument, NULL, OPT_QUIET },
     { "dump-scene", no_argument, NULL, OPT_DUMP_SCENE },
@@ -83,7 +87,11 @@ static void print_help(FILE *out)
         "      --max-depth D     rays per path at most (default %d)\n"
         "      --sky SKY         gradient, black or R,G,B (overrides the scene's sky)\n"
         "      --camera NAME     the glTF camera (node or camera name) to render through\n"
-        "      --c               use the portable C intersector\n"
+        "      --c               use the portable C intersector (the reference)\n"
+        "      --asm             use the fastest assembly intersector; an error if none\n"
+        "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
+        "                        (also $PTR_CPUMASK; default: the best the CPU has)\n"
+        "      --print-dispatch  print which intersector each level uses, and exit\n"
         "      --half            store .exr pixels as half floats\n"
         "      --quiet           no statistics line\n"
         "      --dump-scene      print the imported scene as JSON and render nothing\n"
@@ -95,6 +103,18 @@ static void print_help(FILE *out)
     for (int r = PTR_OK; r <= PTR_ERR_NOMEM; r++)
         fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
+}
+
+static void print_dispatch(void)
+{
+    PtrCpuLevel detected = ptr_cpu_detected(), level = ptr_cpu_level();
+    for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
+        PtrIsectTable table;
+        ptr_isect_init_level(&table, (PtrCpuLevel)l);
+        printf("%-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+               l > (int)detected ? "  (not on this CPU)" : "",
+               l == (int)level ? "  <- in use" : "");
+    }
 }
 
 /* A whole decimal number in [lo, hi], nothing else. */
@@ -120,6 +140,10 @@ static int usage_error(const char *option, const char *value, const char *expect
 /* Returns -1 to go on rendering, else the exit code to return. */
 static int parse_options(int argc, char **argv, Options *o)
 {
+    const char *env_mask = getenv("PTR_CPUMASK");
+    PtrCpuLevel env_cap;
+    if (env_mask && !ptr_cpu_parse_level(env_mask, &env_cap))
+        return usage_error("PTR_CPUMASK", env_mask, "none, sse41, avx2 or avx512");
     *o = (Options){
         .samples = DEFAULT_SAMPLES, .seed = 1, .max_depth = DEFAULT_MAX_DEPTH,
         .kernel = PTR_KERNEL_AUTO,
@@ -170,13 +194,22 @@ static int parse_options(int argc, char **argv, Options *o)
             break;
         case OPT_CAMERA: o->camera_name = optarg; break;
         case OPT_C: o->kernel = PTR_KERNEL_C; break;
+        case OPT_ASM: o->kernel = PTR_KERNEL_ASM; break;
+        case OPT_CPUMASK: {
+            PtrCpuLevel cap;
+            if (!ptr_cpu_parse_level(optarg, &cap))
+                return usage_error(option, optarg, "none, sse41, avx2 or avx512");
+            ptr_cpu_set_cap(cap);
+            break;
+        }
+        case OPT_PRINT_DISPATCH: print_dispatch(); return 0;
         case OPT_HALF: o->half = 1; break;
         case OPT_QUIET: o->quiet = 1; break;
         case OPT_DUMP_SCENE: o->dump_scene = 1; break;
         case OPT_HELP: print_help(stdout); return 0;
         case OPT_VERSION: {
             PtrIsectTable table;
-            ptr_isect_init(&table, PTR_KERNEL_AUTO);
+            ptr_isect_init_level(&table, ptr_cpu_level());
             printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
             return 0;
         }
@@ -237,9 +270,14 @@ int ptr_cli_main(int argc, char **argv)
     if (!o.dump_scene && ptr_output_check(o.output_path, &err) != PTR_OK)
         return fail(&err);
 
+    /* Refuse an unavailable kernel before reading the scene; the choice is
+     * made again once the scene's size is known. */
     PtrIsectTable isect;
-    if (!ptr_isect_init(&isect, o.kernel)) {
-        ptr_error_set(&err, PTR_ERR_USAGE, "the requested intersector is not available here");
+    if (!ptr_isect_init(&isect, o.kernel, SIZE_MAX)) {
+        ptr_error_set(&err, PTR_ERR_USAGE,
+                      "--asm: no assembly intersector at CPU level '%s' (this build %s)",
+                      ptr_cpu_level_name(ptr_cpu_level()),
+                      ptr_isect_has_asm() ? "has them" : "was built without them");
         return fail(&err);
     }
 
@@ -260,6 +298,7 @@ int ptr_cli_main(int argc, char **argv)
         ptr_scene_free(&scene);
         return 0;
     }
+    ptr_isect_init(&isect, o.kernel, scene.spheres.count);
 
     PtrRenderSettings settings = {
         .samples = o.samples, .seed = o.seed, .max_depth = o.max_depth, .threads = o.threads,

@@ -7,7 +7,7 @@ PtrVec3 ptr_random_unit_vector(PtrRng *rng)
     /* Archimedes: z is uniform on [-1, 1] for a uniform point on the sphere.
      * No rejection loop, so every sample uses the same count of numbers. */
     float z = 1.0f - 2.0f * ptr_rng_float(rng);
-    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float r = sqrtf(ptr_maxf(0.0f, 1.0f - z * z));
     float phi = 2.0f * PTR_PI * ptr_rng_float(rng);
     return v3(r * cosf(phi), r * sinf(phi), z);
 }
@@ -39,8 +39,8 @@ static PtrVec3 scatter_dielectric(const PtrMaterial *m, PtrVec3 d, PtrVec3 n,
                                   int entering, PtrRng *rng)
 {
     float eta_ratio = entering ? 1.0f / m->ior : m->ior;
-    float cos_theta = fminf(-v3_dot(d, n), 1.0f);
-    float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
+    float cos_theta = ptr_minf(-v3_dot(d, n), 1.0f);
+    float sin_theta = sqrtf(ptr_maxf(0.0f, 1.0f - cos_theta * cos_theta));
     int total_internal = eta_ratio * sin_theta > 1.0f;
     if (total_internal || ptr_schlick(cos_theta, eta_ratio) > ptr_rng_float(rng))
         return ptr_reflect(d, n);

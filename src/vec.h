@@ -7,6 +7,11 @@
 
 #define PTR_PI 3.14159265358979323846f
 
+/* Minimum and maximum for numbers known not to be NaN: unlike fminf/fmaxf,
+ * which strict C makes library calls, these compile to one instruction. */
+static inline float ptr_minf(float a, float b) { return a < b ? a : b; }
+static inline float ptr_maxf(float a, float b) { return a > b ? a : b; }
+
 typedef struct PtrVec3 {
     float x, y, z;
 } PtrVec3;
@@ -20,8 +25,8 @@ static inline PtrVec3 v3_scale(PtrVec3 a, float s) { return v3(a.x * s, a.y * s,
 static inline PtrVec3 v3_neg(PtrVec3 a) { return v3(-a.x, -a.y, -a.z); }
 static inline float v3_dot(PtrVec3 a, PtrVec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline float v3_length(PtrVec3 a) { return sqrtf(v3_dot(a, a)); }
-static inline float v3_max_abs(PtrVec3 a) { return fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z))); }
-static inline float v3_max_comp(PtrVec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+static inline float v3_max_abs(PtrVec3 a) { return ptr_maxf(fabsf(a.x), ptr_maxf(fabsf(a.y), fabsf(a.z))); }
+static inline float v3_max_comp(PtrVec3 a) { return ptr_maxf(a.x, ptr_maxf(a.y, a.z)); }
 
 /* a + b * s */
 static inline PtrVec3 v3_madd(PtrVec3 a, PtrVec3 b, float s)

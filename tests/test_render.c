@@ -13,7 +13,7 @@ typedef struct Image {
 static Image render(const PtrScene *scene, PtrRenderSettings settings)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_C);
+    ptr_isect_init(&isect, PTR_KERNEL_C, scene->spheres.count);
     Image img = { settings.width, settings.height,
                   malloc((size_t)settings.width * settings.height * 3 * sizeof(float)) };
     PtrError err = { 0 };

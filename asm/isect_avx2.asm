@@ -1,0 +1,144 @@
+; Closest hit of one ray against a run of spheres, 8 spheres per step (AVX2).
+; Computes exactly what ptr_closest_hit_c computes, in the same order and
+; with the same IEEE operations, so the results are bit-identical.
+
+%include "ptr.inc"
+
+section .rodata
+align 32
+lane_index: dd 0, 1, 2, 3, 4, 5, 6, 7
+lane_step:  times 8 dd 8
+sign_mask:  times 8 dd 0x80000000
+
+section .text
+
+; One step over 8 spheres at index rax. %1 = 1 for the last, partial step:
+; lanes at or past the count are masked off.
+%macro STEP 1
+    vbroadcastss ymm8, [rdi + RAY_ORG_X]
+    vsubps      ymm8, ymm8, [r8 + rax*4]        ; fx = ox - cx
+    vbroadcastss ymm9, [rdi + RAY_ORG_Y]
+    vsubps      ymm9, ymm9, [r9 + rax*4]        ; fy
+    vbroadcastss ymm10, [rdi + RAY_ORG_Z]
+    vsubps      ymm10, ymm10, [r10 + rax*4]     ; fz
+    vmulps      ymm11, ymm8, ymm0
+    vmulps      ymm12, ymm9, ymm1
+    vaddps      ymm11, ymm11, ymm12
+    vmulps      ymm12, ymm10, ymm2
+    vaddps      ymm11, ymm11, ymm12             ; b = f.d
+    vmulps      ymm12, ymm11, ymm0
+    vsubps      ymm12, ymm8, ymm12
+    vmulps      ymm12, ymm12, ymm12             ; vx^2, vx = fx - b dx
+    vmulps      ymm13, ymm11, ymm1
+    vsubps      ymm13, ymm9, ymm13
+    vmulps      ymm13, ymm13, ymm13             ; vy^2
+    vaddps      ymm12, ymm12, ymm13
+    vmulps      ymm13, ymm11, ymm2
+    vsubps      ymm13, ymm10, ymm13
+    vmulps      ymm13, ymm13, ymm13             ; vz^2
+    vaddps      ymm12, ymm12, ymm13             ; |v|^2
+    vmovups     ymm13, [r11 + rax*4]
+    vmulps      ymm13, ymm13, ymm13             ; r^2
+    vsubps      ymm12, ymm13, ymm12             ; disc = r^2 - |v|^2
+    vxorps      ymm14, ymm14, ymm14
+    vcmpps      ymm14, ymm12, ymm14, CMP_GE_OQ  ; disc >= 0 (NaN radius: no)
+%if %1
+    vmovd       xmm15, edx
+    vpbroadcastd ymm15, xmm15
+    vpcmpgtd    ymm15, ymm15, ymm6              ; index < count
+    vandps      ymm14, ymm14, ymm15
+%endif
+    vtestps     ymm14, ymm14
+    jz          %%done                          ; no lane can hit: skip sqrt, div
+    vmulps      ymm8, ymm8, ymm8
+    vmulps      ymm9, ymm9, ymm9
+    vaddps      ymm8, ymm8, ymm9
+    vmulps      ymm10, ymm10, ymm10
+    vaddps      ymm8, ymm8, ymm10
+    vsubps      ymm8, ymm8, ymm13               ; c = f.f - r^2
+    vsqrtps     ymm12, ymm12
+    vandps      ymm9, ymm11, ymm7
+    vandnps     ymm12, ymm7, ymm12
+    vorps       ymm12, ymm12, ymm9              ; copysign(sqrt(disc), b)
+    vxorps      ymm11, ymm11, ymm7
+    vsubps      ymm11, ymm11, ymm12             ; q = -b - copysign(...)
+    vdivps      ymm8, ymm8, ymm11               ; t0 = c / q
+    vminps      ymm9, ymm8, ymm11               ; near = t0 < q ? t0 : q
+    vmaxps      ymm10, ymm8, ymm11              ; far  = t0 > q ? t0 : q
+    vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
+    vblendvps   ymm9, ymm10, ymm9, ymm12        ; t = near > tmin ? near : far
+    vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
+    vandps      ymm14, ymm14, ymm12             ; t > tmin
+    vcmpps      ymm12, ymm9, ymm4, CMP_LT_OQ
+    vandps      ymm14, ymm14, ymm12             ; t < best (strict: first index wins)
+    vblendvps   ymm4, ymm4, ymm9, ymm14
+    vblendvps   ymm5, ymm5, ymm6, ymm14
+%%done:
+    vpaddd      ymm6, ymm6, [lane_step]
+%endmacro
+
+; int ptr_closest_hit_avx2(const PtrRay *ray, const PtrSpheres *spheres,
+;                          size_t count, PtrHit *hit);
+;
+; rdi ray, rsi spheres, rdx count, rcx hit (moved to rsi once the sphere
+; pointers are loaded; rcx then holds the end of the whole steps)
+; r8 cx, r9 cy, r10 cz, r11 radius, rax sphere index
+; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t per lane   ymm5 best index per lane
+; ymm6 lane indices   ymm7 sign mask   ymm8-15 scratch
+FUNCTION ptr_closest_hit_avx2
+    mov         r8,  [rsi + SPHERES_CX]
+    mov         r9,  [rsi + SPHERES_CY]
+    mov         r10, [rsi + SPHERES_CZ]
+    mov         r11, [rsi + SPHERES_RADIUS]
+    mov         rsi, rcx
+    vbroadcastss ymm0, [rdi + RAY_DIR_X]
+    vbroadcastss ymm1, [rdi + RAY_DIR_Y]
+    vbroadcastss ymm2, [rdi + RAY_DIR_Z]
+    vbroadcastss ymm3, [rdi + RAY_TMIN]
+    vbroadcastss ymm4, [rdi + RAY_TMAX]
+    vpcmpeqd    ymm5, ymm5, ymm5                ; PTR_NO_HIT in every lane
+    vmovdqu     ymm6, [lane_index]
+    vmovups     ymm7, [sign_mask]
+    xor         eax, eax
+    mov         rcx, rdx
+    and         rcx, -8                         ; spheres in whole steps
+.whole:
+    cmp         rax, rcx
+    jae         .tail
+    STEP        0
+    add         rax, 8
+    jmp         .whole
+.tail:
+    cmp         rax, rdx
+    jae         .reduce
+    STEP        1
+.reduce:
+    ; The smallest t over the lanes, then the lowest index among the lanes
+    ; that hold it: the sphere a sequential scan with a strict < would keep.
+    vextractf128 xmm8, ymm4, 1
+    vminps      xmm8, xmm8, xmm4
+    vpermilps   xmm9, xmm8, 0x4e
+    vminps      xmm8, xmm8, xmm9
+    vpermilps   xmm9, xmm8, 0xb1
+    vminps      xmm8, xmm8, xmm9                ; the minimum, in every lane
+    vinsertf128 ymm9, ymm8, xmm8, 1
+    vcmpps      ymm9, ymm4, ymm9, CMP_EQ_OQ
+    vpcmpeqd    ymm10, ymm10, ymm10
+    vpxor       ymm9, ymm9, ymm10
+    vpor        ymm9, ymm9, ymm5                ; index where t is the minimum, else ~0
+    vextracti128 xmm10, ymm9, 1
+    vpminud     xmm9, xmm9, xmm10
+    vpshufd     xmm10, xmm9, 0x4e
+    vpminud     xmm9, xmm9, xmm10
+    vpshufd     xmm10, xmm9, 0xb1
+    vpminud     xmm9, xmm9, xmm10
+    vmovss      [rsi + HIT_T], xmm8
+    vmovd       ecx, xmm9
+    mov         [rsi + HIT_SPHERE], ecx
+    xor         eax, eax
+    cmp         ecx, -1
+    setne       al
+    vzeroupper
+    ret
+
+section .note.GNU-stack noalloc noexec nowrite progbits

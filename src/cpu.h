@@ -1,0 +1,33 @@
+/* What the CPU can run, capped by a user mask.
+ *
+ * Levels are cumulative: a level is granted only if every level below it is
+ * too. AVX levels need the OS to save the wider registers on a context
+ * switch, which XGETBV reports; CPUID alone is not enough. */
+#ifndef PTR_CPU_H
+#define PTR_CPU_H
+
+typedef enum PtrCpuLevel {
+    PTR_CPU_NONE,   /* portable C only */
+    PTR_CPU_SSE41,
+    PTR_CPU_AVX2,
+    PTR_CPU_AVX512, /* AVX-512 F */
+    PTR_CPU_LEVEL_COUNT,
+} PtrCpuLevel;
+
+/* The highest level this CPU and OS support, ignoring any cap. */
+PtrCpuLevel ptr_cpu_detected(void);
+
+/* The level in force: the detected one capped by PTR_CPUMASK in the
+ * environment, then by ptr_cpu_set_cap. */
+PtrCpuLevel ptr_cpu_level(void);
+
+/* Caps the level (e.g. from --cpumask). */
+void ptr_cpu_set_cap(PtrCpuLevel cap);
+
+/* "none", "sse41", "avx2", "avx512". */
+const char *ptr_cpu_level_name(PtrCpuLevel level);
+
+/* Parses a level name; returns 0 if it is not one. */
+int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level);
+
+#endif /* PTR_CPU_H */

@@ -1,0 +1,307 @@
+/* Checks every assembly intersector the CPU can run against the C reference,
+ * bit for bit, on random and adversarial rays and sphere sets; with --bench,
+ * times them.
+ *
+ *   checkasm [--rays N] [--seed S]     check (default 1000000 rays per level)
+ *   checkasm --bench                   nanoseconds per ray at 4..512 spheres
+ */
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cpu.h"
+#include "isect.h"
+#include "rng.h"
+#include "scene.h"
+
+typedef struct CheckedCallStatus {
+    uint32_t check_xinuse;
+    uint32_t failures; /* 1: a callee-saved register changed; 2: no vzeroupper */
+} CheckedCallStatus;
+
+int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray, const PtrSpheres *spheres,
+                     size_t count, PtrHit *hit, CheckedCallStatus *status);
+
+#if defined(__x86_64__)
+#include <cpuid.h>
+/* XGETBV with ECX = 1 (XINUSE) exists when CPUID.(0xD, 1):EAX bit 2 is set. */
+static uint32_t xinuse_supported(void)
+{
+    unsigned a, b, c, d;
+    if (ptr_cpu_detected() < PTR_CPU_AVX2 || __get_cpuid_max(0, NULL) < 0xd)
+        return 0;
+    __cpuid_count(0xd, 1, a, b, c, d);
+    return (a >> 2) & 1;
+}
+#endif
+
+static float uniform(PtrRng *rng, float lo, float hi)
+{
+    return lo + (hi - lo) * ptr_rng_float(rng);
+}
+
+/* 10^u for u uniform in [lo, hi]: every decade equally likely. */
+static float log_uniform(PtrRng *rng, float lo, float hi)
+{
+    return powf(10.0f, uniform(rng, lo, hi));
+}
+
+static PtrVec3 random_unit(PtrRng *rng)
+{
+    float z = uniform(rng, -1, 1), phi = uniform(rng, 0, 2 * PTR_PI);
+    float r = sqrtf(fmaxf(0, 1 - z * z));
+    return v3_normalize(v3(r * cosf(phi), r * sinf(phi), z));
+}
+
+typedef struct Case {
+    PtrScene scene;
+    PtrRay ray;
+    size_t count; /* spheres tested: at most scene.spheres.count */
+} Case;
+
+static void set_ray(Case *c, PtrVec3 o, PtrVec3 d, PtrRng *rng)
+{
+    d = v3_normalize(d);
+    float tmin = ptr_rng_float(rng) < 0.7f ? 0.0f : log_uniform(rng, -8, 1);
+    float tmax = ptr_rng_float(rng) < 0.7f ? INFINITY : tmin + log_uniform(rng, -3, 7);
+    c->ray = (PtrRay){ { o.x, o.y, o.z }, tmin, { d.x, d.y, d.z }, tmax };
+}
+
+/* A cluster of spheres at a random scale and distance from the origin, and a
+ * ray from inside it, aimed at a sphere or anywhere. */
+static void random_case(Case *c, PtrRng *rng, int extreme)
+{
+    float scale = extreme ? log_uniform(rng, -12, 12) : log_uniform(rng, -6, 6);
+    float offset = extreme ? log_uniform(rng, -3, 15) : log_uniform(rng, -3, 7);
+    PtrVec3 base = v3_scale(random_unit(rng), offset);
+    size_t n = ptr_rng_float(rng) < 0.9f ? (size_t)(ptr_rng_float(rng) * 80)
+                                         : 80 + (size_t)(ptr_rng_float(rng) * 600);
+    for (size_t i = 0; i < n; i++) {
+        PtrVec3 p = v3_add(base, v3_scale(random_unit(rng), scale * ptr_rng_float(rng) * 4));
+        float r = scale * (extreme ? log_uniform(rng, -20, 1) : log_uniform(rng, -3, 0));
+        ptr_scene_add_sphere(&c->scene, p, r, 0);
+    }
+    PtrVec3 o = v3_add(base, v3_scale(random_unit(rng), scale * ptr_rng_float(rng) * 6));
+    PtrVec3 d = random_unit(rng);
+    if (n && ptr_rng_float(rng) < 0.7f) {
+        size_t k = (size_t)(ptr_rng_float(rng) * n) % n;
+        PtrVec3 target = v3_add(ptr_sphere_centre(&c->scene.spheres, k),
+                                v3_scale(random_unit(rng), c->scene.spheres.radius[k] *
+                                                               ptr_rng_float(rng) * 1.2f));
+        if (ptr_rng_float(rng) < 0.2f)
+            o = ptr_sphere_centre(&c->scene.spheres, k); /* start inside */
+        PtrVec3 dir = v3_sub(target, o);
+        if (v3_max_abs(dir) > 0)
+            d = dir;
+    }
+    set_ray(c, o, d, rng);
+}
+
+/* Rays that touch a sphere exactly: with these values every step is exact,
+ * so the discriminant is exactly 0 (and, one ulp away, just below or above). */
+static void tangent_case(Case *c, PtrRng *rng)
+{
+    float r = (float)(1 + (int)(ptr_rng_float(rng) * 64)) / 8.0f;
+    float d = (float)(1 + (int)(ptr_rng_float(rng) * 64));
+    float nudge = ptr_rng_float(rng) < 0.5f ? 1.0f : ptr_rng_float(rng) < 0.5f ? 1.0f - 0x1p-23f
+                                                                                : 1.0f + 0x1p-23f;
+    for (int i = 0; i < 5; i++)
+        ptr_scene_add_sphere(&c->scene, v3(r * nudge, 0, -d - 3.0f * (float)i), r, 0);
+    set_ray(c, v3(0, 0, 0), v3(0, 0, -1), rng);
+    c->ray.tmin = 0.0f;
+    c->ray.tmax = INFINITY;
+}
+
+/* The same sphere at several indices, within and across SIMD steps: the
+ * lowest index must win. */
+static void tie_case(Case *c, PtrRng *rng)
+{
+    size_t n = 2 + (size_t)(ptr_rng_float(rng) * 60);
+    PtrVec3 centre = v3(uniform(rng, -1, 1), uniform(rng, -1, 1), -10);
+    for (size_t i = 0; i < n; i++) {
+        int copy = ptr_rng_float(rng) < 0.4f;
+        PtrVec3 p = copy ? centre : v3(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -30, -11));
+        ptr_scene_add_sphere(&c->scene, p, copy ? 1.0f : 0.5f, 0);
+    }
+    set_ray(c, v3(0, 0, 0), v3_add(centre, v3(uniform(rng, -.5f, .5f), uniform(rng, -.5f, .5f), 0)),
+            rng);
+    c->ray.tmin = 0.0f;
+    c->ray.tmax = INFINITY;
+}
+
+static void make_case(Case *c, PtrRng *rng)
+{
+    ptr_scene_init(&c->scene);
+    float kind = ptr_rng_float(rng);
+    if (kind < 0.6f)
+        random_case(c, rng, 0);
+    else if (kind < 0.75f)
+        random_case(c, rng, 1);
+    else if (kind < 0.88f)
+        tangent_case(c, rng);
+    else
+        tie_case(c, rng);
+    /* Test all spheres, or only the first few (the rest must be ignored). */
+    size_t n = c->scene.spheres.count;
+    c->count = ptr_rng_float(rng) < 0.8f ? n : (size_t)(ptr_rng_float(rng) * (float)(n + 1)) % (n + 1);
+}
+
+static void print_hit(const char *who, int ret, const PtrHit *h)
+{
+    fprintf(stderr, "    %-7s returned %d, t = %.9g (%a), sphere = %" PRIu32 "\n", who, ret, h->t,
+            h->t, h->sphere);
+}
+
+static int check(uint64_t rays, uint64_t seed)
+{
+    PtrIsectTable tables[PTR_CPU_LEVEL_COUNT];
+    uint64_t mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, hits = 0;
+    CheckedCallStatus status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
+    PtrCpuLevel top = ptr_cpu_level();
+    int levels = 0;
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+        ptr_isect_init_level(&tables[l], (PtrCpuLevel)l);
+        status[l].check_xinuse = xinuse_supported();
+        levels += tables[l].closest_hit != ptr_closest_hit_c;
+    }
+    if (!levels) {
+        printf("checkasm: no assembly intersector at CPU level %s in this build: nothing to check\n",
+               ptr_cpu_level_name(top));
+        printf("0 passed, 0 failed\n");
+        return 0;
+    }
+
+    PtrRng rng = ptr_rng_for_sample(seed, 0, 0);
+    for (uint64_t i = 0; i < rays; i++) {
+        Case c;
+        make_case(&c, &rng);
+        PtrHit ref;
+        memset(&ref, 0xaa, sizeof ref);
+        int ref_ret = ptr_closest_hit_c(&c.ray, &c.scene.spheres, c.count, &ref);
+        hits += ref_ret;
+        for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+            if (tables[l].closest_hit == ptr_closest_hit_c)
+                continue;
+            PtrHit got;
+            memset(&got, 0x55, sizeof got); /* a different sentinel: unwritten shows */
+            int ret = ptr_checked_call(tables[l].closest_hit, &c.ray, &c.scene.spheres, c.count,
+                                       &got, &status[l]);
+            if (ret == ref_ret && !memcmp(&got, &ref, sizeof got))
+                continue;
+            if (mismatches[l]++ < 5) {
+                fprintf(stderr, "%s differs from c on ray %" PRIu64 " (count %zu, tmin %a, tmax %a):\n",
+                        tables[l].name, i, c.count, c.ray.tmin, c.ray.tmax);
+                print_hit("c", ref_ret, &ref);
+                print_hit(tables[l].name, ret, &got);
+            }
+        }
+        ptr_scene_free(&c.scene);
+    }
+
+    int passed = 0, failed = 0;
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+        if (tables[l].closest_hit == ptr_closest_hit_c)
+            continue;
+        int ok = !mismatches[l] && !status[l].failures;
+        printf("%-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s%s\n",
+               tables[l].name, rays, hits, mismatches[l],
+               status[l].failures & 1 ? "; a callee-saved register was clobbered" : "",
+               status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
+               status[l].check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
+        ok ? passed++ : failed++;
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Nanoseconds per closest-hit query: random rays from outside a box of
+ * spheres into it, as in a scene where most spheres are missed. */
+static double time_kernel(PtrClosestHitFn fn, const PtrScene *scene, const PtrRay *rays,
+                          size_t ray_count)
+{
+    double best = INFINITY;
+    volatile uint32_t sink = 0;
+    for (int rep = 0; rep < 5; rep++) {
+        size_t queries = 0;
+        double start = now(), elapsed;
+        do {
+            for (size_t i = 0; i < ray_count; i++) {
+                PtrHit hit;
+                fn(&rays[i], &scene->spheres, scene->spheres.count, &hit);
+                sink += hit.sphere;
+            }
+            queries += ray_count;
+            elapsed = now() - start;
+        } while (elapsed < 0.05);
+        best = fmin(best, elapsed / (double)queries * 1e9);
+    }
+    (void)sink;
+    return best;
+}
+
+static int bench(void)
+{
+    enum { RAYS = 1024 };
+    static const size_t sizes[] = { 4, 16, 64, 512 };
+    PtrRng rng = ptr_rng_for_sample(7, 0, 0);
+    PtrRay rays[RAYS];
+    PtrCpuLevel top = ptr_cpu_level();
+
+    printf("%-8s %10s", "spheres", "c ns/ray");
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
+        printf("  %7s ns/ray (x c)", ptr_cpu_level_name((PtrCpuLevel)l));
+    printf("\n");
+    for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
+        PtrScene scene;
+        ptr_scene_init(&scene);
+        for (size_t i = 0; i < sizes[s]; i++)
+            ptr_scene_add_sphere(&scene, v3(uniform(&rng, -10, 10), uniform(&rng, -1, 1),
+                                            uniform(&rng, -10, 10)),
+                                 uniform(&rng, 0.2f, 0.5f), 0);
+        for (int i = 0; i < RAYS; i++) {
+            PtrVec3 o = v3(uniform(&rng, -15, 15), uniform(&rng, 0, 3), 15);
+            PtrVec3 d = v3_normalize(v3_sub(v3(uniform(&rng, -10, 10), 0, uniform(&rng, -10, 10)), o));
+            rays[i] = (PtrRay){ { o.x, o.y, o.z }, 0, { d.x, d.y, d.z }, INFINITY };
+        }
+        double c_ns = time_kernel(ptr_closest_hit_c, &scene, rays, RAYS);
+        printf("%-8zu %10.1f", sizes[s], c_ns);
+        for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+            PtrIsectTable t;
+            ptr_isect_init_level(&t, (PtrCpuLevel)l);
+            double ns = time_kernel(t.closest_hit, &scene, rays, RAYS);
+            printf("  %14.1f (%4.1fx)", ns, c_ns / ns);
+        }
+        printf("\n");
+        ptr_scene_free(&scene);
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    uint64_t rays = 1000000, seed = 1;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--bench"))
+            return bench();
+        if (!strcmp(argv[i], "--rays") && i + 1 < argc)
+            rays = strtoull(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--seed") && i + 1 < argc)
+            seed = strtoull(argv[++i], NULL, 10);
+        else {
+            fprintf(stderr, "usage: checkasm [--rays N] [--seed S] | --bench\n");
+            return 2;
+        }
+    }
+    printf("checkasm: CPU level %s, seed %" PRIu64 "\n", ptr_cpu_level_name(ptr_cpu_level()), seed);
+    return check(rays, seed);
+}

@@ -1,0 +1,84 @@
+; Test support for the checker (not a kernel): calls a closest-hit function
+; with every System V callee-saved register holding a known value, then reports
+; which survived, and whether the function left the upper halves of the YMM
+; registers dirty (it must end AVX code with vzeroupper).
+
+%include "ptr.inc"
+
+CHECK_XINUSE     equ 0 ; CheckedCallStatus.check_xinuse: XGETBV(1) is usable
+FAILURES         equ 4 ; CheckedCallStatus.failures
+
+FAIL_CALLEE_SAVED equ 1
+FAIL_VZEROUPPER   equ 2
+
+%macro SENTINELS 0
+    mov         rbx, 0x1b0fa4c6d39e2751
+    mov         rbp, 0x2c1e95b7e48f3862
+    mov         r12, 0x3d2f86a8f57e4973
+    mov         r13, 0x4e4077990a6d5a84
+    mov         r14, 0x5f5168aa1b5c6b95
+    mov         r15, 0x606259bb2c4b7ca6
+%endmacro
+
+%macro EXPECT 2 ; register, value
+    mov         r10, %2
+    cmp         %1, r10
+    setne       cl
+    or          r11b, cl
+%endmacro
+
+section .text
+
+; int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray,
+;                      const PtrSpheres *spheres, size_t count, PtrHit *hit,
+;                      CheckedCallStatus *status);
+FUNCTION ptr_checked_call
+    push        rbp
+    push        rbx
+    push        r12
+    push        r13
+    push        r14
+    push        r15
+    sub         rsp, 24                         ; 16-byte aligned at the call
+    mov         [rsp], r9
+    mov         rax, rdi
+    mov         rdi, rsi
+    mov         rsi, rdx
+    mov         rdx, rcx
+    mov         rcx, r8
+    cmp         dword [r9 + CHECK_XINUSE], 0
+    je          .call
+    vzeroupper                                  ; start clean
+.call:
+    SENTINELS
+    call        rax
+    mov         r8d, eax
+    xor         r11d, r11d
+    EXPECT      rbx, 0x1b0fa4c6d39e2751
+    EXPECT      rbp, 0x2c1e95b7e48f3862
+    EXPECT      r12, 0x3d2f86a8f57e4973
+    EXPECT      r13, 0x4e4077990a6d5a84
+    EXPECT      r14, 0x5f5168aa1b5c6b95
+    EXPECT      r15, 0x606259bb2c4b7ca6
+    mov         r9, [rsp]
+    mov         r10d, r11d                      ; FAIL_CALLEE_SAVED if any differed
+    cmp         dword [r9 + CHECK_XINUSE], 0
+    je          .report
+    mov         ecx, 1
+    xgetbv                                      ; XINUSE: bit 2 = upper YMM in use
+    test        eax, 4
+    jz          .report
+    or          r10d, FAIL_VZEROUPPER
+.report:
+    or          [r9 + FAILURES], r10d
+    mov         eax, r8d
+    add         rsp, 24
+    pop         r15
+    pop         r14
+    pop         r13
+    pop         r12
+    pop         rbx
+    pop         rbp
+    ret
+
+section .note.GNU-stack noalloc noexec nowrite progbits

@@ -1,0 +1,95 @@
+/* Every intersector gives the same image, byte for byte: through the library
+ * at each CPU level this machine has, and through the command line's EXR
+ * files with --c and --asm. */
+#include <stdarg.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "cpu.h"
+#include "image/image.h"
+#include "importer.h"
+#include "render.h"
+#include "test.h"
+
+static float *render_with(const PtrScene *scene, const PtrIsectTable *isect,
+                          const PtrRenderSettings *settings)
+{
+    float *rgb = malloc((size_t)settings->width * settings->height * 3 * sizeof *rgb);
+    PtrError err = { 0 };
+    CHECK_INT(ptr_render(scene, isect, settings, rgb, NULL, &err), PTR_OK);
+    return rgb;
+}
+
+static void check_levels(const char *path, int width, int height)
+{
+    PtrScene scene;
+    PtrWarnings warnings = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(path, NULL, &scene, &warnings, &err), PTR_OK);
+    ptr_warnings_free(&warnings);
+    PtrRenderSettings settings = { .width = width, .height = height, .samples = 4, .seed = 3,
+                                   .max_depth = 50, .threads = 2 };
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    float *reference = render_with(&scene, &c, &settings);
+    size_t bytes = (size_t)width * height * 3 * sizeof(float);
+    for (int l = PTR_CPU_SSE41; l <= (int)ptr_cpu_level(); l++) {
+        PtrIsectTable t;
+        ptr_isect_init_level(&t, (PtrCpuLevel)l);
+        if (t.closest_hit == c.closest_hit)
+            continue;
+        float *rgb = render_with(&scene, &t, &settings);
+        int same = !memcmp(rgb, reference, bytes);
+        CHECK(same);
+        printf("%s: %s %s c\n", path, t.name, same ? "==" : "!=");
+        free(rgb);
+    }
+    free(reference);
+    ptr_scene_free(&scene);
+}
+
+static PtrImage *render_file(const char *scene, const char *out, const char *kernel)
+{
+    char *argv[] = { "ptr", (char *)scene, "-o", (char *)out, "--width", "96", "--samples", "3",
+                     "--quiet", (char *)kernel, NULL };
+    CHECK_INT(ptr_cli_main(10, argv), 0);
+    char err[256];
+    PtrImage *img = ptr_image_read(out, err, sizeof err);
+    CHECK(img != NULL);
+    return img;
+}
+
+static void check_cli(const char *scene)
+{
+    char dir[] = "/tmp/ptr-dispatch-XXXXXX", c_path[64], asm_path[64];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(c_path, sizeof c_path, "%s/c.exr", dir);
+    snprintf(asm_path, sizeof asm_path, "%s/asm.exr", dir);
+    PtrImage *c = render_file(scene, c_path, "--c");
+    PtrImage *a = render_file(scene, asm_path, "--asm");
+    if (c && a) {
+        CHECK_STR(ptr_image_attr(c, "ptr:kernel"), "c");
+        CHECK(strcmp(ptr_image_attr(a, "ptr:kernel"), "c") != 0);
+        size_t bytes = (size_t)ptr_image_width(c) * ptr_image_height(c) * 3 * sizeof(float);
+        CHECK(ptr_image_width(a) == ptr_image_width(c) && ptr_image_height(a) == ptr_image_height(c));
+        CHECK(!memcmp(ptr_image_pixels(c), ptr_image_pixels(a), bytes));
+    }
+    ptr_image_free(c);
+    ptr_image_free(a);
+    unlink(c_path);
+    unlink(asm_path);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    if (!ptr_isect_has_asm() || ptr_cpu_level() < PTR_CPU_SSE41) {
+        printf("no assembly intersector in this build or at this CPU level: nothing to compare\n");
+        return test_report();
+    }
+    check_levels(PTR_SOURCE_DIR "/scenes/seed.gltf", 100, 100);
+    check_levels(PTR_SOURCE_DIR "/scenes/final.gltf", 160, 90);
+    check_cli(PTR_SOURCE_DIR "/scenes/seed.gltf");
+    check_cli(PTR_SOURCE_DIR "/scenes/final.gltf");
+    return test_report();
+}
