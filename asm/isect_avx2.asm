@@ -21,25 +21,7 @@ section .text
     vsubps      ymm9, ymm9, [r9 + rax*4]        ; fy
     vbroadcastss ymm10, [rdi + RAY_ORG_Z]
     vsubps      ymm10, ymm10, [r10 + rax*4]     ; fz
-    vmulps      ymm11, ymm8, ymm0
-    vmulps      ymm12, ymm9, ymm1
-    vaddps      ymm11, ymm11, ymm12
-    vmulps      ymm12, ymm10, ymm2
-    vaddps      ymm11, ymm11, ymm12             ; b = f.d
-    vmulps      ymm12, ymm11, ymm0
-    vsubps      ymm12, ymm8, ymm12
-    vmulps      ymm12, ymm12, ymm12             ; vx^2, vx = fx - b dx
-    vmulps      ymm13, ymm11, ymm1
-    vsubps      ymm13, ymm9, ymm13
-    vmulps      ymm13, ymm13, ymm13             ; vy^2
-    vaddps      ymm12, ymm12, ymm13
-    vmulps      ymm13, ymm11, ymm2
-    vsubps      ymm13, ymm10, ymm13
-    vmulps      ymm13, ymm13, ymm13             ; vz^2
-    vaddps      ymm12, ymm12, ymm13             ; |v|^2
-    vmovups     ymm13, [r11 + rax*4]
-    vmulps      ymm13, ymm13, ymm13             ; r^2
-    vsubps      ymm12, ymm13, ymm12             ; disc = r^2 - |v|^2
+    DISCRIMINANT y
     vxorps      ymm14, ymm14, ymm14
     vcmpps      ymm14, ymm12, ymm14, CMP_GE_OQ  ; disc >= 0 (NaN radius: no)
 %if %1
@@ -50,12 +32,7 @@ section .text
 %endif
     vtestps     ymm14, ymm14
     jz          %%done                          ; no lane can hit: skip sqrt, div
-    vmulps      ymm8, ymm8, ymm8
-    vmulps      ymm9, ymm9, ymm9
-    vaddps      ymm8, ymm8, ymm9
-    vmulps      ymm10, ymm10, ymm10
-    vaddps      ymm8, ymm8, ymm10
-    vsubps      ymm8, ymm8, ymm13               ; c = f.f - r^2
+    OFFSET_TERM y
     vsqrtps     ymm12, ymm12
     vandps      ymm9, ymm11, ymm7
     vandnps     ymm12, ymm7, ymm12
@@ -86,11 +63,7 @@ section .text
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t per lane   ymm5 best index per lane
 ; ymm6 lane indices   ymm7 sign mask   ymm8-15 scratch
 FUNCTION ptr_closest_hit_avx2
-    mov         r8,  [rsi + SPHERES_CX]
-    mov         r9,  [rsi + SPHERES_CY]
-    mov         r10, [rsi + SPHERES_CZ]
-    mov         r11, [rsi + SPHERES_RADIUS]
-    mov         rsi, rcx
+    LOAD_SPHERE_POINTERS
     vbroadcastss ymm0, [rdi + RAY_DIR_X]
     vbroadcastss ymm1, [rdi + RAY_DIR_Y]
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
@@ -99,46 +72,19 @@ FUNCTION ptr_closest_hit_avx2
     vpcmpeqd    ymm5, ymm5, ymm5                ; PTR_NO_HIT in every lane
     vmovdqu     ymm6, [lane_index]
     vmovups     ymm7, [sign_mask]
-    xor         eax, eax
-    mov         rcx, rdx
-    and         rcx, -8                         ; spheres in whole steps
-.whole:
-    cmp         rax, rcx
-    jae         .tail
-    STEP        0
-    add         rax, 8
-    jmp         .whole
-.tail:
-    cmp         rax, rdx
-    jae         .reduce
-    STEP        1
-.reduce:
+    STEP_LOOP   8
     ; The smallest t over the lanes, then the lowest index among the lanes
     ; that hold it: the sphere a sequential scan with a strict < would keep.
     vextractf128 xmm8, ymm4, 1
     vminps      xmm8, xmm8, xmm4
-    vpermilps   xmm9, xmm8, 0x4e
-    vminps      xmm8, xmm8, xmm9
-    vpermilps   xmm9, xmm8, 0xb1
-    vminps      xmm8, xmm8, xmm9                ; the minimum, in every lane
+    HORIZONTAL_MIN_XMM8                         ; the minimum, in every lane
     vinsertf128 ymm9, ymm8, xmm8, 1
     vcmpps      ymm9, ymm4, ymm9, CMP_EQ_OQ
     vpcmpeqd    ymm10, ymm10, ymm10
-    vpxor       ymm9, ymm9, ymm10
-    vpor        ymm9, ymm9, ymm5                ; index where t is the minimum, else ~0
-    vextracti128 xmm10, ymm9, 1
-    vpminud     xmm9, xmm9, xmm10
-    vpshufd     xmm10, xmm9, 0x4e
-    vpminud     xmm9, xmm9, xmm10
-    vpshufd     xmm10, xmm9, 0xb1
-    vpminud     xmm9, xmm9, xmm10
-    vmovss      [rsi + HIT_T], xmm8
-    vmovd       ecx, xmm9
-    mov         [rsi + HIT_SPHERE], ecx
-    xor         eax, eax
-    cmp         ecx, -1
-    setne       al
-    vzeroupper
-    ret
+    vpxor       ymm10, ymm9, ymm10
+    vpor        ymm10, ymm10, ymm5              ; index where t is the minimum, else ~0
+    vextracti128 xmm11, ymm10, 1
+    vpminud     xmm10, xmm10, xmm11
+    STORE_HIT_AND_RETURN
 
 section .note.GNU-stack noalloc noexec nowrite progbits

@@ -19,25 +19,7 @@ section .text
     vsubps      zmm8, zmm16, [r8 + rax*4]       ; fx = ox - cx
     vsubps      zmm9, zmm17, [r9 + rax*4]       ; fy
     vsubps      zmm10, zmm18, [r10 + rax*4]     ; fz
-    vmulps      zmm11, zmm8, zmm0
-    vmulps      zmm12, zmm9, zmm1
-    vaddps      zmm11, zmm11, zmm12
-    vmulps      zmm12, zmm10, zmm2
-    vaddps      zmm11, zmm11, zmm12             ; b = f.d
-    vmulps      zmm12, zmm11, zmm0
-    vsubps      zmm12, zmm8, zmm12
-    vmulps      zmm12, zmm12, zmm12             ; vx^2, vx = fx - b dx
-    vmulps      zmm13, zmm11, zmm1
-    vsubps      zmm13, zmm9, zmm13
-    vmulps      zmm13, zmm13, zmm13             ; vy^2
-    vaddps      zmm12, zmm12, zmm13
-    vmulps      zmm13, zmm11, zmm2
-    vsubps      zmm13, zmm10, zmm13
-    vmulps      zmm13, zmm13, zmm13             ; vz^2
-    vaddps      zmm12, zmm12, zmm13             ; |v|^2
-    vmovups     zmm13, [r11 + rax*4]
-    vmulps      zmm13, zmm13, zmm13             ; r^2
-    vsubps      zmm12, zmm13, zmm12             ; disc = r^2 - |v|^2
+    DISCRIMINANT z
     vcmpps      k1, zmm12, zmm20, CMP_GE_OQ     ; disc >= 0 (NaN radius: no)
 %if %1
     vpcmpgtd    k2, zmm19, zmm6                 ; index < count
@@ -45,12 +27,7 @@ section .text
 %endif
     kortestw    k1, k1
     jz          %%done                          ; no lane can hit: skip sqrt, div
-    vmulps      zmm8, zmm8, zmm8
-    vmulps      zmm9, zmm9, zmm9
-    vaddps      zmm8, zmm8, zmm9
-    vmulps      zmm10, zmm10, zmm10
-    vaddps      zmm8, zmm8, zmm10
-    vsubps      zmm8, zmm8, zmm13               ; c = f.f - r^2
+    OFFSET_TERM z
     vsqrtps     zmm12, zmm12
     vpandd      zmm9, zmm11, zmm7
     vpandnd     zmm12, zmm7, zmm12
@@ -80,11 +57,7 @@ section .text
 ; zmm6 lane indices   zmm7 sign mask   zmm8-13 scratch
 ; zmm16-18 ox, oy, oz   zmm19 count   zmm20 zero   k1, k2 lane masks
 FUNCTION ptr_closest_hit_avx512
-    mov         r8,  [rsi + SPHERES_CX]
-    mov         r9,  [rsi + SPHERES_CY]
-    mov         r10, [rsi + SPHERES_CZ]
-    mov         r11, [rsi + SPHERES_RADIUS]
-    mov         rsi, rcx
+    LOAD_SPHERE_POINTERS
     vbroadcastss zmm16, [rdi + RAY_ORG_X]
     vbroadcastss zmm17, [rdi + RAY_ORG_Y]
     vbroadcastss zmm18, [rdi + RAY_ORG_Z]
@@ -98,30 +71,14 @@ FUNCTION ptr_closest_hit_avx512
     vmovdqu32   zmm7, [sign_mask]
     vpbroadcastd zmm19, edx
     vpxord      zmm20, zmm20, zmm20
-    xor         eax, eax
-    mov         rcx, rdx
-    and         rcx, -16                        ; spheres in whole steps
-.whole:
-    cmp         rax, rcx
-    jae         .tail
-    STEP        0
-    add         rax, 16
-    jmp         .whole
-.tail:
-    cmp         rax, rdx
-    jae         .reduce
-    STEP        1
-.reduce:
+    STEP_LOOP   16
     ; The smallest t over the lanes, then the lowest index among the lanes
     ; that hold it: the sphere a sequential scan with a strict < would keep.
     vextractf64x4 ymm8, zmm4, 1
     vminps      ymm8, ymm8, ymm4
     vextractf128 xmm9, ymm8, 1
     vminps      xmm8, xmm8, xmm9
-    vpermilps   xmm9, xmm8, 0x4e
-    vminps      xmm8, xmm8, xmm9
-    vpermilps   xmm9, xmm8, 0xb1
-    vminps      xmm8, xmm8, xmm9                ; the minimum, in every lane
+    HORIZONTAL_MIN_XMM8                         ; the minimum, in every lane
     vbroadcastss zmm9, xmm8
     vcmpps      k1, zmm4, zmm9, CMP_EQ_OQ
     vpternlogd  zmm10, zmm10, zmm10, 0xff
@@ -130,17 +87,6 @@ FUNCTION ptr_closest_hit_avx512
     vpminud     ymm10, ymm10, ymm11
     vextracti128 xmm11, ymm10, 1
     vpminud     xmm10, xmm10, xmm11
-    vpshufd     xmm11, xmm10, 0x4e
-    vpminud     xmm10, xmm10, xmm11
-    vpshufd     xmm11, xmm10, 0xb1
-    vpminud     xmm10, xmm10, xmm11
-    vmovss      [rsi + HIT_T], xmm8
-    vmovd       ecx, xmm10
-    mov         [rsi + HIT_SPHERE], ecx
-    xor         eax, eax
-    cmp         ecx, -1
-    setne       al
-    vzeroupper
-    ret
+    STORE_HIT_AND_RETURN
 
 section .note.GNU-stack noalloc noexec nowrite progbits

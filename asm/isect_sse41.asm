@@ -18,6 +18,12 @@ ORG_X equ -64
 ORG_Y equ -48
 ORG_Z equ -32
 
+; A register with the float at [rdi + %2] in every lane.
+%macro BROADCAST 2 ; register, ray offset
+    movss       %1, [rdi + %2]
+    shufps      %1, %1, 0
+%endmacro
+
 ; One step over 4 spheres at index rax. %1 = 1 for the last, partial step:
 ; lanes at or past the count are masked off. Memory operands of legacy SSE
 ; arithmetic must be 16-byte aligned: the sphere arrays are 64-byte aligned.
@@ -120,15 +126,7 @@ ORG_Z equ -32
 ; xmm6 lane indices   xmm7 sign mask   xmm8-15 scratch
 ; [rsp-64], [rsp-48], [rsp-32]: ox, oy, oz broadcast (red zone)
 FUNCTION ptr_closest_hit_sse41
-    mov         r8,  [rsi + SPHERES_CX]
-    mov         r9,  [rsi + SPHERES_CY]
-    mov         r10, [rsi + SPHERES_CZ]
-    mov         r11, [rsi + SPHERES_RADIUS]
-    mov         rsi, rcx
-%macro BROADCAST 2 ; register, ray offset
-    movss       %1, [rdi + %2]
-    shufps      %1, %1, 0
-%endmacro
+    LOAD_SPHERE_POINTERS
     BROADCAST   xmm8, RAY_ORG_X
     movups      [rsp + ORG_X], xmm8
     BROADCAST   xmm8, RAY_ORG_Y
@@ -143,20 +141,7 @@ FUNCTION ptr_closest_hit_sse41
     pcmpeqd     xmm5, xmm5                      ; PTR_NO_HIT in every lane
     movdqa      xmm6, [lane_index]
     movaps      xmm7, [sign_mask]
-    xor         eax, eax
-    mov         rcx, rdx
-    and         rcx, -4                         ; spheres in whole steps
-.whole:
-    cmp         rax, rcx
-    jae         .tail
-    STEP        0
-    add         rax, 4
-    jmp         .whole
-.tail:
-    cmp         rax, rdx
-    jae         .reduce
-    STEP        1
-.reduce:
+    STEP_LOOP   4
     ; The smallest t over the lanes, then the lowest index among the lanes
     ; that hold it: the sphere a sequential scan with a strict < would keep.
     movaps      xmm8, xmm4
