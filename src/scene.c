@@ -101,37 +101,6 @@ PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
     return PTR_OK;
 }
 
-PtrCamera ptr_camera_framing(const PtrSpheres *s)
-{
-    PtrVec3 lo = v3_splat(INFINITY), hi = v3_splat(-INFINITY);
-    for (size_t i = 0; i < s->count; i++) {
-        PtrVec3 c = ptr_sphere_centre(s, i);
-        float r = s->radius[i];
-        lo = v3(fminf(lo.x, c.x - r), fminf(lo.y, c.y - r), fminf(lo.z, c.z - r));
-        hi = v3(fmaxf(hi.x, c.x + r), fmaxf(hi.y, c.y + r), fmaxf(hi.z, c.z + r));
-    }
-    if (s->count == 0)
-        lo = hi = v3_splat(0.0f);
-
-    const float vfov_deg = 40.0f;
-    PtrVec3 centre = v3_scale(v3_add(lo, hi), 0.5f);
-    float bound = 0.5f * v3_length(v3_sub(hi, lo));
-    if (!(bound > 0.0f))
-        bound = 1.0f;
-    /* Far enough that the bounding sphere of the box fits the vertical field
-     * of view (and so the wider horizontal one too). */
-    float distance = bound / sinf(0.5f * vfov_deg * PTR_PI / 180.0f);
-    return (PtrCamera){
-        .lookfrom = v3_add(centre, v3(0, 0, distance)),
-        .lookat = centre,
-        .up = v3(0, 1, 0),
-        .vfov_deg = vfov_deg,
-        .aperture = 0.0f,
-        .focus_distance = distance,
-        .aspect = 0.0f,
-    };
-}
-
 PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
 {
     switch (sky->kind) {

@@ -57,6 +57,9 @@ typedef struct PtrSky {
 } PtrSky;
 
 typedef struct PtrScene {
+    /* World position of the point every coordinate below is relative to:
+     * importers put it at the camera (see importers/builder.h). */
+    double origin[3];
     PtrSpheres spheres;
     PtrMaterial *materials;
     size_t material_count;
@@ -82,10 +85,6 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
 {
     return v3(s->cx[i], s->cy[i], s->cz[i]);
 }
-
-/* A camera that frames every sphere, looking down -Z (used when a scene file
- * has none). */
-PtrCamera ptr_camera_framing(const PtrSpheres *spheres);
 
 /* Radiance arriving from the sky along a unit direction. */
 PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir);

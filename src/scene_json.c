@@ -7,6 +7,13 @@ static void write_vec(FILE *out, PtrVec3 v)
     fprintf(out, "[%.9g, %.9g, %.9g]", v.x, v.y, v.z);
 }
 
+/* A position in world coordinates: the scene's origin plus its offset. */
+static void write_point(FILE *out, const PtrScene *scene, PtrVec3 v)
+{
+    fprintf(out, "[%.17g, %.17g, %.17g]", scene->origin[0] + v.x, scene->origin[1] + v.y,
+            scene->origin[2] + v.z);
+}
+
 static void write_string(FILE *out, const char *s)
 {
     fputc('"', out);
@@ -50,7 +57,7 @@ void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
     fputs(",\n  \"spheres\": [", out);
     for (size_t i = 0; i < s->count; i++) {
         fprintf(out, "%s\n    {\"center\": ", i ? "," : "");
-        write_vec(out, ptr_sphere_centre(s, i));
+        write_point(out, scene, ptr_sphere_centre(s, i));
         fprintf(out, ", \"radius\": %.9g, \"material\": %u}", s->radius[i], s->material[i]);
     }
     fputs("\n  ],\n  \"materials\": [", out);
@@ -69,9 +76,9 @@ void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
     }
     const PtrCamera *c = &scene->camera;
     fputs("\n  ],\n  \"camera\": {\"lookfrom\": ", out);
-    write_vec(out, c->lookfrom);
+    write_point(out, scene, c->lookfrom);
     fputs(", \"lookat\": ", out);
-    write_vec(out, c->lookat);
+    write_point(out, scene, c->lookat);
     fputs(", \"up\": ", out);
     write_vec(out, c->up);
     fprintf(out, ", \"vfov_deg\": %.9g, \"aperture\": %.9g, \"focus_distance\": %.9g, "

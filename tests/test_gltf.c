@@ -10,9 +10,10 @@ static void check_sphere(const PtrScene *s, size_t i, float x, float y, float z,
     CHECK(i < s->spheres.count);
     if (i >= s->spheres.count)
         return;
-    CHECK_NEAR(s->spheres.cx[i], x, 1e-5);
-    CHECK_NEAR(s->spheres.cy[i], y, 1e-5);
-    CHECK_NEAR(s->spheres.cz[i], z, 1e-5);
+    /* World coordinates: the scene's origin plus the stored offset. */
+    CHECK_NEAR(s->origin[0] + s->spheres.cx[i], x, 1e-5);
+    CHECK_NEAR(s->origin[1] + s->spheres.cy[i], y, 1e-5);
+    CHECK_NEAR(s->origin[2] + s->spheres.cz[i], z, 1e-5);
     CHECK_NEAR(s->spheres.radius[i], r, 1e-6);
 }
 
@@ -65,9 +66,10 @@ static void test_hierarchy(void)
     CHECK_FLOAT_EQ(glass->ior, 2.0f);                /* an integer in the JSON */
     CHECK_FLOAT_EQ(glass->albedo.x, 0.9f);
 
-    CHECK_NEAR(s.camera.lookfrom.y, 1.0, 1e-6);
-    CHECK_NEAR(s.camera.lookfrom.z, 10.0, 1e-6);
-    CHECK_NEAR(s.camera.lookat.z, 2.0, 1e-5);
+    CHECK_NEAR(s.origin[1], 1.0, 1e-12); /* the camera is the scene's origin */
+    CHECK_NEAR(s.origin[2], 10.0, 1e-12);
+    CHECK_FLOAT_EQ(s.camera.lookfrom.z, 0.0f);
+    CHECK_NEAR(s.camera.lookat.z, -8.0, 1e-5);
     CHECK_NEAR(s.camera.up.y, 1.0, 1e-6);
     CHECK_NEAR(s.camera.vfov_deg, 0.5 * 180 / 3.14159265358979, 1e-4);
     CHECK_FLOAT_EQ(s.camera.aperture, 0.1f);
@@ -88,8 +90,8 @@ static void test_hierarchy(void)
     /* --camera picks another camera by camera or node name. */
     PtrImportOptions by_name = { .camera_name = "Other" };
     CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), &by_name, &s, &w, &err), PTR_OK);
-    CHECK_NEAR(s.camera.lookfrom.x, 5.0, 1e-6);
-    CHECK_NEAR(s.camera.lookat.x, 4.0, 1e-6); /* turned to look down -X */
+    CHECK_NEAR(s.origin[0], 5.0, 1e-12);
+    CHECK_NEAR(s.camera.lookat.x, -1.0, 1e-6); /* turned to look down -X */
     CHECK_NEAR(s.camera.lookat.z, 0.0, 1e-6);
     CHECK_NEAR(s.camera.vfov_deg, 180 / 3.14159265358979, 1e-4);
     ptr_warnings_free(&w);
@@ -123,19 +125,26 @@ static void test_glb_matches_gltf(void)
     ptr_scene_free(&b);
 }
 
-/* No camera in the file: one that frames every sphere, looking down -Z. */
+/* No camera in the file: one that frames every sphere, looking down -Z,
+ * from where the bounding sphere of their box fills a 40 degree view. */
 static void test_automatic_camera(void)
 {
     PtrScene s;
     PtrWarnings w = { 0 };
     PtrError err = { 0 };
-    CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), NULL, &s, &w, &err), PTR_OK);
+    CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), NULL, &s, &w, &err), PTR_OK);
     ptr_warnings_free(&w);
-    PtrCamera framed = ptr_camera_framing(&s.spheres);
-    CHECK_NEAR(framed.lookat.x, 0.5 * (-2 + 16), 1e-5); /* box: x in [-2, 16] */
-    CHECK_NEAR(framed.lookat.y, 0.5 * (-101 + 8), 1e-5);
-    CHECK_NEAR(framed.lookfrom.x, framed.lookat.x, 0);
-    CHECK(framed.lookfrom.z > framed.lookat.z);
+    /* The box is [-4, 5] x [-1, 4] x [-1, 3]: centre (0.5, 1.5, 1), half
+     * diagonal sqrt(81 + 25 + 16) / 2. */
+    double distance = 0.5 * sqrt(122.0) / sin(20.0 * 3.14159265358979 / 180.0);
+    CHECK_NEAR(s.origin[0], 0.5, 1e-12);
+    CHECK_NEAR(s.origin[1], 1.5, 1e-12);
+    CHECK_NEAR(s.origin[2], 1.0 + distance, 1e-9);
+    CHECK_FLOAT_EQ(s.camera.lookfrom.x, 0.0f); /* coordinates are camera-relative */
+    CHECK_NEAR(s.camera.lookat.z, -distance, 1e-5);
+    CHECK_FLOAT_EQ(s.camera.vfov_deg, 40.0f);
+    CHECK_NEAR(s.spheres.cx[0] + s.origin[0], -3.0, 1e-6);
+    CHECK_NEAR(s.spheres.cz[1] + s.origin[2], 1.0, 1e-5);
     ptr_scene_free(&s);
 }
 

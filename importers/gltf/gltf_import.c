@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "builder.h"
 #include "gltf_doc.h"
 #include "importer_internal.h"
 
@@ -84,6 +85,7 @@ typedef struct Importer {
     const char *path;
     const GltfDoc *doc;
     PtrScene *scene;
+    PtrSceneBuilder builder;
     PtrWarnings *warnings;
     PtrError *err;
     const char *camera_name;
@@ -172,9 +174,8 @@ static PtrResult add_sphere(Importer *im, size_t node_index, const GltfNode *nod
                      "%s: node '%s' has a non-uniform scale; its sphere takes the largest axis",
                      im->path, name);
     }
-    PtrVec3 c = vec_from(centre);
     float r = (float)radius;
-    if (!(r > 0.0f) || !isfinite(r) || !isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z))
+    if (!(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3))
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: node %zu ('%s') gives a sphere with a non-finite centre "
                              "or a radius that is not positive and finite",
@@ -183,17 +184,17 @@ static PtrResult add_sphere(Importer *im, size_t node_index, const GltfNode *nod
     PtrResult res = map_material(im, mesh.material, &material);
     if (res != PTR_OK)
         return res;
-    if (ptr_scene_add_sphere(im->scene, c, r, material) != PTR_OK)
+    if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK)
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return PTR_OK;
 }
 
 static PtrResult take_camera(Importer *im, const GltfNode *node, const Mat4 *world)
 {
-    GltfCamera cam;
-    gltf_doc_camera(im->doc, (size_t)node->camera, &cam);
     if (im->camera_found)
         return PTR_OK;
+    GltfCamera cam;
+    gltf_doc_camera(im->doc, (size_t)node->camera, &cam);
     if (im->camera_name && strcmp(im->camera_name, node->name) &&
         strcmp(im->camera_name, cam.name))
         return PTR_OK;
@@ -221,11 +222,11 @@ static PtrResult take_camera(Importer *im, const GltfNode *node, const Mat4 *wor
         target[k] = eye[k] - world->m[8 + k] / fwd_len * focus;
         up[k] = world->m[4 + k] / up_len;
     }
-    im->scene->camera = (PtrCamera){
-        .lookfrom = vec_from(eye), .lookat = vec_from(target), .up = vec_from(up),
+    const PtrCamera lens = {
         .vfov_deg = (float)yfov_deg, .aperture = (float)aperture,
         .focus_distance = (float)focus, .aspect = (float)cam.aspect_ratio,
     };
+    ptr_builder_set_camera(&im->builder, eye, target, up, &lens);
     im->camera_found = 1;
     return PTR_OK;
 }
@@ -341,6 +342,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .camera_name = options ? options->camera_name : NULL,
         .default_material = UINT32_MAX,
     };
+    ptr_builder_init(&im.builder, scene);
     size_t materials = gltf_doc_material_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     PtrResult res = PTR_OK;
@@ -360,8 +362,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: no perspective camera named '%s' in the default scene", path,
                             im.camera_name);
-    if (res == PTR_OK && !im.camera_found)
-        scene->camera = ptr_camera_framing(&scene->spheres);
+    if (res == PTR_OK && ptr_builder_finish(&im.builder, 1) != PTR_OK)
+        res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                            "%s: a sphere lies too far from the camera for single precision", path);
+    ptr_builder_free(&im.builder);
     free(im.material_index);
     gltf_doc_free(doc);
     return res;

@@ -1,0 +1,49 @@
+/* What importers use to build a scene: spheres and the camera in
+ * double-precision world coordinates, turned into a PtrScene once all are
+ * known.
+ *
+ * The scene's float coordinates are taken relative to the camera
+ * (PtrScene.origin), computed in double: single precision is then finest
+ * where the image needs it, next to the viewer, whatever the scene's
+ * distance from the world origin. A radius-1 sphere 10^7 from the origin
+ * cannot even be represented in float world coordinates (their spacing
+ * there is 1); seen from a camera beside it, it renders as it does at the
+ * origin. */
+#ifndef PTR_BUILDER_H
+#define PTR_BUILDER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "result.h"
+#include "scene.h"
+
+typedef struct PtrSceneBuilder {
+    PtrScene *scene;  /* materials, sky and size go to it directly */
+    double *spheres;  /* x, y, z, radius of each sphere */
+    uint32_t *materials;
+    size_t count, capacity;
+    int has_camera;
+    double eye[3], target[3], up[3];
+    PtrCamera lens;   /* field of view, aperture, focus distance, aspect */
+} PtrSceneBuilder;
+
+void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene);
+void ptr_builder_free(PtrSceneBuilder *builder);
+
+PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
+                                 double radius, uint32_t material);
+
+/* lens gives everything but the position and orientation. */
+void ptr_builder_set_camera(PtrSceneBuilder *builder, const double eye[3],
+                            const double target[3], const double up[3], const PtrCamera *lens);
+
+/* Fills the scene's spheres and camera: the camera given, or one that frames
+ * every sphere from +Z, looking down -Z. With recentre, coordinates are taken
+ * relative to the camera; without, relative to the world origin (the stability
+ * suite measures what that costs). Frees the builder's memory. Returns
+ * PTR_ERR_SCENE_INVALID if a sphere is too far from the camera for single
+ * precision, PTR_ERR_NOMEM if memory runs out. */
+PtrResult ptr_builder_finish(PtrSceneBuilder *builder, int recentre);
+
+#endif /* PTR_BUILDER_H */
