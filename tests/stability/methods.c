@@ -1,0 +1,29 @@
+#include "methods.h"
+
+#include "cpu.h"
+#include <stdio.h>
+
+#include "naive.h"
+
+int stability_methods(Method *m)
+{
+    int n = 0;
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    PtrIsectTable naive = { naive_closest_hit, "naive" };
+
+    m[n++] = (Method){ "naive, t_min 1e-3", naive, 1e-3f, 0, 0 };
+    m[n++] = (Method){ "robust, t_min 1e-3", c, 1e-3f, 0, 0 };
+    m[n++] = (Method){ "robust, offset", c, 0.0f, 0, 0 };
+    m[n++] = (Method){ "ptr (c)", c, 0.0f, 1, 1 };
+    for (int l = PTR_CPU_SSE41; l <= (int)ptr_cpu_level(); l++) {
+        PtrIsectTable t;
+        ptr_isect_init_level(&t, (PtrCpuLevel)l);
+        if (t.closest_hit == c.closest_hit)
+            continue;
+        static char names[PTR_CPU_LEVEL_COUNT][16];
+        snprintf(names[l], sizeof names[l], "ptr (%s)", t.name);
+        m[n++] = (Method){ names[l], t, 0.0f, 1, 1 };
+    }
+    return n;
+}
