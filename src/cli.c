@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "color/color.h"
 #include "cpu.h"
 #include "importer.h"
 #include "isect.h"
@@ -36,14 +37,21 @@ typedef struct Options {
     int has_sky;
     PtrSky sky;
     PtrKernel kernel;
-    int half;
+    PtrDepth depth;
+    const char *ocio_config, *display, *view, *look;
+    float exposure;
+    int bake_view;
+    int dither;
     int quiet;
     int dump_scene;
+    int list_views;
 } Options;
 
 enum {
     OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
-    OPT_SKY, OPT_C, OPT_ASM, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_HALF, OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION,
+    OPT_SKY, OPT_C, OPT_ASM, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_DEPTH, OPT_DITHER,
+    OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
+    OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION,
 };
 
 static const struct option long_options[] = {
@@ -60,7 +68,15 @@ static const struct option long_options[] = {
     { "asm", no_argument, NULL, OPT_ASM },
     { "cpumask", required_argument, NULL, OPT_CPUMASK },
     { "print-dispatch", no_argument, NULL, OPT_PRINT_DISPATCH },
-    { "half", no_argument, NULL, OPT_HALF },
+    { "depth", required_argument, NULL, OPT_DEPTH },
+    { "dither", no_argument, NULL, OPT_DITHER },
+    { "ocio-config", required_argument, NULL, OPT_OCIO_CONFIG },
+    { "display", required_argument, NULL, OPT_DISPLAY },
+    { "view", required_argument, NULL, OPT_VIEW },
+    { "look", required_argument, NULL, OPT_LOOK },
+    { "exposure", required_argument, NULL, OPT_EXPOSURE },
+    { "bake-view", no_argument, NULL, OPT_BAKE_VIEW },
+    { "list-views", no_argument, NULL, OPT_LIST_VIEWS },
     { "quiet", no_argument, NULL, OPT_QUIET },
     { "dump-scene", no_argument, NULL, OPT_DUMP_SCENE },
     { "help", no_argument, NULL, OPT_HELP },
@@ -73,10 +89,12 @@ static void print_help(FILE *out)
     fprintf(out,
         "Usage: ptr SCENE -o OUTPUT [options]\n"
         "       ptr --dump-scene SCENE [--camera NAME] [--sky SKY]\n"
+        "       ptr --list-views [--ocio-config FILE]\n"
         "Renders a scene of spheres (.gltf, .glb) with a path tracer.\n"
         "\n"
         "  -o, --output FILE     image to write; the extension picks the format:\n"
-        "                        .exr (scene-linear float), .png/.jpg/.tif (8-bit sRGB)\n"
+        "                        .exr, .hdr (scene-linear float), .png, .jpg, .tif\n"
+        "                        (the display's view of it, 8 bits)\n"
         "      --samples N       samples per pixel (default %d)\n"
         "      --width W         image width; with only one of width/height the other\n"
         "      --height H        follows the camera's aspect ratio (default: the scene's\n"
@@ -92,7 +110,18 @@ static void print_help(FILE *out)
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
         "                        (also $PTR_CPUMASK; default: the best the CPU has)\n"
         "      --print-dispatch  print which intersector each level uses, and exit\n"
-        "      --half            store .exr pixels as half floats\n"
+        "      --depth D         8, 16, half or float, where the format allows; integer\n"
+        "                        depths hold the view, float ones scene-linear light\n"
+        "      --dither          dither 8-bit output before rounding\n"
+        "\n"
+        "Colour (OpenColorIO):\n"
+        "      --ocio-config F   config file (default: $OCIO, else ptr's own)\n"
+        "      --display NAME    display (default: the config's, sRGB in ptr's own)\n"
+        "      --view NAME       view (default: the config's, Standard in ptr's own)\n"
+        "      --look NAME       look applied before the view\n"
+        "      --exposure STOPS  exposure applied in scene-linear before the view\n"
+        "      --bake-view       float outputs too get the view, not scene-linear light\n"
+        "      --list-views      print the config's displays, views and looks, and exit\n"
         "      --quiet           no statistics line\n"
         "      --dump-scene      print the imported scene as JSON and render nothing\n"
         "      --help            this text\n"
@@ -100,7 +129,7 @@ static void print_help(FILE *out)
         "\n"
         "Exit codes:\n",
         DEFAULT_SAMPLES, DEFAULT_WIDTH, DEFAULT_MAX_DEPTH);
-    for (int r = PTR_OK; r <= PTR_ERR_NOMEM; r++)
+    for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
         fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
 }
@@ -203,7 +232,26 @@ static int parse_options(int argc, char **argv, Options *o)
             break;
         }
         case OPT_PRINT_DISPATCH: print_dispatch(); return 0;
-        case OPT_HALF: o->half = 1; break;
+        case OPT_DEPTH:
+            if (!ptr_depth_parse(optarg, &o->depth))
+                return usage_error(option, optarg, "8, 16, half or float");
+            break;
+        case OPT_DITHER: o->dither = 1; break;
+        case OPT_OCIO_CONFIG: o->ocio_config = optarg; break;
+        case OPT_DISPLAY: o->display = optarg; break;
+        case OPT_VIEW: o->view = optarg; break;
+        case OPT_LOOK: o->look = optarg; break;
+        case OPT_EXPOSURE: {
+            char *end;
+            errno = 0;
+            double stops = strtod(optarg, &end);
+            if (errno || end == optarg || *end || !(fabs(stops) <= 64))
+                return usage_error(option, optarg, "a number of stops from -64 to 64");
+            o->exposure = (float)stops;
+            break;
+        }
+        case OPT_BAKE_VIEW: o->bake_view = 1; break;
+        case OPT_LIST_VIEWS: o->list_views = 1; break;
         case OPT_QUIET: o->quiet = 1; break;
         case OPT_DUMP_SCENE: o->dump_scene = 1; break;
         case OPT_HELP: print_help(stdout); return 0;
@@ -221,6 +269,8 @@ static int parse_options(int argc, char **argv, Options *o)
             return ptr_result_exit_code(PTR_ERR_USAGE);
         }
     }
+    if (o->list_views)
+        return -1;
     if (optind >= argc || (!o->output_path && !o->dump_scene) || argc - optind > 1) {
         fprintf(stderr, "ptr: %s (usage: ptr SCENE -o OUTPUT [options]; see ptr --help)\n",
                 optind >= argc ? "no scene file given"
@@ -259,6 +309,84 @@ static int fail(const PtrError *err)
     return ptr_result_exit_code(err->code);
 }
 
+/* Imports the scene, renders it and writes the image. */
+static PtrResult render_scene(const Options *o, const PtrColor *color, PtrIsectTable *isect,
+                              PtrError *err)
+{
+    PtrScene scene;
+    PtrWarnings warnings = { 0 };
+    PtrImportOptions import_options = { .camera_name = o->camera_name };
+    PtrResult res = ptr_import_scene(o->scene_path, &import_options, &scene, &warnings, err);
+    for (size_t i = 0; i < warnings.count; i++)
+        fprintf(stderr, "ptr: warning: %s\n", warnings.lines[i]);
+    if (res == PTR_OK && o->has_sky)
+        scene.sky = o->sky;
+    if (res == PTR_OK && o->dump_scene)
+        ptr_scene_write_json(stdout, o->scene_path, &scene, &warnings);
+    ptr_warnings_free(&warnings);
+    if (res != PTR_OK || o->dump_scene) {
+        ptr_scene_free(&scene);
+        return res;
+    }
+    ptr_isect_init(isect, o->kernel, scene.spheres.count);
+
+    PtrRenderSettings settings = {
+        .samples = o->samples, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
+    };
+    choose_size(o, &scene, &settings.width, &settings.height);
+    float *rgb = malloc((size_t)settings.width * (size_t)settings.height * 3 * sizeof *rgb);
+    PtrRenderStats stats = { 0 };
+    if (!rgb)
+        res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
+                            o->output_path, settings.width, settings.height);
+    else
+        res = ptr_render(&scene, isect, &settings, rgb, &stats, err);
+    if (res == PTR_ERR_SCENE_INVALID) {
+        /* The renderer does not know where the scene came from. */
+        char message[sizeof err->message];
+        memcpy(message, err->message, sizeof message);
+        ptr_error_set(err, res, "%s: %s", o->scene_path, message);
+    }
+    if (res == PTR_OK) {
+        PtrOutputInfo info = {
+            .scene_path = o->scene_path, .kernel = isect->name, .samples = o->samples,
+            .seed = o->seed, .max_depth = o->max_depth, .render_seconds = stats.seconds,
+            .depth = o->depth, .color = color, .exposure = o->exposure,
+            .bake_view = o->bake_view, .dither = o->dither,
+        };
+        res = ptr_output_write(o->output_path, settings.width, settings.height, rgb, &info, err);
+    }
+    free(rgb);
+    ptr_scene_free(&scene);
+    if (res == PTR_OK && !o->quiet)
+        fprintf(stderr,
+                "ptr: %s: %dx%d, %" PRIu32 " spp, %d threads, %s intersector: %.3f s, "
+                "%.2f Mrays/s (%" PRIu64 " rays)\n",
+                o->output_path, settings.width, settings.height, o->samples, stats.threads,
+                isect->name, stats.seconds,
+                stats.seconds > 0 ? (double)stats.rays / stats.seconds * 1e-6 : 0.0, stats.rays);
+    return res;
+}
+
+/* The colour config and the view in force, or an error. */
+static PtrColor *open_color(const Options *o, PtrError *err)
+{
+    char message[sizeof err->message];
+    PtrColor *color = ptr_color_open(o->ocio_config, message, sizeof message);
+    if (!color) {
+        ptr_error_set(err, PTR_ERR_COLOR, "%s", message);
+        return NULL;
+    }
+    int bad = ptr_color_select(color, o->display, o->view, o->look, o->exposure, message,
+                               sizeof message);
+    if (bad) {
+        ptr_error_set(err, bad > 0 ? PTR_ERR_USAGE : PTR_ERR_COLOR, "%s", message);
+        ptr_color_close(color);
+        return NULL;
+    }
+    return color;
+}
+
 int ptr_cli_main(int argc, char **argv)
 {
     Options o;
@@ -267,75 +395,28 @@ int ptr_cli_main(int argc, char **argv)
         return code;
 
     PtrError err = { 0 };
-    if (!o.dump_scene && ptr_output_check(o.output_path, &err) != PTR_OK)
+    PtrColor *color = open_color(&o, &err);
+    if (!color)
         return fail(&err);
-
-    /* Refuse an unavailable kernel before reading the scene; the choice is
-     * made again once the scene's size is known. */
-    PtrIsectTable isect;
-    if (!ptr_isect_init(&isect, o.kernel, SIZE_MAX)) {
-        ptr_error_set(&err, PTR_ERR_USAGE,
-                      "--asm: no assembly intersector at CPU level '%s' (this build %s)",
-                      ptr_cpu_level_name(ptr_cpu_level()),
-                      ptr_isect_has_asm() ? "has them" : "was built without them");
-        return fail(&err);
-    }
-
-    PtrScene scene;
-    PtrWarnings warnings = { 0 };
-    PtrImportOptions import_options = { .camera_name = o.camera_name };
-    PtrResult res = ptr_import_scene(o.scene_path, &import_options, &scene, &warnings, &err);
-    for (size_t i = 0; i < warnings.count; i++)
-        fprintf(stderr, "ptr: warning: %s\n", warnings.lines[i]);
-    if (res == PTR_OK && o.has_sky)
-        scene.sky = o.sky;
-    if (res == PTR_OK && o.dump_scene)
-        ptr_scene_write_json(stdout, o.scene_path, &scene, &warnings);
-    ptr_warnings_free(&warnings);
-    if (res != PTR_OK)
-        return fail(&err);
-    if (o.dump_scene) {
-        ptr_scene_free(&scene);
+    if (o.list_views) {
+        ptr_color_list(color, stdout);
+        ptr_color_close(color);
         return 0;
     }
-    ptr_isect_init(&isect, o.kernel, scene.spheres.count);
 
-    PtrRenderSettings settings = {
-        .samples = o.samples, .seed = o.seed, .max_depth = o.max_depth, .threads = o.threads,
-    };
-    choose_size(&o, &scene, &settings.width, &settings.height);
-    float *rgb = malloc((size_t)settings.width * (size_t)settings.height * 3 * sizeof *rgb);
-    PtrRenderStats stats = { 0 };
-    if (!rgb)
-        res = ptr_error_set(&err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
-                            o.output_path, settings.width, settings.height);
-    else
-        res = ptr_render(&scene, &isect, &settings, rgb, &stats, &err);
-    if (res == PTR_ERR_SCENE_INVALID) {
-        /* The renderer does not know where the scene came from. */
-        char message[sizeof err.message];
-        memcpy(message, err.message, sizeof message);
-        ptr_error_set(&err, res, "%s: %s", o.scene_path, message);
-    }
-    if (res == PTR_OK) {
-        PtrOutputInfo info = {
-            .scene_path = o.scene_path, .kernel = isect.name, .samples = o.samples,
-            .seed = o.seed, .max_depth = o.max_depth, .render_seconds = stats.seconds,
-            .half = o.half,
-        };
-        res = ptr_output_write(o.output_path, settings.width, settings.height, rgb, &info, &err);
-    }
-    free(rgb);
-    ptr_scene_free(&scene);
-    if (res != PTR_OK)
-        return fail(&err);
-    if (!o.quiet)
-        fprintf(stderr,
-                "ptr: %s: %dx%d, %" PRIu32 " spp, %d threads, %s intersector: %.3f s, "
-                "%.2f Mrays/s (%" PRIu64 " rays)\n",
-                o.output_path, settings.width, settings.height, o.samples, stats.threads,
-                isect.name, stats.seconds,
-                stats.seconds > 0 ? (double)stats.rays / stats.seconds * 1e-6 : 0.0,
-                stats.rays);
-    return 0;
+    PtrResult res = PTR_OK;
+    PtrIsectTable isect;
+    if (!o.dump_scene)
+        res = ptr_output_check(o.output_path, o.depth, &err);
+    /* Refuse an unavailable kernel before reading the scene; the choice is
+     * made again once the scene's size is known. */
+    if (res == PTR_OK && !ptr_isect_init(&isect, o.kernel, SIZE_MAX))
+        res = ptr_error_set(&err, PTR_ERR_USAGE,
+                            "--asm: no assembly intersector at CPU level '%s' (this build %s)",
+                            ptr_cpu_level_name(ptr_cpu_level()),
+                            ptr_isect_has_asm() ? "has them" : "was built without them");
+    if (res == PTR_OK)
+        res = render_scene(&o, color, &isect, &err);
+    ptr_color_close(color);
+    return res == PTR_OK ? 0 : fail(&err);
 }

@@ -2,7 +2,6 @@
 
 #include <errno.h>
 #include <inttypes.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,17 +12,57 @@
 #include "image/image.h"
 #include "version.h"
 
-static int is_float_format(const char *path)
+/* The depths each format can store; the first is its default. Formats not
+ * listed (.bmp, .tga, ...) take 8 bits only. */
+static const struct {
+    const char *extension;
+    PtrDepth depths[4];
+} formats[] = {
+    { ".exr", { PTR_DEPTH_FLOAT, PTR_DEPTH_HALF } },
+    { ".hdr", { PTR_DEPTH_FLOAT } },
+    { ".png", { PTR_DEPTH_8, PTR_DEPTH_16 } },
+    { ".tif", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
+    { ".tiff", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
+};
+
+static const char *const depth_names[] = { "default", "8", "16", "half", "float" };
+
+int ptr_depth_parse(const char *text, PtrDepth *depth)
 {
-    const char *dot = strrchr(path, '.');
-    return dot && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr"));
+    for (int d = PTR_DEPTH_8; d <= PTR_DEPTH_FLOAT; d++)
+        if (!strcmp(text, depth_names[d])) {
+            *depth = (PtrDepth)d;
+            return 1;
+        }
+    return 0;
 }
 
-PtrResult ptr_output_check(const char *path, PtrError *err)
+/* The depth a file gets, or PTR_DEPTH_DEFAULT if its format cannot store the
+ * one asked for. */
+static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
+{
+    const char *dot = strrchr(path, '.');
+    for (size_t f = 0; dot && f < sizeof formats / sizeof formats[0]; f++) {
+        if (strcasecmp(dot, formats[f].extension))
+            continue;
+        if (wanted == PTR_DEPTH_DEFAULT)
+            return formats[f].depths[0];
+        for (int i = 0; i < 4; i++)
+            if (formats[f].depths[i] == wanted)
+                return wanted;
+        return PTR_DEPTH_DEFAULT;
+    }
+    return wanted == PTR_DEPTH_DEFAULT || wanted == PTR_DEPTH_8 ? PTR_DEPTH_8 : PTR_DEPTH_DEFAULT;
+}
+
+PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
 {
     if (!ptr_image_can_write(path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);
+    if (resolve_depth(path, depth) == PTR_DEPTH_DEFAULT)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: this format cannot store --depth %s", path,
+                             depth_names[depth]);
     /* The file is written beside its final name and renamed, so the folder
      * must take new files. */
     char dir[4096];
@@ -46,32 +85,36 @@ PtrResult ptr_output_check(const char *path, PtrError *err)
     return PTR_OK;
 }
 
-float ptr_srgb_encode(float linear)
-{
-    float x = fminf(fmaxf(linear, 0.0f), 1.0f);
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
-}
-
 PtrResult ptr_output_write(const char *path, int width, int height, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err)
 {
-    int linear = is_float_format(path);
-    size_t values = (size_t)width * (size_t)height * 3;
-    float *encoded = NULL;
-    if (!linear) {
-        encoded = malloc(values * sizeof *encoded);
-        if (!encoded)
+    PtrDepth depth = resolve_depth(path, info->depth);
+    int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
+    int display_referred = !is_float || info->bake_view;
+    size_t pixels = (size_t)width * (size_t)height;
+    char message[sizeof err->message];
+
+    float *viewed = NULL;
+    if (display_referred) {
+        viewed = malloc(pixels * 3 * sizeof *viewed);
+        if (!viewed)
             return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
-        for (size_t i = 0; i < values; i++)
-            encoded[i] = ptr_srgb_encode(rgb[i]);
+        memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
+        if (ptr_color_apply(info->color, viewed, pixels, message, sizeof message)) {
+            free(viewed);
+            return ptr_error_set(err, PTR_ERR_COLOR, "%s: %s", path, message);
+        }
     }
 
-    char seed[24];
+    char seed[24], exposure[32];
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
+    snprintf(exposure, sizeof exposure, "%g", info->exposure);
+    const char *space = display_referred ? ptr_color_view_space(info->color) : "lin_rec709";
     const PtrImageAttr attrs[] = {
         { .name = "Software", .type = PTR_ATTR_STRING, .string_value = "ptr " PTR_VERSION },
-        { .name = "oiio:ColorSpace", .type = PTR_ATTR_STRING,
-          .string_value = linear ? "lin_rec709" : "sRGB" },
+        { .name = "oiio:ColorSpace", .type = PTR_ATTR_STRING, .string_value = space },
+        /* OpenImageIO reads every EXR back as "Linear": say it where it stays. */
+        { .name = "ptr:colorspace", .type = PTR_ATTR_STRING, .string_value = space },
         { .name = "ptr:scene", .type = PTR_ATTR_STRING, .string_value = info->scene_path },
         { .name = "ptr:samples", .type = PTR_ATTR_INT, .int_value = (int)info->samples },
         { .name = "ptr:seed", .type = PTR_ATTR_STRING, .string_value = seed },
@@ -79,13 +122,23 @@ PtrResult ptr_output_write(const char *path, int width, int height, const float 
         { .name = "ptr:kernel", .type = PTR_ATTR_STRING, .string_value = info->kernel },
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->render_seconds },
+        { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,
+          .string_value = ptr_color_source(info->color) },
+        /* What the pixels went through (when display-referred) or would go
+         * through to be seen as intended. */
+        { .name = "ptr:display", .type = PTR_ATTR_STRING, .string_value = ptr_color_display(info->color) },
+        { .name = "ptr:view", .type = PTR_ATTR_STRING, .string_value = ptr_color_view(info->color) },
+        { .name = "ptr:look", .type = PTR_ATTR_STRING, .string_value = ptr_color_look(info->color) },
+        { .name = "ptr:exposure", .type = PTR_ATTR_STRING, .string_value = exposure },
+        { .name = "oiio:dither", .type = PTR_ATTR_INT, .int_value = info->dither ? 1 : 0 },
     };
-    PtrPixelFormat format = !linear ? PTR_PIXEL_UINT8 : info->half ? PTR_PIXEL_HALF
-                                                                     : PTR_PIXEL_FLOAT;
-    char message[sizeof err->message];
-    int failed = ptr_image_write(path, width, height, linear ? rgb : encoded, format, attrs,
-                                 sizeof attrs / sizeof attrs[0], message, sizeof message);
-    free(encoded);
+    static const PtrPixelFormat pixel_formats[] = {
+        [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
+        [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
+    };
+    int failed = ptr_image_write(path, width, height, viewed ? viewed : rgb, pixel_formats[depth],
+                                 attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
+    free(viewed);
     if (failed)
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s", message);
     return PTR_OK;

@@ -4,7 +4,19 @@
 
 #include <stdint.h>
 
+#include "color/color.h"
 #include "result.h"
+
+/* What each channel is stored as. Integer depths always hold the
+ * display-referred image (the view applied, clamped to [0, 1], rounded);
+ * float depths hold scene-linear values unless bake_view is set. */
+typedef enum PtrDepth {
+    PTR_DEPTH_DEFAULT, /* float for .exr and .hdr, else 8 bits */
+    PTR_DEPTH_8,
+    PTR_DEPTH_16,
+    PTR_DEPTH_HALF,
+    PTR_DEPTH_FLOAT,
+} PtrDepth;
 
 typedef struct PtrOutputInfo {
     const char *scene_path;
@@ -13,21 +25,24 @@ typedef struct PtrOutputInfo {
     uint64_t seed;
     int max_depth;
     double render_seconds;
-    int half; /* float formats: store half instead of float */
+    PtrDepth depth;
+    const PtrColor *color; /* the display, view, look and exposure in force */
+    float exposure;        /* stops, as given to ptr_color_select (for metadata) */
+    int bake_view;         /* float depths too get the display-referred image */
+    int dither;            /* 8-bit: dither before rounding */
 } PtrOutputInfo;
 
-/* Fails early, before any rendering, if no writer exists for the output's
- * extension (PTR_ERR_USAGE) or its folder cannot take the file
- * (PTR_ERR_OUTPUT). */
-PtrResult ptr_output_check(const char *path, PtrError *err);
+/* Parses "8", "16", "half" or "float". */
+int ptr_depth_parse(const char *text, PtrDepth *depth);
 
-/* Float formats (.exr, .hdr) keep scene-linear values; every other format is
- * encoded with the sRGB transfer curve and quantised to 8 bits. The file is
- * replaced atomically. */
+/* Fails early, before any rendering, if no writer exists for the output's
+ * extension or it cannot store that depth (PTR_ERR_USAGE), or its folder
+ * cannot take the file (PTR_ERR_OUTPUT). */
+PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err);
+
+/* Writes the image (rows top to bottom, RGB scene-linear) as info says. The
+ * file is replaced atomically. */
 PtrResult ptr_output_write(const char *path, int width, int height, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err);
-
-/* The sRGB transfer function (IEC 61966-2-1) for one linear value in [0, 1]. */
-float ptr_srgb_encode(float linear);
 
 #endif /* PTR_OUTPUT_H */

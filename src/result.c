@@ -9,6 +9,8 @@ int ptr_result_exit_code(PtrResult result)
 #define PTR_RESULT_EXIT(name, code, text) case name: return code;
     PTR_RESULT_MAP(PTR_RESULT_EXIT)
 #undef PTR_RESULT_EXIT
+    case PTR_RESULT_COUNT:
+        break;
     }
     return 1;
 }
@@ -19,6 +21,8 @@ const char *ptr_result_description(PtrResult result)
 #define PTR_RESULT_TEXT(name, code, text) case name: return text;
     PTR_RESULT_MAP(PTR_RESULT_TEXT)
 #undef PTR_RESULT_TEXT
+    case PTR_RESULT_COUNT:
+        break;
     }
     return "unknown error";
 }

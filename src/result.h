@@ -12,12 +12,14 @@
     X(PTR_ERR_SCENE_UNREADABLE, 3,   "scene file cannot be read")             \
     X(PTR_ERR_SCENE_INVALID,    4,   "scene file is malformed or invalid")    \
     X(PTR_ERR_OUTPUT,           5,   "output image cannot be written")        \
-    X(PTR_ERR_NOMEM,            6,   "out of memory")
+    X(PTR_ERR_NOMEM,            6,   "out of memory")                         \
+    X(PTR_ERR_COLOR,            7,   "colour configuration cannot be used")
 
 typedef enum PtrResult {
 #define PTR_RESULT_ENUM(name, code, text) name,
     PTR_RESULT_MAP(PTR_RESULT_ENUM)
 #undef PTR_RESULT_ENUM
+    PTR_RESULT_COUNT
 } PtrResult;
 
 /* The process exit code for a result. */

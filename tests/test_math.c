@@ -1,8 +1,7 @@
-/* Vector maths, random streams, the camera and the sRGB encoding. */
+/* Vector maths, random streams and the camera. */
 #include <stdint.h>
 
 #include "camera.h"
-#include "output.h"
 #include "rng.h"
 #include "test.h"
 #include "vec.h"
@@ -96,21 +95,10 @@ static void test_camera(void)
     CHECK(!ptr_view_init(&view, &bad, 10, 10));
 }
 
-static void test_srgb(void)
-{
-    CHECK_FLOAT_EQ(ptr_srgb_encode(0.0f), 0.0f);
-    CHECK_NEAR(ptr_srgb_encode(1.0f), 1.0, 1e-6);
-    CHECK_NEAR(ptr_srgb_encode(0.0031308f), 0.04045, 1e-6);
-    CHECK_NEAR(ptr_srgb_encode(0.18f), 0.461356, 1e-5);
-    CHECK_FLOAT_EQ(ptr_srgb_encode(-1.0f), 0.0f);
-    CHECK_NEAR(ptr_srgb_encode(7.0f), 1.0, 1e-6);
-}
-
 int main(void)
 {
     test_vectors();
     test_rng();
     test_camera();
-    test_srgb();
     return test_report();
 }

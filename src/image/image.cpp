@@ -29,6 +29,7 @@ OIIO::TypeDesc pixel_type(PtrPixelFormat format)
 {
     switch (format) {
     case PTR_PIXEL_UINT8: return OIIO::TypeDesc::UINT8;
+    case PTR_PIXEL_UINT16: return OIIO::TypeDesc::UINT16;
     case PTR_PIXEL_HALF: return OIIO::TypeDesc::HALF;
     case PTR_PIXEL_FLOAT: break;
     }

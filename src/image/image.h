@@ -10,6 +10,7 @@ extern "C" {
 
 typedef enum PtrPixelFormat {
     PTR_PIXEL_UINT8,
+    PTR_PIXEL_UINT16,
     PTR_PIXEL_HALF,
     PTR_PIXEL_FLOAT,
 } PtrPixelFormat;

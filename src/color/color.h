@@ -1,0 +1,53 @@
+/* Colour management through OpenColorIO, behind a C interface: which config,
+ * which display, view and look, and the transform from the renderer's
+ * scene-linear Rec.709 to what a display shows. */
+#ifndef PTR_COLOR_H
+#define PTR_COLOR_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct PtrColor PtrColor;
+
+/* Loads a config: the file at path if given, else the one $OCIO names, else
+ * ptr's embedded one. A config that cannot be loaded, fails validation or has
+ * no scene_linear role is an error (NULL, err filled, naming the file): never
+ * a silent fallback to another config. */
+PtrColor *ptr_color_open(const char *path, char *err, size_t err_size);
+void ptr_color_close(PtrColor *color);
+
+/* Where the config came from: its path, or "embedded". */
+const char *ptr_color_source(const PtrColor *color);
+
+/* Chooses the display and view (NULL: the config's defaults), an optional
+ * look, and an exposure in stops applied in scene-linear before the view.
+ * Returns 0; 1 for an unknown name, with err listing the valid ones; -1 if
+ * OpenColorIO fails, with err saying why. */
+int ptr_color_select(PtrColor *color, const char *display, const char *view, const char *look,
+                     float exposure_stops, char *err, size_t err_size);
+
+const char *ptr_color_display(const PtrColor *color);
+const char *ptr_color_view(const PtrColor *color);
+const char *ptr_color_look(const PtrColor *color); /* "" for none */
+/* The colour space a display-referred image is in, for file metadata. */
+const char *ptr_color_view_space(const PtrColor *color);
+
+/* Transforms RGB pixels in place from scene-linear to the selected view.
+ * Returns 0, or -1 with err filled. */
+int ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels, char *err, size_t err_size);
+
+/* Prints the displays with their views, and the looks. */
+void ptr_color_list(const PtrColor *color, FILE *out);
+
+/* ptr's embedded config, as text. */
+extern const char ptr_embedded_ocio_config[];
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PTR_COLOR_H */
