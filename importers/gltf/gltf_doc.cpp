@@ -1,4 +1,5 @@
 #include "gltf_doc.h"
+#include "shim_error.h"
 
 #include <tiny_gltf.h>
 
@@ -17,17 +18,6 @@ struct GltfDoc {
 };
 
 namespace {
-
-void set_error(char *err, size_t size, const std::string &text)
-{
-    std::string line = text;
-    for (char &c : line)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    while (!line.empty() && line.back() == ' ')
-        line.pop_back();
-    std::snprintf(err, size, "%s", line.c_str());
-}
 
 // ptr never looks at textures: skip decoding every embedded image.
 bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
@@ -134,7 +124,7 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
         bool binary = is_binary_gltf(path, &readable);
         if (!readable) {
             *unreadable = 1;
-            set_error(err, err_size, std::string(path) + ": " + std::strerror(errno));
+            ptr_shim_error(err, err_size, std::string(path) + ": " + std::strerror(errno));
             return nullptr;
         }
         auto doc = std::make_unique<GltfDoc>();
@@ -144,22 +134,22 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
         bool ok = binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
                          : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path);
         if (!ok) {
-            set_error(err, err_size, std::string(path) + ": " +
+            ptr_shim_error(err, err_size, std::string(path) + ": " +
                                          (error.empty() ? "not a valid glTF file" : error));
             return nullptr;
         }
         std::string fault = check_indices(doc->model);
         if (!fault.empty()) {
-            set_error(err, err_size, std::string(path) + ": " + fault);
+            ptr_shim_error(err, err_size, std::string(path) + ": " + fault);
             return nullptr;
         }
         const tinygltf::Model &m = doc->model;
         doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
         return doc.release();
     } catch (const std::exception &e) {
-        set_error(err, err_size, std::string(path) + ": " + e.what());
+        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
     } catch (...) {
-        set_error(err, err_size, std::string(path) + ": unexpected error while parsing");
+        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while parsing");
     }
     return nullptr;
 }

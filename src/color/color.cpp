@@ -1,4 +1,5 @@
 #include "color.h"
+#include "shim_error.h"
 
 #include <OpenColorIO/OpenColorIO.h>
 
@@ -19,15 +20,6 @@ struct PtrColor {
 };
 
 namespace {
-
-void set_error(char *err, size_t size, const std::string &text)
-{
-    std::string line = text;
-    for (char &c : line)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    std::snprintf(err, size, "%s", line.c_str());
-}
 
 std::string join(const std::string &label, int count, const std::function<const char *(int)> &name)
 {
@@ -63,9 +55,9 @@ extern "C" PtrColor *ptr_color_open(const char *path, char *err, size_t err_size
         color->source = source;
         return color.release();
     } catch (const std::exception &e) {
-        set_error(err, err_size, label + ": " + e.what());
+        ptr_shim_error(err, err_size, label + ": " + e.what());
     } catch (...) {
-        set_error(err, err_size, label + ": unexpected error");
+        ptr_shim_error(err, err_size, label + ": unexpected error");
     }
     return nullptr;
 }
@@ -87,7 +79,7 @@ extern "C" int ptr_color_select(PtrColor *color, const char *display, const char
         for (int i = 0; i < config->getNumDisplays(); i++)
             known = known || d == config->getDisplay(i);
         if (!known) {
-            set_error(err, err_size,
+            ptr_shim_error(err, err_size,
                       join("unknown display '" + d + "'; " + color->source + " has",
                            config->getNumDisplays(), [&](int i) { return config->getDisplay(i); }));
             return 1;
@@ -97,14 +89,14 @@ extern "C" int ptr_color_select(PtrColor *color, const char *display, const char
         for (int i = 0; i < config->getNumViews(d.c_str()); i++)
             known = known || v == config->getView(d.c_str(), i);
         if (!known) {
-            set_error(err, err_size,
+            ptr_shim_error(err, err_size,
                       join("unknown view '" + v + "' for display '" + d + "'; it has",
                            config->getNumViews(d.c_str()),
                            [&](int i) { return config->getView(d.c_str(), i); }));
             return 1;
         }
         if (look && *look && !config->getLook(look)) {
-            set_error(err, err_size,
+            ptr_shim_error(err, err_size,
                       join(std::string("unknown look '") + look + "'; " + color->source + " has",
                            config->getNumLooks(), [&](int i) { return config->getLookNameByIndex(i); }));
             return 1;
@@ -134,9 +126,9 @@ extern "C" int ptr_color_select(PtrColor *color, const char *display, const char
         color->view_space = config->getDisplayViewColorSpaceName(d.c_str(), v.c_str());
         return 0;
     } catch (const std::exception &e) {
-        set_error(err, err_size, "OCIO config " + color->source + ": " + e.what());
+        ptr_shim_error(err, err_size, "OCIO config " + color->source + ": " + e.what());
     } catch (...) {
-        set_error(err, err_size, "OCIO config " + color->source + ": unexpected error");
+        ptr_shim_error(err, err_size, "OCIO config " + color->source + ": unexpected error");
     }
     return -1;
 }
@@ -149,9 +141,9 @@ extern "C" int ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels,
         color->cpu->apply(image);
         return 0;
     } catch (const std::exception &e) {
-        set_error(err, err_size, std::string("OCIO: ") + e.what());
+        ptr_shim_error(err, err_size, std::string("OCIO: ") + e.what());
     } catch (...) {
-        set_error(err, err_size, "OCIO: unexpected error");
+        ptr_shim_error(err, err_size, "OCIO: unexpected error");
     }
     return -1;
 }

@@ -1,4 +1,5 @@
 #include "image.h"
+#include "shim_error.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -11,19 +12,6 @@
 #include <vector>
 
 namespace {
-
-void set_error(char *err, size_t size, const std::string &text)
-{
-    if (!err || size == 0)
-        return;
-    std::string line = text;
-    for (char &c : line)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    while (!line.empty() && line.back() == ' ')
-        line.pop_back();
-    std::snprintf(err, size, "%s", line.c_str());
-}
 
 OIIO::TypeDesc pixel_type(PtrPixelFormat format)
 {
@@ -76,7 +64,7 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
         // receives the bytes.
         auto out = OIIO::ImageOutput::create(path);
         if (!out) {
-            set_error(err, err_size, std::string(path) + ": no image format for this extension");
+            ptr_shim_error(err, err_size, std::string(path) + ": no image format for this extension");
             return -1;
         }
         OIIO::ImageSpec spec(width, height, 3, pixel_type(format));
@@ -90,28 +78,28 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
         }
         tmp = temporary_name(path);
         if (!out->open(tmp, spec)) {
-            set_error(err, err_size, std::string(path) + ": " + out->geterror());
+            ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
             return -1;
         }
         bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
         ok = out->close() && ok;
         if (!ok) {
-            set_error(err, err_size, std::string(path) + ": " + out->geterror());
+            ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
             return -1;
         }
         if (std::rename(tmp.c_str(), path) != 0) {
-            set_error(err, err_size, std::string(path) + ": cannot replace file: " +
+            ptr_shim_error(err, err_size, std::string(path) + ": cannot replace file: " +
                                          std::strerror(errno));
             std::remove(tmp.c_str());
             return -1;
         }
         return 0;
     } catch (const std::exception &e) {
-        set_error(err, err_size, std::string(path) + ": " + e.what());
+        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
     } catch (...) {
-        set_error(err, err_size, std::string(path) + ": unexpected error while writing");
+        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while writing");
     }
     if (!tmp.empty())
         std::remove(tmp.c_str());
@@ -123,13 +111,13 @@ extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size
     try {
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
-            set_error(err, err_size, std::string(path) + ": " + OIIO::geterror());
+            ptr_shim_error(err, err_size, std::string(path) + ": " + OIIO::geterror());
             return nullptr;
         }
         const OIIO::ImageSpec &spec = in->spec();
         std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
         if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
-            set_error(err, err_size, std::string(path) + ": " + in->geterror());
+            ptr_shim_error(err, err_size, std::string(path) + ": " + in->geterror());
             return nullptr;
         }
         auto image = std::make_unique<PtrImage>();
@@ -146,9 +134,9 @@ extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size
         in->close();
         return image.release();
     } catch (const std::exception &e) {
-        set_error(err, err_size, std::string(path) + ": " + e.what());
+        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
     } catch (...) {
-        set_error(err, err_size, std::string(path) + ": unexpected error while reading");
+        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while reading");
     }
     return nullptr;
 }
