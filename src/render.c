@@ -82,9 +82,11 @@ typedef struct RenderJob {
     const PtrIsectTable *isect;
     const PtrRenderSettings *settings;
     PtrView view;
-    float *rgb;
+    PtrRegion region;
+    uint32_t first, count;
+    double *sums;
     int tiles_x, tile_count;
-    atomic_int next_tile;
+    atomic_int next_tile, tiles_done, workers_running;
 } RenderJob;
 
 typedef struct Worker {
@@ -96,10 +98,13 @@ typedef struct Worker {
 static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
 {
     const PtrRenderSettings *s = job->settings;
+    /* Streams are keyed by full-image pixel, so a region renders the very
+     * samples the whole image would. */
     uint64_t pixel = (uint64_t)y * (uint64_t)s->width + (uint64_t)x;
-    double sum[3] = { 0, 0, 0 };
-
-    for (uint32_t i = 0; i < s->samples; i++) {
+    double *sum = job->sums + 3 * ((size_t)(y - job->region.y0) *
+                                   (size_t)(job->region.x1 - job->region.x0) +
+                                   (size_t)(x - job->region.x0));
+    for (uint32_t i = job->first; i < job->first + job->count; i++) {
         PtrRng rng = ptr_rng_for_sample(s->seed, pixel, i);
         float sx = ptr_rng_float(&rng), sy = ptr_rng_float(&rng);
         float lens_r = sqrtf(ptr_rng_float(&rng));
@@ -113,28 +118,27 @@ static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
         sum[1] += l.y;
         sum[2] += l.z;
     }
-    float *out = job->rgb + 3 * pixel;
-    for (int c = 0; c < 3; c++)
-        out[c] = (float)(sum[c] / (double)s->samples);
 }
 
 static void *render_worker(void *arg)
 {
     Worker *w = arg;
     RenderJob *job = w->job;
-    const PtrRenderSettings *s = job->settings;
+    const PtrRegion *r = &job->region;
     for (;;) {
         int tile = atomic_fetch_add(&job->next_tile, 1);
         if (tile >= job->tile_count)
             break;
-        int x0 = (tile % job->tiles_x) * TILE_SIZE;
-        int y0 = (tile / job->tiles_x) * TILE_SIZE;
-        int x1 = x0 + TILE_SIZE < s->width ? x0 + TILE_SIZE : s->width;
-        int y1 = y0 + TILE_SIZE < s->height ? y0 + TILE_SIZE : s->height;
+        int x0 = r->x0 + (tile % job->tiles_x) * TILE_SIZE;
+        int y0 = r->y0 + (tile / job->tiles_x) * TILE_SIZE;
+        int x1 = x0 + TILE_SIZE < r->x1 ? x0 + TILE_SIZE : r->x1;
+        int y1 = y0 + TILE_SIZE < r->y1 ? y0 + TILE_SIZE : r->y1;
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++)
                 render_pixel(job, x, y, &w->rays);
+        atomic_fetch_add(&job->tiles_done, 1);
     }
+    atomic_fetch_sub(&job->workers_running, 1);
     return NULL;
 }
 
@@ -151,24 +155,41 @@ static int online_cpus(void)
     return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
 }
 
-PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
-                     const PtrRenderSettings *settings, float *rgb,
-                     PtrRenderStats *stats, PtrError *err)
+PtrRegion ptr_render_region(const PtrRenderSettings *s)
+{
+    PtrRegion r = s->region;
+    if (!r.x0 && !r.y0 && !r.x1 && !r.y1)
+        r = (PtrRegion){ 0, 0, s->width, s->height };
+    if (r.x0 < 0 || r.y0 < 0 || r.x1 > s->width || r.y1 > s->height || r.x0 >= r.x1 ||
+        r.y0 >= r.y1)
+        return (PtrRegion){ 0, 0, 0, 0 };
+    return r;
+}
+
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+                             const PtrRenderSettings *settings, uint32_t first, uint32_t count,
+                             double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
+                             PtrError *err)
 {
     RenderJob job = {
-        .scene = scene, .isect = isect, .settings = settings, .rgb = rgb,
+        .scene = scene, .isect = isect, .settings = settings, .first = first, .count = count,
+        .sums = sums, .region = ptr_render_region(settings),
     };
-    if (settings->samples == 0 || settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f))
+    if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
         return ptr_error_set(err, PTR_ERR_USAGE,
-                             "samples must be positive, max depth and fixed t_min not negative");
+                             "max depth and fixed t_min must not be negative, samples must fit 32 bits");
+    if (job.region.x1 == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
+                             settings->width, settings->height);
     if (!ptr_view_init(&job.view, &scene->camera, settings->width, settings->height))
         return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                              "camera is degenerate (look-from equals look-at, up along the view, "
                              "field of view outside (0, 180) degrees, or bad focus distance/aperture)");
-    job.tiles_x = (settings->width + TILE_SIZE - 1) / TILE_SIZE;
-    int tiles_y = (settings->height + TILE_SIZE - 1) / TILE_SIZE;
+    job.tiles_x = (job.region.x1 - job.region.x0 + TILE_SIZE - 1) / TILE_SIZE;
+    int tiles_y = (job.region.y1 - job.region.y0 + TILE_SIZE - 1) / TILE_SIZE;
     job.tile_count = job.tiles_x * tiles_y;
     atomic_init(&job.next_tile, 0);
+    atomic_init(&job.tiles_done, 0);
 
     int threads = settings->threads > 0 ? settings->threads : online_cpus();
     if (threads > job.tile_count)
@@ -179,25 +200,54 @@ PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
 
     double start = now_seconds();
     int started = 0;
+    atomic_init(&job.workers_running, threads);
     for (; started < threads; started++) {
         workers[started].job = &job;
-        /* The calling thread is a worker too, so that one thread costs no
-         * thread creation; if creation fails the rest share the work. */
-        if (started == 0)
-            continue;
         if (pthread_create(&workers[started].thread, NULL, render_worker, &workers[started]))
             break;
     }
-    render_worker(&workers[0]);
-    uint64_t rays = workers[0].rays;
-    for (int i = 1; i < started; i++) {
+    atomic_fetch_sub(&job.workers_running, threads - started);
+    if (started == 0) {
+        /* No thread could be created: render here. */
+        atomic_fetch_add(&job.workers_running, 1);
+        render_worker(&workers[0]);
+    }
+    /* This thread watches: it reports progress until the workers are done. */
+    while (tick && atomic_load(&job.workers_running) > 0) {
+        tick(user, (double)atomic_load(&job.tiles_done) / job.tile_count);
+        nanosleep(&(struct timespec){ 0, 100 * 1000 * 1000 }, NULL);
+    }
+    uint64_t rays = started == 0 ? workers[0].rays : 0;
+    for (int i = 0; i < started; i++) {
         pthread_join(workers[i].thread, NULL);
         rays += workers[i].rays;
     }
     double seconds = now_seconds() - start;
     free(workers);
-
+    if (tick)
+        tick(user, 1.0);
     if (stats)
-        *stats = (PtrRenderStats){ .seconds = seconds, .rays = rays, .threads = started };
+        *stats = (PtrRenderStats){ .seconds = seconds, .rays = rays,
+                                   .threads = started ? started : 1 };
     return PTR_OK;
+}
+
+PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+                     const PtrRenderSettings *settings, float *rgb,
+                     PtrRenderStats *stats, PtrError *err)
+{
+    if (settings->samples == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive");
+    PtrRegion r = ptr_render_region(settings);
+    size_t values = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0) * 3;
+    double *sums = calloc(values ? values : 1, sizeof *sums);
+    if (!sums)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image",
+                             r.x1 - r.x0, r.y1 - r.y0);
+    PtrResult res = ptr_render_samples(scene, isect, settings, 0, settings->samples, sums, NULL,
+                                       NULL, stats, err);
+    for (size_t i = 0; res == PTR_OK && i < values; i++)
+        rgb[i] = (float)(sums[i] / (double)settings->samples);
+    free(sums);
+    return res;
 }

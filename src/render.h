@@ -9,9 +9,15 @@
 #include "result.h"
 #include "scene.h"
 
+/* Pixels x0 <= x < x1, y0 <= y < y1 of the full image. */
+typedef struct PtrRegion {
+    int x0, y0, x1, y1;
+} PtrRegion;
+
 typedef struct PtrRenderSettings {
-    int width, height;
-    uint32_t samples;  /* per pixel */
+    int width, height; /* the full image */
+    PtrRegion region;  /* the pixels to render; all zero: the whole image */
+    uint32_t samples;  /* per pixel, for ptr_render */
     uint64_t seed;
     int max_depth;     /* rays per path at most; a path cut there adds nothing */
     int threads;       /* 0: one per online CPU */
@@ -28,9 +34,26 @@ typedef struct PtrRenderStats {
     int threads;
 } PtrRenderStats;
 
-/* Renders into rgb (width * height * 3 floats, rows top to bottom): each pixel
- * is the mean radiance of its samples. The image depends on the settings and
- * the scene only, never on the thread count. */
+/* Called on the rendering call's own thread about ten times a second while
+ * the workers run, with the share of the call's pixels done. */
+typedef void (*PtrTickFn)(void *user, double fraction_done);
+
+/* The region the settings name (the whole image if theirs is all zero), or
+ * all zero if it does not lie inside the image. */
+PtrRegion ptr_render_region(const PtrRenderSettings *settings);
+
+/* Adds the radiance of samples first .. first + count - 1 of every pixel of
+ * the region to sums (3 doubles a pixel, region rows top to bottom), sample
+ * by sample in index order: split into passes of any size, the sums come out
+ * bit for bit the same, and never depend on the thread count. tick may be
+ * NULL; stats (may be NULL) gets this call's figures. */
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+                             const PtrRenderSettings *settings, uint32_t first, uint32_t count,
+                             double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
+                             PtrError *err);
+
+/* The whole region with settings->samples samples, as means in rgb (3 floats
+ * a pixel, region rows top to bottom). */
 PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err);
