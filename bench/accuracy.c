@@ -59,13 +59,13 @@ int main(int argc, char **argv)
     for (size_t b = 0; b < sizeof benches / sizeof benches[0]; b++) {
         const Bench *bench = &benches[b];
         PtrScene scene;
-        PtrWarnings warnings = { 0 };
+        PtrStrings warnings = { 0 };
         PtrError err = { 0 };
         if (ptr_import_scene(bench->path, NULL, &scene, &warnings, &err) != PTR_OK) {
             fprintf(stderr, "accuracy: %s\n", err.message);
             return 1;
         }
-        ptr_warnings_free(&warnings);
+        ptr_strings_free(&warnings);
         size_t n = (size_t)bench->width * bench->height * 3;
         float *ref = malloc(n * sizeof *ref), *img = malloc(n * sizeof *img);
         PtrIsectTable fastest;

@@ -11,7 +11,7 @@
 #include "importer_internal.h"
 
 typedef PtrResult (*ImportFn)(const char *, const PtrImportOptions *, PtrScene *,
-                              PtrWarnings *, PtrError *);
+                              PtrStrings *, PtrError *);
 
 static const struct {
     const char *extension;
@@ -21,7 +21,7 @@ static const struct {
     { ".glb", ptr_import_gltf },
 };
 
-void ptr_warn(PtrWarnings *warnings, const char *fmt, ...)
+void ptr_warn(PtrStrings *warnings, const char *fmt, ...)
 {
     char line[512];
     va_list ap;
@@ -37,7 +37,7 @@ void ptr_warn(PtrWarnings *warnings, const char *fmt, ...)
         warnings->count++;
 }
 
-void ptr_warnings_free(PtrWarnings *warnings)
+void ptr_strings_free(PtrStrings *warnings)
 {
     for (size_t i = 0; i < warnings->count; i++)
         free(warnings->lines[i]);
@@ -47,7 +47,7 @@ void ptr_warnings_free(PtrWarnings *warnings)
 }
 
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
-                           PtrScene *scene, PtrWarnings *warnings, PtrError *err)
+                           PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {
     ptr_scene_init(scene);
     struct stat st;

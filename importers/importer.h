@@ -9,25 +9,29 @@
 #include "result.h"
 #include "scene.h"
 
-typedef struct PtrImportOptions {
-    const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
-} PtrImportOptions;
-
-typedef struct PtrWarnings {
+/* A list of lines of text (warnings, file names). */
+typedef struct PtrStrings {
     char **lines;
     size_t count;
-} PtrWarnings;
+} PtrStrings;
+
+typedef struct PtrImportOptions {
+    const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
+    /* If set, receives the other files the scene was read from (a glTF's
+     * external buffers): what --watch must watch besides the scene file. */
+    PtrStrings *dependencies;
+} PtrImportOptions;
 
 /* Reads path into scene (which the call initialises). On failure the scene
  * is left empty and err holds one line naming the file and the problem:
  * PTR_ERR_SCENE_UNREADABLE if it could not be read, PTR_ERR_SCENE_INVALID if
  * it was read and is wrong. Warnings are appended to warnings either way. */
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
-                           PtrScene *scene, PtrWarnings *warnings, PtrError *err);
+                           PtrScene *scene, PtrStrings *warnings, PtrError *err);
 
-/* Appends a printf-formatted warning line. */
-void ptr_warn(PtrWarnings *warnings, const char *fmt, ...)
+/* Appends a printf-formatted line. */
+void ptr_warn(PtrStrings *lines, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
-void ptr_warnings_free(PtrWarnings *warnings);
+void ptr_strings_free(PtrStrings *lines);
 
 #endif /* PTR_IMPORTER_H */

@@ -5,6 +5,6 @@
 #include "importer.h"
 
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
-                          PtrScene *scene, PtrWarnings *warnings, PtrError *err);
+                          PtrScene *scene, PtrStrings *warnings, PtrError *err);
 
 #endif /* PTR_IMPORTER_INTERNAL_H */

@@ -85,13 +85,13 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
     return PTR_OK;
 }
 
-PtrResult ptr_output_write(const char *path, int width, int height, const float *rgb,
+PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err)
 {
     PtrDepth depth = resolve_depth(path, info->depth);
     int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
     int display_referred = !is_float || info->bake_view;
-    size_t pixels = (size_t)width * (size_t)height;
+    size_t pixels = (size_t)layout->width * (size_t)layout->height;
     char message[sizeof err->message];
 
     float *viewed = NULL;
@@ -106,8 +106,9 @@ PtrResult ptr_output_write(const char *path, int width, int height, const float 
         }
     }
 
-    char seed[24], exposure[32];
+    char seed[24], exposure[32], hash[24];
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
+    snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
     snprintf(exposure, sizeof exposure, "%g", info->exposure);
     const char *space = display_referred ? ptr_color_view_space(info->color) : "lin_rec709";
     const PtrImageAttr attrs[] = {
@@ -116,7 +117,10 @@ PtrResult ptr_output_write(const char *path, int width, int height, const float 
         /* OpenImageIO reads every EXR back as "Linear": say it where it stays. */
         { .name = "ptr:colorspace", .type = PTR_ATTR_STRING, .string_value = space },
         { .name = "ptr:scene", .type = PTR_ATTR_STRING, .string_value = info->scene_path },
+        { .name = "ptr:scene_hash", .type = PTR_ATTR_STRING, .string_value = hash },
         { .name = "ptr:samples", .type = PTR_ATTR_INT, .int_value = (int)info->samples },
+        { .name = "ptr:sample_first", .type = PTR_ATTR_INT, .int_value = (int)info->sample_first },
+        { .name = "ptr:interrupted", .type = PTR_ATTR_INT, .int_value = info->interrupted },
         { .name = "ptr:seed", .type = PTR_ATTR_STRING, .string_value = seed },
         { .name = "ptr:max_depth", .type = PTR_ATTR_INT, .int_value = info->max_depth },
         { .name = "ptr:kernel", .type = PTR_ATTR_STRING, .string_value = info->kernel },
@@ -136,7 +140,7 @@ PtrResult ptr_output_write(const char *path, int width, int height, const float 
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    int failed = ptr_image_write(path, width, height, viewed ? viewed : rgb, pixel_formats[depth],
+    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, pixel_formats[depth],
                                  attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
     free(viewed);
     if (failed)

@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include "color/color.h"
+#include "image/image.h"
 #include "result.h"
 
 /* What each channel is stored as. Integer depths always hold the
@@ -20,8 +21,11 @@ typedef enum PtrDepth {
 
 typedef struct PtrOutputInfo {
     const char *scene_path;
+    uint64_t scene_hash;   /* ptr_scene_hash: merge refuses parts of other scenes */
     const char *kernel;
+    uint32_t sample_first; /* the samples taken: first .. first + samples - 1 */
     uint32_t samples;
+    int interrupted;       /* the render stopped before all samples asked for */
     uint64_t seed;
     int max_depth;
     double render_seconds;
@@ -40,9 +44,9 @@ int ptr_depth_parse(const char *text, PtrDepth *depth);
  * cannot take the file (PTR_ERR_OUTPUT). */
 PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err);
 
-/* Writes the image (rows top to bottom, RGB scene-linear) as info says. The
- * file is replaced atomically. */
-PtrResult ptr_output_write(const char *path, int width, int height, const float *rgb,
+/* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
+ * full image as layout says) as info says. The file is replaced atomically. */
+PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err);
 
 #endif /* PTR_OUTPUT_H */

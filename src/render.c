@@ -86,7 +86,10 @@ typedef struct RenderJob {
     uint32_t first, count;
     double *sums;
     int tiles_x, tile_count;
-    atomic_int next_tile, tiles_done, workers_running;
+    atomic_int next_tile, tiles_done;
+    pthread_mutex_t lock; /* guards workers_running, signalled on all_done */
+    pthread_cond_t all_done;
+    int workers_running;
 } RenderJob;
 
 typedef struct Worker {
@@ -138,7 +141,10 @@ static void *render_worker(void *arg)
                 render_pixel(job, x, y, &w->rays);
         atomic_fetch_add(&job->tiles_done, 1);
     }
-    atomic_fetch_sub(&job->workers_running, 1);
+    pthread_mutex_lock(&job->lock);
+    if (--job->workers_running == 0)
+        pthread_cond_signal(&job->all_done);
+    pthread_mutex_unlock(&job->lock);
     return NULL;
 }
 
@@ -200,23 +206,44 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
 
     double start = now_seconds();
     int started = 0;
-    atomic_init(&job.workers_running, threads);
+    pthread_mutex_init(&job.lock, NULL);
+    pthread_cond_init(&job.all_done, NULL);
+    job.workers_running = threads;
     for (; started < threads; started++) {
         workers[started].job = &job;
         if (pthread_create(&workers[started].thread, NULL, render_worker, &workers[started]))
             break;
     }
-    atomic_fetch_sub(&job.workers_running, threads - started);
+    pthread_mutex_lock(&job.lock);
+    job.workers_running -= threads - started;
+    pthread_mutex_unlock(&job.lock);
     if (started == 0) {
         /* No thread could be created: render here. */
-        atomic_fetch_add(&job.workers_running, 1);
+        job.workers_running = 1;
         render_worker(&workers[0]);
     }
-    /* This thread watches: it reports progress until the workers are done. */
-    while (tick && atomic_load(&job.workers_running) > 0) {
+    /* This thread watches: it reports progress until the last worker says
+     * it is done. */
+    pthread_mutex_lock(&job.lock);
+    while (job.workers_running > 0) {
+        if (!tick) {
+            pthread_cond_wait(&job.all_done, &job.lock);
+            continue;
+        }
+        pthread_mutex_unlock(&job.lock);
         tick(user, (double)atomic_load(&job.tiles_done) / job.tile_count);
-        nanosleep(&(struct timespec){ 0, 100 * 1000 * 1000 }, NULL);
+        pthread_mutex_lock(&job.lock);
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_nsec += 100 * 1000 * 1000;
+        if (until.tv_nsec >= 1000000000) {
+            until.tv_sec++;
+            until.tv_nsec -= 1000000000;
+        }
+        if (job.workers_running > 0)
+            pthread_cond_timedwait(&job.all_done, &job.lock, &until);
     }
+    pthread_mutex_unlock(&job.lock);
     uint64_t rays = started == 0 ? workers[0].rays : 0;
     for (int i = 0; i < started; i++) {
         pthread_join(workers[i].thread, NULL);
@@ -224,6 +251,8 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     }
     double seconds = now_seconds() - start;
     free(workers);
+    pthread_cond_destroy(&job.all_done);
+    pthread_mutex_destroy(&job.lock);
     if (tick)
         tick(user, 1.0);
     if (stats)

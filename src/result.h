@@ -13,7 +13,9 @@
     X(PTR_ERR_SCENE_INVALID,    4,   "scene file is malformed or invalid")    \
     X(PTR_ERR_OUTPUT,           5,   "output image cannot be written")        \
     X(PTR_ERR_NOMEM,            6,   "out of memory")                         \
-    X(PTR_ERR_COLOR,            7,   "colour configuration cannot be used")
+    X(PTR_ERR_COLOR,            7,   "colour configuration cannot be used")  \
+    X(PTR_ERR_INTERRUPTED,      8,   "interrupted: the image holds the samples done") \
+    X(PTR_ERR_BATCH,            9,   "some scenes of a batch failed")
 
 typedef enum PtrResult {
 #define PTR_RESULT_ENUM(name, code, text) name,

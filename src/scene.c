@@ -101,6 +101,50 @@ PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
     return PTR_OK;
 }
 
+/* FNV-1a over the bytes of the values, field by field (never over structure
+ * padding). */
+static uint64_t hash_bytes(uint64_t h, const void *data, size_t size)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++)
+        h = (h ^ p[i]) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+static uint64_t hash_vec(uint64_t h, PtrVec3 v)
+{
+    const float f[3] = { v.x, v.y, v.z };
+    return hash_bytes(h, f, sizeof f);
+}
+
+uint64_t ptr_scene_hash(const PtrScene *scene)
+{
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    const PtrSpheres *s = &scene->spheres;
+    h = hash_bytes(h, scene->origin, sizeof scene->origin);
+    h = hash_bytes(h, &s->count, sizeof s->count);
+    h = hash_bytes(h, s->cx, s->count * sizeof *s->cx);
+    h = hash_bytes(h, s->cy, s->count * sizeof *s->cy);
+    h = hash_bytes(h, s->cz, s->count * sizeof *s->cz);
+    h = hash_bytes(h, s->radius, s->count * sizeof *s->radius);
+    h = hash_bytes(h, s->material, s->count * sizeof *s->material);
+    for (size_t i = 0; i < scene->material_count; i++) {
+        const PtrMaterial *m = &scene->materials[i];
+        const int kind = m->kind;
+        const float scalars[2] = { m->fuzz, m->ior };
+        h = hash_bytes(h, &kind, sizeof kind);
+        h = hash_vec(hash_vec(h, m->albedo), m->emission);
+        h = hash_bytes(h, scalars, sizeof scalars);
+    }
+    const PtrCamera *c = &scene->camera;
+    const float lens[4] = { c->vfov_deg, c->aperture, c->focus_distance, c->aspect };
+    h = hash_vec(hash_vec(hash_vec(h, c->lookfrom), c->lookat), c->up);
+    h = hash_bytes(h, lens, sizeof lens);
+    const int sky = scene->sky.kind;
+    h = hash_bytes(h, &sky, sizeof sky);
+    return hash_vec(h, scene->sky.radiance);
+}
+
 PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
 {
     switch (sky->kind) {

@@ -86,6 +86,11 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
     return v3(s->cx[i], s->cy[i], s->cz[i]);
 }
 
+/* A 64-bit fingerprint of everything in the scene that shapes an image
+ * (spheres, materials, camera, sky, origin): parts of one render match, parts
+ * of different scenes almost surely do not. */
+uint64_t ptr_scene_hash(const PtrScene *scene);
+
 /* Radiance arriving from the sky along a unit direction. */
 PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir);
 

@@ -1,5 +1,7 @@
 #include "scene_json.h"
 
+#include "report.h"
+
 /* Floats print with 9 significant digits, enough to read back the same
  * float exactly. */
 static void write_vec(FILE *out, PtrVec3 v)
@@ -12,21 +14,6 @@ static void write_point(FILE *out, const PtrScene *scene, PtrVec3 v)
 {
     fprintf(out, "[%.17g, %.17g, %.17g]", scene->origin[0] + v.x, scene->origin[1] + v.y,
             scene->origin[2] + v.z);
-}
-
-static void write_string(FILE *out, const char *s)
-{
-    fputc('"', out);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(out, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(out, "\\u%04x", c);
-        else
-            fputc(c, out);
-    }
-    fputc('"', out);
 }
 
 static const char *material_kind(PtrMaterialKind kind)
@@ -49,11 +36,11 @@ static void write_sky(FILE *out, const PtrSky *sky)
 }
 
 void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
-                          const PtrWarnings *warnings)
+                          const PtrStrings *warnings)
 {
     const PtrSpheres *s = &scene->spheres;
     fputs("{\n  \"scene\": ", out);
-    write_string(out, path);
+    ptr_json_string(out, path);
     fputs(",\n  \"spheres\": [", out);
     for (size_t i = 0; i < s->count; i++) {
         fprintf(out, "%s\n    {\"center\": ", i ? "," : "");
@@ -90,7 +77,7 @@ void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
     fputs(",\n  \"warnings\": [", out);
     for (size_t i = 0; i < warnings->count; i++) {
         fputs(i ? ", " : "", out);
-        write_string(out, warnings->lines[i]);
+        ptr_json_string(out, warnings->lines[i]);
     }
     fputs("]\n}\n", out);
 }

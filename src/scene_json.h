@@ -8,6 +8,6 @@
 #include "scene.h"
 
 void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
-                          const PtrWarnings *warnings);
+                          const PtrStrings *warnings);
 
 #endif /* PTR_SCENE_JSON_H */

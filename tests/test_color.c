@@ -58,7 +58,8 @@ static void oracle(const char *config, const char *display, const char *view)
 {
     char err[256], cmd[1024];
     const char *in = path_in("in.exr"), *ours = path_in("ours.png"), *theirs = path_in("theirs.png");
-    CHECK_INT(ptr_image_write(in, N, 1, &inputs[0][0], PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
+    const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
+    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
 
     PtrColor *color = ptr_color_open(config, err, sizeof err);
     CHECK(color != NULL);
@@ -67,7 +68,7 @@ static void oracle(const char *config, const char *display, const char *view)
     CHECK_INT(ptr_color_select(color, display, view, NULL, 0, err, sizeof err), 0);
     PtrOutputInfo info = info_for(color);
     PtrError perr = { 0 };
-    CHECK_INT(ptr_output_write(ours, N, 1, &inputs[0][0], &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(ours, &row, &inputs[0][0], &info, &perr), PTR_OK);
     ptr_color_close(color);
 
     snprintf(cmd, sizeof cmd, "'%s' --colorconfig '%s' '%s' --ociodisplay '%s' '%s' -d uint8 -o '%s'",
@@ -186,6 +187,7 @@ static void test_output_path(void)
     char err[256];
     PtrColor *c = ptr_color_open(NULL, err, sizeof err);
     const float grey[3] = { 0.18f, 0.18f, 0.18f }, doubled[3] = { 0.36f, 0.36f, 0.36f };
+    const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
 
     /* +1 stop of 0.18 is 0.36 through the same view. */
     float a[3], b[3];
@@ -208,7 +210,7 @@ static void test_output_path(void)
     PtrOutputInfo info = info_for(c);
     PtrError perr = { 0 };
     info.depth = PTR_DEPTH_16;
-    CHECK_INT(ptr_output_write(path_in("grey16.png"), 1, 1, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(path_in("grey16.png"), &one, grey, &info, &perr), PTR_OK);
     PtrImage *img = read_image(path_in("grey16.png"));
     CHECK_NEAR(ptr_image_pixels(img)[0] * 65535.0, 30235.0, 1.0);
     CHECK_STR(ptr_image_attr(img, "ptr:view"), "Standard");
@@ -217,13 +219,13 @@ static void test_output_path(void)
 
     /* EXR stays scene-linear; --bake-view stores the display-referred values. */
     info.depth = PTR_DEPTH_DEFAULT;
-    CHECK_INT(ptr_output_write(path_in("linear.exr"), 1, 1, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(path_in("linear.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(path_in("linear.exr"));
     CHECK_FLOAT_EQ(ptr_image_pixels(img)[0], 0.18f);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "lin_rec709");
     ptr_image_free(img);
     info.bake_view = 1;
-    CHECK_INT(ptr_output_write(path_in("baked.exr"), 1, 1, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(path_in("baked.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(path_in("baked.exr"));
     CHECK_NEAR(ptr_image_pixels(img)[0], 0.461356, 1e-5);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "sRGB - Display");

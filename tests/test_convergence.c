@@ -100,11 +100,11 @@ static void test_convergence_rate(void)
 
 int main(void)
 {
-    PtrWarnings warnings = { 0 };
+    PtrStrings warnings = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(PTR_SOURCE_DIR "/scenes/seed.gltf", NULL, &scene, &warnings, &err),
               PTR_OK);
-    ptr_warnings_free(&warnings);
+    ptr_strings_free(&warnings);
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
     test_seed_independence();
     test_convergence_rate();

@@ -23,10 +23,10 @@ static float *render_with(const PtrScene *scene, const PtrIsectTable *isect,
 static void check_levels(const char *path, int width, int height)
 {
     PtrScene scene;
-    PtrWarnings warnings = { 0 };
+    PtrStrings warnings = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(path, NULL, &scene, &warnings, &err), PTR_OK);
-    ptr_warnings_free(&warnings);
+    ptr_strings_free(&warnings);
     PtrRenderSettings settings = { .width = width, .height = height, .samples = 4, .seed = 3,
                                    .max_depth = 50, .threads = 2 };
     PtrIsectTable c;

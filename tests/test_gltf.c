@@ -22,7 +22,7 @@ static const PtrMaterial *material_of(const PtrScene *s, size_t sphere)
     return &s->materials[s->spheres.material[sphere]];
 }
 
-static int has_warning(const PtrWarnings *w, const char *needle)
+static int has_warning(const PtrStrings *w, const char *needle)
 {
     int n = 0;
     for (size_t i = 0; i < w->count; i++)
@@ -33,7 +33,7 @@ static int has_warning(const PtrWarnings *w, const char *needle)
 static void test_hierarchy(void)
 {
     PtrScene s;
-    PtrWarnings w = { 0 };
+    PtrStrings w = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), NULL, &s, &w, &err), PTR_OK);
 
@@ -84,7 +84,7 @@ static void test_hierarchy(void)
     CHECK_INT(w.count, 2);
     CHECK_INT(has_warning(&w, "'Squashed' has a non-uniform scale"), 1);
     CHECK_INT(has_warning(&w, "textures are ignored"), 1);
-    ptr_warnings_free(&w);
+    ptr_strings_free(&w);
     ptr_scene_free(&s);
 
     /* --camera picks another camera by camera or node name. */
@@ -94,21 +94,21 @@ static void test_hierarchy(void)
     CHECK_NEAR(s.camera.lookat.x, -1.0, 1e-6); /* turned to look down -X */
     CHECK_NEAR(s.camera.lookat.z, 0.0, 1e-6);
     CHECK_NEAR(s.camera.vfov_deg, 180 / 3.14159265358979, 1e-4);
-    ptr_warnings_free(&w);
+    ptr_strings_free(&w);
     ptr_scene_free(&s);
 
     by_name.camera_name = "Nowhere";
     CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), &by_name, &s, &w, &err),
               PTR_ERR_SCENE_INVALID);
     CHECK(strstr(err.message, "Nowhere") != NULL);
-    ptr_warnings_free(&w);
+    ptr_strings_free(&w);
 }
 
 /* The binary container holds the same scene as the text one. */
 static void test_glb_matches_gltf(void)
 {
     PtrScene a, b;
-    PtrWarnings w = { 0 };
+    PtrStrings w = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(PTR_SOURCE_DIR "/scenes/seed.gltf", NULL, &a, &w, &err), PTR_OK);
     CHECK_INT(ptr_import_scene(FIXTURE("seed.glb"), NULL, &b, &w, &err), PTR_OK);
@@ -130,10 +130,10 @@ static void test_glb_matches_gltf(void)
 static void test_automatic_camera(void)
 {
     PtrScene s;
-    PtrWarnings w = { 0 };
+    PtrStrings w = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), NULL, &s, &w, &err), PTR_OK);
-    ptr_warnings_free(&w);
+    ptr_strings_free(&w);
     /* The box is [-4, 5] x [-1, 4] x [-1, 3]: centre (0.5, 1.5, 1), half
      * diagonal sqrt(81 + 25 + 16) / 2. */
     double distance = 0.5 * sqrt(122.0) / sin(20.0 * 3.14159265358979 / 180.0);
@@ -151,7 +151,7 @@ static void test_automatic_camera(void)
 static void check_bad(const char *path, PtrResult expected, const char *needle)
 {
     PtrScene s;
-    PtrWarnings w = { 0 };
+    PtrStrings w = { 0 };
     PtrError err = { 0 };
     PtrResult r = ptr_import_scene(path, NULL, &s, &w, &err);
     CHECK_INT(r, expected);
@@ -163,7 +163,7 @@ static void check_bad(const char *path, PtrResult expected, const char *needle)
     if (needle && !strstr(err.message, needle))
         TEST_FAIL_("'%s' not in \"%s\"", needle, err.message);
     CHECK_INT(s.spheres.count, 0);
-    ptr_warnings_free(&w);
+    ptr_strings_free(&w);
     ptr_scene_free(&s);
 }
 

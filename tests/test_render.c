@@ -105,11 +105,11 @@ static void test_inside_emitter(void)
 static void test_thread_independence(void)
 {
     PtrScene s;
-    PtrWarnings warnings = { 0 };
+    PtrStrings warnings = { 0 };
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(PTR_SOURCE_DIR "/scenes/seed.gltf", NULL, &s, &warnings, &err),
               PTR_OK);
-    ptr_warnings_free(&warnings);
+    ptr_strings_free(&warnings);
     PtrRenderSettings settings = { .width = 67, .height = 43, .samples = 3, .seed = 9,
                                    .max_depth = 50, .threads = 1 };
     Image one = render(&s, settings);

@@ -11,10 +11,12 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 struct GltfDoc {
     tinygltf::Model model;
     int scene = -1;
+    std::vector<std::string> files;
 };
 
 namespace {
@@ -145,6 +147,13 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
         }
         const tinygltf::Model &m = doc->model;
         doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
+        // External buffers' URIs are relative to the .gltf's folder.
+        const std::string scene_path = path;
+        const size_t slash = scene_path.rfind('/');
+        const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
+        for (const tinygltf::Buffer &b : m.buffers)
+            if (!b.uri.empty() && b.uri.compare(0, 5, "data:") != 0)
+                doc->files.push_back(b.uri[0] == '/' ? b.uri : dir + b.uri);
         return doc.release();
     } catch (const std::exception &e) {
         ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
@@ -156,6 +165,8 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
 
 extern "C" void gltf_doc_free(GltfDoc *doc) { delete doc; }
 
+extern "C" size_t gltf_doc_file_count(const GltfDoc *d) { return d->files.size(); }
+extern "C" const char *gltf_doc_file(const GltfDoc *d, size_t i) { return d->files[i].c_str(); }
 extern "C" size_t gltf_doc_node_count(const GltfDoc *d) { return d->model.nodes.size(); }
 extern "C" size_t gltf_doc_mesh_count(const GltfDoc *d) { return d->model.meshes.size(); }
 extern "C" size_t gltf_doc_material_count(const GltfDoc *d) { return d->model.materials.size(); }

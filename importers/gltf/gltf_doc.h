@@ -72,6 +72,10 @@ typedef struct GltfScene {
 GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size, int *unreadable);
 void gltf_doc_free(GltfDoc *doc);
 
+/* Files besides the .gltf that were read: external buffers, as paths. */
+size_t gltf_doc_file_count(const GltfDoc *doc);
+const char *gltf_doc_file(const GltfDoc *doc, size_t index);
+
 size_t gltf_doc_node_count(const GltfDoc *doc);
 size_t gltf_doc_mesh_count(const GltfDoc *doc);
 size_t gltf_doc_material_count(const GltfDoc *doc);

@@ -86,7 +86,7 @@ typedef struct Importer {
     const GltfDoc *doc;
     PtrScene *scene;
     PtrSceneBuilder builder;
-    PtrWarnings *warnings;
+    PtrStrings *warnings;
     PtrError *err;
     const char *camera_name;
     int camera_found;
@@ -328,7 +328,7 @@ static PtrResult read_scene_extras(Importer *im, const GltfScene *gs)
 }
 
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
-                          PtrScene *scene, PtrWarnings *warnings, PtrError *err)
+                          PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {
     char message[sizeof err->message];
     int unreadable;
@@ -362,6 +362,8 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: no perspective camera named '%s' in the default scene", path,
                             im.camera_name);
+    for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
+        ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
     if (res == PTR_OK && ptr_builder_finish(&im.builder, 1) != PTR_OK)
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: a sphere lies too far from the camera for single precision", path);

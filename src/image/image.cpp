@@ -3,6 +3,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -39,7 +40,13 @@ std::string temporary_name(const std::string &path)
 
 } // namespace
 
+// The temporary file of the write under way, for ptr_image_discard_partial:
+// plain storage a signal handler may read.
+static char partial_path[4096];
+static volatile std::sig_atomic_t partial_active;
+
 struct PtrImage {
+    PtrImageLayout layout = {};
     int width = 0, height = 0;
     std::vector<float> rgb;
     std::map<std::string, std::string> attrs;
@@ -54,7 +61,13 @@ extern "C" int ptr_image_can_write(const char *path)
     }
 }
 
-extern "C" int ptr_image_write(const char *path, int width, int height, const float *rgb,
+extern "C" void ptr_image_discard_partial(void)
+{
+    if (partial_active)
+        unlink(partial_path);
+}
+
+extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                                PtrPixelFormat format, const PtrImageAttr *attrs,
                                size_t attr_count, char *err, size_t err_size)
 {
@@ -67,7 +80,13 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
             ptr_shim_error(err, err_size, std::string(path) + ": no image format for this extension");
             return -1;
         }
-        OIIO::ImageSpec spec(width, height, 3, pixel_type(format));
+        OIIO::ImageSpec spec(layout->width, layout->height, 3, pixel_type(format));
+        spec.x = layout->x;
+        spec.y = layout->y;
+        spec.full_x = 0;
+        spec.full_y = 0;
+        spec.full_width = layout->full_width;
+        spec.full_height = layout->full_height;
         for (size_t i = 0; i < attr_count; i++) {
             const PtrImageAttr &a = attrs[i];
             switch (a.type) {
@@ -77,7 +96,12 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
             }
         }
         tmp = temporary_name(path);
+        if (tmp.size() < sizeof partial_path) {
+            std::memcpy(partial_path, tmp.c_str(), tmp.size() + 1);
+            partial_active = 1;
+        }
         if (!out->open(tmp, spec)) {
+            partial_active = 0;
             ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
             return -1;
@@ -87,14 +111,17 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
         if (!ok) {
             ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
+            partial_active = 0;
             return -1;
         }
         if (std::rename(tmp.c_str(), path) != 0) {
             ptr_shim_error(err, err_size, std::string(path) + ": cannot replace file: " +
                                          std::strerror(errno));
             std::remove(tmp.c_str());
+            partial_active = 0;
             return -1;
         }
+        partial_active = 0;
         return 0;
     } catch (const std::exception &e) {
         ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
@@ -103,6 +130,7 @@ extern "C" int ptr_image_write(const char *path, int width, int height, const fl
     }
     if (!tmp.empty())
         std::remove(tmp.c_str());
+    partial_active = 0;
     return -1;
 }
 
@@ -123,6 +151,7 @@ extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size
         auto image = std::make_unique<PtrImage>();
         image->width = spec.width;
         image->height = spec.height;
+        image->layout = { spec.width, spec.height, spec.x, spec.y, spec.full_width, spec.full_height };
         size_t pixels = size_t(spec.width) * size_t(spec.height);
         image->rgb.resize(pixels * 3);
         for (size_t p = 0; p < pixels; p++)
@@ -144,6 +173,7 @@ extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size
 extern "C" void ptr_image_free(PtrImage *image) { delete image; }
 extern "C" int ptr_image_width(const PtrImage *image) { return image->width; }
 extern "C" int ptr_image_height(const PtrImage *image) { return image->height; }
+extern "C" PtrImageLayout ptr_image_layout(const PtrImage *image) { return image->layout; }
 extern "C" const float *ptr_image_pixels(const PtrImage *image) { return image->rgb.data(); }
 
 extern "C" const char *ptr_image_attr(const PtrImage *image, const char *name)

@@ -26,6 +26,15 @@ typedef struct PtrImageAttr {
     const char *string_value;
 } PtrImageAttr;
 
+/* Where the stored pixels sit in the full image: a crop is a data window
+ * inside a larger display window (formats that have no such notion store the
+ * crop alone). */
+typedef struct PtrImageLayout {
+    int width, height;           /* pixels stored */
+    int x, y;                    /* their top-left corner in the full image */
+    int full_width, full_height; /* the full image */
+} PtrImageLayout;
+
 /* Whether a writer exists for the file's extension. */
 int ptr_image_can_write(const char *path);
 
@@ -34,9 +43,13 @@ int ptr_image_can_write(const char *path);
  * renamed over path only once complete, so an existing file is replaced by a
  * whole new one or not at all. Returns 0 on success; otherwise fills err with
  * one line and returns -1. */
-int ptr_image_write(const char *path, int width, int height, const float *rgb,
+int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                     PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
                     char *err, size_t err_size);
+
+/* Removes the temporary file of a write under way, if any. Safe to call from
+ * a signal handler: for a process that is about to _exit mid-write. */
+void ptr_image_discard_partial(void);
 
 /* An image read back as float RGB (extra channels dropped, grey replicated). */
 typedef struct PtrImage PtrImage;
@@ -45,6 +58,7 @@ PtrImage *ptr_image_read(const char *path, char *err, size_t err_size);
 void ptr_image_free(PtrImage *image);
 int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);
+PtrImageLayout ptr_image_layout(const PtrImage *image);
 const float *ptr_image_pixels(const PtrImage *image);
 
 /* A header attribute as text (numbers formatted), or NULL if absent. The

@@ -1,0 +1,50 @@
+/* The command line's options, parsed. */
+#ifndef PTR_CLI_OPTIONS_H
+#define PTR_CLI_OPTIONS_H
+
+#include <stdint.h>
+
+#include "isect.h"
+#include "output.h"
+#include "render.h"
+#include "scene.h"
+
+enum { PTR_DEFAULT_WIDTH = 800, PTR_MAX_IMAGE_SIZE = 1 << 16 };
+
+typedef struct PtrOptions {
+    char **inputs;          /* scenes; for `ptr merge`, the parts */
+    int input_count;
+    int merge;              /* `ptr merge PART... -o OUT` */
+    const char *output;     /* a file, a folder, or a pattern with {name} */
+    const char *camera_name;
+    uint32_t samples;
+    uint32_t sample_first;  /* --sample-range START:END sets both */
+    int samples_given;
+    uint64_t seed;
+    int width, height;      /* 0: from the scene */
+    PtrRegion region;       /* all zero: the whole image */
+    int max_depth;
+    int threads;
+    int has_sky;
+    PtrSky sky;
+    PtrKernel kernel;
+    PtrDepth depth;
+    const char *ocio_config, *display, *view, *look;
+    float exposure;
+    int bake_view;
+    int dither;
+    double time_budget;     /* seconds; 0: none */
+    int preview;
+    int watch;
+    int json;
+    int quiet;
+    int dump_scene;
+    int list_views;
+} PtrOptions;
+
+/* Parses argv. Returns -1 to go on, else the exit code to return at once
+ * (after --help, --version, --print-dispatch, or a usage error, which it has
+ * reported). */
+int ptr_options_parse(int argc, char **argv, PtrOptions *options);
+
+#endif /* PTR_CLI_OPTIONS_H */
