@@ -27,7 +27,8 @@ void ptr_progress_print(void *user, const PtrProgress *p)
 {
     PtrProgressPrinter *printer = user;
     enum { PLAIN_EVERY = 5 }; /* seconds between lines in a log */
-    if (!printer->terminal && p->elapsed - printer->last_line < PLAIN_EVERY)
+    /* In a log: a line as the render starts, then every few seconds. */
+    if (!printer->terminal && printer->lines > 0 && p->elapsed - printer->last_line < PLAIN_EVERY)
         return;
     char elapsed[32], left[32] = "?";
     clock_text(elapsed, sizeof elapsed, p->elapsed);
@@ -40,6 +41,7 @@ void ptr_progress_print(void *user, const PtrProgress *p)
             p->samples_done, p->samples_total, elapsed, left, rate, printer->terminal ? "" : "\n");
     fflush(stderr);
     printer->last_line = p->elapsed;
+    printer->lines++;
     printer->drawn = printer->terminal;
 }
 

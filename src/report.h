@@ -33,6 +33,7 @@ typedef struct PtrProgressPrinter {
     const char *label;
     int terminal;
     double last_line; /* elapsed time of the last plain line */
+    int lines;        /* plain lines printed */
     int drawn;        /* a terminal line is on screen */
 } PtrProgressPrinter;
 

@@ -1,0 +1,88 @@
+#!/bin/sh
+# A real ptr process under signals and --watch.
+# Usage: test_process.sh PTR SOURCE_DIR
+set -u
+ptr=$1
+src=$2
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+passed=0
+failed=0
+
+check() {
+    if eval "$2"; then
+        passed=$((passed + 1))
+    else
+        failed=$((failed + 1))
+        echo "FAIL: $1" >&2
+    fi
+}
+
+# Waits (up to 60 s) until the command in $1 succeeds.
+wait_until() {
+    i=0
+    while ! eval "$1"; do
+        i=$((i + 1))
+        [ $i -gt 600 ] && return 1
+        sleep 0.1
+    done
+}
+
+meta() { iinfo -v "$1" 2>/dev/null; }
+
+# A first SIGINT or SIGTERM: the pass finishes, its samples are written, exit 8.
+for sig in INT TERM; do
+    "$ptr" "$src/scenes/final.gltf" -o "$dir/stop.exr" --samples 1000000 --width 80 \
+        2>"$dir/stop.log" &
+    pid=$!
+    wait_until 'grep -q "spp" "$dir/stop.log"'
+    kill -$sig $pid
+    wait $pid
+    code=$?
+    check "first SIG$sig exits 8 (got $code)" '[ $code -eq 8 ]'
+    check "SIG$sig: the samples done are written" 'meta "$dir/stop.exr" | grep -q "ptr:interrupted: 1"'
+    samples=$(meta "$dir/stop.exr" | sed -n 's/.*ptr:samples: //p')
+    check "SIG$sig: metadata counts the samples taken ($samples)" \
+        '[ -n "$samples" ] && [ "$samples" -ge 1 ] && [ "$samples" -lt 1000000 ]'
+    rm -f "$dir/stop.exr"
+done
+
+# A second signal aborts at once: exit 130, the existing file untouched, no temporary left.
+# The first pass (one sample of a 4000x2250 image) takes seconds, so both signals land in
+# it; sent at once they would arrive as one.
+echo "an existing image" >"$dir/keep.exr"
+"$ptr" "$src/scenes/final.gltf" -o "$dir/keep.exr" --samples 1000000 --width 4000 \
+    2>"$dir/keep.log" &
+pid=$!
+wait_until 'grep -q "spp" "$dir/keep.log"'
+kill -INT $pid
+sleep 0.2
+kill -INT $pid
+wait $pid
+code=$?
+check "a second SIGINT exits 130 (got $code)" '[ $code -eq 130 ]'
+check "the existing output is untouched" '[ "$(cat "$dir/keep.exr")" = "an existing image" ]'
+check "no temporary file is left" '[ -z "$(ls -A "$dir" | grep ptr-)" ]'
+
+# --watch: renders, renders again on a save, keeps the last good image on a broken save,
+# ends cleanly (exit 0) on SIGINT while waiting.
+cp "$src/scenes/seed.gltf" "$dir/watched.gltf"
+"$ptr" "$dir/watched.gltf" -o "$dir/watched.exr" --watch --samples 1 --width 32 \
+    2>"$dir/watch.log" &
+pid=$!
+wait_until '[ -s "$dir/watched.exr" ]'
+first=$(cksum <"$dir/watched.exr")
+sed 's/"sky": "gradient"/"sky": "black"/' "$src/scenes/seed.gltf" >"$dir/watched.gltf.new"
+mv "$dir/watched.gltf.new" "$dir/watched.gltf"
+check "a save renders again" 'wait_until "[ \"\$(cksum <\"$dir/watched.exr\")\" != \"$first\" ]"'
+second=$(cksum <"$dir/watched.exr")
+echo '{ "asset": ' >"$dir/watched.gltf"
+check "a broken save is reported" 'wait_until "grep -q \"keeping the last good image\" \"$dir/watch.log\""'
+check "and the last good image kept" '[ "$(cksum <"$dir/watched.exr")" = "$second" ]'
+kill -INT $pid
+wait $pid
+code=$?
+check "SIGINT while watching exits 0 (got $code)" '[ $code -eq 0 ]'
+
+echo "$passed passed, $failed failed"
+[ $failed -eq 0 ]
