@@ -110,15 +110,20 @@ void ptr_report_json(FILE *out, const PtrJobReport *r)
 
 void ptr_report_summary(FILE *out, const PtrJobReport *reports, int count)
 {
-    int failed = 0;
-    fprintf(out, "\n%-32s %-32s %-12s %6s %9s %8s\n", "scene", "output", "result", "spp",
-            "seconds", "Mrays/s");
+    int failed = 0, scene_width = 5, output_width = 6;
+    for (int i = 0; i < count; i++) {
+        int s = (int)strlen(reports[i].scene), o = reports[i].output ? (int)strlen(reports[i].output) : 1;
+        scene_width = s > scene_width ? s : scene_width;
+        output_width = o > output_width ? o : output_width;
+    }
+    fprintf(out, "\n%-*s  %-*s  %-11s %6s %9s %8s\n", scene_width, "scene", output_width, "output",
+            "result", "spp", "seconds", "Mrays/s");
     for (int i = 0; i < count; i++) {
         const PtrJobReport *r = &reports[i];
         const char *result = r->result == PTR_OK ? "ok" : r->interrupted ? "interrupted" : "FAILED";
         failed += r->result != PTR_OK;
-        fprintf(out, "%-32s %-32s %-12s %6" PRIu32 " %9.2f %8.2f\n", r->scene,
-                r->output ? r->output : "-", result, r->samples, r->seconds,
+        fprintf(out, "%-*s  %-*s  %-11s %6" PRIu32 " %9.2f %8.2f\n", scene_width, r->scene,
+                output_width, r->output ? r->output : "-", result, r->samples, r->seconds,
                 r->seconds > 0 ? (double)r->rays / r->seconds * 1e-6 : 0.0);
     }
     fprintf(out, "%d scene%s, %d failed\n", count, count == 1 ? "" : "s", failed);
