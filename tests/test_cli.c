@@ -1,6 +1,5 @@
 /* The command line end to end, in process: what the executable runs. */
 #include <dirent.h>
-#include <stdarg.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -8,34 +7,10 @@
 #include "image/image.h"
 #include "result.h"
 #include "test.h"
+#include "test_files.h"
 
 #define SEED_SCENE PTR_SOURCE_DIR "/scenes/seed.gltf"
 #define FIXTURE(name) PTR_SOURCE_DIR "/tests/fixtures/" name
-
-static char tmpdir[64];
-
-static const char *tmp_path(const char *name)
-{
-    static char paths[8][256];
-    static int next;
-    char *p = paths[next++ % 8];
-    snprintf(p, 256, "%s/%s", tmpdir, name);
-    return p;
-}
-
-/* Runs ptr with a NULL-terminated argument list. */
-static int run(const char *first, ...)
-{
-    char *argv[32] = { "ptr", (char *)first };
-    int argc = 2;
-    va_list ap;
-    va_start(ap, first);
-    for (char *a; argc < 31 && (a = va_arg(ap, char *));)
-        argv[argc++] = a;
-    va_end(ap);
-    argv[argc] = NULL;
-    return ptr_cli_main(argc, argv);
-}
 
 static void write_file(const char *path, const char *text)
 {
@@ -58,7 +33,7 @@ static int file_is(const char *path, const char *text)
 /* Files in the temporary folder: a failed write must leave no temporary. */
 static int file_count(void)
 {
-    DIR *d = opendir(tmpdir);
+    DIR *d = opendir(test_dir);
     int n = 0;
     for (struct dirent *e; (e = readdir(d));)
         n += e->d_name[0] != '.' || (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."));
@@ -68,8 +43,8 @@ static int file_count(void)
 
 static void test_render_seed_exr(void)
 {
-    const char *out = tmp_path("seed.exr");
-    CHECK_INT(run(SEED_SCENE, "-o", out, "--samples", "8", "--width", "60", "--seed", "42",
+    const char *out = test_path("seed.exr");
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "8", "--width", "60", "--seed", "42",
                   "--quiet", "--c", NULL), 0);
     char err[256];
     PtrImage *img = ptr_image_read(out, err, sizeof err);
@@ -108,8 +83,8 @@ static void test_render_seed_exr(void)
 
 static void test_png_and_options(void)
 {
-    const char *png = tmp_path("seed.png");
-    CHECK_INT(run(SEED_SCENE, "-o", png, "--samples", "2", "--width", "40", "--height", "20",
+    const char *png = test_path("seed.png");
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "2", "--width", "40", "--height", "20",
                   "--sky", "black", "--threads", "1", "--max-depth", "5", "--quiet", NULL), 0);
     char err[256];
     PtrImage *img = ptr_image_read(png, err, sizeof err);
@@ -126,7 +101,7 @@ static void test_png_and_options(void)
     ptr_image_free(img);
 
     /* A constant sky of 0.5 seen directly encodes to sRGB 0.735 -> code 188. */
-    CHECK_INT(run(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
                   "--camera", "Camera", "--quiet", NULL), 0);
     img = ptr_image_read(png, err, sizeof err);
     CHECK_NEAR(ptr_image_pixels(img)[0] * 255.0f, 188.0, 1e-3);
@@ -135,7 +110,7 @@ static void test_png_and_options(void)
 
 static void test_bad_input(void)
 {
-    const char *out = tmp_path("keep.exr");
+    const char *out = test_path("keep.exr");
     const char *keep = "an existing output file";
     int ok_files;
     struct {
@@ -172,35 +147,31 @@ static void test_bad_input(void)
     }
 
     /* Output problems: unknown format, missing folder, a folder as output. */
-    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("x.unknown"), NULL),
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("x.unknown"), NULL),
               ptr_result_exit_code(PTR_ERR_USAGE));
-    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("no/such/dir.exr"), NULL),
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("no/such/dir.exr"), NULL),
               ptr_result_exit_code(PTR_ERR_OUTPUT));
     /* A folder as -o takes NAME.exr. */
-    mkdir(tmp_path("folder"), 0755);
-    CHECK_INT(run(SEED_SCENE, "-o", tmp_path("folder"), "--samples", "1", "--width", "8",
+    mkdir(test_path("folder"), 0755);
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("folder"), "--samples", "1", "--width", "8",
                   "--quiet", NULL), 0);
     struct stat st;
-    CHECK(stat(tmp_path("folder/seed.exr"), &st) == 0 && st.st_size > 0);
-    unlink(tmp_path("folder/seed.exr"));
-    rmdir(tmp_path("folder"));
-    CHECK_INT(run(SEED_SCENE, NULL), ptr_result_exit_code(PTR_ERR_USAGE));
-    CHECK_INT(run("--help", NULL), 0);
-    CHECK_INT(run("--version", NULL), 0);
+    CHECK(stat(test_path("folder/seed.exr"), &st) == 0 && st.st_size > 0);
+    unlink(test_path("folder/seed.exr"));
+    rmdir(test_path("folder"));
+    CHECK_INT(test_ptr(SEED_SCENE, NULL), ptr_result_exit_code(PTR_ERR_USAGE));
+    CHECK_INT(test_ptr("--help", NULL), 0);
+    CHECK_INT(test_ptr("--version", NULL), 0);
     CHECK_INT(file_count(), ok_files);
 }
 
 int main(void)
 {
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/ptr-test-cli-XXXXXX");
-    if (!mkdtemp(tmpdir))
+    if (!test_dir_create("test-cli"))
         return 1;
     test_render_seed_exr();
     test_png_and_options();
     test_bad_input();
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    if (system(cmd) != 0)
-        fprintf(stderr, "could not remove %s\n", tmpdir);
+    test_dir_remove();
     return test_report();
 }

@@ -13,21 +13,11 @@
 #include "output.h"
 #include "result.h"
 #include "test.h"
+#include "test_files.h"
 
 #define PTR_CONFIG PTR_SOURCE_DIR "/src/color/config.ocio"
 #define SECOND_CONFIG PTR_SOURCE_DIR "/tests/fixtures/ocio/second.ocio"
 #define BROKEN_CONFIG PTR_SOURCE_DIR "/tests/fixtures/ocio/broken.ocio"
-
-static char dir[64];
-
-static const char *path_in(const char *name)
-{
-    static char paths[4][128];
-    static int next;
-    char *p = paths[next++ % 4];
-    snprintf(p, 128, "%s/%s", dir, name);
-    return p;
-}
 
 /* Scene-linear test values: black, the sRGB toe, mid grey, white, over-range
  * and saturated colours. */
@@ -57,7 +47,7 @@ static PtrImage *read_image(const char *path)
 static void oracle(const char *config, const char *display, const char *view)
 {
     char err[256], cmd[1024];
-    const char *in = path_in("in.exr"), *ours = path_in("ours.png"), *theirs = path_in("theirs.png");
+    const char *in = test_path("in.exr"), *ours = test_path("ours.png"), *theirs = test_path("theirs.png");
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
     CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
 
@@ -167,16 +157,15 @@ static void test_errors(void)
     ptr_color_close(c);
 
     /* Through the command line: exit codes, and the output left alone. */
-    const char *out = path_in("keep.png");
+    const char *out = test_path("keep.png");
     FILE *f = fopen(out, "w");
     fputs("keep", f);
     fclose(f);
-    char *bad_view[] = { "ptr", PTR_SOURCE_DIR "/scenes/seed.gltf", "-o", (char *)out, "--view",
-                         "Filmic", NULL };
-    CHECK_INT(ptr_cli_main(6, bad_view), ptr_result_exit_code(PTR_ERR_USAGE));
-    char *bad_config[] = { "ptr", PTR_SOURCE_DIR "/scenes/seed.gltf", "-o", (char *)out,
-                           "--ocio-config", BROKEN_CONFIG, NULL };
-    CHECK_INT(ptr_cli_main(6, bad_config), ptr_result_exit_code(PTR_ERR_COLOR));
+    CHECK_INT(test_ptr(PTR_SOURCE_DIR "/scenes/seed.gltf", "-o", out, "--view", "Filmic", NULL),
+              ptr_result_exit_code(PTR_ERR_USAGE));
+    CHECK_INT(test_ptr(PTR_SOURCE_DIR "/scenes/seed.gltf", "-o", out, "--ocio-config", BROKEN_CONFIG,
+                       NULL),
+              ptr_result_exit_code(PTR_ERR_COLOR));
     struct stat st;
     CHECK(stat(out, &st) == 0 && st.st_size == 4);
 }
@@ -210,8 +199,8 @@ static void test_output_path(void)
     PtrOutputInfo info = info_for(c);
     PtrError perr = { 0 };
     info.depth = PTR_DEPTH_16;
-    CHECK_INT(ptr_output_write(path_in("grey16.png"), &one, grey, &info, &perr), PTR_OK);
-    PtrImage *img = read_image(path_in("grey16.png"));
+    CHECK_INT(ptr_output_write(test_path("grey16.png"), &one, grey, &info, &perr), PTR_OK);
+    PtrImage *img = read_image(test_path("grey16.png"));
     CHECK_NEAR(ptr_image_pixels(img)[0] * 65535.0, 30235.0, 1.0);
     CHECK_STR(ptr_image_attr(img, "ptr:view"), "Standard");
     CHECK_STR(ptr_image_attr(img, "oiio:ColorSpace"), "sRGB - Display");
@@ -219,38 +208,34 @@ static void test_output_path(void)
 
     /* EXR stays scene-linear; --bake-view stores the display-referred values. */
     info.depth = PTR_DEPTH_DEFAULT;
-    CHECK_INT(ptr_output_write(path_in("linear.exr"), &one, grey, &info, &perr), PTR_OK);
-    img = read_image(path_in("linear.exr"));
+    CHECK_INT(ptr_output_write(test_path("linear.exr"), &one, grey, &info, &perr), PTR_OK);
+    img = read_image(test_path("linear.exr"));
     CHECK_FLOAT_EQ(ptr_image_pixels(img)[0], 0.18f);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "lin_rec709");
     ptr_image_free(img);
     info.bake_view = 1;
-    CHECK_INT(ptr_output_write(path_in("baked.exr"), &one, grey, &info, &perr), PTR_OK);
-    img = read_image(path_in("baked.exr"));
+    CHECK_INT(ptr_output_write(test_path("baked.exr"), &one, grey, &info, &perr), PTR_OK);
+    img = read_image(test_path("baked.exr"));
     CHECK_NEAR(ptr_image_pixels(img)[0], 0.461356, 1e-5);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "sRGB - Display");
     ptr_image_free(img);
 
     /* Formats refuse depths they cannot hold. */
-    CHECK_INT(ptr_output_check(path_in("x.jpg"), PTR_DEPTH_16, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(path_in("x.exr"), PTR_DEPTH_8, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(path_in("x.tif"), PTR_DEPTH_FLOAT, &perr), PTR_OK);
+    CHECK_INT(ptr_output_check(test_path("x.jpg"), PTR_DEPTH_16, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(test_path("x.exr"), PTR_DEPTH_8, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(test_path("x.tif"), PTR_DEPTH_FLOAT, &perr), PTR_OK);
     ptr_color_close(c);
 }
 
 int main(void)
 {
-    snprintf(dir, sizeof dir, "/tmp/ptr-test-color-XXXXXX");
-    if (!mkdtemp(dir))
+    if (!test_dir_create("test-color"))
         return 1;
     test_oracle();
     test_embedded_matches_file();
     test_lookup_order();
     test_errors();
     test_output_path();
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    if (system(cmd) != 0)
-        fprintf(stderr, "could not remove %s\n", dir);
+    test_dir_remove();
     return test_report();
 }

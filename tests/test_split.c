@@ -2,7 +2,6 @@
  * budgets and previews, driven in process through the library and the command
  * line. */
 #include <fcntl.h>
-#include <stdarg.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -12,33 +11,10 @@
 #include "render.h"
 #include "result.h"
 #include "test.h"
+#include "test_files.h"
 
 #define SEED_SCENE PTR_SOURCE_DIR "/scenes/seed.gltf"
 #define FINAL_SCENE PTR_SOURCE_DIR "/scenes/final.gltf"
-
-static char dir[64];
-
-static char *in_dir(const char *name)
-{
-    static char paths[16][160];
-    static int next;
-    char *p = paths[next++ % 16];
-    snprintf(p, 160, "%s/%s", dir, name);
-    return p;
-}
-
-static int run(const char *first, ...)
-{
-    char *argv[40] = { "ptr", (char *)first };
-    int argc = 2;
-    va_list ap;
-    va_start(ap, first);
-    for (char *a; argc < 39 && (a = va_arg(ap, char *));)
-        argv[argc++] = a;
-    va_end(ap);
-    argv[argc] = NULL;
-    return ptr_cli_main(argc, argv);
-}
 
 static PtrImage *load(const char *path)
 {
@@ -86,18 +62,18 @@ static double worst_difference(const PtrImage *a, const PtrImage *b)
  * regions merged equal it exactly. */
 static void test_split_and_merge(void)
 {
-    const char *whole = in_dir("whole.exr");
-    CHECK_INT(run(FINAL_SCENE, "-o", whole, "--width", "80", "--samples", "16", "--quiet", NULL), 0);
+    const char *whole = test_path("whole.exr");
+    CHECK_INT(test_ptr(FINAL_SCENE, "-o", whole, "--width", "80", "--samples", "16", "--quiet", NULL), 0);
     const char *ranges[] = { "0:4", "4:8", "8:12", "12:16" };
     for (int i = 0; i < 4; i++) {
         char name[32];
         snprintf(name, sizeof name, "range%d.exr", i);
-        CHECK_INT(run(FINAL_SCENE, "-o", in_dir(name), "--width", "80", "--sample-range",
+        CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path(name), "--width", "80", "--sample-range",
                       ranges[i], "--quiet", NULL), 0);
     }
-    CHECK_INT(run("merge", in_dir("range2.exr"), in_dir("range0.exr"), in_dir("range3.exr"),
-                  in_dir("range1.exr"), "-o", in_dir("merged.exr"), "--quiet", NULL), 0);
-    PtrImage *a = load(whole), *b = load(in_dir("merged.exr"));
+    CHECK_INT(test_ptr("merge", test_path("range2.exr"), test_path("range0.exr"), test_path("range3.exr"),
+                  test_path("range1.exr"), "-o", test_path("merged.exr"), "--quiet", NULL), 0);
+    PtrImage *a = load(whole), *b = load(test_path("merged.exr"));
     if (a && b) {
         CHECK_INT(ptr_image_width(b), 80);
         CHECK_STR(ptr_image_attr(b, "ptr:samples"), "16");
@@ -112,19 +88,19 @@ static void test_split_and_merge(void)
     for (int i = 0; i < 4; i++) {
         char name[32];
         snprintf(name, sizeof name, "region%d.exr", i);
-        CHECK_INT(run(FINAL_SCENE, "-o", in_dir(name), "--width", "80", "--samples", "16",
+        CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path(name), "--width", "80", "--samples", "16",
                       "--region", regions[i], "--quiet", NULL), 0);
     }
-    PtrImage *crop = load(in_dir("region3.exr"));
+    PtrImage *crop = load(test_path("region3.exr"));
     if (crop) {
         PtrImageLayout l = ptr_image_layout(crop);
         CHECK(l.width == 40 && l.height == 22 && l.x == 40 && l.y == 23 && l.full_width == 80 &&
               l.full_height == 45);
     }
     ptr_image_free(crop);
-    CHECK_INT(run("merge", in_dir("region0.exr"), in_dir("region1.exr"), in_dir("region2.exr"),
-                  in_dir("region3.exr"), "-o", in_dir("tiles.exr"), "--quiet", NULL), 0);
-    b = load(in_dir("tiles.exr"));
+    CHECK_INT(test_ptr("merge", test_path("region0.exr"), test_path("region1.exr"), test_path("region2.exr"),
+                  test_path("region3.exr"), "-o", test_path("tiles.exr"), "--quiet", NULL), 0);
+    b = load(test_path("tiles.exr"));
     if (a && b)
         CHECK(!memcmp(ptr_image_pixels(a), ptr_image_pixels(b), 80 * 45 * 3 * sizeof(float)));
     ptr_image_free(a);
@@ -134,48 +110,48 @@ static void test_split_and_merge(void)
 static void test_merge_refuses(void)
 {
     const int usage = ptr_result_exit_code(PTR_ERR_USAGE);
-    CHECK_INT(run(FINAL_SCENE, "-o", in_dir("seed9.exr"), "--width", "80", "--sample-range", "0:4",
+    CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path("seed9.exr"), "--width", "80", "--sample-range", "0:4",
                   "--seed", "9", "--quiet", NULL), 0);
-    CHECK_INT(run(SEED_SCENE, "-o", in_dir("other.exr"), "--width", "80", "--height", "45",
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("other.exr"), "--width", "80", "--height", "45",
                   "--sample-range", "4:8", "--quiet", NULL), 0);
-    CHECK_INT(run(FINAL_SCENE, "-o", in_dir("small.exr"), "--width", "40", "--sample-range", "4:8",
+    CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path("small.exr"), "--width", "40", "--sample-range", "4:8",
                   "--quiet", NULL), 0);
-    CHECK_INT(run(FINAL_SCENE, "-o", in_dir("range0.png"), "--width", "80", "--sample-range", "4:8",
+    CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path("range0.png"), "--width", "80", "--sample-range", "4:8",
                   "--quiet", NULL), 0);
-    const char *out = in_dir("refused.exr");
-    CHECK_INT(run("merge", in_dir("range0.exr"), in_dir("seed9.exr"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", in_dir("range0.exr"), in_dir("other.exr"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", in_dir("range1.exr"), in_dir("small.exr"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", in_dir("range0.exr"), in_dir("range0.exr"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", in_dir("region0.exr"), in_dir("region1.exr"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", in_dir("range0.exr"), in_dir("range0.png"), "-o", out, NULL), usage);
-    CHECK_INT(run("merge", PTR_SOURCE_DIR "/README.md", "-o", out, NULL), usage);
+    const char *out = test_path("refused.exr");
+    CHECK_INT(test_ptr("merge", test_path("range0.exr"), test_path("seed9.exr"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", test_path("range0.exr"), test_path("other.exr"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", test_path("range1.exr"), test_path("small.exr"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", test_path("range0.exr"), test_path("range0.exr"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", test_path("region0.exr"), test_path("region1.exr"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", test_path("range0.exr"), test_path("range0.png"), "-o", out, NULL), usage);
+    CHECK_INT(test_ptr("merge", PTR_SOURCE_DIR "/README.md", "-o", out, NULL), usage);
     struct stat st;
     CHECK(stat(out, &st) != 0);
 }
 
 static void test_batch(void)
 {
-    mkdir(in_dir("batch"), 0755);
+    mkdir(test_path("batch"), 0755);
     /* --json writes to stdout: catch it in a file. */
     fflush(stdout);
-    int saved = dup(STDOUT_FILENO), json = open(in_dir("batch.json"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int saved = dup(STDOUT_FILENO), json = open(test_path("batch.json"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(json, STDOUT_FILENO);
-    int code = run(SEED_SCENE, PTR_SOURCE_DIR "/tests/fixtures/bad/cycle.gltf", FINAL_SCENE, "-o",
-                   in_dir("batch/{name}-preview.png"), "--preview", "--json", "--quiet", NULL);
+    int code = test_ptr(SEED_SCENE, PTR_SOURCE_DIR "/tests/fixtures/bad/cycle.gltf", FINAL_SCENE, "-o",
+                   test_path("batch/{name}-preview.png"), "--preview", "--json", "--quiet", NULL);
     fflush(stdout);
     dup2(saved, STDOUT_FILENO);
     close(saved);
     close(json);
     CHECK_INT(code, ptr_result_exit_code(PTR_ERR_BATCH));
-    PtrImage *seed = load(in_dir("batch/seed-preview.png")), *final = load(in_dir("batch/final-preview.png"));
+    PtrImage *seed = load(test_path("batch/seed-preview.png")), *final = load(test_path("batch/final-preview.png"));
     if (seed && final) {
         CHECK_INT(ptr_image_width(seed), 125); /* a quarter of 500 */
         CHECK_INT(ptr_image_width(final), 100);
     }
     ptr_image_free(seed);
     ptr_image_free(final);
-    FILE *f = fopen(in_dir("batch.json"), "r");
+    FILE *f = fopen(test_path("batch.json"), "r");
     char line[4096];
     int lines = 0, errors = 0, previews = 0;
     while (f && fgets(line, sizeof line, f)) {
@@ -190,16 +166,16 @@ static void test_batch(void)
     CHECK_INT(previews, 2);
 
     /* Two scenes, one file: refused before anything renders. */
-    CHECK_INT(run(SEED_SCENE, FINAL_SCENE, "-o", in_dir("one.exr"), "--quiet", NULL),
+    CHECK_INT(test_ptr(SEED_SCENE, FINAL_SCENE, "-o", test_path("one.exr"), "--quiet", NULL),
               ptr_result_exit_code(PTR_ERR_USAGE));
 }
 
 /* A time budget stops early and says how many samples it took. */
 static void test_time_budget(void)
 {
-    CHECK_INT(run(FINAL_SCENE, "-o", in_dir("budget.exr"), "--samples", "1000000", "--time", "0.3",
+    CHECK_INT(test_ptr(FINAL_SCENE, "-o", test_path("budget.exr"), "--samples", "1000000", "--time", "0.3",
                   "--width", "80", "--quiet", NULL), 0);
-    PtrImage *img = load(in_dir("budget.exr"));
+    PtrImage *img = load(test_path("budget.exr"));
     if (img) {
         long samples = atol(ptr_image_attr(img, "ptr:samples"));
         CHECK(samples >= 1 && samples < 1000000);
@@ -210,17 +186,13 @@ static void test_time_budget(void)
 
 int main(void)
 {
-    snprintf(dir, sizeof dir, "/tmp/ptr-test-split-XXXXXX");
-    if (!mkdtemp(dir))
+    if (!test_dir_create("test-split"))
         return 1;
     test_passes_are_exact();
     test_split_and_merge();
     test_merge_refuses();
     test_batch();
     test_time_budget();
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    if (system(cmd) != 0)
-        fprintf(stderr, "could not remove %s\n", dir);
+    test_dir_remove();
     return test_report();
 }
