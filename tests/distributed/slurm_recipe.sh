@@ -28,6 +28,7 @@ cleanup() {
     rm -rf "$work"
 }
 trap cleanup EXIT
+trap 'exit 1' INT TERM
 
 # munge: a key of our own, the daemon as the munge user with its own socket.
 mkdir -p "$work/munge" && chown munge: "$work/munge" && chmod 700 "$work/munge"
@@ -70,7 +71,7 @@ export SLURM_CONF="$work/slurm.conf"
 slurmctld -D -f "$SLURM_CONF" >"$work/slurmctld.out" 2>&1 & pids="$pids $!"
 slurmd -D -f "$SLURM_CONF" >"$work/slurmd.out" 2>&1 & pids="$pids $!"
 i=0
-until sinfo -h -o %T 2>/dev/null | grep -q idle; do
+until timeout 5 sinfo -h -o %T 2>/dev/null | grep -q idle; do
     i=$((i + 1)); [ $i -gt 60 ] && { echo "slurm did not come up" >&2; cat "$work"/*.log >&2; exit 1; }
     sleep 1
 done
@@ -90,7 +91,7 @@ export SCENE SPP PARTS OUT
 sh -eu -c "$submit"
 
 i=0
-until [ -s merged.exr ] && ! squeue -h | grep -q .; do
+until [ -s merged.exr ] && ! timeout 5 squeue -h | grep -q .; do
     i=$((i + 1)); [ $i -gt 300 ] && { echo "the jobs did not finish" >&2; squeue >&2; exit 1; }
     sleep 1
 done
