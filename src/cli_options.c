@@ -196,7 +196,6 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
                 return usage_error(option, optarg, "a whole number from 1 to 2^30");
             o->samples = (uint32_t)v;
             o->sample_first = 0;
-            o->samples_given = 1;
             break;
         case OPT_SAMPLE_RANGE: {
             unsigned long long a, b;
@@ -206,7 +205,6 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
                 return usage_error(option, optarg, "START:END with 0 <= START < END <= 2^30");
             o->sample_first = (uint32_t)a;
             o->samples = (uint32_t)(b - a);
-            o->samples_given = 1;
             break;
         }
         case OPT_REGION: {

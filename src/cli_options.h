@@ -19,7 +19,6 @@ typedef struct PtrOptions {
     const char *camera_name;
     uint32_t samples;
     uint32_t sample_first;  /* --sample-range START:END sets both */
-    int samples_given;
     uint64_t seed;
     int width, height;      /* 0: from the scene */
     PtrRegion region;       /* all zero: the whole image */

@@ -39,8 +39,9 @@ PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHi
     return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
 }
 
-PtrVec3 ptr_trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
-                       const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays)
+/* The radiance one camera ray carries back. */
+static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
+                          const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays)
 {
     const PtrSpheres *spheres = &scene->spheres;
     PtrVec3 radiance = v3_splat(0.0f);
@@ -116,7 +117,7 @@ static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
         ptr_view_ray(&job->view, x, y, sx, sy, lens_r * cosf(lens_phi),
                      lens_r * sinf(lens_phi), &o, &d);
         PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
-        PtrVec3 l = ptr_trace_path(job->scene, job->isect, ray, s, &rng, rays);
+        PtrVec3 l = trace_path(job->scene, job->isect, ray, s, &rng, rays);
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;

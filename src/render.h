@@ -5,7 +5,6 @@
 #include <stdint.h>
 
 #include "isect.h"
-#include "rng.h"
 #include "result.h"
 #include "scene.h"
 
@@ -57,10 +56,6 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
 PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err);
-
-/* The radiance one camera ray carries back: exposed for tests. */
-PtrVec3 ptr_trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
-                       const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays);
 
 /* The outward unit normal where ray met the sphere hit names. */
 PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHit *hit);
