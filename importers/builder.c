@@ -5,10 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene)
+void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrCameraSpec *override)
 {
     memset(builder, 0, sizeof *builder);
     builder->scene = scene;
+    builder->override = override;
 }
 
 void ptr_builder_free(PtrSceneBuilder *builder)
@@ -44,14 +45,34 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     return PTR_OK;
 }
 
-void ptr_builder_set_camera(PtrSceneBuilder *b, const double eye[3], const double target[3],
-                            const double up[3], const PtrCamera *lens)
+static void place_camera(PtrSceneBuilder *b, const double eye[3], const double target[3],
+                         const double up[3], const PtrCamera *lens)
 {
     memcpy(b->eye, eye, sizeof b->eye);
     memcpy(b->target, target, sizeof b->target);
     memcpy(b->up, up, sizeof b->up);
     b->lens = *lens;
     b->has_camera = 1;
+}
+
+void ptr_builder_set_camera(PtrSceneBuilder *b, const double eye[3], const double target[3],
+                            const double up[3], const PtrCamera *lens)
+{
+    if (!b->override)
+        place_camera(b, eye, target, up, lens);
+}
+
+static void use_override(PtrSceneBuilder *b)
+{
+    const PtrCameraSpec *c = b->override;
+    double d2 = 0;
+    for (int k = 0; k < 3; k++)
+        d2 += (c->lookat[k] - c->lookfrom[k]) * (c->lookat[k] - c->lookfrom[k]);
+    const PtrCamera lens = {
+        .vfov_deg = (float)c->vfov_deg, .aperture = (float)c->aperture,
+        .focus_distance = (float)(c->focus_distance > 0 ? c->focus_distance : sqrt(d2)),
+    };
+    place_camera(b, c->lookfrom, c->lookat, c->up, &lens);
 }
 
 /* Far enough back along +Z that the bounding sphere of all spheres' box fits
@@ -77,7 +98,7 @@ static void frame_spheres(PtrSceneBuilder *b)
     const double eye[3] = { centre[0], centre[1], centre[2] + distance };
     const double up[3] = { 0, 1, 0 };
     const PtrCamera lens = { .vfov_deg = (float)vfov_deg, .focus_distance = (float)distance };
-    ptr_builder_set_camera(b, eye, centre, up, &lens);
+    place_camera(b, eye, centre, up, &lens);
 }
 
 static PtrVec3 relative(const double p[3], const double origin[3])
@@ -89,7 +110,9 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, int recentre)
 {
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
-    if (!b->has_camera)
+    if (b->override)
+        use_override(b);
+    else if (!b->has_camera)
         frame_spheres(b);
     const double zero[3] = { 0, 0, 0 };
     const double *origin = recentre ? b->eye : zero;

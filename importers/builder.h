@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "importer.h"
 #include "result.h"
 #include "scene.h"
 
@@ -26,15 +27,18 @@ typedef struct PtrSceneBuilder {
     int has_camera;
     double eye[3], target[3], up[3];
     PtrCamera lens;   /* field of view, aperture, focus distance, aspect */
+    const PtrCameraSpec *override; /* the command line's camera, if any */
 } PtrSceneBuilder;
 
-void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene);
+/* override (may be NULL): a camera that replaces any the file gives. */
+void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrCameraSpec *override);
 void ptr_builder_free(PtrSceneBuilder *builder);
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
                                  double radius, uint32_t material);
 
-/* lens gives everything but the position and orientation. */
+/* lens gives everything but the position and orientation. Ignored when the
+ * builder has an override. */
 void ptr_builder_set_camera(PtrSceneBuilder *builder, const double eye[3],
                             const double target[3], const double up[3], const PtrCamera *lens);
 

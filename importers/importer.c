@@ -19,6 +19,7 @@ static const struct {
 } importers[] = {
     { ".gltf", ptr_import_gltf },
     { ".glb", ptr_import_gltf },
+    { ".obj", ptr_import_obj },
 };
 
 void ptr_warn(PtrStrings *warnings, const char *fmt, ...)
@@ -72,5 +73,5 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
         }
     }
     return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                         "%s: unknown scene format (expected .gltf or .glb)", path);
+                         "%s: unknown scene format (expected .gltf, .glb or .obj)", path);
 }

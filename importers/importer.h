@@ -15,8 +15,19 @@ typedef struct PtrStrings {
     size_t count;
 } PtrStrings;
 
+/* A camera given on the command line, in world coordinates: it replaces the
+ * scene's. */
+typedef struct PtrCameraSpec {
+    double lookfrom[3], lookat[3], up[3];
+    double vfov_deg;
+    double aperture;       /* lens diameter; 0: a pinhole */
+    double focus_distance; /* 0: the distance from lookfrom to lookat */
+} PtrCameraSpec;
+
 typedef struct PtrImportOptions {
     const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
+    const PtrCameraSpec *camera; /* if set, the camera, whatever the file says */
+    int fit_all_objects;     /* OBJ: fit every object, not only those named *sphere* */
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

@@ -4,6 +4,9 @@
 
 #include "importer.h"
 
+PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options,
+                         PtrScene *scene, PtrStrings *warnings, PtrError *err);
+
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                           PtrScene *scene, PtrStrings *warnings, PtrError *err);
 

@@ -70,7 +70,7 @@ static int dump_scenes(const PtrOptions *o)
         PtrScene scene;
         PtrStrings warnings = { 0 };
         PtrError err = { 0 };
-        PtrImportOptions import = { .camera_name = o->camera_name };
+        PtrImportOptions import = ptr_options_import(o, NULL);
         PtrResult res = ptr_import_scene(o->inputs[i], &import, &scene, &warnings, &err);
         for (size_t w = 0; w < warnings.count; w++)
             fprintf(stderr, "ptr: warning: %s\n", warnings.lines[w]);

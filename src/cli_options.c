@@ -21,7 +21,8 @@ enum {
     OPT_SKY, OPT_C, OPT_ASM, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_DEPTH, OPT_DITHER,
     OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
     OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION, OPT_JSON, OPT_TIME, OPT_PREVIEW, OPT_WATCH,
-    OPT_SAMPLE_RANGE, OPT_REGION,
+    OPT_SAMPLE_RANGE, OPT_REGION, OPT_LOOKFROM, OPT_LOOKAT, OPT_UP, OPT_VFOV, OPT_APERTURE,
+    OPT_FOCUS_DISTANCE, OPT_FIT_ALL,
 };
 
 static const struct option long_options[] = {
@@ -53,6 +54,13 @@ static const struct option long_options[] = {
     { "watch", no_argument, NULL, OPT_WATCH },
     { "sample-range", required_argument, NULL, OPT_SAMPLE_RANGE },
     { "region", required_argument, NULL, OPT_REGION },
+    { "lookfrom", required_argument, NULL, OPT_LOOKFROM },
+    { "lookat", required_argument, NULL, OPT_LOOKAT },
+    { "up", required_argument, NULL, OPT_UP },
+    { "vfov", required_argument, NULL, OPT_VFOV },
+    { "aperture", required_argument, NULL, OPT_APERTURE },
+    { "focus-distance", required_argument, NULL, OPT_FOCUS_DISTANCE },
+    { "fit-all-objects", no_argument, NULL, OPT_FIT_ALL },
     { "quiet", no_argument, NULL, OPT_QUIET },
     { "dump-scene", no_argument, NULL, OPT_DUMP_SCENE },
     { "help", no_argument, NULL, OPT_HELP },
@@ -84,6 +92,10 @@ static void print_help(FILE *out)
         "      --max-depth D     rays per path at most (default %d)\n"
         "      --sky SKY         gradient, black or R,G,B (overrides the scene's sky)\n"
         "      --camera NAME     the glTF camera (node or camera name) to render through\n"
+        "      --lookfrom X,Y,Z --lookat X,Y,Z --vfov DEG [--up X,Y,Z] [--aperture A]\n"
+        "        [--focus-distance D]  a camera in world coordinates, replacing the\n"
+        "                        scene's (default up 0,1,0; focus at the look-at point)\n"
+        "      --fit-all-objects OBJ: fit every object, not only those named *sphere*\n"
         "      --c               use the portable C intersector (the reference)\n"
         "      --asm             use the fastest assembly intersector; an error if none\n"
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
@@ -171,7 +183,7 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         return usage_error("PTR_CPUMASK", env_mask, "none, sse41, avx2 or avx512");
     *o = (PtrOptions){
         .samples = DEFAULT_SAMPLES, .seed = 1, .max_depth = DEFAULT_MAX_DEPTH,
-        .kernel = PTR_KERNEL_AUTO,
+        .kernel = PTR_KERNEL_AUTO, .camera = { .up = { 0, 1, 0 } },
     };
     if (argc > 1 && !strcmp(argv[1], "merge")) {
         o->merge = 1;
@@ -225,6 +237,37 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
             o->time_budget = t;
             break;
         }
+        case OPT_LOOKFROM:
+        case OPT_LOOKAT:
+        case OPT_UP: {
+            double *xyz = c == OPT_LOOKFROM ? o->camera.lookfrom : c == OPT_LOOKAT ? o->camera.lookat
+                                                                                : o->camera.up;
+            char tail;
+            if (sscanf(optarg, "%lf,%lf,%lf%c", &xyz[0], &xyz[1], &xyz[2], &tail) != 3 ||
+                !isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
+                return usage_error(option, optarg, "X,Y,Z (three finite numbers)");
+            o->has_camera |= c == OPT_LOOKFROM ? 1 : c == OPT_LOOKAT ? 2 : 0;
+            break;
+        }
+        case OPT_VFOV:
+        case OPT_APERTURE:
+        case OPT_FOCUS_DISTANCE: {
+            char *end;
+            errno = 0;
+            double x = strtod(optarg, &end);
+            int ok = !errno && end != optarg && !*end && isfinite(x) &&
+                     (c == OPT_VFOV ? x > 0 && x < 180 : c == OPT_APERTURE ? x >= 0 : x > 0);
+            if (!ok)
+                return usage_error(option, optarg,
+                                   c == OPT_VFOV ? "an angle between 0 and 180 degrees"
+                                   : c == OPT_APERTURE ? "a diameter, 0 or more"
+                                                       : "a distance above 0");
+            *(c == OPT_VFOV ? &o->camera.vfov_deg : c == OPT_APERTURE ? &o->camera.aperture
+                                                                      : &o->camera.focus_distance) = x;
+            o->has_camera |= c == OPT_VFOV ? 4 : 0;
+            break;
+        }
+        case OPT_FIT_ALL: o->fit_all_objects = 1; break;
         case OPT_PREVIEW: o->preview = 1; break;
         case OPT_WATCH: o->watch = 1; break;
         case OPT_JSON: o->json = 1; break;
@@ -306,7 +349,9 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         return -1;
     o->inputs = argv + optind;
     o->input_count = argc - optind;
-    const char *problem = o->input_count == 0 ? (o->merge ? "no parts given" : "no scene file given")
+    const char *problem = o->has_camera && o->has_camera != 7
+                              ? "a camera needs --lookfrom, --lookat and --vfov together"
+                          : o->input_count == 0 ? (o->merge ? "no parts given" : "no scene file given")
                           : !o->output && !o->dump_scene ? "no output given (-o)"
                           : o->watch && o->input_count > 1 ? "--watch takes one scene"
                           : o->merge && o->dump_scene ? "--dump-scene is not for merge"
@@ -314,4 +359,14 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
     if (problem)
         return usage_error_line(problem);
     return -1;
+}
+
+PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencies)
+{
+    return (PtrImportOptions){
+        .camera_name = o->camera_name,
+        .camera = o->has_camera ? &o->camera : NULL,
+        .fit_all_objects = o->fit_all_objects,
+        .dependencies = dependencies,
+    };
 }

@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "importer.h"
 #include "isect.h"
 #include "output.h"
 #include "render.h"
@@ -17,6 +18,9 @@ typedef struct PtrOptions {
     int merge;              /* `ptr merge PART... -o OUT` */
     const char *output;     /* a file, a folder, or a pattern with {name} */
     const char *camera_name;
+    PtrCameraSpec camera;   /* --lookfrom ... */
+    int has_camera;
+    int fit_all_objects;
     uint32_t samples;
     uint32_t sample_first;  /* --sample-range START:END sets both */
     uint64_t seed;
@@ -40,6 +44,9 @@ typedef struct PtrOptions {
     int dump_scene;
     int list_views;
 } PtrOptions;
+
+/* What the importers need of the options. */
+PtrImportOptions ptr_options_import(const PtrOptions *options, PtrStrings *dependencies);
 
 /* Parses argv. Returns -1 to go on, else the exit code to return at once
  * (after --help, --version, --print-dispatch, or a usage error, which it has

@@ -118,7 +118,7 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
     };
     PtrError err = { 0 };
     PtrScene scene;
-    PtrImportOptions import = { .camera_name = o->camera_name, .dependencies = dependencies };
+    PtrImportOptions import = ptr_options_import(o, dependencies);
     PtrResult res = ptr_import_scene(scene_path, &import, &scene, &report->warnings, &err);
     for (size_t i = 0; i < report->warnings.count; i++)
         fprintf(stderr, "ptr: warning: %s\n", report->warnings.lines[i]);

@@ -342,7 +342,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .camera_name = options ? options->camera_name : NULL,
         .default_material = UINT32_MAX,
     };
-    ptr_builder_init(&im.builder, scene);
+    ptr_builder_init(&im.builder, scene, options ? options->camera : NULL);
     size_t materials = gltf_doc_material_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     PtrResult res = PTR_OK;
@@ -358,7 +358,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         if (res == PTR_OK)
             res = walk_nodes(&im, &gs);
     }
-    if (res == PTR_OK && im.camera_name && !im.camera_found)
+    if (res == PTR_OK && im.camera_name && !im.camera_found && !(options && options->camera))
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: no perspective camera named '%s' in the default scene", path,
                             im.camera_name);

@@ -32,7 +32,7 @@ static PtrScene one_sphere(const PtrMaterial *material, double radius, const dou
     ptr_scene_init(&s);
     CHECK_INT(ptr_scene_add_material(&s, material, &m), PTR_OK);
     PtrSceneBuilder b;
-    ptr_builder_init(&b, &s);
+    ptr_builder_init(&b, &s, NULL);
     CHECK_INT(ptr_builder_add_sphere(&b, centre, radius, m), PTR_OK);
     double dx = target[0] - eye[0], dy = target[1] - eye[1], dz = target[2] - eye[2];
     PtrCamera lens = { .vfov_deg = vfov_deg, .focus_distance = (float)sqrt(dx * dx + dy * dy + dz * dz) };
@@ -174,7 +174,7 @@ static int resting_sphere_row(const Method *methods, int n)
         ptr_scene_add_material(&s, &ground, &g);
         ptr_scene_add_material(&s, &black, &b);
         PtrSceneBuilder builder;
-        ptr_builder_init(&builder, &s);
+        ptr_builder_init(&builder, &s, NULL);
         const double ground_centre[3] = { 0, -big, 0 }, ball[3] = { 0, 1, 0 };
         ptr_builder_add_sphere(&builder, ground_centre, big, g);
         ptr_builder_add_sphere(&builder, ball, 1.0, b);

@@ -1,0 +1,467 @@
+/* OBJ (with its MTL) to spheres, following docs/scenes.md.
+ *
+ * A reader written here, not tinyobjloader: the conventions take objects (`o`)
+ * and, only in files without any, groups (`g`), and tinyobjloader folds both
+ * into one notion of shape that keeps only the latest name. ptr needs a small
+ * part of OBJ (v, f, o, g, usemtl, mtllib and a dozen MTL keys), reads it line
+ * by line with errors that name the line, and is fuzzed (tests/fuzz/). */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "builder.h"
+#include "importer_internal.h"
+
+enum { MAX_LINE = 64 << 20 }; /* longer lines are not OBJ */
+
+typedef struct Part { /* an object (o) or a group (g) */
+    char *name;       /* NULL: faces before any o or g */
+    long line;
+    double lo[3], hi[3];
+    size_t faces;
+    char *material;   /* usemtl in force at its first face */
+} Part;
+
+typedef struct Parts {
+    Part *items;
+    size_t count, capacity;
+    long current;     /* index of the part faces go to, -1: none yet */
+    int named;        /* the file has at least one o (or g) line */
+} Parts;
+
+typedef struct Mtl {
+    char *name;
+    double kd[3], ke[3], tf[3];
+    double ni, d, tr, ns, pr, pm;
+    int illum;
+    int has_tf, has_pr, has_pm, has_d, has_tr;
+    uint32_t scene_index; /* in the scene once used, else UINT32_MAX */
+} Mtl;
+
+typedef struct Reader {
+    const char *path;
+    PtrStrings *warnings;
+    PtrError *err;
+    double *v;        /* x, y, z per vertex */
+    size_t nv, capacity;
+    Parts objects, groups;
+    char *material;   /* usemtl in force */
+    char **libs;      /* mtllib files, as paths */
+    size_t nlibs;
+    Mtl *mtls;
+    size_t nmtls;
+    int missing_lib;  /* an mtllib could not be read (and was reported) */
+} Reader;
+
+static char *copy(const char *s)
+{
+    char *c = strdup(s);
+    return c;
+}
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    char *end = s + strlen(s);
+    while (end > s && isspace((unsigned char)end[-1]))
+        *--end = '\0';
+    return s;
+}
+
+/* Reads one line into *buf; returns its length, -1 at the end, -2 on an
+ * error already set (NUL bytes, too long). */
+static long read_line(Reader *r, FILE *f, const char *path, long number, char **buf, size_t *size)
+{
+    errno = 0;
+    ssize_t n = getline(buf, size, f);
+    if (n < 0)
+        return errno ? (ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path,
+                                      strerror(errno)), -2)
+                     : -1;
+    if (n > MAX_LINE)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: a line of %zd bytes", path,
+                             number, n), -2;
+    if (memchr(*buf, '\0', (size_t)n))
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                             "%s:%ld: binary data, not text", path, number), -2;
+    return (long)n;
+}
+
+/* Parses up to max finite numbers from s; returns how many. */
+static int numbers(const char *s, double *out, int max, int *bad)
+{
+    int n = 0;
+    *bad = 0;
+    while (n < max) {
+        while (isspace((unsigned char)*s))
+            s++;
+        if (!*s)
+            break;
+        char *end;
+        double x = strtod(s, &end);
+        if (end == s) {
+            *bad = 1;
+            break;
+        }
+        if (!isfinite(x))
+            *bad = 1;
+        out[n++] = x;
+        s = end;
+    }
+    return n;
+}
+
+static PtrResult grow(void **items, size_t *capacity, size_t need, size_t size)
+{
+    if (need <= *capacity)
+        return PTR_OK;
+    size_t c = *capacity ? *capacity : 16;
+    while (c < need)
+        c *= 2;
+    void *p = realloc(*items, c * size);
+    if (!p)
+        return PTR_ERR_NOMEM;
+    *items = p;
+    *capacity = c;
+    return PTR_OK;
+}
+
+static PtrResult start_part(Reader *r, Parts *parts, const char *name, long line)
+{
+    if (grow((void **)&parts->items, &parts->capacity, parts->count + 1, sizeof(Part)))
+        return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+    Part *p = &parts->items[parts->count];
+    *p = (Part){ .name = name ? copy(name) : NULL, .line = line };
+    for (int k = 0; k < 3; k++) {
+        p->lo[k] = INFINITY;
+        p->hi[k] = -INFINITY;
+    }
+    parts->current = (long)parts->count++;
+    parts->named |= name != NULL;
+    return PTR_OK;
+}
+
+static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int first_corner)
+{
+    if (parts->current < 0 && start_part(r, parts, NULL, line) != PTR_OK)
+        return r->err->code;
+    Part *part = &parts->items[parts->current];
+    for (int k = 0; k < 3; k++) {
+        part->lo[k] = fmin(part->lo[k], p[k]);
+        part->hi[k] = fmax(part->hi[k], p[k]);
+    }
+    if (first_corner) {
+        if (!part->faces && r->material)
+            part->material = copy(r->material);
+        part->faces++;
+    }
+    return PTR_OK;
+}
+
+static PtrResult face(Reader *r, char *s, long line)
+{
+    int corners = 0;
+    char *save;
+    for (char *tok = strtok_r(s, " \t\r\n", &save); tok; tok = strtok_r(NULL, " \t\r\n", &save)) {
+        char *end;
+        errno = 0;
+        long i = strtol(tok, &end, 10);
+        if (end == tok || (*end && *end != '/') || errno)
+            return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: '%.40s' is not a vertex index",
+                                 r->path, line, tok);
+        /* 1-based, or negative: counted back from the last vertex. */
+        long index = i > 0 ? i - 1 : (long)r->nv + i;
+        if (i == 0 || index < 0 || (size_t)index >= r->nv)
+            return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                                 "%s:%ld: vertex %ld does not exist (%zu defined so far)", r->path,
+                                 line, i, r->nv);
+        const double *p = &r->v[3 * index];
+        if (add_to(r, &r->objects, p, line, corners == 0) != PTR_OK ||
+            add_to(r, &r->groups, p, line, corners == 0) != PTR_OK)
+            return r->err->code;
+        corners++;
+    }
+    if (corners == 0)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: a face with no vertices",
+                             r->path, line);
+    return PTR_OK;
+}
+
+static PtrResult obj_line(Reader *r, char *line, long number)
+{
+    char *s = trim(line);
+    if (!*s || *s == '#')
+        return PTR_OK;
+    char *rest = s;
+    while (*rest && !isspace((unsigned char)*rest))
+        rest++;
+    if (*rest)
+        *rest++ = '\0';
+    rest = trim(rest);
+
+    if (!strcmp(s, "v")) {
+        double p[3];
+        int bad;
+        if (numbers(rest, p, 3, &bad) < 3 || bad)
+            return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                                 "%s:%ld: a vertex needs three finite numbers", r->path, number);
+        if (grow((void **)&r->v, &r->capacity, 3 * (r->nv + 1), sizeof(double)))
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        memcpy(&r->v[3 * r->nv++], p, sizeof p);
+    } else if (!strcmp(s, "f")) {
+        return face(r, rest, number);
+    } else if (!strcmp(s, "o")) {
+        return start_part(r, &r->objects, rest, number);
+    } else if (!strcmp(s, "g")) {
+        return start_part(r, &r->groups, rest, number);
+    } else if (!strcmp(s, "usemtl")) {
+        free(r->material);
+        r->material = *rest ? copy(rest) : NULL;
+    } else if (!strcmp(s, "mtllib")) {
+        const char *slash = strrchr(r->path, '/');
+        int dir = slash ? (int)(slash - r->path + 1) : 0;
+        char *save;
+        for (char *name = strtok_r(rest, " \t", &save); name; name = strtok_r(NULL, " \t", &save)) {
+            char **libs = realloc(r->libs, (r->nlibs + 1) * sizeof *libs);
+            if (!libs)
+                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+            r->libs = libs;
+            size_t n = (size_t)dir + strlen(name) + 1;
+            if (!(libs[r->nlibs] = malloc(n)))
+                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+            snprintf(libs[r->nlibs++], n, "%.*s%s", name[0] == '/' ? 0 : dir, r->path, name);
+        }
+    }
+    /* Everything else (vt, vn, s, l, p, curves, ...) shapes no sphere. */
+    return PTR_OK;
+}
+
+static PtrResult mtl_line(Reader *r, const char *path, char *line, long number)
+{
+    char *s = trim(line);
+    if (!*s || *s == '#')
+        return PTR_OK;
+    char *rest = s;
+    while (*rest && !isspace((unsigned char)*rest))
+        rest++;
+    if (*rest)
+        *rest++ = '\0';
+    rest = trim(rest);
+
+    if (!strcmp(s, "newmtl")) {
+        Mtl *m = realloc(r->mtls, (r->nmtls + 1) * sizeof *m);
+        if (!m)
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", path);
+        r->mtls = m;
+        r->mtls[r->nmtls++] = (Mtl){ .name = copy(rest), .kd = { 0.8, 0.8, 0.8 }, .ni = 1.5,
+                                     .d = 1, .scene_index = UINT32_MAX };
+        return PTR_OK;
+    }
+    static const char *const keys[] = { "Kd", "Ke", "Tf", "Ni", "d", "Tr", "Ns", "Pr", "Pm", "illum" };
+    int key = -1;
+    for (int k = 0; k < (int)(sizeof keys / sizeof keys[0]); k++)
+        if (!strcmp(s, keys[k]))
+            key = k;
+    if (key < 0)
+        return PTR_OK; /* maps, Ka, Ks, ...: nothing a sphere here uses */
+    if (r->nmtls == 0)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: %s before any newmtl", path,
+                             number, s);
+    Mtl *m = &r->mtls[r->nmtls - 1];
+    double x[3];
+    int bad, n = numbers(rest, x, 3, &bad);
+    if (key == 2 && n == 0) /* Tf spectral or xyz: not modelled */
+        return PTR_OK;
+    if (n == 0 || bad)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: %s needs finite numbers", path,
+                             number, s);
+    if (key <= 2 && n < 3) /* "Kd r" means r r r */
+        x[1] = x[2] = x[0];
+    switch (key) {
+    case 0: memcpy(m->kd, x, sizeof x); break;
+    case 1: memcpy(m->ke, x, sizeof x); break;
+    case 2: memcpy(m->tf, x, sizeof x); m->has_tf = 1; break;
+    case 3: m->ni = x[0]; break;
+    case 4: m->d = x[0]; m->has_d = 1; break;
+    case 5: m->tr = x[0]; m->has_tr = 1; break;
+    case 6: m->ns = x[0]; break;
+    case 7: m->pr = x[0]; m->has_pr = 1; break;
+    case 8: m->pm = x[0]; m->has_pm = 1; break;
+    case 9: m->illum = (int)x[0]; break;
+    }
+    return PTR_OK;
+}
+
+/* Reads a whole file with line(reader, path, line, number). */
+static PtrResult read_file(Reader *r, const char *path, int required,
+                           PtrResult (*line)(Reader *, const char *, char *, long))
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        if (required)
+            return ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path, strerror(errno));
+        ptr_warn(r->warnings, "%s: material library %s cannot be read (%s); its materials are "
+                              "grey diffuse", r->path, path, strerror(errno));
+        r->missing_lib = 1;
+        return PTR_OK;
+    }
+    char *buf = NULL;
+    size_t size = 0;
+    PtrResult res = PTR_OK;
+    long n, number = 0;
+    while (res == PTR_OK && (n = read_line(r, f, path, ++number, &buf, &size)) >= 0)
+        res = line(r, path, buf, number);
+    if (res == PTR_OK && n == -2)
+        res = r->err->code;
+    free(buf);
+    fclose(f);
+    return res;
+}
+
+static PtrResult obj_line_at(Reader *r, const char *path, char *line, long number)
+{
+    (void)path;
+    return obj_line(r, line, number);
+}
+
+static int contains_sphere(const char *name)
+{
+    for (const char *s = name; *s; s++)
+        if (!strncasecmp(s, "sphere", 6))
+            return 1;
+    return 0;
+}
+
+static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint32_t *index,
+                              uint32_t *grey)
+{
+    Mtl *m = NULL;
+    for (size_t i = 0; name && i < r->nmtls; i++)
+        if (r->mtls[i].name && !strcmp(r->mtls[i].name, name))
+            m = &r->mtls[i];
+    if (m && m->scene_index != UINT32_MAX) {
+        *index = m->scene_index;
+        return PTR_OK;
+    }
+    if (!m) {
+        if (name && r->nlibs && !r->missing_lib)
+            ptr_warn(r->warnings, "%s: material '%s' is not in its material library; grey diffuse",
+                     r->path, name);
+        if (*grey == UINT32_MAX) {
+            const PtrMaterial g = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.8f), .ior = 1.5f };
+            if (ptr_scene_add_material(scene, &g, grey) != PTR_OK)
+                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        }
+        *index = *grey;
+        return PTR_OK;
+    }
+    PtrMaterial out = { .kind = PTR_MATERIAL_DIFFUSE,
+                        .albedo = v3((float)m->kd[0], (float)m->kd[1], (float)m->kd[2]),
+                        .emission = v3((float)m->ke[0], (float)m->ke[1], (float)m->ke[2]),
+                        .ior = (float)m->ni };
+    int tf = m->has_tf && (m->tf[0] != 0 || m->tf[1] != 0 || m->tf[2] != 0);
+    if (tf || m->illum == 4 || m->illum == 6 || m->illum == 7 || (m->has_d && m->d < 1) ||
+        (m->has_tr && m->tr > 0)) {
+        out.kind = PTR_MATERIAL_DIELECTRIC;
+        out.albedo = m->has_tf ? v3((float)m->tf[0], (float)m->tf[1], (float)m->tf[2]) : v3_splat(1);
+    } else if ((m->has_pm && m->pm >= 0.5) || m->illum == 3) {
+        out.kind = PTR_MATERIAL_METAL;
+        out.fuzz = (float)(m->has_pr ? m->pr : 1.0 - sqrt(fmin(fmax(m->ns, 0), 1000) / 1000));
+    }
+    if (!(out.ior > 0) || out.emission.x < 0 || out.emission.y < 0 || out.emission.z < 0)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                             "%s: material '%s' has a value out of range (Ni > 0, Ke >= 0)", r->path,
+                             m->name);
+    if (ptr_scene_add_material(scene, &out, index) != PTR_OK)
+        return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+    m->scene_index = *index;
+    return PTR_OK;
+}
+
+static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *scene)
+{
+    /* Objects; in a file without any o, groups. */
+    const Parts *parts = r->objects.named || !r->groups.named ? &r->objects : &r->groups;
+    const char *base = strrchr(r->path, '/') ? strrchr(r->path, '/') + 1 : r->path;
+    PtrSceneBuilder builder;
+    ptr_builder_init(&builder, scene, options ? options->camera : NULL);
+    uint32_t grey = UINT32_MAX;
+    size_t fitted = 0;
+    PtrResult res = PTR_OK;
+    for (size_t i = 0; res == PTR_OK && i < parts->count; i++) {
+        const Part *p = &parts->items[i];
+        const char *name = p->name ? p->name : base;
+        if (!p->faces)
+            continue;
+        if (!contains_sphere(name) && !(options && options->fit_all_objects)) {
+            ptr_warn(r->warnings, "%s:%ld: object '%s' is skipped: its name lacks 'sphere' "
+                                  "(--fit-all-objects fits every object)", r->path, p->line, name);
+            continue;
+        }
+        double centre[3], extent = 0;
+        for (int k = 0; k < 3; k++) {
+            centre[k] = 0.5 * (p->lo[k] + p->hi[k]);
+            extent = fmax(extent, p->hi[k] - p->lo[k]);
+        }
+        if (!(extent > 0) || !isfinite(extent) || !((float)(0.5 * extent) > 0)) {
+            res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                                "%s:%ld: object '%s': its vertices span no space", r->path,
+                                p->line, name);
+            break;
+        }
+        uint32_t material;
+        res = material_for(r, p->material, scene, &material, &grey);
+        if (res == PTR_OK && ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material))
+            res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        fitted++;
+    }
+    if (res == PTR_OK && fitted == 0 && r->nv == 0)
+        res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: no vertices: not an OBJ file?",
+                            r->path);
+    if (res == PTR_OK && ptr_builder_finish(&builder, 1) != PTR_OK)
+        res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                            "%s: a sphere lies too far from the camera for single precision", r->path);
+    ptr_builder_free(&builder);
+    return res;
+}
+
+static void free_parts(Parts *parts)
+{
+    for (size_t i = 0; i < parts->count; i++) {
+        free(parts->items[i].name);
+        free(parts->items[i].material);
+    }
+    free(parts->items);
+}
+
+PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options, PtrScene *scene,
+                         PtrStrings *warnings, PtrError *err)
+{
+    Reader r = { .path = path, .warnings = warnings, .err = err,
+                 .objects = { .current = -1 }, .groups = { .current = -1 } };
+    PtrResult res = read_file(&r, path, 1, obj_line_at);
+    for (size_t i = 0; res == PTR_OK && i < r.nlibs; i++) {
+        if (options && options->dependencies)
+            ptr_warn(options->dependencies, "%s", r.libs[i]);
+        res = read_file(&r, r.libs[i], 0, mtl_line);
+    }
+    if (res == PTR_OK)
+        res = build(&r, options, scene);
+    free(r.v);
+    free_parts(&r.objects);
+    free_parts(&r.groups);
+    free(r.material);
+    for (size_t i = 0; i < r.nlibs; i++)
+        free(r.libs[i]);
+    free(r.libs);
+    for (size_t i = 0; i < r.nmtls; i++)
+        free(r.mtls[i].name);
+    free(r.mtls);
+    return res;
+}
