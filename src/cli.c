@@ -72,7 +72,7 @@ static int dump_scenes(const PtrOptions *o)
         PtrError err = { 0 };
         PtrImportOptions import = ptr_options_import(o, NULL);
         PtrResult res = ptr_import_scene(o->inputs[i], &import, &scene, &warnings, &err);
-        for (size_t w = 0; w < warnings.count; w++)
+        for (size_t w = 0; res == PTR_OK && w < warnings.count; w++)
             fprintf(stderr, "ptr: warning: %s\n", warnings.lines[w]);
         if (res == PTR_OK) {
             if (o->has_sky)

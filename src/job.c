@@ -120,7 +120,8 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
     PtrScene scene;
     PtrImportOptions import = ptr_options_import(o, dependencies);
     PtrResult res = ptr_import_scene(scene_path, &import, &scene, &report->warnings, &err);
-    for (size_t i = 0; i < report->warnings.count; i++)
+    /* A file that failed gets its one line of error, nothing more. */
+    for (size_t i = 0; res == PTR_OK && i < report->warnings.count; i++)
         fprintf(stderr, "ptr: warning: %s\n", report->warnings.lines[i]);
     if (res == PTR_OK) {
         if (o->has_sky)

@@ -64,6 +64,38 @@ std::string check_indices(const tinygltf::Model &m)
                        std::to_string(pos->second) + ", which does not exist";
         }
     }
+    // Accessors, views and buffers must lie inside one another, even where ptr
+    // reads only the bounds: a file that lies about them is broken.
+    for (size_t i = 0; i < m.bufferViews.size(); i++) {
+        const tinygltf::BufferView &v = m.bufferViews[i];
+        if (!in_range(v.buffer, m.buffers.size()))
+            return "buffer view " + std::to_string(i) + " refers to buffer " +
+                   std::to_string(v.buffer) + ", which does not exist";
+        const size_t size = m.buffers[size_t(v.buffer)].data.size();
+        if (v.byteOffset > size || v.byteLength > size - v.byteOffset)
+            return "buffer view " + std::to_string(i) + " lies past the end of buffer " +
+                   std::to_string(v.buffer) + " (" + std::to_string(size) + " bytes)";
+    }
+    for (size_t i = 0; i < m.accessors.size(); i++) {
+        const tinygltf::Accessor &a = m.accessors[i];
+        if (a.bufferView == -1)
+            continue;
+        if (!in_range(a.bufferView, m.bufferViews.size()))
+            return "accessor " + std::to_string(i) + " refers to buffer view " +
+                   std::to_string(a.bufferView) + ", which does not exist";
+        const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+        const int stride = a.ByteStride(v);
+        const int element = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) *
+                            tinygltf::GetNumComponentsInType(uint32_t(a.type));
+        if (stride <= 0 || element <= 0)
+            return "accessor " + std::to_string(i) + " has an unknown type or stride";
+        // Last element's end, in 64 bits so that no count can wrap it.
+        const unsigned long long end = a.count == 0 ? a.byteOffset
+            : a.byteOffset + (unsigned long long)(a.count - 1) * unsigned(stride) + unsigned(element);
+        if (end > v.byteLength)
+            return "accessor " + std::to_string(i) + " reads past the end of buffer view " +
+                   std::to_string(a.bufferView);
+    }
     for (size_t s = 0; s < m.scenes.size(); s++)
         for (int root : m.scenes[s].nodes)
             if (!in_range(root, nodes))

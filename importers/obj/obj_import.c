@@ -84,12 +84,14 @@ static long read_line(Reader *r, FILE *f, const char *path, long number, char **
         return errno ? (ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path,
                                       strerror(errno)), -2)
                      : -1;
+    /* An error in a material library names the scene file too. */
+    const char *scene = path == r->path ? "" : r->path, *colon = path == r->path ? "" : ": ";
     if (n > MAX_LINE)
-        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: a line of %zd bytes", path,
-                             number, n), -2;
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s%s%s:%ld: a line of %zd bytes", scene,
+                             colon, path, number, n), -2;
     if (memchr(*buf, '\0', (size_t)n))
-        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
-                             "%s:%ld: binary data, not text", path, number), -2;
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s%s%s:%ld: binary data, not text",
+                             scene, colon, path, number), -2;
     return (long)n;
 }
 
@@ -257,7 +259,7 @@ static PtrResult mtl_line(Reader *r, const char *path, char *line, long number)
     if (!strcmp(s, "newmtl")) {
         Mtl *m = realloc(r->mtls, (r->nmtls + 1) * sizeof *m);
         if (!m)
-            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", path);
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         r->mtls = m;
         r->mtls[r->nmtls++] = (Mtl){ .name = copy(rest), .kd = { 0.8, 0.8, 0.8 }, .ni = 1.5,
                                      .d = 1, .scene_index = UINT32_MAX };
@@ -271,16 +273,16 @@ static PtrResult mtl_line(Reader *r, const char *path, char *line, long number)
     if (key < 0)
         return PTR_OK; /* maps, Ka, Ks, ...: nothing a sphere here uses */
     if (r->nmtls == 0)
-        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: %s before any newmtl", path,
-                             number, s);
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: %s:%ld: %s before any newmtl",
+                             r->path, path, number, s);
     Mtl *m = &r->mtls[r->nmtls - 1];
     double x[3];
     int bad, n = numbers(rest, x, 3, &bad);
     if (key == 2 && n == 0) /* Tf spectral or xyz: not modelled */
         return PTR_OK;
     if (n == 0 || bad)
-        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: %s needs finite numbers", path,
-                             number, s);
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: %s:%ld: %s needs finite numbers",
+                             r->path, path, number, s);
     if (key <= 2 && n < 3) /* "Kd r" means r r r */
         x[1] = x[2] = x[0];
     switch (key) {
