@@ -2,7 +2,7 @@
 # Installs the dependencies, then builds and runs the whole test suite three
 # times: a Release build; the same build with the assembly intersectors
 # disabled through PTR_CPUMASK=none; and a build under AddressSanitizer and
-# UndefinedBehaviorSanitizer. On x86-64 the assembly is required: a build
+# UndefinedBehaviorSanitizer. Then fuzzes both importers for a minute each. On x86-64 the assembly is required: a build
 # that silently fell back to C only would test less than it claims.
 set -eu
 cd "$(dirname "$0")/.."
@@ -23,3 +23,6 @@ PTR_CPUMASK=none ctest --test-dir build --output-on-failure -j "$jobs"
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DPTR_SANITIZE=ON -DPTR_REQUIRE_ASM=$require_asm
 cmake --build build-sanitize -j "$jobs"
 ctest --test-dir build-sanitize --output-on-failure -j "$jobs"
+
+echo "== fuzzing the importers, a minute each"
+scripts/fuzz.sh 60

@@ -1,0 +1,34 @@
+#!/bin/sh
+# Fuzzes the glTF and OBJ importers with libFuzzer under AddressSanitizer and
+# UndefinedBehaviorSanitizer, each for SECONDS (default 60), starting from the
+# test fixtures and the hostile corpus. A crash leaves crash-* files in
+# build-fuzz/ and fails; add such a file to tests/fixtures/hostile/ (and fix
+# the importer) so that the ordinary suite keeps it fixed.
+# Usage: scripts/fuzz.sh [SECONDS]
+set -eu
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+if ! command -v clang >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+    run() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
+    run apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends \
+        clang libclang-rt-14-dev >/dev/null
+fi
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPTR_FUZZ=ON \
+    -DPTR_BUILD_TESTS=OFF >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target fuzz_gltf fuzz_obj >/dev/null
+
+for format in gltf obj; do
+    corpus=build-fuzz/corpus-$format
+    mkdir -p "$corpus"
+    case $format in
+    gltf) find tests/fixtures scenes -name '*.gltf' -o -name '*.glb' | xargs -I{} cp {} "$corpus"/ ;;
+    obj) find tests/fixtures -name '*.obj' -size -200k -o -name '*.mtl' | xargs -I{} cp {} "$corpus"/ ;;
+    esac
+    echo "== fuzz_$format, $seconds s"
+    (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 tests/fuzz/fuzz_$format -max_total_time="$seconds" \
+        -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 "corpus-$format" \
+        2>"fuzz_$format.log") || { tail -40 "build-fuzz/fuzz_$format.log"; exit 1; }
+    grep -E "^Done|stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb" \
+        "build-fuzz/fuzz_$format.log"
+done

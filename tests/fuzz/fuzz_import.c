@@ -1,0 +1,62 @@
+/* libFuzzer harness for the importers: each input becomes a scene file, which
+ * ptr_import_scene must accept or refuse cleanly, never crash on, within
+ * bounded time and memory. FUZZ_FORMAT picks the importer: 1 for glTF (a .glb
+ * when the input starts with the binary magic, else a .gltf), 2 for OBJ (the
+ * input is also its own fuzz.mtl, so that `mtllib fuzz.mtl` lines reach the
+ * MTL reader). */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "importer.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+static char dir[64];
+
+static void write_file(const char *path, const uint8_t *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        abort();
+    if (size && fwrite(data, 1, size, f) != size)
+        abort();
+    fclose(f);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    if (!dir[0]) {
+        snprintf(dir, sizeof dir, "/tmp/ptr-fuzz-%d", (int)getpid());
+        char cmd[96];
+        snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
+        if (system(cmd) != 0)
+            abort();
+    }
+    char path[96];
+#if FUZZ_FORMAT == 1
+    int binary = size >= 4 && !memcmp(data, "glTF", 4);
+    snprintf(path, sizeof path, "%s/fuzz.%s", dir, binary ? "glb" : "gltf");
+#else
+    snprintf(path, sizeof path, "%s/fuzz.mtl", dir);
+    write_file(path, data, size);
+    snprintf(path, sizeof path, "%s/fuzz.obj", dir);
+#endif
+    write_file(path, data, size);
+
+    PtrScene scene;
+    PtrStrings warnings = { 0 }, dependencies = { 0 };
+    PtrError err = { 0 };
+    PtrImportOptions options = { .dependencies = &dependencies, .fit_all_objects = size & 1 };
+    PtrResult r = ptr_import_scene(path, &options, &scene, &warnings, &err);
+    /* A refusal is one line that names the file. */
+    if (r != PTR_OK && (strchr(err.message, '\n') || strncmp(err.message, path, strlen(dir))))
+        abort();
+    ptr_strings_free(&warnings);
+    ptr_strings_free(&dependencies);
+    ptr_scene_free(&scene);
+    return 0;
+}
