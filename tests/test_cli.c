@@ -129,6 +129,9 @@ static void test_bad_input(void)
         { PTR_ERR_USAGE, { SEED_SCENE, "--seed", "18446744073709551616" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--no-such-option" } },
         { PTR_ERR_SCENE_INVALID, { SEED_SCENE, "--camera", "NoSuchCamera" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5" } }, /* needs --lookat, --vfov */
+        { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0", "--lookat", "0,0,0", "--vfov", "40" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--vfov", "180" } },
     };
     write_file(out, keep);
     ok_files = file_count();
