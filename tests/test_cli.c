@@ -136,7 +136,7 @@ static void test_bad_input(void)
     write_file(out, keep);
     ok_files = file_count();
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        char *argv[12] = { "ptr", "-o", (char *)out, "--samples", "1", "--quiet" };
+        char *argv[16] = { "ptr", "-o", (char *)out, "--samples", "1", "--quiet" };
         int argc = 6;
         for (int k = 0; cases[i].args[k]; k++)
             argv[argc++] = (char *)cases[i].args[k];
