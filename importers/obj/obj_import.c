@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "builder.h"
 #include "importer_internal.h"
@@ -80,12 +81,12 @@ static long read_line(Reader *r, FILE *f, const char *path, long number, char **
 {
     errno = 0;
     ssize_t n = getline(buf, size, f);
-    if (n < 0)
-        return errno ? (ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path,
-                                      strerror(errno)), -2)
-                     : -1;
     /* An error in a material library names the scene file too. */
     const char *scene = path == r->path ? "" : r->path, *colon = path == r->path ? "" : ": ";
+    if (n < 0)
+        return errno ? (ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s%s%s: %s", scene, colon,
+                                      path, strerror(errno)), -2)
+                     : -1;
     if (n > MAX_LINE)
         return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s%s%s:%ld: a line of %zd bytes", scene,
                              colon, path, number, n), -2;
@@ -304,12 +305,17 @@ static PtrResult mtl_line(Reader *r, const char *path, char *line, long number)
 static PtrResult read_file(Reader *r, const char *path, int required,
                            PtrResult (*line)(Reader *, const char *, char *, long))
 {
-    FILE *f = fopen(path, "rb");
+    /* A material library that is not a readable file (missing, a folder, ...)
+     * costs its materials, not the scene. */
+    struct stat st;
+    int found = stat(path, &st) == 0, regular = found && S_ISREG(st.st_mode);
+    FILE *f = regular || required ? fopen(path, "rb") : NULL;
     if (!f) {
+        const char *why = found && !regular ? "not a file" : strerror(errno);
         if (required)
             return ptr_error_set(r->err, PTR_ERR_SCENE_UNREADABLE, "%s: %s", path, strerror(errno));
         ptr_warn(r->warnings, "%s: material library %s cannot be read (%s); its materials are "
-                              "grey diffuse", r->path, path, strerror(errno));
+                              "grey diffuse", r->path, path, why);
         r->missing_lib = 1;
         return PTR_OK;
     }
