@@ -4,6 +4,7 @@
 # test fixtures and the hostile corpus. A crash leaves crash-* files in
 # build-fuzz/ and fails; add such a file to tests/fixtures/hostile/ (and fix
 # the importer) so that the ordinary suite keeps it fixed.
+# The seed is fixed (FUZZ_SEED, default 1) so that a run can be repeated.
 # Usage: scripts/fuzz.sh [SECONDS]
 set -eu
 cd "$(dirname "$0")/.."
@@ -27,7 +28,8 @@ for format in gltf obj; do
     esac
     echo "== fuzz_$format, $seconds s"
     (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 tests/fuzz/fuzz_$format -max_total_time="$seconds" \
-        -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 "corpus-$format" \
+        -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+        "corpus-$format" \
         2>"fuzz_$format.log") || { tail -40 "build-fuzz/fuzz_$format.log"; exit 1; }
     grep -E "^Done|stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb" \
         "build-fuzz/fuzz_$format.log"
