@@ -196,17 +196,29 @@ static PtrResult face(Reader *r, char *s, long line)
     return PTR_OK;
 }
 
-static PtrResult obj_line(Reader *r, char *line, long number)
+/* Splits a line into its keyword and the rest, both trimmed; returns 0 for a
+ * blank line or a comment. */
+static int split_keyword(char *line, char **keyword, char **rest)
 {
     char *s = trim(line);
     if (!*s || *s == '#')
+        return 0;
+    char *r = s;
+    while (*r && !isspace((unsigned char)*r))
+        r++;
+    if (*r)
+        *r++ = '\0';
+    *keyword = s;
+    *rest = trim(r);
+    return 1;
+}
+
+static PtrResult obj_line(Reader *r, const char *path, char *line, long number)
+{
+    (void)path; /* the scene file: r->path */
+    char *s, *rest;
+    if (!split_keyword(line, &s, &rest))
         return PTR_OK;
-    char *rest = s;
-    while (*rest && !isspace((unsigned char)*rest))
-        rest++;
-    if (*rest)
-        *rest++ = '\0';
-    rest = trim(rest);
 
     if (!strcmp(s, "v")) {
         double p[3];
@@ -247,15 +259,9 @@ static PtrResult obj_line(Reader *r, char *line, long number)
 
 static PtrResult mtl_line(Reader *r, const char *path, char *line, long number)
 {
-    char *s = trim(line);
-    if (!*s || *s == '#')
+    char *s, *rest;
+    if (!split_keyword(line, &s, &rest))
         return PTR_OK;
-    char *rest = s;
-    while (*rest && !isspace((unsigned char)*rest))
-        rest++;
-    if (*rest)
-        *rest++ = '\0';
-    rest = trim(rest);
 
     if (!strcmp(s, "newmtl")) {
         Mtl *m = realloc(r->mtls, (r->nmtls + 1) * sizeof *m);
@@ -330,12 +336,6 @@ static PtrResult read_file(Reader *r, const char *path, int required,
     free(buf);
     fclose(f);
     return res;
-}
-
-static PtrResult obj_line_at(Reader *r, const char *path, char *line, long number)
-{
-    (void)path;
-    return obj_line(r, line, number);
 }
 
 static int contains_sphere(const char *name)
@@ -453,7 +453,7 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options, PtrS
 {
     Reader r = { .path = path, .warnings = warnings, .err = err,
                  .objects = { .current = -1 }, .groups = { .current = -1 } };
-    PtrResult res = read_file(&r, path, 1, obj_line_at);
+    PtrResult res = read_file(&r, path, 1, obj_line);
     for (size_t i = 0; res == PTR_OK && i < r.nlibs; i++) {
         if (options && options->dependencies)
             ptr_warn(options->dependencies, "%s", r.libs[i]);
