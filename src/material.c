@@ -2,7 +2,8 @@
 
 #include <math.h>
 
-PtrVec3 ptr_random_unit_vector(PtrRng *rng)
+/* A uniformly distributed unit vector. */
+static PtrVec3 random_unit_vector(PtrRng *rng)
 {
     /* Archimedes: z is uniform on [-1, 1] for a uniform point on the sphere.
      * No rejection loop, so every sample uses the same count of numbers. */
@@ -14,7 +15,7 @@ PtrVec3 ptr_random_unit_vector(PtrRng *rng)
 
 static PtrVec3 random_in_unit_ball(PtrRng *rng)
 {
-    PtrVec3 dir = ptr_random_unit_vector(rng);
+    PtrVec3 dir = random_unit_vector(rng);
     return v3_scale(dir, cbrtf(ptr_rng_float(rng)));
 }
 
@@ -28,7 +29,7 @@ float ptr_schlick(float cosine, float eta_ratio)
 
 static PtrVec3 scatter_diffuse(PtrVec3 n, PtrRng *rng)
 {
-    PtrVec3 dir = v3_add(n, ptr_random_unit_vector(rng));
+    PtrVec3 dir = v3_add(n, random_unit_vector(rng));
     /* The sample can cancel the normal; fall back to it then. */
     if (v3_max_abs(dir) < 1e-6f)
         return n;

@@ -25,7 +25,4 @@ static inline PtrVec3 ptr_reflect(PtrVec3 d, PtrVec3 n)
     return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n)));
 }
 
-/* A uniformly distributed unit vector. */
-PtrVec3 ptr_random_unit_vector(PtrRng *rng);
-
 #endif /* PTR_MATERIAL_H */

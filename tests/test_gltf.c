@@ -2,20 +2,10 @@
  * worked out by hand from docs/scenes.md. */
 #include "importer.h"
 #include "test.h"
+#include "test_scene.h"
 
 #define FIXTURE(name) PTR_SOURCE_DIR "/tests/fixtures/" name
 
-static void check_sphere(const PtrScene *s, size_t i, float x, float y, float z, float r)
-{
-    CHECK(i < s->spheres.count);
-    if (i >= s->spheres.count)
-        return;
-    /* World coordinates: the scene's origin plus the stored offset. */
-    CHECK_NEAR(s->origin[0] + s->spheres.cx[i], x, 1e-5);
-    CHECK_NEAR(s->origin[1] + s->spheres.cy[i], y, 1e-5);
-    CHECK_NEAR(s->origin[2] + s->spheres.cz[i], z, 1e-5);
-    CHECK_NEAR(s->spheres.radius[i], r, 1e-6);
-}
 
 static const PtrMaterial *material_of(const PtrScene *s, size_t sphere)
 {
@@ -38,13 +28,13 @@ static void test_hierarchy(void)
     CHECK_INT(ptr_import_scene(FIXTURE("hierarchy.gltf"), NULL, &s, &w, &err), PTR_OK);
 
     CHECK_INT(s.spheres.count, 7);
-    check_sphere(&s, 0, 12, 0, 0, 2);     /* parent TRS composed with the child's */
-    check_sphere(&s, 1, 12, 4, -2, 4);    /* rotated off-centre bounds */
-    check_sphere(&s, 2, 0, 5, 0, 0.5f);   /* matrix */
-    check_sphere(&s, 3, 0, 0, -3, 0.25f); /* extras.radius overrides the scale */
-    check_sphere(&s, 4, 0, 0, 0, 2);      /* non-uniform: the largest axis */
-    check_sphere(&s, 5, 0, -100, 0, 1);
-    check_sphere(&s, 6, 3, 3, 3, 1);
+    check_sphere(&s, 0, 12, 0, 0, 2, 1e-5);     /* parent TRS composed with the child's */
+    check_sphere(&s, 1, 12, 4, -2, 4, 1e-5);    /* rotated off-centre bounds */
+    check_sphere(&s, 2, 0, 5, 0, 0.5f, 1e-5);   /* matrix */
+    check_sphere(&s, 3, 0, 0, -3, 0.25f, 1e-5); /* extras.radius overrides the scale */
+    check_sphere(&s, 4, 0, 0, 0, 2, 1e-5);      /* non-uniform: the largest axis */
+    check_sphere(&s, 5, 0, -100, 0, 1, 1e-5);
+    check_sphere(&s, 6, 3, 3, 3, 1, 1e-5);
 
     CHECK_INT(s.material_count, 5); /* Red is shared by spheres 0, 3 and 4 */
     CHECK_INT(s.spheres.material[0], s.spheres.material[3]);

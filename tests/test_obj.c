@@ -3,19 +3,10 @@
  * warnings, errors with line numbers, and a camera from the command line. */
 #include "importer.h"
 #include "test.h"
+#include "test_scene.h"
 
 #define OBJ(name) PTR_SOURCE_DIR "/tests/fixtures/obj/" name
 
-static void check_sphere(const PtrScene *s, size_t i, double x, double y, double z, double r)
-{
-    CHECK(i < s->spheres.count);
-    if (i >= s->spheres.count)
-        return;
-    CHECK_NEAR(s->origin[0] + s->spheres.cx[i], x, 1e-4);
-    CHECK_NEAR(s->origin[1] + s->spheres.cy[i], y, 1e-4);
-    CHECK_NEAR(s->origin[2] + s->spheres.cz[i], z, 1e-4);
-    CHECK_NEAR(s->spheres.radius[i], r, 1e-6);
-}
 
 static const PtrMaterial *material(const PtrScene *s, size_t sphere)
 {
@@ -29,10 +20,10 @@ static void test_materials(void)
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(OBJ("spheres.obj"), NULL, &s, &w, &err), PTR_OK);
     CHECK_INT(s.spheres.count, 6); /* the Cube is skipped */
-    check_sphere(&s, 0, 0, -100, 0, 99);
-    check_sphere(&s, 1, 0, 1, 0, 1);
-    check_sphere(&s, 3, -3, 1, 0, 0.5);
-    check_sphere(&s, 4, 0, 3, 0, 0.25); /* "Ball.SPHERE.001": any case */
+    check_sphere(&s, 0, 0, -100, 0, 99, 1e-4);
+    check_sphere(&s, 1, 0, 1, 0, 1, 1e-4);
+    check_sphere(&s, 3, -3, 1, 0, 0.5, 1e-4);
+    check_sphere(&s, 4, 0, 3, 0, 0.25, 1e-4); /* "Ball.SPHERE.001": any case */
 
     const PtrMaterial *none = material(&s, 0), *red = material(&s, 1), *glass = material(&s, 2),
                       *brushed = material(&s, 3), *chrome = material(&s, 4), *lamp = material(&s, 5);
@@ -63,7 +54,7 @@ static void test_materials(void)
     PtrImportOptions all = { .fit_all_objects = 1 };
     CHECK_INT(ptr_import_scene(OBJ("spheres.obj"), &all, &s, &w, &err), PTR_OK);
     CHECK_INT(s.spheres.count, 7);
-    check_sphere(&s, 6, 5, 5, 5, 1);
+    check_sphere(&s, 6, 5, 5, 5, 1, 1e-4);
     CHECK_INT(w.count, 0);
     ptr_strings_free(&w);
     ptr_scene_free(&s);
@@ -77,8 +68,8 @@ static void test_groups_and_missing_mtl(void)
     /* No o lines: the groups are the objects; relative indices work. */
     CHECK_INT(ptr_import_scene(OBJ("groups.obj"), NULL, &s, &w, &err), PTR_OK);
     CHECK_INT(s.spheres.count, 2);
-    check_sphere(&s, 0, 1, 2, 3, 0.5);
-    check_sphere(&s, 1, -1, 0, 0, 2);
+    check_sphere(&s, 0, 1, 2, 3, 0.5, 1e-4);
+    check_sphere(&s, 1, -1, 0, 0, 2, 1e-4);
     ptr_scene_free(&s);
 
     PtrImportOptions options = { .dependencies = &deps };

@@ -200,9 +200,7 @@ extern "C" void gltf_doc_free(GltfDoc *doc) { delete doc; }
 extern "C" size_t gltf_doc_file_count(const GltfDoc *d) { return d->files.size(); }
 extern "C" const char *gltf_doc_file(const GltfDoc *d, size_t i) { return d->files[i].c_str(); }
 extern "C" size_t gltf_doc_node_count(const GltfDoc *d) { return d->model.nodes.size(); }
-extern "C" size_t gltf_doc_mesh_count(const GltfDoc *d) { return d->model.meshes.size(); }
 extern "C" size_t gltf_doc_material_count(const GltfDoc *d) { return d->model.materials.size(); }
-extern "C" size_t gltf_doc_camera_count(const GltfDoc *d) { return d->model.cameras.size(); }
 
 extern "C" void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *out)
 {

@@ -77,9 +77,7 @@ size_t gltf_doc_file_count(const GltfDoc *doc);
 const char *gltf_doc_file(const GltfDoc *doc, size_t index);
 
 size_t gltf_doc_node_count(const GltfDoc *doc);
-size_t gltf_doc_mesh_count(const GltfDoc *doc);
 size_t gltf_doc_material_count(const GltfDoc *doc);
-size_t gltf_doc_camera_count(const GltfDoc *doc);
 
 /* Index arguments must be below the matching count; every index the
  * structures hold has been checked to be in range when the file loaded. */
