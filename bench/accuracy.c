@@ -13,9 +13,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "cpu.h"
+#include "accel/cpu.h"
 #include "importer.h"
-#include "render.h"
+#include "core/render.h"
 
 typedef struct Bench {
     const char *name, *path;

@@ -16,8 +16,8 @@
 #include <stdint.h>
 
 #include "importer.h"
-#include "result.h"
-#include "scene.h"
+#include "core/result.h"
+#include "core/scene.h"
 
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */

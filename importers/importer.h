@@ -6,8 +6,8 @@
 
 #include <stddef.h>
 
-#include "result.h"
-#include "scene.h"
+#include "core/result.h"
+#include "core/scene.h"
 
 /* A list of lines of text (warnings, file names). */
 typedef struct PtrStrings {

@@ -3,9 +3,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cli.h"
+#include "app/cli.h"
 #include "image/image.h"
-#include "result.h"
+#include "core/result.h"
 #include "test.h"
 #include "test_files.h"
 

@@ -7,11 +7,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cli.h"
+#include "app/cli.h"
 #include "color/color.h"
 #include "image/image.h"
-#include "output.h"
-#include "result.h"
+#include "app/output.h"
+#include "core/result.h"
 #include "test.h"
 #include "test_files.h"
 

@@ -12,7 +12,7 @@
 #include <stdint.h>
 
 #include "importer.h"
-#include "render.h"
+#include "core/render.h"
 #include "test.h"
 
 enum { SIZE = 32, BLOCK = 8, GROUP = 16 };

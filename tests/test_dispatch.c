@@ -4,11 +4,11 @@
 #include <stdarg.h>
 #include <unistd.h>
 
-#include "cli.h"
-#include "cpu.h"
+#include "app/cli.h"
+#include "accel/cpu.h"
 #include "image/image.h"
 #include "importer.h"
-#include "render.h"
+#include "core/render.h"
 #include "test.h"
 
 static float *render_with(const PtrScene *scene, const PtrIsectTable *isect,

@@ -1,9 +1,9 @@
 /* The C reference intersector against rays whose answers are known. */
 #include <stdint.h>
 
-#include "isect.h"
-#include "rng.h"
-#include "scene.h"
+#include "accel/isect.h"
+#include "sampling/rng.h"
+#include "core/scene.h"
 #include "test.h"
 
 static PtrRay make_ray(PtrVec3 o, PtrVec3 d)

@@ -1,5 +1,5 @@
 /* Scattering: energy, reflection laws, Fresnel and total internal reflection. */
-#include "material.h"
+#include "core/material.h"
 #include "test.h"
 
 static void test_schlick(void)

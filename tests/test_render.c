@@ -2,7 +2,7 @@
 #include <stdint.h>
 
 #include "importer.h"
-#include "render.h"
+#include "core/render.h"
 #include "test.h"
 
 typedef struct Image {

@@ -5,11 +5,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cli.h"
+#include "app/cli.h"
 #include "image/image.h"
 #include "importer.h"
-#include "render.h"
-#include "result.h"
+#include "core/render.h"
+#include "core/result.h"
 #include "test.h"
 #include "test_files.h"
 

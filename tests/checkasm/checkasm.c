@@ -12,10 +12,10 @@
 #include <string.h>
 #include <time.h>
 
-#include "cpu.h"
-#include "isect.h"
-#include "rng.h"
-#include "scene.h"
+#include "accel/cpu.h"
+#include "accel/isect.h"
+#include "sampling/rng.h"
+#include "core/scene.h"
 
 typedef struct CheckedCallStatus {
     uint32_t check_xinuse;

@@ -1,6 +1,6 @@
 #include "methods.h"
 
-#include "cpu.h"
+#include "accel/cpu.h"
 #include <stdio.h>
 
 #include "naive.h"

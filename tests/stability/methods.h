@@ -3,7 +3,7 @@
 #ifndef PTR_TEST_METHODS_H
 #define PTR_TEST_METHODS_H
 
-#include "isect.h"
+#include "accel/isect.h"
 
 typedef struct Method {
     const char *name;

@@ -3,7 +3,7 @@
 #ifndef PTR_TEST_NAIVE_H
 #define PTR_TEST_NAIVE_H
 
-#include "isect.h"
+#include "accel/isect.h"
 
 /* The quadratic's discriminant as b*b - c and the roots -b -/+ sqrt(disc),
  * all in float: both differences cancel catastrophically, for small spheres

@@ -18,7 +18,7 @@
  * somewhere, or the suite could not tell them apart. */
 #include "builder.h"
 #include "methods.h"
-#include "render.h"
+#include "core/render.h"
 #include "test.h"
 
 enum { SIZE = 16 };

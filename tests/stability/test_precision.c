@@ -11,8 +11,8 @@
 
 #include "methods.h"
 #include "naive.h"
-#include "render.h"
-#include "rng.h"
+#include "core/render.h"
+#include "sampling/rng.h"
 #include "test.h"
 
 static float uniform(PtrRng *rng, float lo, float hi)

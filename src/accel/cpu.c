@@ -1,0 +1,80 @@
+#include "accel/cpu.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__x86_64__) || defined(_M_X64)
+#include <cpuid.h>
+
+static int xgetbv_low(void)
+{
+    unsigned int eax, edx;
+    __asm__ volatile("xgetbv" : "=a"(eax), "=d"(edx) : "c"(0));
+    return (int)eax;
+}
+
+static PtrCpuLevel detect(void)
+{
+    unsigned int a, b, c, d;
+    if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & bit_SSE4_1))
+        return PTR_CPU_NONE;
+    /* OSXSAVE and AVX, then XCR0: SSE (bit 1) and AVX (bit 2) state saved. */
+    if (!(c & bit_OSXSAVE) || !(c & bit_AVX) || (xgetbv_low() & 0x6) != 0x6)
+        return PTR_CPU_SSE41;
+    if (__get_cpuid_max(0, NULL) < 7)
+        return PTR_CPU_SSE41;
+    __cpuid_count(7, 0, a, b, c, d);
+    if (!(b & bit_AVX2))
+        return PTR_CPU_SSE41;
+    /* AVX-512 F, and XCR0 opmask (5), ZMM0-15 upper (6), ZMM16-31 (7) saved. */
+    if (!(b & bit_AVX512F) || (xgetbv_low() & 0xe6) != 0xe6)
+        return PTR_CPU_AVX2;
+    return PTR_CPU_AVX512;
+}
+#else
+static PtrCpuLevel detect(void)
+{
+    return PTR_CPU_NONE;
+}
+#endif
+
+static const char *const level_names[PTR_CPU_LEVEL_COUNT] = {
+    "none", "sse41", "avx2", "avx512",
+};
+
+static PtrCpuLevel user_cap = PTR_CPU_LEVEL_COUNT - 1;
+
+PtrCpuLevel ptr_cpu_detected(void)
+{
+    return detect();
+}
+
+PtrCpuLevel ptr_cpu_level(void)
+{
+    PtrCpuLevel level = detect();
+    PtrCpuLevel env_cap;
+    const char *env = getenv("PTR_CPUMASK");
+    if (env && ptr_cpu_parse_level(env, &env_cap) && env_cap < level)
+        level = env_cap;
+    return user_cap < level ? user_cap : level;
+}
+
+void ptr_cpu_set_cap(PtrCpuLevel cap)
+{
+    user_cap = cap;
+}
+
+const char *ptr_cpu_level_name(PtrCpuLevel level)
+{
+    return level < PTR_CPU_LEVEL_COUNT ? level_names[level] : "unknown";
+}
+
+int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level)
+{
+    for (int i = 0; i < PTR_CPU_LEVEL_COUNT; i++)
+        if (!strcmp(name, level_names[i])) {
+            *level = (PtrCpuLevel)i;
+            return 1;
+        }
+    return 0;
+}

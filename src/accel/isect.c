@@ -1,0 +1,130 @@
+#include "accel/isect.h"
+
+#include <assert.h>
+#include <math.h>
+#include <stddef.h>
+
+/* The assembly kernels read these structures at fixed offsets (asm/ptr.inc). */
+static_assert(offsetof(PtrRay, tmin) == 12 && offsetof(PtrRay, dir) == 16 &&
+              offsetof(PtrRay, tmax) == 28 && sizeof(PtrRay) == 32, "PtrRay layout");
+static_assert(offsetof(PtrSpheres, cx) == 0 && offsetof(PtrSpheres, cy) == 8 &&
+              offsetof(PtrSpheres, cz) == 16 && offsetof(PtrSpheres, radius) == 24,
+              "PtrSpheres layout");
+static_assert(offsetof(PtrHit, t) == 0 && offsetof(PtrHit, sphere) == 4, "PtrHit layout");
+
+#ifndef PTR_HAVE_ASM
+#define PTR_HAVE_ASM 0
+#endif
+
+#if PTR_HAVE_ASM
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_sse41);
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx2);
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx512);
+#endif
+
+/* The formulation avoids the cancellation of the textbook b*b - 4ac: the
+ * discriminant is r^2 minus the squared distance from the centre to the ray's
+ * line, and the second root comes from the product of roots (c / q), not
+ * from a difference of nearly equal numbers. With a unit direction the
+ * quadratic is t^2 + 2bt + c = 0, where b = f.d and c = f.f - r^2.
+ *
+ * Assembly versions must compute exactly these operations in this order
+ * (no FMA, IEEE division and square root) so that they agree bit for bit;
+ * the selects are written as minps/maxps/cmpps compute them. */
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c)
+{
+    assert(count <= spheres->capacity && count < ((size_t)1 << 31));
+    assert((uintptr_t)spheres->cx % PTR_SPHERE_ALIGN == 0 &&
+           (uintptr_t)spheres->cy % PTR_SPHERE_ALIGN == 0 &&
+           (uintptr_t)spheres->cz % PTR_SPHERE_ALIGN == 0 &&
+           (uintptr_t)spheres->radius % PTR_SPHERE_ALIGN == 0);
+    assert(ray->tmin >= 0.0f && ray->tmin < ray->tmax);
+    const float ox = ray->org[0], oy = ray->org[1], oz = ray->org[2];
+    const float dx = ray->dir[0], dy = ray->dir[1], dz = ray->dir[2];
+    const float tmin = ray->tmin;
+    float best = ray->tmax;
+    uint32_t best_index = PTR_NO_HIT;
+
+    for (size_t i = 0; i < count; i++) {
+        const float fx = ox - spheres->cx[i];
+        const float fy = oy - spheres->cy[i];
+        const float fz = oz - spheres->cz[i];
+        const float r = spheres->radius[i];
+        const float b = fx * dx + fy * dy + fz * dz;
+        const float vx = fx - b * dx;
+        const float vy = fy - b * dy;
+        const float vz = fz - b * dz;
+        const float r2 = r * r;
+        const float disc = r2 - (vx * vx + vy * vy + vz * vz);
+        if (!(disc >= 0.0f)) /* also rejects the NaN radius of padding */
+            continue;
+        const float c = (fx * fx + fy * fy + fz * fz) - r2;
+        const float q = -b - copysignf(sqrtf(disc), b);
+        const float t0 = c / q;
+        const float t1 = q;
+        const float near = t0 < t1 ? t0 : t1;
+        const float far = t0 > t1 ? t0 : t1;
+        const float t = near > tmin ? near : far;
+        if (t > tmin && t < best) {
+            best = t;
+            best_index = (uint32_t)i;
+        }
+    }
+    hit->t = best;
+    hit->sphere = best_index;
+    return best_index != PTR_NO_HIT;
+}
+
+void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
+{
+    table->closest_hit = ptr_closest_hit_c;
+    table->name = "c";
+#if PTR_HAVE_ASM
+    if (level < PTR_CPU_SSE41)
+        return;
+    table->closest_hit = ptr_closest_hit_sse41;
+    table->name = "sse41";
+    if (level < PTR_CPU_AVX2)
+        return;
+    table->closest_hit = ptr_closest_hit_avx2;
+    table->name = "avx2";
+    if (level < PTR_CPU_AVX512)
+        return;
+    table->closest_hit = ptr_closest_hit_avx512;
+    table->name = "avx512";
+#else
+    (void)level;
+#endif
+}
+
+int ptr_isect_has_asm(void)
+{
+    return PTR_HAVE_ASM;
+}
+
+/* The narrowest level whose vector a scene of this many spheres fills:
+ * 4 lanes (SSE4.1), 8 (AVX2), 16 (AVX-512). */
+static PtrCpuLevel widest_useful_level(size_t sphere_count)
+{
+    return sphere_count <= 4 ? PTR_CPU_SSE41 : sphere_count <= 8 ? PTR_CPU_AVX2 : PTR_CPU_AVX512;
+}
+
+int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, size_t sphere_count)
+{
+    PtrCpuLevel level = ptr_cpu_level();
+    PtrCpuLevel useful = widest_useful_level(sphere_count);
+    if (level > useful)
+        level = useful;
+    switch (kernel) {
+    case PTR_KERNEL_C:
+        ptr_isect_init_level(table, PTR_CPU_NONE);
+        return 1;
+    case PTR_KERNEL_AUTO:
+        ptr_isect_init_level(table, level);
+        return 1;
+    case PTR_KERNEL_ASM:
+        ptr_isect_init_level(table, level);
+        return table->closest_hit != ptr_closest_hit_c;
+    }
+    return 0;
+}

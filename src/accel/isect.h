@@ -1,0 +1,75 @@
+/* Closest-hit queries of one ray against a run of spheres.
+ *
+ * The kernel sits behind a function-pointer table filled once at start-up:
+ * first with the portable C reference, then overridden by faster versions
+ * the CPU supports. Hot code makes one indirect call and never branches on the
+ * CPU. Every version returns exactly what the C reference returns.
+ */
+#ifndef PTR_ISECT_H
+#define PTR_ISECT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "accel/cpu.h"
+#include "core/scene.h"
+
+/* A ray with a unit direction; hits count only for tmin < t < tmax.
+ * Layout is fixed (32 bytes) because assembly kernels read it. */
+typedef struct PtrRay {
+    float org[3];
+    float tmin;
+    float dir[3];
+    float tmax;
+} PtrRay;
+
+typedef struct PtrHit {
+    float t;         /* ray->tmax on a miss */
+    uint32_t sphere; /* PTR_NO_HIT on a miss */
+} PtrHit;
+
+#define PTR_NO_HIT UINT32_MAX
+
+/* One signature for the pointer type, the C reference and every assembly
+ * version, so that they cannot drift apart. Tests the first count spheres;
+ * writes *hit in every case and returns 1 on a hit, 0 on a miss. On equal
+ * distances the lowest index wins.
+ *
+ * Preconditions, which the C reference asserts and the SIMD versions rely on:
+ * the sphere arrays are PTR_SPHERE_ALIGN-aligned and readable up to count
+ * rounded up to PTR_SPHERE_BLOCK (count <= capacity), count < 2^31, and
+ * 0 <= tmin < tmax with tmax not NaN. */
+#define PTR_DECL_CLOSEST_HIT(name)                                            \
+    int name(const PtrRay *ray, const PtrSpheres *spheres, size_t count,      \
+             PtrHit *hit)
+
+typedef PTR_DECL_CLOSEST_HIT((*PtrClosestHitFn));
+
+typedef enum PtrKernel {
+    PTR_KERNEL_AUTO, /* the fastest at the CPU level in force */
+    PTR_KERNEL_C,    /* the portable reference */
+    PTR_KERNEL_ASM,  /* the fastest assembly version; fails if there is none */
+} PtrKernel;
+
+typedef struct PtrIsectTable {
+    PtrClosestHitFn closest_hit;
+    const char *name; /* which implementation closest_hit is: "c", "avx2", ... */
+} PtrIsectTable;
+
+/* Fills the table for the requested kernel at the CPU level in force
+ * (ptr_cpu_level), for scenes of sphere_count spheres: a vector wider than
+ * the scene only tests padding, so the widest kernel is the one the scene
+ * fills. Returns 0 if the requested kernel is not available. */
+int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, size_t sphere_count);
+
+/* Fills the table as a CPU of exactly this level would (for the checker and
+ * for --print-dispatch). */
+void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level);
+
+/* Whether this build contains the assembly kernels. */
+int ptr_isect_has_asm(void);
+
+/* The reference implementation. */
+PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c);
+
+#endif /* PTR_ISECT_H */

@@ -1,0 +1,56 @@
+/* The command line's options, parsed. */
+#ifndef PTR_CLI_OPTIONS_H
+#define PTR_CLI_OPTIONS_H
+
+#include <stdint.h>
+
+#include "importer.h"
+#include "accel/isect.h"
+#include "app/output.h"
+#include "core/render.h"
+#include "core/scene.h"
+
+enum { PTR_DEFAULT_WIDTH = 800, PTR_MAX_IMAGE_SIZE = 1 << 16 };
+
+typedef struct PtrOptions {
+    char **inputs;          /* scenes; for `ptr merge`, the parts */
+    int input_count;
+    int merge;              /* `ptr merge PART... -o OUT` */
+    const char *output;     /* a file, a folder, or a pattern with {name} */
+    const char *camera_name;
+    PtrCameraSpec camera;   /* --lookfrom ... */
+    int has_camera;
+    int fit_all_objects;
+    uint32_t samples;
+    uint32_t sample_first;  /* --sample-range START:END sets both */
+    uint64_t seed;
+    int width, height;      /* 0: from the scene */
+    PtrRegion region;       /* all zero: the whole image */
+    int max_depth;
+    int threads;
+    int has_sky;
+    PtrSky sky;
+    PtrKernel kernel;
+    PtrDepth depth;
+    const char *ocio_config, *display, *view, *look;
+    float exposure;
+    int bake_view;
+    int dither;
+    double time_budget;     /* seconds; 0: none */
+    int preview;
+    int watch;
+    int json;
+    int quiet;
+    int dump_scene;
+    int list_views;
+} PtrOptions;
+
+/* What the importers need of the options. */
+PtrImportOptions ptr_options_import(const PtrOptions *options, PtrStrings *dependencies);
+
+/* Parses argv. Returns -1 to go on, else the exit code to return at once
+ * (after --help, --version, --print-dispatch, or a usage error, which it has
+ * reported). */
+int ptr_options_parse(int argc, char **argv, PtrOptions *options);
+
+#endif /* PTR_CLI_OPTIONS_H */

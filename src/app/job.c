@@ -1,0 +1,140 @@
+#include "app/job.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "importer.h"
+#include "app/output.h"
+#include "core/progressive.h"
+#include "app/signals.h"
+
+enum { PREVIEW_SCALE = 4, PREVIEW_SAMPLES = 4 };
+
+/* Width and height: the command line's, else the scene's, filling a missing
+ * one from the camera's aspect ratio (else the scene's, else 16:9). */
+static void choose_size(const PtrOptions *o, const PtrScene *scene, int *width, int *height)
+{
+    float aspect = scene->camera.aspect > 0.0f ? scene->camera.aspect
+                   : scene->width > 0          ? (float)scene->width / (float)scene->height
+                                               : 16.0f / 9.0f;
+    int w = o->width, h = o->height;
+    if (!w && !h && scene->width > 0) {
+        w = scene->width;
+        h = scene->height;
+    }
+    if (!w && !h)
+        w = PTR_DEFAULT_WIDTH;
+    if (!h)
+        h = (int)lroundf((float)w / aspect);
+    if (!w)
+        w = (int)lroundf((float)h * aspect);
+    if (o->preview) {
+        w /= PREVIEW_SCALE;
+        h /= PREVIEW_SCALE;
+    }
+    *width = w < 1 ? 1 : w > PTR_MAX_IMAGE_SIZE ? PTR_MAX_IMAGE_SIZE : w;
+    *height = h < 1 ? 1 : h > PTR_MAX_IMAGE_SIZE ? PTR_MAX_IMAGE_SIZE : h;
+}
+
+static PtrResult fail(PtrJobReport *report, const PtrError *err)
+{
+    report->result = err->code;
+    snprintf(report->error, sizeof report->error, "%s", err->message);
+    return err->code;
+}
+
+/* Renders the imported scene and writes the image. */
+static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, const PtrColor *color,
+                                  PtrJobReport *report, PtrError *err)
+{
+    PtrIsectTable isect;
+    ptr_isect_init(&isect, o->kernel, scene->spheres.count);
+    snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
+
+    PtrRenderSettings settings = {
+        .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
+    };
+    choose_size(o, scene, &settings.width, &settings.height);
+    report->width = settings.width;
+    report->height = settings.height;
+    PtrRegion region = ptr_render_region(&settings);
+    if (region.x1 == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "--region %d,%d,%d,%d lies outside the %dx%d image",
+                             o->region.x0, o->region.y0, o->region.x1, o->region.y1,
+                             settings.width, settings.height);
+    const PtrImageLayout layout = { region.x1 - region.x0, region.y1 - region.y0, region.x0,
+                                    region.y0, settings.width, settings.height };
+
+    PtrProgressPrinter printer;
+    ptr_progress_printer_init(&printer, report->output);
+    PtrProgressiveOptions passes = {
+        .first_sample = report->sample_first, .samples = report->samples_requested,
+        .time_budget = o->time_budget, .stop = &ptr_stop_requested,
+        .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
+    };
+    float *rgb = malloc((size_t)layout.width * (size_t)layout.height * 3 * sizeof *rgb);
+    if (!rgb)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
+                             report->output, layout.width, layout.height);
+    PtrProgressiveResult done;
+    PtrResult res = ptr_render_progressive(scene, &isect, &settings, &passes, rgb, &done, err);
+    ptr_progress_done(&printer);
+    if (res == PTR_ERR_SCENE_INVALID) {
+        /* The renderer does not know where the scene came from. */
+        char message[sizeof err->message];
+        memcpy(message, err->message, sizeof message);
+        ptr_error_set(err, res, "%s: %s", report->scene, message);
+    }
+    if (res == PTR_OK) {
+        report->samples = done.samples_done;
+        report->seconds = done.stats.seconds;
+        report->rays = done.stats.rays;
+        report->interrupted = done.stopped;
+        PtrOutputInfo info = {
+            .scene_path = report->scene, .scene_hash = ptr_scene_hash(scene),
+            .kernel = isect.name, .sample_first = report->sample_first,
+            .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
+            .max_depth = o->max_depth, .render_seconds = done.stats.seconds, .depth = o->depth,
+            .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
+            .dither = o->dither,
+        };
+        res = ptr_output_write(report->output, &layout, rgb, &info, err);
+    }
+    free(rgb);
+    if (res == PTR_OK && done.stopped)
+        res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
+                            "%s: interrupted; wrote the %u samples done of %u",
+                            report->output, done.samples_done, report->samples_requested);
+    return res;
+}
+
+PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char *output,
+                         const PtrColor *color, PtrStrings *dependencies, PtrJobReport *report)
+{
+    *report = (PtrJobReport){
+        .scene = scene_path, .output = output, .seed = o->seed, .sample_first = o->sample_first,
+        .samples_requested = o->preview && o->samples > PREVIEW_SAMPLES ? PREVIEW_SAMPLES : o->samples,
+    };
+    PtrError err = { 0 };
+    PtrScene scene;
+    PtrImportOptions import = ptr_options_import(o, dependencies);
+    PtrResult res = ptr_import_scene(scene_path, &import, &scene, &report->warnings, &err);
+    /* A file that failed gets its one line of error, nothing more. */
+    for (size_t i = 0; res == PTR_OK && i < report->warnings.count; i++)
+        fprintf(stderr, "ptr: warning: %s\n", report->warnings.lines[i]);
+    if (res == PTR_OK) {
+        if (o->has_sky)
+            scene.sky = o->sky;
+        res = render_and_write(o, &scene, color, report, &err);
+    }
+    ptr_scene_free(&scene);
+    if (res != PTR_OK && res != PTR_ERR_INTERRUPTED)
+        return fail(report, &err);
+    report->result = res;
+    if (res == PTR_ERR_INTERRUPTED)
+        snprintf(report->error, sizeof report->error, "%s", err.message);
+    if (!o->quiet)
+        ptr_report_stats_line(stderr, report);
+    return res;
+}

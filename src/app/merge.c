@@ -1,0 +1,186 @@
+#include "app/merge.h"
+
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image/image.h"
+#include "app/output.h"
+
+typedef struct Part {
+    const char *path;
+    PtrImage *image;
+    PtrImageLayout layout;
+    const char *scene, *hash, *seed, *kernel;
+    long first, samples, max_depth;
+} Part;
+
+static const char *required(const Part *p, const char *name, PtrError *err)
+{
+    const char *value = ptr_image_attr(p->image, name);
+    if (!value)
+        ptr_error_set(err, PTR_ERR_USAGE, "%s: no %s in the metadata: not a part written by ptr",
+                      p->path, name);
+    return value;
+}
+
+static PtrResult read_part(Part *p, PtrError *err)
+{
+    char message[sizeof err->message];
+    p->image = ptr_image_read(p->path, message, sizeof message);
+    if (!p->image)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s", message);
+    p->layout = ptr_image_layout(p->image);
+    const char *first, *samples, *depth, *space;
+    if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||
+        !(p->seed = required(p, "ptr:seed", err)) || !(p->kernel = required(p, "ptr:kernel", err)) ||
+        !(first = required(p, "ptr:sample_first", err)) ||
+        !(samples = required(p, "ptr:samples", err)) || !(depth = required(p, "ptr:max_depth", err)) ||
+        !(space = required(p, "ptr:colorspace", err)))
+        return PTR_ERR_USAGE;
+    if (strcmp(space, "lin_rec709"))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "%s: holds display-referred values (%s); merge needs scene-linear "
+                             "parts (.exr without --bake-view)", p->path, space);
+    p->first = atol(first);
+    p->samples = atol(samples);
+    p->max_depth = atol(depth);
+    if (p->samples <= 0 || p->first < 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: no samples", p->path);
+    return PTR_OK;
+}
+
+static int overlap(const PtrImageLayout *a, const PtrImageLayout *b)
+{
+    return a->x < b->x + b->width && b->x < a->x + a->width && a->y < b->y + b->height &&
+           b->y < a->y + a->height;
+}
+
+/* Parts must come from one render, and never hold the same sample of the
+ * same pixel twice. */
+static PtrResult check_parts(const Part *parts, int count, PtrError *err)
+{
+    const Part *a = &parts[0];
+    for (int i = 1; i < count; i++) {
+        const Part *b = &parts[i];
+        const char *what = strcmp(a->hash, b->hash)    ? "scene"
+                           : strcmp(a->seed, b->seed) ? "seed"
+                           : a->max_depth != b->max_depth ? "depth limit"
+                           : a->layout.full_width != b->layout.full_width ||
+                                   a->layout.full_height != b->layout.full_height
+                               ? "image size"
+                               : NULL;
+        if (what)
+            return ptr_error_set(err, PTR_ERR_USAGE, "%s: another %s than %s: not parts of one render",
+                                 b->path, what, a->path);
+    }
+    for (int i = 0; i < count; i++)
+        for (int j = i + 1; j < count; j++) {
+            const Part *p = &parts[i], *q = &parts[j];
+            if (overlap(&p->layout, &q->layout) && p->first < q->first + q->samples &&
+                q->first < p->first + p->samples)
+                return ptr_error_set(err, PTR_ERR_USAGE,
+                                     "%s and %s: overlapping pixels hold the same samples (%ld..%ld "
+                                     "and %ld..%ld)", p->path, q->path, p->first,
+                                     p->first + p->samples - 1, q->first, q->first + q->samples - 1);
+        }
+    return PTR_OK;
+}
+
+static PtrResult combine(const Part *parts, int count, const char *output, const PtrOptions *o,
+                         const PtrColor *color, PtrJobReport *report, PtrError *err)
+{
+    const int w = parts[0].layout.full_width, h = parts[0].layout.full_height;
+    size_t pixels = (size_t)w * (size_t)h;
+    double *sum = calloc(pixels * 3, sizeof *sum);
+    long *n = calloc(pixels, sizeof *n);
+    float *rgb = malloc(pixels * 3 * sizeof *rgb);
+    PtrResult res = PTR_OK;
+    if (!sum || !n || !rgb) {
+        res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", output);
+        goto done;
+    }
+    long first = parts[0].first;
+    for (int i = 0; i < count; i++) {
+        const Part *p = &parts[i];
+        const float *px = ptr_image_pixels(p->image);
+        first = p->first < first ? p->first : first;
+        for (int y = 0; y < p->layout.height; y++)
+            for (int x = 0; x < p->layout.width; x++) {
+                int fx = p->layout.x + x, fy = p->layout.y + y;
+                if (fx < 0 || fy < 0 || fx >= w || fy >= h)
+                    continue;
+                size_t at = (size_t)fy * (size_t)w + (size_t)fx;
+                for (int c = 0; c < 3; c++)
+                    sum[3 * at + c] += (double)px[3 * ((size_t)y * p->layout.width + x) + c] * p->samples;
+                n[at] += p->samples;
+            }
+    }
+    long fewest = n[0], most = n[0];
+    for (size_t at = 0; at < pixels; at++) {
+        if (n[at] == 0) {
+            res = ptr_error_set(err, PTR_ERR_USAGE, "%s: no part covers pixel (%zu, %zu)", output,
+                                at % (size_t)w, at / (size_t)w);
+            goto done;
+        }
+        fewest = n[at] < fewest ? n[at] : fewest;
+        most = n[at] > most ? n[at] : most;
+        for (int c = 0; c < 3; c++)
+            rgb[3 * at + c] = (float)(sum[3 * at + c] / (double)n[at]);
+    }
+    if (fewest != most)
+        fprintf(stderr, "ptr: warning: %s: pixels hold %ld to %ld samples\n", output, fewest, most);
+
+    int same_kernel = 1;
+    for (int i = 1; i < count; i++)
+        same_kernel = same_kernel && !strcmp(parts[i].kernel, parts[0].kernel);
+    snprintf(report->kernel, sizeof report->kernel, "%s", same_kernel ? parts[0].kernel : "mixed");
+    report->width = w;
+    report->height = h;
+    report->sample_first = (uint32_t)first;
+    report->samples = report->samples_requested = (uint32_t)fewest;
+    report->seed = strtoull(parts[0].seed, NULL, 10);
+    const PtrImageLayout full = { w, h, 0, 0, w, h };
+    PtrOutputInfo info = {
+        .scene_path = parts[0].scene, .scene_hash = strtoull(parts[0].hash, NULL, 16),
+        .kernel = report->kernel, .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
+        .seed = report->seed, .max_depth = (int)parts[0].max_depth, .depth = o->depth,
+        .color = color, .exposure = o->exposure, .bake_view = o->bake_view, .dither = o->dither,
+    };
+    res = ptr_output_write(output, &full, rgb, &info, err);
+done:
+    free(sum);
+    free(n);
+    free(rgb);
+    return res;
+}
+
+PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOptions *o,
+                    const PtrColor *color, PtrJobReport *report)
+{
+    /* The report outlives the parts' metadata: it names the first part. */
+    *report = (PtrJobReport){ .scene = count > 0 ? paths[0] : "merge", .output = output };
+    PtrError err = { 0 };
+    Part *parts = calloc((size_t)count, sizeof *parts);
+    PtrResult res = parts ? PTR_OK : ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
+    for (int i = 0; res == PTR_OK && i < count; i++) {
+        parts[i].path = paths[i];
+        res = read_part(&parts[i], &err);
+    }
+    if (res == PTR_OK)
+        res = ptr_output_check(output, o->depth, &err);
+    if (res == PTR_OK)
+        res = check_parts(parts, count, &err);
+    if (res == PTR_OK)
+        res = combine(parts, count, output, o, color, report, &err);
+    for (int i = 0; parts && i < count; i++)
+        ptr_image_free(parts[i].image);
+    free(parts);
+    report->result = res;
+    if (res != PTR_OK)
+        snprintf(report->error, sizeof report->error, "%s", err.message);
+    else if (!o->quiet)
+        fprintf(stderr, "ptr: %s: merged %d parts, %dx%d, %" PRIu32 " spp\n", output, count,
+                report->width, report->height, report->samples);
+    return res;
+}

@@ -1,0 +1,18 @@
+/* ptr merge: parts of one render (sample ranges, regions, or both) into one
+ * image. */
+#ifndef PTR_MERGE_H
+#define PTR_MERGE_H
+
+#include "app/cli_options.h"
+#include "color/color.h"
+#include "app/report.h"
+
+/* Reads the parts (scene-linear EXRs written by ptr), checks that they belong
+ * together (same scene hash, image size, seed and depth limit; overlapping
+ * regions with disjoint sample ranges; every pixel covered), and writes each
+ * pixel's mean over all the samples the parts hold, weighted by their counts.
+ * Fills report; returns its result. */
+PtrResult ptr_merge(char **parts, int count, const char *output, const PtrOptions *options,
+                    const PtrColor *color, PtrJobReport *report);
+
+#endif /* PTR_MERGE_H */

@@ -1,0 +1,149 @@
+#include "app/output.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "image/image.h"
+#include "version.h"
+
+/* The depths each format can store; the first is its default. Formats not
+ * listed (.bmp, .tga, ...) take 8 bits only. */
+static const struct {
+    const char *extension;
+    PtrDepth depths[4];
+} formats[] = {
+    { ".exr", { PTR_DEPTH_FLOAT, PTR_DEPTH_HALF } },
+    { ".hdr", { PTR_DEPTH_FLOAT } },
+    { ".png", { PTR_DEPTH_8, PTR_DEPTH_16 } },
+    { ".tif", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
+    { ".tiff", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
+};
+
+static const char *const depth_names[] = { "default", "8", "16", "half", "float" };
+
+int ptr_depth_parse(const char *text, PtrDepth *depth)
+{
+    for (int d = PTR_DEPTH_8; d <= PTR_DEPTH_FLOAT; d++)
+        if (!strcmp(text, depth_names[d])) {
+            *depth = (PtrDepth)d;
+            return 1;
+        }
+    return 0;
+}
+
+/* The depth a file gets, or PTR_DEPTH_DEFAULT if its format cannot store the
+ * one asked for. */
+static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
+{
+    const char *dot = strrchr(path, '.');
+    for (size_t f = 0; dot && f < sizeof formats / sizeof formats[0]; f++) {
+        if (strcasecmp(dot, formats[f].extension))
+            continue;
+        if (wanted == PTR_DEPTH_DEFAULT)
+            return formats[f].depths[0];
+        for (int i = 0; i < 4; i++)
+            if (formats[f].depths[i] == wanted)
+                return wanted;
+        return PTR_DEPTH_DEFAULT;
+    }
+    return wanted == PTR_DEPTH_DEFAULT || wanted == PTR_DEPTH_8 ? PTR_DEPTH_8 : PTR_DEPTH_DEFAULT;
+}
+
+PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
+{
+    if (!ptr_image_can_write(path))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "%s: no image format for this extension (try .exr or .png)", path);
+    if (resolve_depth(path, depth) == PTR_DEPTH_DEFAULT)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: this format cannot store --depth %s", path,
+                             depth_names[depth]);
+    /* The file is written beside its final name and renamed, so the folder
+     * must take new files. */
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    size_t len = slash ? (size_t)(slash - path) : 1;
+    if (len >= sizeof dir)
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
+    memcpy(dir, slash ? path : ".", len);
+    dir[len] = '\0';
+    if (slash && len == 0)
+        strcpy(dir, "/");
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: folder %s does not exist", path, dir);
+    if (access(dir, W_OK | X_OK) != 0)
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: cannot create files in %s: %s", path, dir,
+                             strerror(errno));
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: is a directory", path);
+    return PTR_OK;
+}
+
+PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
+                           const PtrOutputInfo *info, PtrError *err)
+{
+    PtrDepth depth = resolve_depth(path, info->depth);
+    int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
+    int display_referred = !is_float || info->bake_view;
+    size_t pixels = (size_t)layout->width * (size_t)layout->height;
+    char message[sizeof err->message];
+
+    float *viewed = NULL;
+    if (display_referred) {
+        viewed = malloc(pixels * 3 * sizeof *viewed);
+        if (!viewed)
+            return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+        memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
+        if (ptr_color_apply(info->color, viewed, pixels, message, sizeof message)) {
+            free(viewed);
+            return ptr_error_set(err, PTR_ERR_COLOR, "%s: %s", path, message);
+        }
+    }
+
+    char seed[24], exposure[32], hash[24];
+    snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
+    snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
+    snprintf(exposure, sizeof exposure, "%g", info->exposure);
+    const char *space = display_referred ? ptr_color_view_space(info->color) : "lin_rec709";
+    const PtrImageAttr attrs[] = {
+        { .name = "Software", .type = PTR_ATTR_STRING, .string_value = "ptr " PTR_VERSION },
+        { .name = "oiio:ColorSpace", .type = PTR_ATTR_STRING, .string_value = space },
+        /* OpenImageIO reads every EXR back as "Linear": say it where it stays. */
+        { .name = "ptr:colorspace", .type = PTR_ATTR_STRING, .string_value = space },
+        { .name = "ptr:scene", .type = PTR_ATTR_STRING, .string_value = info->scene_path },
+        { .name = "ptr:scene_hash", .type = PTR_ATTR_STRING, .string_value = hash },
+        { .name = "ptr:samples", .type = PTR_ATTR_INT, .int_value = (int)info->samples },
+        { .name = "ptr:sample_first", .type = PTR_ATTR_INT, .int_value = (int)info->sample_first },
+        { .name = "ptr:interrupted", .type = PTR_ATTR_INT, .int_value = info->interrupted },
+        { .name = "ptr:seed", .type = PTR_ATTR_STRING, .string_value = seed },
+        { .name = "ptr:max_depth", .type = PTR_ATTR_INT, .int_value = info->max_depth },
+        { .name = "ptr:kernel", .type = PTR_ATTR_STRING, .string_value = info->kernel },
+        { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
+          .float_value = (float)info->render_seconds },
+        { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,
+          .string_value = ptr_color_source(info->color) },
+        /* What the pixels went through (when display-referred) or would go
+         * through to be seen as intended. */
+        { .name = "ptr:display", .type = PTR_ATTR_STRING, .string_value = ptr_color_display(info->color) },
+        { .name = "ptr:view", .type = PTR_ATTR_STRING, .string_value = ptr_color_view(info->color) },
+        { .name = "ptr:look", .type = PTR_ATTR_STRING, .string_value = ptr_color_look(info->color) },
+        { .name = "ptr:exposure", .type = PTR_ATTR_STRING, .string_value = exposure },
+        { .name = "oiio:dither", .type = PTR_ATTR_INT, .int_value = info->dither ? 1 : 0 },
+    };
+    static const PtrPixelFormat pixel_formats[] = {
+        [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
+        [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
+    };
+    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, pixel_formats[depth],
+                                 attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
+    free(viewed);
+    if (failed)
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s", message);
+    return PTR_OK;
+}

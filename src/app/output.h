@@ -1,0 +1,52 @@
+/* From the renderer's scene-linear float image to a file on disk. */
+#ifndef PTR_OUTPUT_H
+#define PTR_OUTPUT_H
+
+#include <stdint.h>
+
+#include "color/color.h"
+#include "image/image.h"
+#include "core/result.h"
+
+/* What each channel is stored as. Integer depths always hold the
+ * display-referred image (the view applied, clamped to [0, 1], rounded);
+ * float depths hold scene-linear values unless bake_view is set. */
+typedef enum PtrDepth {
+    PTR_DEPTH_DEFAULT, /* float for .exr and .hdr, else 8 bits */
+    PTR_DEPTH_8,
+    PTR_DEPTH_16,
+    PTR_DEPTH_HALF,
+    PTR_DEPTH_FLOAT,
+} PtrDepth;
+
+typedef struct PtrOutputInfo {
+    const char *scene_path;
+    uint64_t scene_hash;   /* ptr_scene_hash: merge refuses parts of other scenes */
+    const char *kernel;
+    uint32_t sample_first; /* the samples taken: first .. first + samples - 1 */
+    uint32_t samples;
+    int interrupted;       /* the render stopped before all samples asked for */
+    uint64_t seed;
+    int max_depth;
+    double render_seconds;
+    PtrDepth depth;
+    const PtrColor *color; /* the display, view, look and exposure in force */
+    float exposure;        /* stops, as given to ptr_color_select (for metadata) */
+    int bake_view;         /* float depths too get the display-referred image */
+    int dither;            /* 8-bit: dither before rounding */
+} PtrOutputInfo;
+
+/* Parses "8", "16", "half" or "float". */
+int ptr_depth_parse(const char *text, PtrDepth *depth);
+
+/* Fails early, before any rendering, if no writer exists for the output's
+ * extension or it cannot store that depth (PTR_ERR_USAGE), or its folder
+ * cannot take the file (PTR_ERR_OUTPUT). */
+PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err);
+
+/* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
+ * full image as layout says) as info says. The file is replaced atomically. */
+PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
+                           const PtrOutputInfo *info, PtrError *err);
+
+#endif /* PTR_OUTPUT_H */

@@ -1,0 +1,13 @@
+/* The scene as JSON, as the importer understood it (ptr --dump-scene). */
+#ifndef PTR_SCENE_JSON_H
+#define PTR_SCENE_JSON_H
+
+#include <stdio.h>
+
+#include "importer.h"
+#include "core/scene.h"
+
+void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
+                          const PtrStrings *warnings);
+
+#endif /* PTR_SCENE_JSON_H */

@@ -1,0 +1,88 @@
+#include "core/progressive.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <time.h>
+
+typedef struct PassWatch {
+    const PtrProgressiveOptions *options;
+    PtrProgress progress;
+    uint32_t pass_samples;
+    double start;
+} PassWatch;
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void on_tick(void *user, double pass_fraction)
+{
+    PassWatch *w = user;
+    PtrProgress p = w->progress;
+    p.fraction = ((double)p.samples_done + pass_fraction * w->pass_samples) / p.samples_total;
+    p.elapsed = now_seconds() - w->start;
+    w->options->report(w->options->user, &p);
+}
+
+PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *isect,
+                                 const PtrRenderSettings *settings,
+                                 const PtrProgressiveOptions *options, float *rgb,
+                                 PtrProgressiveResult *result, PtrError *err)
+{
+    PtrRegion r = ptr_render_region(settings);
+    size_t values = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0) * 3;
+    if (options->samples == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive");
+    if (values == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
+                             settings->width, settings->height);
+    double *sums = calloc(values, sizeof *sums);
+    if (!sums)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image", r.x1 - r.x0,
+                             r.y1 - r.y0);
+
+    PassWatch watch = { .options = options, .start = now_seconds() };
+    watch.progress.samples_total = options->samples;
+    *result = (PtrProgressiveResult){ 0 };
+    PtrResult res = PTR_OK;
+    /* About a second a pass keeps progress and a stop responsive at a cost
+     * of nothing measurable; with a budget, passes are finer still. */
+    double pass_seconds = options->time_budget > 0 ? fmin(1.0, fmax(0.05, options->time_budget / 8))
+                                                   : 1.0;
+    uint32_t done = 0, pass = 1;
+    while (done < options->samples) {
+        watch.pass_samples = pass;
+        PtrRenderStats stats;
+        res = ptr_render_samples(scene, isect, settings, options->first_sample + done, pass, sums,
+                                 options->report ? on_tick : NULL, &watch, &stats, err);
+        if (res != PTR_OK)
+            break;
+        done += pass;
+        result->stats.rays += stats.rays;
+        result->stats.threads = stats.threads;
+        double elapsed = now_seconds() - watch.start;
+        watch.progress.samples_done = done;
+        watch.progress.rays = result->stats.rays;
+        watch.progress.rays_seconds = elapsed;
+
+        if (options->stop && *options->stop) {
+            result->stopped = done < options->samples;
+            break;
+        }
+        if (options->time_budget > 0 && elapsed >= options->time_budget)
+            break;
+        /* Size the next pass from the time a sample has taken so far. */
+        double per_sample = elapsed / done;
+        double next = per_sample > 0 ? pass_seconds / per_sample : 1e9;
+        pass = next < 1 ? 1 : next > options->samples - done ? options->samples - done : (uint32_t)next;
+    }
+    result->samples_done = done;
+    result->stats.seconds = now_seconds() - watch.start;
+    for (size_t i = 0; res == PTR_OK && i < values; i++)
+        rgb[i] = (float)(sums[i] / (double)done);
+    free(sums);
+    return res;
+}

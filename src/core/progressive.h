@@ -1,0 +1,44 @@
+/* A render in passes of samples: progress between passes, a time budget, and
+ * a clean stop when asked. */
+#ifndef PTR_PROGRESSIVE_H
+#define PTR_PROGRESSIVE_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "core/render.h"
+
+typedef struct PtrProgress {
+    uint32_t samples_done, samples_total;
+    double fraction; /* of all samples, counting the pass under way */
+    double elapsed;  /* seconds */
+    uint64_t rays;   /* in the passes finished */
+    double rays_seconds; /* the time those passes took */
+} PtrProgress;
+
+typedef struct PtrProgressiveOptions {
+    uint32_t first_sample, samples; /* the sample indices to render */
+    double time_budget;             /* seconds; stop after the pass that reaches it; 0: none */
+    /* Set from a signal handler: stop after the current pass. */
+    const volatile sig_atomic_t *stop;
+    /* Called about ten times a second (may be NULL). */
+    void (*report)(void *user, const PtrProgress *progress);
+    void *user;
+} PtrProgressiveOptions;
+
+typedef struct PtrProgressiveResult {
+    uint32_t samples_done; /* from first_sample on */
+    int stopped;           /* 1 if stopped by the flag, 0 if done or out of time */
+    PtrRenderStats stats;  /* all passes */
+} PtrProgressiveResult;
+
+/* Renders the settings' region in passes: the first of one sample, then
+ * passes sized to take about a second each. Writes the means of the samples
+ * done into rgb (3 floats a pixel of the region), the same bits as one pass
+ * of that many samples would give. */
+PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *isect,
+                                 const PtrRenderSettings *settings,
+                                 const PtrProgressiveOptions *options, float *rgb,
+                                 PtrProgressiveResult *result, PtrError *err);
+
+#endif /* PTR_PROGRESSIVE_H */

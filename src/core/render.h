@@ -1,0 +1,69 @@
+/* The path tracer: renders a scene into a scene-linear RGB float image. */
+#ifndef PTR_RENDER_H
+#define PTR_RENDER_H
+
+#include <stdint.h>
+
+#include "accel/isect.h"
+#include "core/result.h"
+#include "core/scene.h"
+
+/* Pixels x0 <= x < x1, y0 <= y < y1 of the full image. */
+typedef struct PtrRegion {
+    int x0, y0, x1, y1;
+} PtrRegion;
+
+typedef struct PtrRenderSettings {
+    int width, height; /* the full image */
+    PtrRegion region;  /* the pixels to render; all zero: the whole image */
+    uint32_t samples;  /* per pixel, for ptr_render */
+    uint64_t seed;
+    int max_depth;     /* rays per path at most; a path cut there adds nothing */
+    int threads;       /* 0: one per online CPU */
+    /* 0: rays leave a surface by ptr's scaled offset (ptr_spawn_ray). When
+     * positive, they leave it the seed renderer's way instead, from the hit
+     * point with this fixed t_min (0.001 there): the counter-example the
+     * stability suite measures against. */
+    float fixed_tmin;
+} PtrRenderSettings;
+
+typedef struct PtrRenderStats {
+    double seconds;
+    uint64_t rays; /* closest-hit queries, camera and scattered */
+    int threads;
+} PtrRenderStats;
+
+/* Called on the rendering call's own thread about ten times a second while
+ * the workers run, with the share of the call's pixels done. */
+typedef void (*PtrTickFn)(void *user, double fraction_done);
+
+/* The region the settings name (the whole image if theirs is all zero), or
+ * all zero if it does not lie inside the image. */
+PtrRegion ptr_render_region(const PtrRenderSettings *settings);
+
+/* Adds the radiance of samples first .. first + count - 1 of every pixel of
+ * the region to sums (3 doubles a pixel, region rows top to bottom), sample
+ * by sample in index order: split into passes of any size, the sums come out
+ * bit for bit the same, and never depend on the thread count. tick may be
+ * NULL; stats (may be NULL) gets this call's figures. */
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+                             const PtrRenderSettings *settings, uint32_t first, uint32_t count,
+                             double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
+                             PtrError *err);
+
+/* The whole region with settings->samples samples, as means in rgb (3 floats
+ * a pixel, region rows top to bottom). */
+PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+                     const PtrRenderSettings *settings, float *rgb,
+                     PtrRenderStats *stats, PtrError *err);
+
+/* The outward unit normal where ray met the sphere hit names. */
+PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHit *hit);
+
+/* A ray leaving the surface of a sphere along dir from the point where
+ * outward_normal meets it: its origin is that point pushed off the surface,
+ * along the normal and to the side dir goes, by a bound on the float error of
+ * locating it, so that it cannot hit the same surface again at t ~ 0. */
+PtrRay ptr_spawn_ray(PtrVec3 centre, float radius, PtrVec3 outward_normal, PtrVec3 dir);
+
+#endif /* PTR_RENDER_H */

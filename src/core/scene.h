@@ -1,0 +1,100 @@
+/* The scene: the only thing importers hand to the renderer.
+ *
+ * Spheres are stored as a structure of arrays so that SIMD kernels can test
+ * 4, 8 or 16 of them per instruction. Each array is 64-byte aligned and
+ * padded to a multiple of PTR_SPHERE_BLOCK entries; padding entries have a NaN
+ * radius, which fails every ordered comparison and so can never be hit. */
+#ifndef PTR_SCENE_H
+#define PTR_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/result.h"
+#include "core/vec.h"
+
+enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
+
+typedef struct PtrSpheres {
+    /* Kernels depend on this field order (see isect.h). */
+    float *cx, *cy, *cz, *radius;
+    uint32_t *material;  /* index into PtrScene.materials */
+    size_t count;        /* spheres in use */
+    size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
+} PtrSpheres;
+
+typedef enum PtrMaterialKind {
+    PTR_MATERIAL_DIFFUSE,
+    PTR_MATERIAL_METAL,
+    PTR_MATERIAL_DIELECTRIC,
+} PtrMaterialKind;
+
+typedef struct PtrMaterial {
+    PtrMaterialKind kind;
+    PtrVec3 albedo;   /* diffuse and metal reflectance; dielectric attenuation */
+    float fuzz;       /* metal only: 0 is a perfect mirror */
+    float ior;        /* dielectric only */
+    PtrVec3 emission; /* emitted radiance, seen from both sides */
+} PtrMaterial;
+
+typedef struct PtrCamera {
+    PtrVec3 lookfrom, lookat, up;
+    float vfov_deg;       /* vertical field of view */
+    float aperture;       /* lens diameter; 0 is a pinhole */
+    float focus_distance; /* distance to the plane in focus */
+    float aspect;         /* width / height the scene suggests; 0 if none */
+} PtrCamera;
+
+typedef enum PtrSkyKind {
+    PTR_SKY_GRADIENT, /* white at the horizon to (0.5, 0.7, 1.0) overhead */
+    PTR_SKY_CONSTANT,
+    PTR_SKY_BLACK,
+} PtrSkyKind;
+
+typedef struct PtrSky {
+    PtrSkyKind kind;
+    PtrVec3 radiance; /* PTR_SKY_CONSTANT only */
+} PtrSky;
+
+typedef struct PtrScene {
+    /* World position of the point every coordinate below is relative to:
+     * importers put it at the camera (see importers/builder.h). */
+    double origin[3];
+    PtrSpheres spheres;
+    PtrMaterial *materials;
+    size_t material_count;
+    PtrCamera camera;
+    PtrSky sky;
+    /* Image size the scene asks for (glTF scene extras.resolution); 0 if none. */
+    int width, height;
+} PtrScene;
+
+/* An empty scene: no spheres, no materials, gradient sky, default camera. */
+void ptr_scene_init(PtrScene *scene);
+void ptr_scene_free(PtrScene *scene);
+
+/* Appends a sphere; returns PTR_ERR_NOMEM if the arrays cannot grow. */
+PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
+                               uint32_t material);
+
+/* Appends a material and stores its index in *index. */
+PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
+                                 uint32_t *index);
+
+static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
+{
+    return v3(s->cx[i], s->cy[i], s->cz[i]);
+}
+
+/* A 64-bit fingerprint of everything in the scene that shapes an image
+ * (spheres, materials, camera, sky, origin): parts of one render match, parts
+ * of different scenes almost surely do not. */
+uint64_t ptr_scene_hash(const PtrScene *scene);
+
+/* Radiance arriving from the sky along a unit direction. */
+PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir);
+
+/* "gradient", "black" or "R,G,B" (as --sky takes it). */
+int ptr_sky_parse(const char *text, PtrSky *sky);
+
+#endif /* PTR_SCENE_H */
