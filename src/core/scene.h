@@ -19,6 +19,10 @@ typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
     uint32_t *material;  /* index into PtrScene.materials */
+    /* The sphere's position in the scene file's order. An acceleration
+     * structure may reorder the arrays; on equal hit distances the lowest id
+     * wins, so the order never shows in an image. */
+    uint32_t *id;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
 } PtrSpheres;
