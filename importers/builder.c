@@ -106,7 +106,104 @@ static PtrVec3 relative(const double p[3], const double origin[3])
     return v3((float)(p[0] - origin[0]), (float)(p[1] - origin[1]), (float)(p[2] - origin[2]));
 }
 
-PtrResult ptr_builder_finish(PtrSceneBuilder *b, int recentre)
+/* Which spheres are huge (see accel/huge.h): those whose radius is more than
+ * HUGE_RATIO times the extent of the region the rays live in, taken as the
+ * box around the camera and every sphere of a radius within HUGE_RATIO of
+ * the smallest. A radius-1e5 ground under spheres of radius 1 is huge; a
+ * cloud of like spheres has none. At most PTR_HUGE_MAX, the largest first
+ * (every ray tests them all). Testing a sphere in double is never less
+ * accurate, only slower, so the rule needs to be right only about cost.
+ * Marks them in huge[] (all zero on entry) and returns how many. */
+#define HUGE_RATIO 16.0
+
+static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigned char *huge)
+{
+    double smallest = INFINITY;
+    for (size_t i = 0; i < b->count; i++)
+        smallest = fmin(smallest, b->spheres[4 * i + 3]);
+    double lo[3], hi[3];
+    memcpy(lo, eye, sizeof lo);
+    memcpy(hi, eye, sizeof hi);
+    for (size_t i = 0; i < b->count; i++) {
+        const double *s = &b->spheres[4 * i];
+        if (s[3] > HUGE_RATIO * smallest)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], s[k] - s[3]);
+            hi[k] = fmax(hi[k], s[k] + s[3]);
+        }
+    }
+    double extent = 0;
+    for (int k = 0; k < 3; k++)
+        extent = fmax(extent, hi[k] - lo[k]);
+    /* The largest candidates, largest first (the earliest on equal radii). */
+    size_t top[PTR_HUGE_MAX], count = 0;
+    for (size_t i = 0; i < b->count; i++) {
+        double r = b->spheres[4 * i + 3];
+        if (!(r > HUGE_RATIO * extent))
+            continue;
+        size_t at = count < PTR_HUGE_MAX ? count++ : PTR_HUGE_MAX;
+        for (; at > 0 && b->spheres[4 * top[at - 1] + 3] < r; at--)
+            if (at < PTR_HUGE_MAX)
+                top[at] = top[at - 1];
+        if (at < PTR_HUGE_MAX)
+            top[at] = i;
+    }
+    for (size_t k = 0; k < count; k++)
+        huge[top[k]] = 1;
+    return count;
+}
+
+/* Adds sphere i of the builder (already relative to the scene's origin). */
+static PtrResult add_sphere(PtrSceneBuilder *b, size_t i)
+{
+    const double *s = &b->spheres[4 * i];
+    PtrVec3 c = v3((float)s[0], (float)s[1], (float)s[2]);
+    float r = (float)s[3];
+    if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
+        return PTR_ERR_SCENE_INVALID;
+    PtrScene *scene = b->scene;
+    PtrResult res = ptr_scene_add_sphere(scene, c, r, b->materials[i]);
+    if (res == PTR_OK)
+        scene->spheres.id[scene->spheres.count - 1] = (uint32_t)i;
+    return res;
+}
+
+/* The spheres in file order, the huge ones last (their ids keep the file's
+ * order; see PtrSpheres.id), with the huge ones in double as well. */
+static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double)
+{
+    PtrScene *scene = b->scene;
+    unsigned char *huge = malloc(b->count ? b->count : 1);
+    if (!huge)
+        return PTR_ERR_NOMEM;
+    const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
+    for (size_t i = 0; i < b->count; i++)
+        for (int k = 0; k < 3; k++)
+            b->spheres[4 * i + k] -= origin[k];
+    memset(huge, 0, b->count);
+    size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
+    PtrResult res = PTR_OK;
+    for (size_t i = 0; i < b->count && res == PTR_OK; i++)
+        if (!huge[i])
+            res = add_sphere(b, i);
+    if (res == PTR_OK && huge_count) {
+        scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
+        if (!scene->huge.centre_radius)
+            res = PTR_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < b->count && res == PTR_OK; i++) {
+        if (!huge[i])
+            continue;
+        res = add_sphere(b, i);
+        memcpy(&scene->huge.centre_radius[4 * scene->huge.count++], &b->spheres[4 * i],
+               4 * sizeof(double));
+    }
+    free(huge);
+    return res;
+}
+
+PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags)
 {
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
@@ -115,17 +212,10 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, int recentre)
     else if (!b->has_camera)
         frame_spheres(b);
     const double zero[3] = { 0, 0, 0 };
-    const double *origin = recentre ? b->eye : zero;
+    const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : zero;
     memcpy(scene->origin, origin, sizeof scene->origin);
 
-    for (size_t i = 0; i < b->count && res == PTR_OK; i++) {
-        PtrVec3 c = relative(&b->spheres[4 * i], origin);
-        float r = (float)b->spheres[4 * i + 3];
-        if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
-            res = PTR_ERR_SCENE_INVALID;
-        else
-            res = ptr_scene_add_sphere(scene, c, r, b->materials[i]);
-    }
+    res = add_spheres(b, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE);
     scene->camera = b->lens;
     scene->camera.lookfrom = relative(b->eye, origin);
     scene->camera.lookat = relative(b->target, origin);

@@ -42,12 +42,20 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 void ptr_builder_set_camera(PtrSceneBuilder *builder, const double eye[3],
                             const double target[3], const double up[3], const PtrCamera *lens);
 
+/* How ptr_builder_finish stores the scene. Importers use both; the stability
+ * suite measures what leaving either out costs. */
+typedef enum PtrBuildFlags {
+    /* Coordinates relative to the camera, else to the world origin. */
+    PTR_BUILD_RECENTRE = 1,
+    /* Spheres far larger than the scene tested in double (accel/huge.h). */
+    PTR_BUILD_HUGE_IN_DOUBLE = 2,
+    PTR_BUILD_DEFAULT = PTR_BUILD_RECENTRE | PTR_BUILD_HUGE_IN_DOUBLE,
+} PtrBuildFlags;
+
 /* Fills the scene's spheres and camera: the camera given, or one that frames
- * every sphere from +Z, looking down -Z. With recentre, coordinates are taken
- * relative to the camera; without, relative to the world origin (the stability
- * suite measures what that costs). Frees the builder's memory. Returns
+ * every sphere from +Z, looking down -Z. Frees the builder's memory. Returns
  * PTR_ERR_SCENE_INVALID if a sphere is too far from the camera for single
  * precision, PTR_ERR_NOMEM if memory runs out. */
-PtrResult ptr_builder_finish(PtrSceneBuilder *builder, int recentre);
+PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags);
 
 #endif /* PTR_BUILDER_H */

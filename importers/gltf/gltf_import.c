@@ -364,7 +364,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                             im.camera_name);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
-    if (res == PTR_OK && ptr_builder_finish(&im.builder, 1) != PTR_OK)
+    if (res == PTR_OK && ptr_builder_finish(&im.builder, PTR_BUILD_DEFAULT) != PTR_OK)
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: a sphere lies too far from the camera for single precision", path);
     ptr_builder_free(&im.builder);

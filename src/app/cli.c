@@ -77,11 +77,12 @@ static int dump_scenes(const PtrOptions *o)
         if (res == PTR_OK) {
             if (o->has_sky)
                 scene.sky = o->sky;
-            ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings);
-        } else if (!code) {
-            code = fail(&err);
-        } else {
-            fail(&err);
+            if (ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings) != PTR_OK)
+                res = ptr_error_set(&err, PTR_ERR_NOMEM, "%s: out of memory", o->inputs[i]);
+        }
+        if (res != PTR_OK) {
+            int failed = fail(&err);
+            code = code ? code : failed;
         }
         ptr_strings_free(&warnings);
         ptr_scene_free(&scene);

@@ -1,5 +1,7 @@
 #include "app/scene_json.h"
 
+#include <stdlib.h>
+
 #include "app/report.h"
 
 /* Floats print with 9 significant digits, enough to read back the same
@@ -35,18 +37,26 @@ static void write_sky(FILE *out, const PtrSky *sky)
     }
 }
 
-void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
-                          const PtrStrings *warnings)
+PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
+                               const PtrStrings *warnings)
 {
     const PtrSpheres *s = &scene->spheres;
+    /* In the file's order, whatever order the arrays are in. */
+    size_t *by_id = malloc((s->count ? s->count : 1) * sizeof *by_id);
+    if (!by_id)
+        return PTR_ERR_NOMEM;
+    for (size_t i = 0; i < s->count; i++)
+        by_id[s->id[i]] = i;
     fputs("{\n  \"scene\": ", out);
     ptr_json_string(out, path);
     fputs(",\n  \"spheres\": [", out);
-    for (size_t i = 0; i < s->count; i++) {
-        fprintf(out, "%s\n    {\"center\": ", i ? "," : "");
+    for (size_t n = 0; n < s->count; n++) {
+        size_t i = by_id[n];
+        fprintf(out, "%s\n    {\"center\": ", n ? "," : "");
         write_point(out, scene, ptr_sphere_centre(s, i));
         fprintf(out, ", \"radius\": %.9g, \"material\": %u}", s->radius[i], s->material[i]);
     }
+    free(by_id);
     fputs("\n  ],\n  \"materials\": [", out);
     for (size_t i = 0; i < scene->material_count; i++) {
         const PtrMaterial *m = &scene->materials[i];
@@ -80,4 +90,5 @@ void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
         ptr_json_string(out, warnings->lines[i]);
     }
     fputs("]\n}\n", out);
+    return PTR_OK;
 }

@@ -7,7 +7,8 @@
 #include "importer.h"
 #include "core/scene.h"
 
-void ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
-                          const PtrStrings *warnings);
+/* PTR_ERR_NOMEM if memory runs out before anything is written. */
+PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,
+                               const PtrStrings *warnings);
 
 #endif /* PTR_SCENE_JSON_H */

@@ -7,6 +7,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "accel/huge.h"
 #include "core/camera.h"
 #include "core/material.h"
 
@@ -39,6 +40,27 @@ PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHi
     return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
 }
 
+/* The closest hit in the scene: the huge spheres in double, then the rest
+ * through the intersector up to that distance (ties included, so that the
+ * lowest id wins as it would among spheres of one kind). */
+static int closest_hit(const PtrScene *scene, const PtrIsectTable *isect, const PtrRay *ray,
+                       PtrHit *hit)
+{
+    const PtrSpheres *s = &scene->spheres;
+    if (!scene->huge.count)
+        return isect->closest_hit(ray, s, s->count, hit);
+    PtrHit huge;
+    PtrRay rest = *ray;
+    if (ptr_huge_closest_hit(ray, scene, &huge))
+        rest.tmax = nextafterf(huge.t, INFINITY);
+    if (isect->closest_hit(&rest, s, s->count - scene->huge.count, hit) &&
+        (huge.sphere == PTR_NO_HIT || hit->t < huge.t ||
+         (hit->t == huge.t && s->id[hit->sphere] < s->id[huge.sphere])))
+        return 1;
+    *hit = huge;
+    return huge.sphere != PTR_NO_HIT;
+}
+
 /* The radiance one camera ray carries back. */
 static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
                           const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays)
@@ -51,14 +73,16 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
         PtrHit hit;
         PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
         ++*rays;
-        if (!isect->closest_hit(&ray, spheres, spheres->count, &hit)) {
+        if (!closest_hit(scene, isect, &ray, &hit)) {
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
         const PtrMaterial *m = &scene->materials[spheres->material[hit.sphere]];
         radiance = v3_add(radiance, v3_mul(throughput, m->emission));
 
-        PtrVec3 normal = ptr_hit_normal(spheres, &ray, &hit);
+        const int huge = ptr_is_huge(scene, hit.sphere);
+        PtrVec3 normal = huge ? ptr_huge_hit_normal(scene, &ray, &hit)
+                              : ptr_hit_normal(spheres, &ray, &hit);
 
         PtrVec3 out_dir, attenuation;
         if (!ptr_scatter(m, dir, normal, rng, &out_dir, &attenuation))
@@ -70,6 +94,8 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
             PtrVec3 p = v3_madd(v3(ray.org[0], ray.org[1], ray.org[2]), dir, hit.t);
             ray = (PtrRay){ { p.x, p.y, p.z }, settings->fixed_tmin,
                             { out_dir.x, out_dir.y, out_dir.z }, INFINITY };
+        } else if (huge) {
+            ray = ptr_huge_spawn_ray(scene, &ray, &hit, out_dir);
         } else {
             ray = ptr_spawn_ray(ptr_sphere_centre(spheres, hit.sphere),
                                 spheres->radius[hit.sphere], normal, out_dir);

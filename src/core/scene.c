@@ -22,12 +22,14 @@ static void spheres_free(PtrSpheres *s)
     free(s->cz);
     free(s->radius);
     free(s->material);
+    free(s->id);
     memset(s, 0, sizeof *s);
 }
 
 void ptr_scene_free(PtrScene *scene)
 {
     spheres_free(&scene->spheres);
+    free(scene->huge.centre_radius);
     free(scene->materials);
     ptr_scene_init(scene);
 }
@@ -49,7 +51,8 @@ static PtrResult spheres_grow(PtrSpheres *s)
     grown.cz = aligned_floats(capacity);
     grown.radius = aligned_floats(capacity);
     grown.material = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
-    if (!grown.cx || !grown.cy || !grown.cz || !grown.radius || !grown.material) {
+    grown.id = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
+    if (!grown.cx || !grown.cy || !grown.cz || !grown.radius || !grown.material || !grown.id) {
         spheres_free(&grown);
         return PTR_ERR_NOMEM;
     }
@@ -62,6 +65,7 @@ static PtrResult spheres_grow(PtrSpheres *s)
         grown.cz[i] = old ? s->cz[i] : 0.0f;
         grown.radius[i] = old ? s->radius[i] : NAN;
         grown.material[i] = old ? s->material[i] : 0;
+        grown.id[i] = old ? s->id[i] : 0;
     }
     spheres_free(s);
     *s = grown;
@@ -83,6 +87,7 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     s->cz[i] = centre.z;
     s->radius[i] = radius;
     s->material[i] = material;
+    s->id[i] = (uint32_t)i;
     return PTR_OK;
 }
 
@@ -128,6 +133,7 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     h = hash_bytes(h, s->cz, s->count * sizeof *s->cz);
     h = hash_bytes(h, s->radius, s->count * sizeof *s->radius);
     h = hash_bytes(h, s->material, s->count * sizeof *s->material);
+    h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {
         const PtrMaterial *m = &scene->materials[i];
         const int kind = m->kind;

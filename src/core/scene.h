@@ -60,11 +60,23 @@ typedef struct PtrSky {
     PtrVec3 radiance; /* PTR_SKY_CONSTANT only */
 } PtrSky;
 
+/* Spheres far larger than the region the rays live in (see accel/huge.h):
+ * the last count entries of PtrScene.spheres, kept here too in double
+ * precision (relative to PtrScene.origin), where every ray tests them. The
+ * float kernels and acceleration structures leave them out. */
+typedef struct PtrHugeSpheres {
+    double *centre_radius; /* x, y, z, radius of each */
+    size_t count;
+} PtrHugeSpheres;
+
+enum { PTR_HUGE_MAX = 16 };
+
 typedef struct PtrScene {
     /* World position of the point every coordinate below is relative to:
      * importers put it at the camera (see importers/builder.h). */
     double origin[3];
     PtrSpheres spheres;
+    PtrHugeSpheres huge;
     PtrMaterial *materials;
     size_t material_count;
     PtrCamera camera;

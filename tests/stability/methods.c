@@ -3,6 +3,7 @@
 #include "accel/cpu.h"
 #include <stdio.h>
 
+#include "builder.h"
 #include "naive.h"
 
 int stability_methods(Method *m)
@@ -15,7 +16,8 @@ int stability_methods(Method *m)
     m[n++] = (Method){ "naive, t_min 1e-3", naive, 1e-3f, 0, 0 };
     m[n++] = (Method){ "robust, t_min 1e-3", c, 1e-3f, 0, 0 };
     m[n++] = (Method){ "robust, offset", c, 0.0f, 0, 0 };
-    m[n++] = (Method){ "ptr (c)", c, 0.0f, 1, 1 };
+    m[n++] = (Method){ "huge in float", c, 0.0f, PTR_BUILD_RECENTRE, 0 };
+    m[n++] = (Method){ "ptr (c)", c, 0.0f, PTR_BUILD_DEFAULT, 1 };
     for (int l = PTR_CPU_SSE41; l <= (int)ptr_cpu_level(); l++) {
         PtrIsectTable t;
         ptr_isect_init_level(&t, (PtrCpuLevel)l);
@@ -23,7 +25,7 @@ int stability_methods(Method *m)
             continue;
         static char names[PTR_CPU_LEVEL_COUNT][16];
         snprintf(names[l], sizeof names[l], "ptr (%s)", t.name);
-        m[n++] = (Method){ names[l], t, 0.0f, 1, 1 };
+        m[n++] = (Method){ names[l], t, 0.0f, PTR_BUILD_DEFAULT, 1 };
     }
     return n;
 }

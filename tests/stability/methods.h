@@ -9,7 +9,7 @@ typedef struct Method {
     const char *name;
     PtrIsectTable isect;
     float fixed_tmin; /* 0: ptr's scaled offset */
-    int recentre;     /* scene coordinates relative to the camera */
+    unsigned build_flags; /* PtrBuildFlags: recentred, huge spheres in double */
     int is_ptr;       /* ptr's own method: it must pass everything */
 } Method;
 

@@ -1,0 +1,43 @@
+/* Spheres far larger than the region the rays live in, tested in double
+ * precision.
+ *
+ * A radius-1e5 ground under a scene a few units across is how many scenes
+ * make a floor. In float, f.f - r^2 for a point near such a sphere cancels
+ * two numbers near 1e10: its error is about 1e3, which puts the re-hit
+ * distance out by ~0.006 units, and the spawn offset that covers it lifts
+ * rays by ~0.1. In double the same error is 1e-6 and the geometry near the
+ * camera is exact: the limit was the arithmetic, not the scene. So such
+ * spheres are kept (last in the scene's arrays, see PtrHugeSpheres) in
+ * double precision, every ray tests them in double, and a ray leaving one
+ * is pushed off by the error of the point actually computed rather than by
+ * a share of the sphere's size.
+ *
+ * There are few of them (PTR_HUGE_MAX at most), so one scalar routine
+ * serves every intersector level: the C reference and every assembly level
+ * then agree bit for bit by construction. */
+#ifndef PTR_HUGE_H
+#define PTR_HUGE_H
+
+#include "accel/isect.h"
+#include "core/scene.h"
+
+/* Among the huge spheres, the closest hit with tmin < t < tmax, computed in
+ * double and rounded to float; on equal distances the lowest id. Writes *hit
+ * in every case (sphere: the position in the scene's arrays) and returns 1
+ * on a hit. */
+int ptr_huge_closest_hit(const PtrRay *ray, const PtrScene *scene, PtrHit *hit);
+
+/* Where ray met huge sphere hit->sphere: its outward unit normal, and a ray
+ * leaving that point along dir, computed in double and pushed off the
+ * surface by a bound on the error of rounding the point to float. */
+PtrVec3 ptr_huge_hit_normal(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit);
+PtrRay ptr_huge_spawn_ray(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
+                          PtrVec3 dir);
+
+/* Whether sphere i of the scene's arrays is one of the huge ones. */
+static inline int ptr_is_huge(const PtrScene *scene, size_t i)
+{
+    return i >= scene->spheres.count - scene->huge.count;
+}
+
+#endif /* PTR_HUGE_H */

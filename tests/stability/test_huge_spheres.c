@@ -1,0 +1,89 @@
+/* Spheres far larger than the scene (accel/huge.h), as smallpt builds a room:
+ * six radius-1e5 walls closing a 100 x 80 x 170 box, lit by a small emitter
+ * inside, the camera inside looking into a corner.
+ *
+ * The walls overlap outside the box, so no path can leave it: rendered under
+ * a black sky and under a sky of 1000, every pixel must come out the same bit
+ * for bit (same seed, so the same paths). A ray that slipped out at a corner
+ * or through a wall, or started behind one, would see the bright sky. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "builder.h"
+#include "methods.h"
+#include "core/render.h"
+#include "test.h"
+
+enum { SIZE = 32, SAMPLES = 32 };
+
+static PtrScene room(unsigned build_flags, PtrSky sky)
+{
+    const PtrMaterial wall = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.75f, 0.7f, 0.65f) };
+    const PtrMaterial light = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.0f),
+                                .emission = v3_splat(12.0f) };
+    PtrScene s;
+    uint32_t w, l;
+    ptr_scene_init(&s);
+    CHECK_INT(ptr_scene_add_material(&s, &wall, &w), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &light, &l), PTR_OK);
+    PtrSceneBuilder b;
+    ptr_builder_init(&b, &s, NULL);
+    const double big = 1e5;
+    const double walls[6][3] = {
+        { -big, 40, 85 }, { 100 + big, 40, 85 }, { 50, -big, 85 },
+        { 50, 80 + big, 85 }, { 50, 40, -big }, { 50, 40, 170 + big },
+    };
+    for (int i = 0; i < 6; i++)
+        CHECK_INT(ptr_builder_add_sphere(&b, walls[i], big, w), PTR_OK);
+    const double lamp[3] = { 50, 75, 85 };
+    CHECK_INT(ptr_builder_add_sphere(&b, lamp, 4.0, l), PTR_OK);
+    const double eye[3] = { 70, 50, 160 }, corner[3] = { 0, 0, 0 }, up[3] = { 0, 1, 0 };
+    const PtrCamera lens = { .vfov_deg = 50.0f, .focus_distance = 1.0f };
+    ptr_builder_set_camera(&b, eye, corner, up, &lens);
+    CHECK_INT(ptr_builder_finish(&b, build_flags), PTR_OK);
+    s.sky = sky;
+    return s;
+}
+
+static float *render(const Method *m, PtrSky sky)
+{
+    PtrScene s = room(m->build_flags, sky);
+    PtrRenderSettings settings = { .width = SIZE, .height = SIZE, .samples = SAMPLES, .seed = 3,
+                                   .max_depth = 50, .threads = 2, .fixed_tmin = m->fixed_tmin };
+    float *rgb = malloc(SIZE * SIZE * 3 * sizeof *rgb);
+    PtrError err = { 0 };
+    CHECK_INT(ptr_render(&s, &m->isect, &settings, rgb, NULL, &err), PTR_OK);
+    ptr_scene_free(&s);
+    return rgb;
+}
+
+int main(void)
+{
+    Method methods[MAX_METHODS];
+    int n = stability_methods(methods);
+    const PtrSky black = { .kind = PTR_SKY_BLACK };
+    const PtrSky bright = { .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(1000.0f) };
+
+    PtrScene probe = room(PTR_BUILD_DEFAULT, black);
+    CHECK_INT((int)probe.huge.count, 6); /* the walls, not the lamp */
+    ptr_scene_free(&probe);
+
+    printf("radius-1e5 walls closing a room: pixels that see the sky outside (of %d)\n",
+           SIZE * SIZE);
+    for (int i = 0; i < n; i++) {
+        float *closed = render(&methods[i], black);
+        float *open = render(&methods[i], bright);
+        int leaking = 0;
+        double mean = 0;
+        for (int p = 0; p < SIZE * SIZE; p++) {
+            leaking += memcmp(&closed[3 * p], &open[3 * p], 3 * sizeof *closed) != 0;
+            mean += closed[3 * p];
+        }
+        printf("%-20s %5d   (mean red %.4f)\n", methods[i].name, leaking, mean / (SIZE * SIZE));
+        if (methods[i].is_ptr)
+            CHECK_INT(leaking, 0);
+        free(closed);
+        free(open);
+    }
+    return test_report();
+}
