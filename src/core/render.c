@@ -156,12 +156,6 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int online_cpus(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
-}
-
 PtrRegion ptr_render_region(const PtrRenderSettings *s)
 {
     PtrRegion r = s->region;
@@ -198,7 +192,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.tiles_done, 0);
 
-    int threads = settings->threads > 0 ? settings->threads : online_cpus();
+    int threads = settings->threads > 0 ? settings->threads : ptr_online_cpus();
     if (threads > job.tile_count)
         threads = job.tile_count;
     Worker *workers = calloc((size_t)threads, sizeof *workers);

@@ -1,5 +1,6 @@
 #include "core/scene.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,13 +16,36 @@ void ptr_scene_init(PtrScene *scene)
     };
 }
 
+/* Every per-sphere array, with the value its padding entries hold: growing,
+ * freeing and reordering go through this list, so a new array is one line. */
+typedef struct SphereArray {
+    void **data;
+    size_t size;     /* of one entry */
+    uint32_t padding; /* bits of a padding entry */
+} SphereArray;
+
+enum { SPHERE_ARRAYS = 6 };
+
+static void sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS])
+{
+    union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
+    SphereArray list[SPHERE_ARRAYS] = {
+        { (void **)&s->cx, sizeof *s->cx, zero.u },
+        { (void **)&s->cy, sizeof *s->cy, zero.u },
+        { (void **)&s->cz, sizeof *s->cz, zero.u },
+        { (void **)&s->radius, sizeof *s->radius, nan_bits.u }, /* never hit */
+        { (void **)&s->material, sizeof *s->material, 0 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX },
+    };
+    memcpy(a, list, sizeof list);
+}
+
 static void spheres_free(PtrSpheres *s)
 {
-    free(s->cx);
-    free(s->cy);
-    free(s->cz);
-    free(s->radius);
-    free(s->material);
+    SphereArray a[SPHERE_ARRAYS];
+    sphere_arrays(s, a);
+    for (int k = 0; k < SPHERE_ARRAYS; k++)
+        free(*a[k].data);
     memset(s, 0, sizeof *s);
 }
 
@@ -32,39 +56,54 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-static float *aligned_floats(size_t n)
+/* Arrays like s's with room for capacity entries, the first keep entries
+ * copied from s in the order given (all of s if order is NULL) and the rest
+ * padding. Every entry is 4 bytes, so that one pass moves them all. */
+static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t capacity,
+                              PtrSpheres *out)
 {
-    return aligned_alloc(PTR_SPHERE_ALIGN, n * sizeof(float));
+    static_assert(sizeof(float) == 4 && sizeof(uint32_t) == 4, "4-byte sphere entries");
+    if (capacity > SIZE_MAX / 2 / sizeof(float))
+        return PTR_ERR_NOMEM;
+    PtrSpheres copy = { .count = s->count, .capacity = capacity };
+    SphereArray from[SPHERE_ARRAYS], to[SPHERE_ARRAYS];
+    sphere_arrays((PtrSpheres *)s, from);
+    sphere_arrays(&copy, to);
+    for (int k = 0; k < SPHERE_ARRAYS; k++) {
+        *to[k].data = aligned_alloc(PTR_SPHERE_ALIGN, capacity * to[k].size);
+        if (!*to[k].data) {
+            spheres_free(&copy);
+            return PTR_ERR_NOMEM;
+        }
+        const uint32_t *src = *from[k].data;
+        uint32_t *dst = *to[k].data;
+        for (size_t i = 0; i < capacity; i++)
+            dst[i] = i >= s->count ? to[k].padding : src[order ? order[i] : i];
+    }
+    *out = copy;
+    return PTR_OK;
 }
 
 static PtrResult spheres_grow(PtrSpheres *s)
 {
-    size_t capacity = s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK;
-    if (capacity > SIZE_MAX / 2 / sizeof(float))
-        return PTR_ERR_NOMEM;
-
-    PtrSpheres grown = { 0 };
-    grown.cx = aligned_floats(capacity);
-    grown.cy = aligned_floats(capacity);
-    grown.cz = aligned_floats(capacity);
-    grown.radius = aligned_floats(capacity);
-    grown.material = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
-    if (!grown.cx || !grown.cy || !grown.cz || !grown.radius || !grown.material) {
-        spheres_free(&grown);
-        return PTR_ERR_NOMEM;
-    }
-    grown.count = s->count;
-    grown.capacity = capacity;
-    for (size_t i = 0; i < capacity; i++) {
-        int old = i < s->count;
-        grown.cx[i] = old ? s->cx[i] : 0.0f;
-        grown.cy[i] = old ? s->cy[i] : 0.0f;
-        grown.cz[i] = old ? s->cz[i] : 0.0f;
-        grown.radius[i] = old ? s->radius[i] : NAN;
-        grown.material[i] = old ? s->material[i] : 0;
-    }
+    PtrSpheres grown;
+    PtrResult r = spheres_copy(s, NULL, s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK, &grown);
+    if (r != PTR_OK)
+        return r;
     spheres_free(s);
     *s = grown;
+    return PTR_OK;
+}
+
+PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
+{
+    PtrSpheres permuted;
+    size_t capacity = (s->count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
+    PtrResult r = spheres_copy(s, order, capacity, &permuted);
+    if (r != PTR_OK)
+        return r;
+    spheres_free(s);
+    *s = permuted;
     return PTR_OK;
 }
 
@@ -83,6 +122,7 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     s->cz[i] = centre.z;
     s->radius[i] = radius;
     s->material[i] = material;
+    s->id[i] = (uint32_t)i;
     return PTR_OK;
 }
 
