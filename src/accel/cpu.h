@@ -34,4 +34,7 @@ int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level);
  * count. */
 int ptr_online_cpus(void);
 
+/* Seconds on a monotonic clock, for timing. */
+double ptr_now_seconds(void);
+
 #endif /* PTR_CPU_H */

@@ -5,8 +5,8 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <time.h>
-#include <unistd.h>
 
+#include "accel/cpu.h"
 #include "core/camera.h"
 #include "core/material.h"
 
@@ -40,7 +40,7 @@ PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHi
 }
 
 /* The radiance one camera ray carries back. */
-static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
+static PtrVec3 trace_path(const PtrScene *scene, const PtrAccel *accel, PtrRay ray,
                           const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays)
 {
     const PtrSpheres *spheres = &scene->spheres;
@@ -51,7 +51,7 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
         PtrHit hit;
         PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
         ++*rays;
-        if (!isect->closest_hit(&ray, spheres, spheres->count, &hit)) {
+        if (!ptr_trace(accel, &ray, &hit)) {
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
@@ -80,7 +80,7 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
 
 typedef struct RenderJob {
     const PtrScene *scene;
-    const PtrIsectTable *isect;
+    const PtrAccel *accel;
     const PtrRenderSettings *settings;
     PtrView view;
     PtrRegion region;
@@ -117,7 +117,7 @@ static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
         ptr_view_ray(&job->view, x, y, sx, sy, lens_r * cosf(lens_phi),
                      lens_r * sinf(lens_phi), &o, &d);
         PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
-        PtrVec3 l = trace_path(job->scene, job->isect, ray, s, &rng, rays);
+        PtrVec3 l = trace_path(job->scene, job->accel, ray, s, &rng, rays);
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
@@ -149,13 +149,6 @@ static void *render_worker(void *arg)
     return NULL;
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 PtrRegion ptr_render_region(const PtrRenderSettings *s)
 {
     PtrRegion r = s->region;
@@ -167,13 +160,13 @@ PtrRegion ptr_render_region(const PtrRenderSettings *s)
     return r;
 }
 
-PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              const PtrRenderSettings *settings, uint32_t first, uint32_t count,
                              double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err)
 {
     RenderJob job = {
-        .scene = scene, .isect = isect, .settings = settings, .first = first, .count = count,
+        .scene = scene, .accel = accel, .settings = settings, .first = first, .count = count,
         .sums = sums, .region = ptr_render_region(settings),
     };
     if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
@@ -199,7 +192,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     if (!workers)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate %d render threads", threads);
 
-    double start = now_seconds();
+    double start = ptr_now_seconds();
     int started = 0;
     pthread_mutex_init(&job.lock, NULL);
     pthread_cond_init(&job.all_done, NULL);
@@ -244,7 +237,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
         pthread_join(workers[i].thread, NULL);
         rays += workers[i].rays;
     }
-    double seconds = now_seconds() - start;
+    double seconds = ptr_now_seconds() - start;
     free(workers);
     pthread_cond_destroy(&job.all_done);
     pthread_mutex_destroy(&job.lock);
@@ -256,7 +249,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     return PTR_OK;
 }
 
-PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err)
 {
@@ -268,7 +261,7 @@ PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
     if (!sums)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image",
                              r.x1 - r.x0, r.y1 - r.y0);
-    PtrResult res = ptr_render_samples(scene, isect, settings, 0, settings->samples, sums, NULL,
+    PtrResult res = ptr_render_samples(scene, accel, settings, 0, settings->samples, sums, NULL,
                                        NULL, stats, err);
     for (size_t i = 0; res == PTR_OK && i < values; i++)
         rgb[i] = (float)(sums[i] / (double)settings->samples);

@@ -157,17 +157,41 @@ static uint64_t hash_vec(uint64_t h, PtrVec3 v)
     return hash_bytes(h, f, sizeof f);
 }
 
+/* The entries of a 4-byte per-sphere array in file order: by_id[k] is the
+ * position of the sphere whose id is k (NULL: the arrays are in file order). */
+static uint64_t hash_in_file_order(uint64_t h, const void *array, const uint32_t *by_id,
+                                   size_t count)
+{
+    const uint32_t *a = array;
+    if (!by_id)
+        return hash_bytes(h, a, count * sizeof *a);
+    for (size_t k = 0; k < count; k++)
+        h = hash_bytes(h, &a[by_id[k]], sizeof *a);
+    return h;
+}
+
 uint64_t ptr_scene_hash(const PtrScene *scene)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
+    /* A tree reorders the spheres; the hash takes them in file order, so
+     * that parts rendered with and without one merge. (Out of memory, it
+     * takes them as they are: callers that may be short of memory hash
+     * before building a tree, as the renderer does.) */
+    size_t reordered = 0;
+    while (reordered < s->count && s->id[reordered] == reordered)
+        reordered++;
+    uint32_t *by_id = reordered < s->count ? malloc(s->count * sizeof *by_id) : NULL;
+    for (size_t j = 0; by_id && j < s->count; j++)
+        by_id[s->id[j]] = (uint32_t)j;
     h = hash_bytes(h, scene->origin, sizeof scene->origin);
     h = hash_bytes(h, &s->count, sizeof s->count);
-    h = hash_bytes(h, s->cx, s->count * sizeof *s->cx);
-    h = hash_bytes(h, s->cy, s->count * sizeof *s->cy);
-    h = hash_bytes(h, s->cz, s->count * sizeof *s->cz);
-    h = hash_bytes(h, s->radius, s->count * sizeof *s->radius);
-    h = hash_bytes(h, s->material, s->count * sizeof *s->material);
+    h = hash_in_file_order(h, s->cx, by_id, s->count);
+    h = hash_in_file_order(h, s->cy, by_id, s->count);
+    h = hash_in_file_order(h, s->cz, by_id, s->count);
+    h = hash_in_file_order(h, s->radius, by_id, s->count);
+    h = hash_in_file_order(h, s->material, by_id, s->count);
+    free(by_id);
     for (size_t i = 0; i < scene->material_count; i++) {
         const PtrMaterial *m = &scene->materials[i];
         const int kind = m->kind;

@@ -1,0 +1,60 @@
+/* How the renderer finds closest hits: brute force over all spheres, or the
+ * tree, chosen once per render by the number of spheres. The path tracer
+ * makes every query through ptr_trace. */
+#ifndef PTR_ACCEL_H
+#define PTR_ACCEL_H
+
+#include <stddef.h>
+
+#include "accel/bvh.h"
+#include "accel/isect.h"
+#include "core/result.h"
+#include "core/scene.h"
+
+typedef enum PtrAccelChoice {
+    PTR_ACCEL_AUTO,  /* brute force below PTR_ACCEL_CROSSOVER spheres, else the tree */
+    PTR_ACCEL_BRUTE,
+    PTR_ACCEL_BVH,
+} PtrAccelChoice;
+
+/* The sphere count from which the tree beats brute force, measured with
+ * bench/bvh on cloud scenes (see docs/intersectors.md, "Choosing"): at 16
+ * spheres, brute force with the AVX-512 kernel and the C traversal of the
+ * tree take about as long; above, the tree wins. */
+enum { PTR_ACCEL_CROSSOVER = 16 };
+
+typedef struct PtrAccel {
+    PtrAccelChoice kind;       /* PTR_ACCEL_BRUTE or PTR_ACCEL_BVH */
+    const PtrSpheres *spheres; /* as the tree reordered them */
+    PtrIsectTable isect;
+    PtrBvh bvh;                /* empty for brute force */
+    double build_seconds;
+} PtrAccel;
+
+/* Chooses and prepares the structure for spheres with the kernels of isect;
+ * the tree reorders the spheres (all arrays together; see bvh.h). threads:
+ * for the build, 0 for one per CPU. Only PTR_ERR_NOMEM can fail. */
+PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
+                         PtrSpheres *spheres, int threads);
+
+/* Brute force over spheres as they are: nothing to build or free. */
+PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrSpheres *spheres);
+
+void ptr_accel_free(PtrAccel *accel);
+
+/* "brute" or "bvh". */
+const char *ptr_accel_name(const PtrAccel *accel);
+
+/* Parses "auto", "brute" or "bvh"; returns 0 if it is none of them. */
+int ptr_accel_parse(const char *text, PtrAccelChoice *choice);
+
+/* The closest hit along ray, as PTR_DECL_CLOSEST_HIT describes it; on equal
+ * distances the sphere first in the scene file wins, whichever structure. */
+static inline int ptr_trace(const PtrAccel *accel, const PtrRay *ray, PtrHit *hit)
+{
+    if (accel->kind == PTR_ACCEL_BVH)
+        return accel->isect.bvh_closest_hit(ray, &accel->bvh, accel->spheres, hit);
+    return accel->isect.closest_hit(ray, accel->spheres, accel->spheres->count, hit);
+}
+
+#endif /* PTR_ACCEL_H */
