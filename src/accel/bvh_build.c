@@ -3,13 +3,16 @@
  *
  * A node is grown Embree's way: its range is split in two by the binned
  * surface area heuristic, then the child with the largest box is split
- * again, until there are eight children or none is worth splitting. A range
- * of more than PTR_BVH_LEAF_MAX spheres is always split; a smaller one only
- * while the heuristic says the split halves cost less than the leaf.
+ * again, until there are eight children or none has more spheres than a
+ * leaf holds. Ranges of up to PTR_BVH_LEAF_MAX spheres are never split: the
+ * SIMD leaf test takes 8 spheres in one step, and larger leaves keep the
+ * tree small (splitting further by the heuristic doubled the bytes per
+ * sphere and did not speed up the C traversal; measured with bench/bvh).
  *
  * Threads: the top of the tree is built on the calling thread, with the
- * binning and partitioning of large ranges spread over all threads; every
- * subtree of at most TASK_SPHERES spheres is a task built whole by one
+ * binning of large ranges spread over all threads; every
+ * subtree of at most task_spheres spheres (1/64 of all, at least
+ * TASK_SPHERES_MIN: a rule of the sphere count alone) is a task built by one
  * thread into its own node array. The arrays are then laid out in task
  * order, so the tree's bytes never depend on the number of threads. */
 #include "accel/bvh.h"
@@ -29,19 +32,24 @@ enum {
     /* From this level on ranges are split in the middle, which bounds the
      * depth by PTR_BVH_MAX_DEPTH whatever the heuristic would do. */
     MIDDLE_SPLIT_LEVEL = PTR_BVH_MAX_DEPTH - 16,
-    TASK_SPHERES = 4096,     /* subtrees at most this big are built by one thread */
+    TASK_SPHERES_MIN = 4096, /* smaller subtrees are never split among tasks */
+    TASKS_PER_TREE = 64,     /* about this many tasks, for an even load */
     TASK_FLAG = 1u << 31,    /* a top-level child that is a task, not yet laid out */
 };
 
-/* A range of prims being split into a node's children, with its bounds and
- * the best binned split found for it. */
+/* A range of prims being split into a node's children: its box, and the
+ * best binned split found for it with the boxes of its two halves. */
 typedef struct Candidate {
     size_t begin, end;
     float lower[3], upper[3];
-    int axis;            /* of the best split; -1: split in the middle of the range */
-    int split_bin;       /* prims in bins <= split_bin go left */
-    float split_cost;    /* area-weighted count of the two halves */
-    float centre_lo[3], centre_scale[3]; /* binning of the centres (lower + upper) */
+    int axis;         /* of the best split; -1: split in the middle of the range */
+    int bins;         /* BINS, fewer for small ranges */
+    int split_bin;    /* prims in bins <= split_bin go left */
+    float left_lower[3], left_upper[3], right_lower[3], right_upper[3];
+    /* Binning: a prim's bin on axis a is (lower + upper - bin_base) * bin_scale,
+     * over the candidate's box (cheaper than the box of the centres, which
+     * would need a pass of its own, and as good for spheres of similar size). */
+    float bin_base[3], bin_scale[3];
 } Candidate;
 
 /* Node arrays: the top level's, and one per task. */
@@ -59,9 +67,9 @@ typedef struct Task {
 } Task;
 
 typedef struct Build {
-    const PtrSpheres *spheres;
     BvhPrim *prims;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
+    size_t task_spheres;
     int threads;
     Task *tasks;
     size_t task_count, task_capacity;
@@ -92,41 +100,36 @@ static void bounds_grow(float lo[3], float hi[3], const float plo[3], const floa
 }
 
 /* The bins of one run of prims: boxes and counts per axis, plus the run's
- * box and the bounds of its centres (as lower + upper, twice the centre). */
+ * box. */
 typedef struct Bins {
     float lower[3][BINS][3], upper[3][BINS][3];
     size_t count[3][BINS];
-    float box_lo[3], box_hi[3], centre_lo[3], centre_hi[3];
+    float box_lo[3], box_hi[3];
 } Bins;
 
-static void bins_clear(Bins *b)
+static void bins_clear(Bins *b, int bins)
 {
     for (int a = 0; a < 3; a++)
-        for (int k = 0; k < BINS; k++) {
+        for (int k = 0; k < bins; k++) {
             bounds_empty(b->lower[a][k], b->upper[a][k]);
             b->count[a][k] = 0;
         }
     bounds_empty(b->box_lo, b->box_hi);
-    bounds_empty(b->centre_lo, b->centre_hi);
 }
 
 static int bin_of(const Candidate *c, const BvhPrim *p, int axis)
 {
     float centre = p->lower[axis] + p->upper[axis];
-    int k = (int)((centre - c->centre_lo[axis]) * c->centre_scale[axis]);
-    return k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
+    /* Clamped as a float, then converted: no branch, and a NaN-free range. */
+    float k = (centre - c->bin_base[axis]) * c->bin_scale[axis];
+    return (int)ptr_minf(ptr_maxf(k, 0.0f), (float)(c->bins - 1));
 }
 
-/* Bounds only (the first pass over a range whose centre bounds are unknown). */
+/* The box only (of a range split in the middle, or of the root). */
 static void bound_run(const BvhPrim *prims, size_t begin, size_t end, Bins *b)
 {
-    for (size_t i = begin; i < end; i++) {
-        const BvhPrim *p = &prims[i];
-        float centre[3] = { p->lower[0] + p->upper[0], p->lower[1] + p->upper[1],
-                            p->lower[2] + p->upper[2] };
-        bounds_grow(b->box_lo, b->box_hi, p->lower, p->upper);
-        bounds_grow(b->centre_lo, b->centre_hi, centre, centre);
-    }
+    for (size_t i = begin; i < end; i++)
+        bounds_grow(b->box_lo, b->box_hi, prims[i].lower, prims[i].upper);
 }
 
 static void bin_run(const BvhPrim *prims, size_t begin, size_t end, const Candidate *c, Bins *b)
@@ -141,15 +144,14 @@ static void bin_run(const BvhPrim *prims, size_t begin, size_t end, const Candid
     }
 }
 
-static void bins_merge(Bins *into, const Bins *b)
+static void bins_merge(Bins *into, const Bins *b, int bins)
 {
     for (int a = 0; a < 3; a++)
-        for (int k = 0; k < BINS; k++) {
+        for (int k = 0; k < bins; k++) {
             bounds_grow(into->lower[a][k], into->upper[a][k], b->lower[a][k], b->upper[a][k]);
             into->count[a][k] += b->count[a][k];
         }
     bounds_grow(into->box_lo, into->box_hi, b->box_lo, b->box_hi);
-    bounds_grow(into->centre_lo, into->centre_hi, b->centre_lo, b->centre_hi);
 }
 
 /* Runs of this many prims are bounded, binned and partitioned by all threads
@@ -170,7 +172,7 @@ static void *parallel_bin_worker(void *arg)
     size_t n = r->end - r->begin;
     size_t lo = r->begin + n * (size_t)r->thread / (size_t)r->threads;
     size_t hi = r->begin + n * (size_t)(r->thread + 1) / (size_t)r->threads;
-    bins_clear(r->bins);
+    bins_clear(r->bins, r->candidate ? r->candidate->bins : 0);
     if (r->candidate)
         bin_run(r->build->prims, lo, hi, r->candidate, r->bins);
     else
@@ -184,99 +186,115 @@ static void *parallel_bin_worker(void *arg)
 static int bin_range(const Build *build, size_t begin, size_t end, const Candidate *c, Bins *out)
 {
     int threads = end - begin >= PARALLEL_PRIMS ? build->threads : 1;
+    int bins = c ? c->bins : 0;
     if (threads == 1) {
-        bins_clear(out);
+        bins_clear(out, bins);
         if (c)
             bin_run(build->prims, begin, end, c, out);
         else
             bound_run(build->prims, begin, end, out);
         return 1;
     }
-    Bins *bins = malloc((size_t)threads * sizeof *bins);
+    Bins *per_thread = malloc((size_t)threads * sizeof *per_thread);
     ParallelRun *runs = malloc((size_t)threads * sizeof *runs);
     pthread_t *ids = malloc((size_t)threads * sizeof *ids);
-    if (!bins || !runs || !ids) {
-        free(bins);
+    if (!per_thread || !runs || !ids) {
+        free(per_thread);
         free(runs);
         free(ids);
         return 0;
     }
-    int started = 1;
-    for (int t = 0; t < threads; t++) {
-        runs[t] = (ParallelRun){ build, begin, end, c, &bins[t], t, threads };
-        if (t > 0 && pthread_create(&ids[t], NULL, parallel_bin_worker, &runs[t]) == 0)
-            started = t + 1;
-        else if (t > 0)
-            parallel_bin_worker(&runs[t]); /* no thread: do its share here */
-    }
+    int started = 1; /* threads 1 .. started - 1 run; the rest are done here */
+    for (int t = 0; t < threads; t++)
+        runs[t] = (ParallelRun){ build, begin, end, c, &per_thread[t], t, threads };
+    while (started < threads &&
+           pthread_create(&ids[started], NULL, parallel_bin_worker, &runs[started]) == 0)
+        started++;
     parallel_bin_worker(&runs[0]);
+    for (int t = started; t < threads; t++)
+        parallel_bin_worker(&runs[t]);
     for (int t = 1; t < started; t++)
         pthread_join(ids[t], NULL);
-    bins_clear(out);
+    bins_clear(out, bins);
     for (int t = 0; t < threads; t++)
-        bins_merge(out, &bins[t]);
-    free(bins);
+        bins_merge(out, &per_thread[t], bins);
+    free(per_thread);
     free(runs);
     free(ids);
     return 1;
 }
 
-/* Fills c's bounds and best split from the prims of its range. */
-static int candidate_init(const Build *build, Candidate *c, size_t begin, size_t end)
+/* Sets c to the range begin .. end - 1 with box lower, upper (NULL: find
+ * it) and, if it has more prims than a leaf holds, finds its best split.
+ * Returns 0 if out of memory. */
+static int candidate_init(const Build *build, Candidate *c, size_t begin, size_t end,
+                          const float lower[3], const float upper[3])
 {
-    Bins *bins = malloc(sizeof *bins);
-    if (!bins || !bin_range(build, begin, end, NULL, bins)) {
-        free(bins);
-        return 0;
-    }
+    Bins bins;
     c->begin = begin;
     c->end = end;
-    memcpy(c->lower, bins->box_lo, sizeof c->lower);
-    memcpy(c->upper, bins->box_hi, sizeof c->upper);
+    c->axis = -1;
+    if (!lower) {
+        if (!bin_range(build, begin, end, NULL, &bins))
+            return 0;
+        lower = bins.box_lo;
+        upper = bins.box_hi;
+    }
+    memcpy(c->lower, lower, sizeof c->lower);
+    memcpy(c->upper, upper, sizeof c->upper);
+    if (end - begin <= PTR_BVH_LEAF_MAX)
+        return 1;
+    /* Embree's rule: few bins for few prims, where more would mostly be
+     * empty and only cost time. */
+    c->bins = 4 + (int)((end - begin) / 20);
+    if (c->bins > BINS)
+        c->bins = BINS;
     int spread = 0;
     for (int a = 0; a < 3; a++) {
-        float extent = bins->centre_hi[a] - bins->centre_lo[a];
-        c->centre_lo[a] = bins->centre_lo[a];
-        /* Just under BINS / extent, so the largest centre lands in the last bin. */
-        c->centre_scale[a] = extent > 0.0f ? (float)BINS * 0.99999f / extent : 0.0f;
+        float extent = 2.0f * (c->upper[a] - c->lower[a]);
+        c->bin_base[a] = 2.0f * c->lower[a];
+        /* Just under bins / extent, so the largest centre lands in the last bin. */
+        c->bin_scale[a] = extent > 0.0f ? (float)c->bins * 0.99999f / extent : 0.0f;
         spread |= extent > 0.0f;
     }
-    c->axis = -1;
-    c->split_cost = INFINITY;
-    if (!spread || end - begin < 2 || !bin_range(build, begin, end, c, bins)) {
-        int ok = !spread || end - begin < 2;
-        free(bins);
-        return ok;
-    }
+    if (!spread)
+        return 1;
+    if (!bin_range(build, begin, end, c, &bins))
+        return 0;
+    float best = INFINITY;
     for (int a = 0; a < 3; a++) {
-        float right_area[BINS];
+        float right_lo[BINS][3], right_hi[BINS][3];
         size_t right_count[BINS];
         float lo[3], hi[3];
         bounds_empty(lo, hi);
         size_t n = 0;
-        for (int k = BINS - 1; k > 0; k--) {
-            bounds_grow(lo, hi, bins->lower[a][k], bins->upper[a][k]);
-            n += bins->count[a][k];
-            right_area[k] = half_area(lo, hi);
+        for (int k = c->bins - 1; k > 0; k--) {
+            bounds_grow(lo, hi, bins.lower[a][k], bins.upper[a][k]);
+            n += bins.count[a][k];
+            memcpy(right_lo[k], lo, sizeof lo);
+            memcpy(right_hi[k], hi, sizeof hi);
             right_count[k] = n;
         }
         bounds_empty(lo, hi);
         n = 0;
-        for (int k = 0; k < BINS - 1; k++) {
-            bounds_grow(lo, hi, bins->lower[a][k], bins->upper[a][k]);
-            n += bins->count[a][k];
+        for (int k = 0; k < c->bins - 1; k++) {
+            bounds_grow(lo, hi, bins.lower[a][k], bins.upper[a][k]);
+            n += bins.count[a][k];
             if (n == 0 || right_count[k + 1] == 0)
                 continue;
             float cost = half_area(lo, hi) * (float)n +
-                         right_area[k + 1] * (float)right_count[k + 1];
-            if (cost < c->split_cost) {
-                c->split_cost = cost;
+                         half_area(right_lo[k + 1], right_hi[k + 1]) * (float)right_count[k + 1];
+            if (cost < best) {
+                best = cost;
                 c->axis = a;
                 c->split_bin = k;
+                memcpy(c->left_lower, lo, sizeof lo);
+                memcpy(c->left_upper, hi, sizeof hi);
+                memcpy(c->right_lower, right_lo[k + 1], sizeof lo);
+                memcpy(c->right_upper, right_hi[k + 1], sizeof hi);
             }
         }
     }
-    free(bins);
     return 1;
 }
 
@@ -304,15 +322,19 @@ static size_t partition(const Build *build, const Candidate *c)
     }
 }
 
-/* Whether splitting c pays: always above PTR_BVH_LEAF_MAX spheres, else if
- * the two halves cost less than the leaf by the heuristic. */
-static int worth_splitting(const Candidate *c)
+/* Splits c in two (into *left and *right, which may be c). */
+static int split(const Build *build, const Candidate *c, int level, Candidate *left,
+                 Candidate *right)
 {
-    size_t n = c->end - c->begin;
-    if (n > PTR_BVH_LEAF_MAX)
-        return 1;
-    return n > 1 && c->axis >= 0 &&
-           c->split_cost < LEAF_SPLIT_GAIN * half_area(c->lower, c->upper) * (float)n;
+    Candidate whole = *c;
+    if (level >= MIDDLE_SPLIT_LEVEL)
+        whole.axis = -1;
+    size_t mid = partition(build, &whole);
+    if (whole.axis < 0)
+        return candidate_init(build, left, whole.begin, mid, NULL, NULL) &&
+               candidate_init(build, right, mid, whole.end, NULL, NULL);
+    return candidate_init(build, left, whole.begin, mid, whole.left_lower, whole.left_upper) &&
+           candidate_init(build, right, mid, whole.end, whole.right_lower, whole.right_upper);
 }
 
 static int node_array_add(NodeArray *a, size_t *index)
@@ -349,7 +371,7 @@ static int add_task(Build *build, size_t begin, size_t end, int level, uint32_t 
 
 /* Builds the node at this level over c's range into nodes (its index in
  * *index), and its inner children below it; depth: levels below the node. In
- * the top level (top set), inner children of at most TASK_SPHERES spheres
+ * the top level (top set), inner children of at most task_spheres spheres
  * become tasks. */
 static int build_node(Build *build, NodeArray *nodes, const Candidate *range, int top,
                       int level, size_t *index, int *depth)
@@ -362,19 +384,14 @@ static int build_node(Build *build, NodeArray *nodes, const Candidate *range, in
         float pick_area = -1.0f;
         for (int k = 0; k < n; k++) {
             float area = half_area(child[k].lower, child[k].upper);
-            if (worth_splitting(&child[k]) && area > pick_area) {
+            if (child[k].end - child[k].begin > PTR_BVH_LEAF_MAX && area > pick_area) {
                 pick = k;
                 pick_area = area;
             }
         }
         if (pick < 0)
             break;
-        Candidate whole = child[pick];
-        if (level >= MIDDLE_SPLIT_LEVEL)
-            whole.axis = -1;
-        size_t mid = partition(build, &whole);
-        if (!candidate_init(build, &child[pick], whole.begin, mid) ||
-            !candidate_init(build, &child[n], mid, whole.end))
+        if (!split(build, &child[pick], level, &child[pick], &child[n]))
             return 0;
     }
 
@@ -399,14 +416,14 @@ static int build_node(Build *build, NodeArray *nodes, const Candidate *range, in
         node.upper_y[k] = c->upper[1];
         node.upper_z[k] = c->upper[2];
         size_t count = c->end - c->begin;
-        if (count <= PTR_BVH_LEAF_MAX && !worth_splitting(c)) {
-            ptr_bvh_sort_leaf(build->prims + c->begin, count, build->spheres);
+        if (count <= PTR_BVH_LEAF_MAX) {
+            ptr_bvh_sort_leaf(build->prims + c->begin, count);
             node.child[k] = (uint32_t)(build->first_sphere + c->begin);
             node.leaf_count[k] = (uint32_t)count;
             continue;
         }
         node.leaf_count[k] = 0;
-        if (top && count <= TASK_SPHERES) {
+        if (top && count <= build->task_spheres) {
             uint32_t task;
             if (!add_task(build, c->begin, c->end, level + 1, &task))
                 return 0;
@@ -435,7 +452,7 @@ static void *task_worker(void *arg)
         Task *t = &build->tasks[i];
         Candidate range;
         size_t root;
-        t->failed = !candidate_init(build, &range, t->begin, t->end) ||
+        t->failed = !candidate_init(build, &range, t->begin, t->end, NULL, NULL) ||
                     !build_node(build, &t->nodes, &range, 0, t->level, &root, &t->nodes.depth);
     }
 }
@@ -512,7 +529,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, int threads)
     if (count >= TASK_FLAG)
         return PTR_ERR_NOMEM;
     uint32_t *order = malloc((count ? count : 1) * sizeof *order);
-    Build build = { .spheres = spheres, .threads = threads > 0 ? threads : ptr_online_cpus() };
+    Build build = { .threads = threads > 0 ? threads : ptr_online_cpus() };
     build.prims = malloc((count ? count : 1) * sizeof *build.prims);
     NodeArray top = { 0 };
     int ok = order && build.prims;
@@ -520,10 +537,12 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, int threads)
     if (ok)
         ok = ptr_bvh_prims(spheres, order, &bvh->unbounded_count, build.prims, &prim_count);
     build.first_sphere = bvh->unbounded_count;
+    build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
+                             ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
     if (ok && prim_count > 0) {
         Candidate root;
         size_t index;
-        ok = candidate_init(&build, &root, 0, prim_count) &&
+        ok = candidate_init(&build, &root, 0, prim_count, NULL, NULL) &&
              build_node(&build, &top, &root, 1, 0, &index, &top.depth) && run_tasks(&build) &&
              lay_out(&build, &top, bvh);
     }

@@ -146,18 +146,19 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
         p->upper[1] = s->cy[i] + extent;
         p->upper[2] = s->cz[i] + extent;
         p->index = (uint32_t)i;
+        p->id = s->id[i];
     }
     *unbounded_count = u;
     *prim_count = n;
     return 1;
 }
 
-void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count, const PtrSpheres *s)
+void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)
 {
     for (size_t i = 1; i < count; i++) {
         BvhPrim v = prims[i];
         size_t j = i;
-        for (; j > 0 && s->id[prims[j - 1].index] > s->id[v.index]; j--)
+        for (; j > 0 && prims[j - 1].id > v.id; j--)
             prims[j] = prims[j - 1];
         prims[j] = v;
     }

@@ -11,13 +11,8 @@
 typedef struct BvhPrim {
     float lower[3], upper[3];
     uint32_t index; /* of the sphere in the arrays as they were before the build */
+    uint32_t id;    /* the sphere's id, which orders a leaf */
 } BvhPrim;
-
-/* A leaf of n spheres costs n sphere tests; its two halves by the heuristic
- * cost their area-weighted counts. Splitting a small range pays only when the
- * halves cost less than this share of the leaf: below PTR_BVH_LEAF_MAX the
- * extra child is a box test that saves little (measured with bench/bvh). */
-#define LEAF_SPLIT_GAIN 0.7f
 
 /* Puts the spheres kept out of the tree at order[0 .. *unbounded_count - 1]
  * (by ascending id) and a box for each of the others in prims (their count
@@ -26,6 +21,6 @@ int ptr_bvh_prims(const PtrSpheres *spheres, uint32_t *order, size_t *unbounded_
                   BvhPrim *prims, size_t *prim_count);
 
 /* Sorts a leaf's prims by ascending sphere id. */
-void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count, const PtrSpheres *spheres);
+void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count);
 
 #endif /* PTR_BVH_PRIMS_H */
