@@ -3,9 +3,12 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "accel/accel.h"
 #include "accel/bvh.h"
 #include "accel/isect.h"
 #include "bvh_scenes.h"
+#include "core/render.h"
+#include "importer.h"
 #include "test.h"
 
 /* Walks the tree: every sphere in the tree is in exactly one leaf, every
@@ -209,11 +212,128 @@ static void test_small(void)
     ptr_scene_free(&s);
 }
 
+/* Renders scene with the C kernels through the structure chosen; returns
+ * the image (3 floats a pixel) or NULL. */
+static float *render_with(PtrScene *scene, PtrAccelChoice choice, int width, int height,
+                          const char **used)
+{
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    PtrAccel accel;
+    CHECK_INT(ptr_accel_init(&accel, choice, &c, &scene->spheres, 3), PTR_OK);
+    *used = ptr_accel_name(&accel);
+    PtrRenderSettings settings = { .width = width, .height = height, .samples = 3, .seed = 9,
+                                   .max_depth = 12, .threads = 2 };
+    float *rgb = malloc((size_t)width * (size_t)height * 3 * sizeof *rgb);
+    PtrError err = { 0 };
+    CHECK_INT(ptr_render(scene, &accel, &settings, rgb, NULL, &err), PTR_OK);
+    ptr_accel_free(&accel);
+    return rgb;
+}
+
+/* Brute force and the tree render the same image, bit for bit, and the
+ * scene's hash does not change when the tree reorders the spheres. */
+static void check_same_render(PtrScene *brute, PtrScene *tree, int width, int height,
+                              const char *name)
+{
+    uint64_t hash = ptr_scene_hash(tree);
+    const char *a, *b;
+    float *x = render_with(brute, PTR_ACCEL_BRUTE, width, height, &a);
+    float *y = render_with(tree, PTR_ACCEL_BVH, width, height, &b);
+    CHECK_STR(a, "brute");
+    CHECK_STR(b, "bvh");
+    int same = !memcmp(x, y, (size_t)width * (size_t)height * 3 * sizeof *x);
+    if (!same)
+        fprintf(stderr, "%s: brute force and the tree render differently\n", name);
+    CHECK(same);
+    CHECK(ptr_scene_hash(tree) == hash);
+    CHECK(ptr_scene_hash(brute) == hash);
+    free(x);
+    free(y);
+}
+
+static void test_renders_files(void)
+{
+    const char *files[] = { PTR_SOURCE_DIR "/scenes/seed.gltf", PTR_SOURCE_DIR "/scenes/final.gltf" };
+    for (int f = 0; f < 2; f++) {
+        PtrScene a, b;
+        PtrStrings warnings = { 0 };
+        PtrError err = { 0 };
+        CHECK_INT(ptr_import_scene(files[f], NULL, &a, &warnings, &err), PTR_OK);
+        CHECK_INT(ptr_import_scene(files[f], NULL, &b, &warnings, &err), PTR_OK);
+        ptr_strings_free(&warnings);
+        check_same_render(&a, &b, 48, 27, files[f]);
+        ptr_scene_free(&a);
+        ptr_scene_free(&b);
+    }
+}
+
+/* The hard sets with mixed materials, seen from outside their bounds. */
+static void test_renders_hard(void)
+{
+    const PtrMaterial materials[3] = {
+        { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.6f, 0.4f, 0.3f } },
+        { .kind = PTR_MATERIAL_METAL, .albedo = { 0.9f, 0.9f, 0.9f } },
+        { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = { 1, 1, 1 }, .ior = 1.5f },
+    };
+    for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++) {
+        PtrScene s[2];
+        for (int k = 0; k < 2; k++) {
+            ptr_scene_init(&s[k]);
+            for (int m = 0; m < 3; m++) {
+                uint32_t index;
+                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index), PTR_OK);
+            }
+            CHECK(bvh_scene_make(&s[k], (BvhSceneKind)kind, 600, 4));
+            float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+            PtrSpheres *sp = &s[k].spheres;
+            for (size_t i = 0; i < sp->count; i++) {
+                sp->material[i] = (uint32_t)(i % 3);
+                if (sp->radius[i] > 100.0f) /* a ground: look at what stands on it */
+                    continue;
+                float c[3] = { sp->cx[i], sp->cy[i], sp->cz[i] };
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fminf(lo[a], c[a] - sp->radius[i]);
+                    hi[a] = fmaxf(hi[a], c[a] + sp->radius[i]);
+                }
+            }
+            PtrVec3 centre = v3(0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]), 0.5f * (lo[2] + hi[2]));
+            float size = fmaxf(hi[0] - lo[0], fmaxf(hi[1] - lo[1], hi[2] - lo[2]));
+            s[k].camera = (PtrCamera){ .lookfrom = v3_add(centre, v3(0.3f * size, 0.5f * size, 1.5f * size)),
+                                       .lookat = centre, .up = v3(0, 1, 0), .vfov_deg = 50.0f,
+                                       .focus_distance = 1.0f };
+        }
+        check_same_render(&s[0], &s[1], 40, 30, bvh_scene_names[kind]);
+        ptr_scene_free(&s[0]);
+        ptr_scene_free(&s[1]);
+    }
+}
+
+/* auto: brute force below the crossover, the tree from it on. */
+static void test_auto(void)
+{
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    for (int n = PTR_ACCEL_CROSSOVER - 1; n <= PTR_ACCEL_CROSSOVER; n++) {
+        PtrScene s;
+        ptr_scene_init(&s);
+        CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
+        PtrAccel accel;
+        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, &s.spheres, 0), PTR_OK);
+        CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER ? "brute" : "bvh");
+        ptr_accel_free(&accel);
+        ptr_scene_free(&s);
+    }
+}
+
 int main(void)
 {
     test_small();
     test_unbounded();
     test_scenes();
     test_threads();
+    test_auto();
+    test_renders_files();
+    test_renders_hard();
     return test_report();
 }
