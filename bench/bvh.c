@@ -5,6 +5,10 @@
  * brute force and with the tree, C and the fastest assembly the table has.
  *
  *   bvh [OUT.csv] [MAX_SPHERES] [WIDTH HEIGHT SPP]
+ *   bvh --crossover [WIDTH HEIGHT SPP]
+ *
+ * The second form renders clouds of 3 to 1023 spheres (and the ground), to
+ * find where the tree starts to beat brute force (PTR_ACCEL_CROSSOVER).
  *
  * Prints, per sphere count: the tree's build seconds, the bytes per sphere
  * of the tree plus the sphere arrays, and the render's Mrays/s (camera and
@@ -89,15 +93,16 @@ static double mrays(const PtrScene *scene, const PtrAccel *accel, const Setup *s
 
 int main(int argc, char **argv)
 {
-    FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
-    if (argc > 1 && !csv) {
+    int crossover = argc > 1 && !strcmp(argv[1], "--crossover");
+    FILE *csv = argc > 1 && !crossover ? fopen(argv[1], "w") : NULL;
+    if (argc > 1 && !crossover && !csv) {
         fprintf(stderr, "bvh: cannot write %s\n", argv[1]);
         return 1;
     }
-    size_t max_spheres = argc > 2 ? strtoull(argv[2], NULL, 10) : 1000000;
+    size_t max_spheres = crossover ? 1023 : argc > 2 ? strtoull(argv[2], NULL, 10) : 1000000;
     Setup setup = { 200, 113, 2 };
-    if (argc > 5)
-        setup = (Setup){ atoi(argv[3]), atoi(argv[4]), (uint32_t)atoi(argv[5]) };
+    if (argc > 5 || (crossover && argc > 4))
+        setup = (Setup){ atoi(argv[argc - 3]), atoi(argv[argc - 2]), (uint32_t)atoi(argv[argc - 1]) };
 
     PtrIsectTable c, fastest;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
@@ -108,7 +113,7 @@ int main(int argc, char **argv)
            "brute c", "brute asm", "bvh c", "bvh asm");
     if (csv)
         fprintf(csv, "spheres,build_seconds,bytes_per_sphere,brute_c,brute_asm,bvh_c,bvh_asm,asm\n");
-    for (size_t n = 1000; n <= max_spheres; n *= 10) {
+    for (size_t n = crossover ? 3 : 1000; n <= max_spheres; n = crossover ? 2 * n + 1 : 10 * n) {
         PtrScene scene;
         if (!make_cloud(&scene, n, 7)) {
             fprintf(stderr, "bvh: out of memory at %zu spheres\n", n);

@@ -314,13 +314,13 @@ static void test_auto(void)
 {
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
-    for (int n = PTR_ACCEL_CROSSOVER - 1; n <= PTR_ACCEL_CROSSOVER; n++) {
+    for (int n = PTR_ACCEL_CROSSOVER_C - 1; n <= PTR_ACCEL_CROSSOVER_C; n++) {
         PtrScene s;
         ptr_scene_init(&s);
         CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
         PtrAccel accel;
         CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, &s.spheres, 0), PTR_OK);
-        CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER ? "brute" : "bvh");
+        CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER_C ? "brute" : "bvh");
         ptr_accel_free(&accel);
         ptr_scene_free(&s);
     }

@@ -14,7 +14,7 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
 {
     *accel = ptr_accel_brute(isect, spheres);
     if (choice == PTR_ACCEL_BRUTE ||
-        (choice == PTR_ACCEL_AUTO && spheres->count < PTR_ACCEL_CROSSOVER))
+        (choice == PTR_ACCEL_AUTO && spheres->count < ptr_accel_crossover(isect)))
         return PTR_OK;
     double start = ptr_now_seconds();
     PtrResult r = ptr_bvh_build(&accel->bvh, spheres, threads);
@@ -23,6 +23,12 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
     accel->kind = PTR_ACCEL_BVH;
     accel->build_seconds = ptr_now_seconds() - start;
     return PTR_OK;
+}
+
+size_t ptr_accel_crossover(const PtrIsectTable *isect)
+{
+    return isect->closest_hit == ptr_closest_hit_c ? PTR_ACCEL_CROSSOVER_C
+                                                   : PTR_ACCEL_CROSSOVER_ASM;
 }
 
 void ptr_accel_free(PtrAccel *accel)

@@ -12,16 +12,21 @@
 #include "core/scene.h"
 
 typedef enum PtrAccelChoice {
-    PTR_ACCEL_AUTO,  /* brute force below PTR_ACCEL_CROSSOVER spheres, else the tree */
+    PTR_ACCEL_AUTO,  /* brute force below the crossover, else the tree */
     PTR_ACCEL_BRUTE,
     PTR_ACCEL_BVH,
 } PtrAccelChoice;
 
-/* The sphere count from which the tree beats brute force, measured with
- * bench/bvh on cloud scenes (see docs/intersectors.md, "Choosing"): at 16
- * spheres, brute force with the AVX-512 kernel and the C traversal of the
- * tree take about as long; above, the tree wins. */
-enum { PTR_ACCEL_CROSSOVER = 16 };
+/* The sphere counts from which the tree beats brute force, measured with
+ * `bench/bvh --crossover` (cloud scenes, 200x113, 4 spp, 2 threads; see
+ * docs/intersectors.md, "Choosing"). With the C kernels the C traversal
+ * overtakes brute force between 32 (4.9 against 5.3 Mrays/s) and 64
+ * spheres; the AVX-512 brute-force kernel holds out against the C traversal
+ * up to between 256 (3.6 against 2.0 Mrays/s) and 512 (1.7 against 2.3). */
+enum { PTR_ACCEL_CROSSOVER_C = 48, PTR_ACCEL_CROSSOVER_ASM = 384 };
+
+/* The crossover for brute force with isect's kernel. */
+size_t ptr_accel_crossover(const PtrIsectTable *isect);
 
 typedef struct PtrAccel {
     PtrAccelChoice kind;       /* PTR_ACCEL_BRUTE or PTR_ACCEL_BVH */

@@ -42,6 +42,7 @@
 #include <assert.h>
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 
 #include "accel/sphere_hit.h"
 
@@ -75,12 +76,21 @@ PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
     }
 
     if (bvh->nodes) {
+        /* Per ray: the reciprocal direction, and which of each axis's two
+         * planes is met first, as the offset of its array in a node. */
         float org[3], inv[3];
-        int flip[3]; /* 1: the near plane is the upper one */
+        size_t near[3], far[3];
+        static const size_t lower[3] = { offsetof(PtrBvhNode, lower_x),
+                                         offsetof(PtrBvhNode, lower_y),
+                                         offsetof(PtrBvhNode, lower_z) };
+        static const size_t upper[3] = { offsetof(PtrBvhNode, upper_x),
+                                         offsetof(PtrBvhNode, upper_y),
+                                         offsetof(PtrBvhNode, upper_z) };
         for (int a = 0; a < 3; a++) {
             org[a] = ray->org[a];
             inv[a] = ptr_minf(ptr_maxf(1.0f / ray->dir[a], -FLT_MAX), FLT_MAX);
-            flip[a] = signbit(inv[a]) != 0;
+            near[a] = signbit(inv[a]) ? upper[a] : lower[a];
+            far[a] = signbit(inv[a]) ? lower[a] : upper[a];
         }
         float best_up = best * PTR_BVH_SLACK;
         StackEntry stack[PTR_BVH_MAX_DEPTH * (PTR_BVH_WIDTH - 1) + 1];
@@ -103,26 +113,27 @@ PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
                 continue;
             }
             const PtrBvhNode *node = &bvh->nodes[e.child];
-            const float *lo[3] = { node->lower_x, node->lower_y, node->lower_z };
-            const float *hi[3] = { node->upper_x, node->upper_y, node->upper_z };
-            StackEntry hits[PTR_BVH_WIDTH];
-            int n = 0;
+            const char *base = (const char *)node;
+            float entry[PTR_BVH_WIDTH], exit[PTR_BVH_WIDTH];
             for (int k = 0; k < PTR_BVH_WIDTH; k++) {
                 float tn[3], tf[3];
                 for (int a = 0; a < 3; a++) {
-                    tn[a] = ((flip[a] ? hi : lo)[a][k] - org[a]) * inv[a];
-                    tf[a] = ((flip[a] ? lo : hi)[a][k] - org[a]) * inv[a];
+                    tn[a] = (((const float *)(base + near[a]))[k] - org[a]) * inv[a];
+                    tf[a] = (((const float *)(base + far[a]))[k] - org[a]) * inv[a];
                 }
-                const float entry = ptr_maxf(ptr_maxf(ptr_maxf(tn[0], tn[1]), tn[2]), tmin);
-                const float exit =
-                    ptr_minf(ptr_minf(ptr_minf(tf[0], tf[1]), tf[2]) * PTR_BVH_SLACK, best_up);
-                if (!(entry <= exit))
+                entry[k] = ptr_maxf(ptr_maxf(ptr_maxf(tn[0], tn[1]), tn[2]), tmin);
+                exit[k] = ptr_minf(ptr_minf(ptr_minf(tf[0], tf[1]), tf[2]) * PTR_BVH_SLACK, best_up);
+            }
+            StackEntry hits[PTR_BVH_WIDTH];
+            int n = 0;
+            for (int k = 0; k < PTR_BVH_WIDTH; k++) {
+                if (!(entry[k] <= exit[k]))
                     continue;
                 /* Sorted farthest first, so that the nearest is popped first. */
                 int j = n++;
-                for (; j > 0 && hits[j - 1].entry < entry; j--)
+                for (; j > 0 && hits[j - 1].entry < entry[k]; j--)
                     hits[j] = hits[j - 1];
-                hits[j] = (StackEntry){ node->child[k], node->leaf_count[k], entry };
+                hits[j] = (StackEntry){ node->child[k], node->leaf_count[k], entry[k] };
             }
             for (int j = 0; j < n; j++)
                 stack[top++] = hits[j];

@@ -99,7 +99,8 @@ static void print_help(FILE *out)
         "      --fit-all-objects OBJ: fit every object, not only those named *sphere*\n"
         "      --accel A         auto, brute or bvh: test every sphere, or build a\n"
         "                        tree over them first (default auto: the tree from\n"
-        "                        %d spheres on); the image is the same\n"
+        "                        %d spheres on with --c, %d with assembly); the\n"
+        "                        image is the same\n"
         "      --c               use the portable C intersector (the reference)\n"
         "      --asm             use the fastest assembly intersector; an error if none\n"
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
@@ -134,7 +135,8 @@ static void print_help(FILE *out)
         "samples done (exit 8); a second aborts at once, writing nothing (exit 130).\n"
         "\n"
         "Exit codes:\n",
-        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, PTR_ACCEL_CROSSOVER);
+        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, PTR_ACCEL_CROSSOVER_C,
+        PTR_ACCEL_CROSSOVER_ASM);
     for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
         fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
