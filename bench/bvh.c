@@ -11,8 +11,9 @@
  * find where the tree starts to beat brute force (PTR_ACCEL_CROSSOVER).
  *
  * Prints, per sphere count: the tree's build seconds, the bytes per sphere
- * of the tree plus the sphere arrays, and the render's Mrays/s (camera and
- * scattered rays) for each method; writes the same as CSV rows if asked.
+ * of the tree plus the sphere arrays, the render's Mrays/s (camera and
+ * scattered rays) for each method, and the seconds of the tree's render with
+ * the table's traversal (build + that: the figure to set against Embree's); writes the same as CSV rows if asked.
  * Brute force is skipped where one render would take more than about a
  * minute (from 10^5 spheres on), and shown as "-". */
 #include <inttypes.h>
@@ -78,8 +79,9 @@ typedef struct Setup {
     uint32_t spp;
 } Setup;
 
-/* Mrays/s of one render, or NAN if it fails. */
-static double mrays(const PtrScene *scene, const PtrAccel *accel, const Setup *setup)
+/* Mrays/s of one render (its seconds in *seconds), or NAN if it fails. */
+static double mrays(const PtrScene *scene, const PtrAccel *accel, const Setup *setup,
+                    double *seconds)
 {
     PtrRenderSettings s = { .width = setup->width, .height = setup->height,
                             .samples = setup->spp, .seed = 1, .max_depth = 50 };
@@ -88,6 +90,7 @@ static double mrays(const PtrScene *scene, const PtrAccel *accel, const Setup *s
     PtrError err = { 0 };
     int ok = rgb && ptr_render(scene, accel, &s, rgb, &stats, &err) == PTR_OK;
     free(rgb);
+    *seconds = ok ? stats.seconds : NAN;
     return ok ? (double)stats.rays / stats.seconds * 1e-6 : NAN;
 }
 
@@ -109,8 +112,8 @@ int main(int argc, char **argv)
     ptr_isect_init(&fastest, PTR_KERNEL_AUTO, SIZE_MAX);
     printf("cloud scenes, %dx%d, %" PRIu32 " spp, %d threads; Mrays/s (camera and scattered rays)\n",
            setup.width, setup.height, setup.spp, ptr_online_cpus());
-    printf("%9s %9s %8s %5s %11s %11s %11s %11s\n", "spheres", "build s", "bytes/sp", "depth",
-           "brute c", "brute asm", "bvh c", "bvh asm");
+    printf("%9s %9s %8s %5s %11s %11s %11s %11s %11s\n", "spheres", "build s", "bytes/sp", "depth",
+           "brute c", "brute asm", "bvh c", "bvh asm", "bvh asm s");
     if (csv)
         fprintf(csv, "spheres,build_seconds,bytes_per_sphere,brute_c,brute_asm,bvh_c,bvh_asm,asm\n");
     for (size_t n = crossover ? 3 : 1000; n <= max_spheres; n = crossover ? 2 * n + 1 : 10 * n) {
@@ -119,12 +122,12 @@ int main(int argc, char **argv)
             fprintf(stderr, "bvh: out of memory at %zu spheres\n", n);
             return 1;
         }
-        double rate[4] = { NAN, NAN, NAN, NAN };
+        double rate[4] = { NAN, NAN, NAN, NAN }, seconds[4] = { NAN, NAN, NAN, NAN };
         if (n <= BRUTE_MAX_SPHERES) {
             PtrAccel brute_c = ptr_accel_brute(&c, &scene.spheres);
             PtrAccel brute_asm = ptr_accel_brute(&fastest, &scene.spheres);
-            rate[0] = mrays(&scene, &brute_c, &setup);
-            rate[1] = mrays(&scene, &brute_asm, &setup);
+            rate[0] = mrays(&scene, &brute_c, &setup, &seconds[0]);
+            rate[1] = mrays(&scene, &brute_asm, &setup, &seconds[1]);
         }
         PtrAccel tree;
         if (ptr_accel_init(&tree, PTR_ACCEL_BVH, &c, &scene.spheres, 0) != PTR_OK) {
@@ -133,14 +136,15 @@ int main(int argc, char **argv)
         }
         double bytes = (double)(scene.spheres.capacity * 6 * sizeof(float) +
                                 tree.bvh.node_count * sizeof(PtrBvhNode)) / (double)scene.spheres.count;
-        rate[2] = mrays(&scene, &tree, &setup);
+        rate[2] = mrays(&scene, &tree, &setup, &seconds[2]);
         tree.isect = fastest;
-        rate[3] = mrays(&scene, &tree, &setup);
+        rate[3] = mrays(&scene, &tree, &setup, &seconds[3]);
         char cells[4][16];
         for (int k = 0; k < 4; k++)
             snprintf(cells[k], sizeof cells[k], isnan(rate[k]) ? "-" : "%.3f", rate[k]);
-        printf("%9zu %9.4f %8.1f %5d %11s %11s %11s %11s\n", scene.spheres.count,
-               tree.build_seconds, bytes, tree.bvh.depth, cells[0], cells[1], cells[2], cells[3]);
+        printf("%9zu %9.4f %8.1f %5d %11s %11s %11s %11s %11.3f\n", scene.spheres.count,
+               tree.build_seconds, bytes, tree.bvh.depth, cells[0], cells[1], cells[2], cells[3],
+               seconds[3]);
         fflush(stdout);
         if (csv)
             fprintf(csv, "%zu,%.6f,%.2f,%.6g,%.6g,%.6g,%.6g,%s\n", scene.spheres.count,

@@ -3,7 +3,7 @@
 set datafile separator ","
 set terminal pngcairo size 900,520 font "sans,11"
 set output out
-set title "ptr: cloud scenes (gen_cloud.py's distribution), 400x225, 2 spp, 2 cores"
+set title "ptr: cloud scenes (a ground, spheres at 8% volume fraction), 400x225, 2 spp, 2 cores (AVX2)"
 set logscale xy
 set xlabel "spheres"
 set ylabel "Mrays/s (camera and scattered rays)"

@@ -19,11 +19,12 @@ typedef enum PtrAccelChoice {
 
 /* The sphere counts from which the tree beats brute force, measured with
  * `bench/bvh --crossover` (cloud scenes, 200x113, 4 spp, 2 threads; see
- * docs/intersectors.md, "Choosing"). With the C kernels the C traversal
- * overtakes brute force between 32 (4.9 against 5.3 Mrays/s) and 64
- * spheres; the AVX-512 brute-force kernel holds out against the C traversal
- * up to between 256 (3.6 against 2.0 Mrays/s) and 512 (1.7 against 2.3). */
-enum { PTR_ACCEL_CROSSOVER_C = 48, PTR_ACCEL_CROSSOVER_ASM = 384 };
+ * docs/intersectors.md, "Choosing"), on an AVX2 machine. With the C
+ * kernels the C traversal overtakes brute force between 16 spheres (5.5
+ * against 5.2 Mrays/s) and 32 (3.7 against 4.6); the AVX2 brute-force
+ * kernel holds out against the C traversal up to between 256 (3.9 against
+ * 3.2) and 512 (1.7 against 2.3). */
+enum { PTR_ACCEL_CROSSOVER_C = 24, PTR_ACCEL_CROSSOVER_ASM = 384 };
 
 /* The crossover for brute force with isect's kernel. */
 size_t ptr_accel_crossover(const PtrIsectTable *isect);
