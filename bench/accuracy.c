@@ -29,7 +29,8 @@ static int render(const PtrScene *scene, const PtrIsectTable *isect, int w, int 
                                    .max_depth = 50 };
     PtrRenderStats stats;
     PtrError err = { 0 };
-    if (ptr_render(scene, isect, &settings, rgb, &stats, &err) != PTR_OK) {
+    const PtrAccel accel = ptr_accel_brute(isect, scene);
+    if (ptr_render(scene, &accel, &settings, rgb, &stats, &err) != PTR_OK) {
         fprintf(stderr, "accuracy: %s\n", err.message);
         return 0;
     }

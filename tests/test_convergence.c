@@ -25,7 +25,8 @@ static void render(uint32_t spp, uint64_t seed, float *rgb)
     PtrRenderSettings settings = { .width = SIZE, .height = SIZE, .samples = spp, .seed = seed,
                                    .max_depth = 50 };
     PtrError err = { 0 };
-    CHECK_INT(ptr_render(&scene, &isect, &settings, rgb, NULL, &err), PTR_OK);
+    const PtrAccel accel = ptr_accel_brute(&isect, &scene);
+    CHECK_INT(ptr_render(&scene, &accel, &settings, rgb, NULL, &err), PTR_OK);
 }
 
 /* Means of each 8x8 block and channel. */

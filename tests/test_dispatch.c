@@ -16,7 +16,8 @@ static float *render_with(const PtrScene *scene, const PtrIsectTable *isect,
 {
     float *rgb = malloc((size_t)settings->width * settings->height * 3 * sizeof *rgb);
     PtrError err = { 0 };
-    CHECK_INT(ptr_render(scene, isect, settings, rgb, NULL, &err), PTR_OK);
+    const PtrAccel accel = ptr_accel_brute(isect, scene);
+    CHECK_INT(ptr_render(scene, &accel, settings, rgb, NULL, &err), PTR_OK);
     return rgb;
 }
 

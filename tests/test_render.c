@@ -14,10 +14,11 @@ static Image render(const PtrScene *scene, PtrRenderSettings settings)
 {
     PtrIsectTable isect;
     ptr_isect_init(&isect, PTR_KERNEL_C, scene->spheres.count);
+    const PtrAccel accel = ptr_accel_brute(&isect, scene);
     Image img = { settings.width, settings.height,
                   malloc((size_t)settings.width * settings.height * 3 * sizeof(float)) };
     PtrError err = { 0 };
-    CHECK_INT(ptr_render(scene, &isect, &settings, img.rgb, NULL, &err), PTR_OK);
+    CHECK_INT(ptr_render(scene, &accel, &settings, img.rgb, NULL, &err), PTR_OK);
     return img;
 }
 

@@ -35,12 +35,13 @@ static void test_passes_are_exact(void)
     ptr_strings_free(&warnings);
     PtrIsectTable isect;
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
+    const PtrAccel accel = ptr_accel_brute(&isect, &scene);
     PtrRenderSettings s = { .width = 40, .height = 40, .seed = 5, .max_depth = 50 };
     static double one[40 * 40 * 3], parts[40 * 40 * 3];
-    CHECK_INT(ptr_render_samples(&scene, &isect, &s, 0, 10, one, NULL, NULL, NULL, &err), PTR_OK);
+    CHECK_INT(ptr_render_samples(&scene, &accel, &s, 0, 10, one, NULL, NULL, NULL, &err), PTR_OK);
     const uint32_t cuts[] = { 0, 1, 4, 9, 10 };
     for (int i = 0; i < 4; i++)
-        CHECK_INT(ptr_render_samples(&scene, &isect, &s, cuts[i], cuts[i + 1] - cuts[i], parts,
+        CHECK_INT(ptr_render_samples(&scene, &accel, &s, cuts[i], cuts[i + 1] - cuts[i], parts,
                                      NULL, NULL, NULL, &err), PTR_OK);
     CHECK(!memcmp(one, parts, sizeof one));
     ptr_scene_free(&scene);

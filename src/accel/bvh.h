@@ -18,13 +18,21 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "accel/ray.h"
 #include "core/result.h"
 #include "core/scene.h"
 
 enum {
     PTR_BVH_WIDTH = 8,    /* children per node */
     PTR_BVH_LEAF_MAX = 8, /* spheres per leaf at most */
+    /* Levels below the root at most (the build splits ranges in the middle
+     * when the heuristic goes this deep), so a traversal stack of
+     * PTR_BVH_MAX_DEPTH * (PTR_BVH_WIDTH - 1) + 1 entries always suffices. */
+    PTR_BVH_MAX_DEPTH = 64,
 };
+
+/* 1 + 2^-18: the node test's allowance for rounding (see bvh.c). */
+#define PTR_BVH_SLACK 0x1.00004p0f
 
 /* 256 bytes, 64-byte aligned: the assembly reads it at fixed offsets
  * (asm/ptr.inc). */
@@ -53,5 +61,36 @@ typedef struct PtrBvh {
     size_t unbounded_count;
     int depth; /* levels below the root at most, for the traversal stack */
 } PtrBvh;
+
+/* Builds the tree over the first count spheres, reordering all their arrays
+ * (see bvh.h's head) and leaving the rest in place after them (the scene's
+ * huge spheres, which accel/huge.h tests); threads 0 means one per online
+ * CPU. The tree's bytes depend only on
+ * the spheres, never on the thread count. On failure the spheres keep their
+ * order and *bvh is empty. */
+PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads);
+
+void ptr_bvh_free(PtrBvh *bvh);
+
+/* Entries a traversal stack needs: each node visited pushes at most
+ * PTR_BVH_WIDTH - 1 children and pops one. */
+static inline size_t ptr_bvh_stack_size(const PtrBvh *bvh)
+{
+    return (size_t)bvh->depth * (PTR_BVH_WIDTH - 1) + 1;
+}
+
+/* The closest hit among the spheres of a tree built over them (bvh.c says
+ * how). Same contract as PTR_DECL_CLOSEST_HIT over all spheres->count
+ * spheres, and the same answer bit for bit, except that on equal t the
+ * sphere with the lowest id wins (the arrays are reordered, the ids are the
+ * file order); hit->sphere is the position in the reordered arrays. Writes
+ * *hit in every case and returns 1 on a hit. */
+#define PTR_DECL_BVH_CLOSEST_HIT(name)                                        \
+    int name(const PtrRay *ray, const PtrBvh *bvh, const PtrSpheres *spheres, PtrHit *hit)
+
+typedef PTR_DECL_BVH_CLOSEST_HIT((*PtrBvhClosestHitFn));
+
+/* The reference traversal. */
+PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c);
 
 #endif /* PTR_BVH_H */

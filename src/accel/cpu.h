@@ -30,4 +30,11 @@ const char *ptr_cpu_level_name(PtrCpuLevel level);
 /* Parses a level name; returns 0 if it is not one. */
 int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level);
 
+/* The number of online CPUs (at least 1, at most 1024): the default thread
+ * count. */
+int ptr_online_cpus(void);
+
+/* Seconds on a monotonic clock, for timing. */
+double ptr_now_seconds(void);
+
 #endif /* PTR_CPU_H */

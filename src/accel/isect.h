@@ -11,24 +11,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "accel/bvh.h"
 #include "accel/cpu.h"
+#include "accel/ray.h"
 #include "core/scene.h"
-
-/* A ray with a unit direction; hits count only for tmin < t < tmax.
- * Layout is fixed (32 bytes) because assembly kernels read it. */
-typedef struct PtrRay {
-    float org[3];
-    float tmin;
-    float dir[3];
-    float tmax;
-} PtrRay;
-
-typedef struct PtrHit {
-    float t;         /* ray->tmax on a miss */
-    uint32_t sphere; /* PTR_NO_HIT on a miss */
-} PtrHit;
-
-#define PTR_NO_HIT UINT32_MAX
 
 /* One signature for the pointer type, the C reference and every assembly
  * version, so that they cannot drift apart. Tests the first count spheres;
@@ -53,6 +39,7 @@ typedef enum PtrKernel {
 
 typedef struct PtrIsectTable {
     PtrClosestHitFn closest_hit;
+    PtrBvhClosestHitFn bvh_closest_hit;
     const char *name; /* which implementation closest_hit is: "c", "avx2", ... */
 } PtrIsectTable;
 

@@ -18,7 +18,7 @@ enum {
 
 enum {
     OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
-    OPT_SKY, OPT_C, OPT_ASM, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_DEPTH, OPT_DITHER,
+    OPT_SKY, OPT_C, OPT_ASM, OPT_ACCEL, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_DEPTH, OPT_DITHER,
     OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
     OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION, OPT_JSON, OPT_TIME, OPT_PREVIEW, OPT_WATCH,
     OPT_SAMPLE_RANGE, OPT_REGION, OPT_LOOKFROM, OPT_LOOKAT, OPT_UP, OPT_VFOV, OPT_APERTURE,
@@ -36,6 +36,7 @@ static const struct option long_options[] = {
     { "sky", required_argument, NULL, OPT_SKY },
     { "camera", required_argument, NULL, OPT_CAMERA },
     { "c", no_argument, NULL, OPT_C },
+    { "accel", required_argument, NULL, OPT_ACCEL },
     { "asm", no_argument, NULL, OPT_ASM },
     { "cpumask", required_argument, NULL, OPT_CPUMASK },
     { "print-dispatch", no_argument, NULL, OPT_PRINT_DISPATCH },
@@ -96,6 +97,10 @@ static void print_help(FILE *out)
         "        [--focus-distance D]  a camera in world coordinates, replacing the\n"
         "                        scene's (default up 0,1,0; focus at the look-at point)\n"
         "      --fit-all-objects OBJ: fit every object, not only those named *sphere*\n"
+        "      --accel A         auto, brute or bvh: test every sphere, or build a\n"
+        "                        tree over them first (default auto: the tree from\n"
+        "                        %d spheres on with --c, %d with assembly); the\n"
+        "                        image is the same\n"
         "      --c               use the portable C intersector (the reference)\n"
         "      --asm             use the fastest assembly intersector; an error if none\n"
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
@@ -130,7 +135,8 @@ static void print_help(FILE *out)
         "samples done (exit 8); a second aborts at once, writing nothing (exit 130).\n"
         "\n"
         "Exit codes:\n",
-        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH);
+        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, PTR_ACCEL_CROSSOVER_C,
+        PTR_ACCEL_CROSSOVER_ASM);
     for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
         fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
@@ -299,6 +305,10 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
             break;
         case OPT_CAMERA: o->camera_name = optarg; break;
         case OPT_C: o->kernel = PTR_KERNEL_C; break;
+        case OPT_ACCEL:
+            if (!ptr_accel_parse(optarg, &o->accel))
+                return usage_error(option, optarg, "auto, brute or bvh");
+            break;
         case OPT_ASM: o->kernel = PTR_KERNEL_ASM; break;
         case OPT_CPUMASK: {
             PtrCpuLevel cap;

@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include "importer.h"
+#include "accel/accel.h"
 #include "accel/isect.h"
 #include "app/output.h"
 #include "core/render.h"
@@ -31,6 +32,7 @@ typedef struct PtrOptions {
     int has_sky;
     PtrSky sky;
     PtrKernel kernel;
+    PtrAccelChoice accel;
     PtrDepth depth;
     const char *ocio_config, *display, *view, *look;
     float exposure;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "importer.h"
+#include "accel/cpu.h"
 #include "app/output.h"
 #include "core/progressive.h"
 #include "app/signals.h"
@@ -44,13 +45,11 @@ static PtrResult fail(PtrJobReport *report, const PtrError *err)
     return err->code;
 }
 
-/* Renders the imported scene and writes the image. */
-static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, const PtrColor *color,
-                                  PtrJobReport *report, PtrError *err)
+/* Renders with the structure chosen and writes the image. */
+static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const PtrAccel *accel,
+                              uint64_t scene_hash, const PtrColor *color, PtrJobReport *report,
+                              PtrError *err)
 {
-    PtrIsectTable isect;
-    ptr_isect_init(&isect, o->kernel, scene->spheres.count);
-    snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
 
     PtrRenderSettings settings = {
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
@@ -78,7 +77,7 @@ static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, co
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
                              report->output, layout.width, layout.height);
     PtrProgressiveResult done;
-    PtrResult res = ptr_render_progressive(scene, &isect, &settings, &passes, rgb, &done, err);
+    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, &done, err);
     ptr_progress_done(&printer);
     if (res == PTR_ERR_SCENE_INVALID) {
         /* The renderer does not know where the scene came from. */
@@ -92,8 +91,9 @@ static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, co
         report->rays = done.stats.rays;
         report->interrupted = done.stopped;
         PtrOutputInfo info = {
-            .scene_path = report->scene, .scene_hash = ptr_scene_hash(scene),
-            .kernel = isect.name, .sample_first = report->sample_first,
+            .scene_path = report->scene, .scene_hash = scene_hash,
+            .kernel = accel->isect.name, .accel = report->accel, .spheres = report->spheres,
+            .import_seconds = report->import_seconds, .build_seconds = report->build_seconds, .sample_first = report->sample_first,
             .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
             .max_depth = o->max_depth, .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
@@ -109,6 +109,29 @@ static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, co
     return res;
 }
 
+/* Chooses the structure for the imported scene (the tree reorders its
+ * spheres), renders and writes the image. */
+static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const PtrColor *color,
+                                  PtrJobReport *report, PtrError *err)
+{
+    PtrIsectTable isect;
+    ptr_isect_init(&isect, o->kernel, scene->spheres.count);
+    snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
+    /* Before the tree reorders the spheres: the hash does not depend on
+     * their order, but there is no need to find the file order again. */
+    uint64_t scene_hash = ptr_scene_hash(scene);
+    PtrAccel accel;
+    if (ptr_accel_init(&accel, o->accel, &isect, scene, o->threads) != PTR_OK)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate the tree over %zu spheres",
+                             report->scene, scene->spheres.count);
+    snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&accel));
+    report->spheres = scene->spheres.count;
+    report->build_seconds = accel.build_seconds;
+    PtrResult res = render_accel(o, scene, &accel, scene_hash, color, report, err);
+    ptr_accel_free(&accel);
+    return res;
+}
+
 PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char *output,
                          const PtrColor *color, PtrStrings *dependencies, PtrJobReport *report)
 {
@@ -119,7 +142,9 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
     PtrError err = { 0 };
     PtrScene scene;
     PtrImportOptions import = ptr_options_import(o, dependencies);
+    double import_start = ptr_now_seconds();
     PtrResult res = ptr_import_scene(scene_path, &import, &scene, &report->warnings, &err);
+    report->import_seconds = ptr_now_seconds() - import_start;
     /* A file that failed gets its one line of error, nothing more. */
     for (size_t i = 0; res == PTR_OK && i < report->warnings.count; i++)
         fprintf(stderr, "ptr: warning: %s\n", report->warnings.lines[i]);

@@ -11,7 +11,7 @@ typedef struct Part {
     const char *path;
     PtrImage *image;
     PtrImageLayout layout;
-    const char *scene, *hash, *seed, *kernel;
+    const char *scene, *hash, *seed;
     long first, samples, max_depth;
 } Part;
 
@@ -33,7 +33,7 @@ static PtrResult read_part(Part *p, PtrError *err)
     p->layout = ptr_image_layout(p->image);
     const char *first, *samples, *depth, *space;
     if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||
-        !(p->seed = required(p, "ptr:seed", err)) || !(p->kernel = required(p, "ptr:kernel", err)) ||
+        !(p->seed = required(p, "ptr:seed", err)) || !required(p, "ptr:kernel", err) ||
         !(first = required(p, "ptr:sample_first", err)) ||
         !(samples = required(p, "ptr:samples", err)) || !(depth = required(p, "ptr:max_depth", err)) ||
         !(space = required(p, "ptr:colorspace", err)))
@@ -48,6 +48,21 @@ static PtrResult read_part(Part *p, PtrError *err)
     if (p->samples <= 0 || p->first < 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "%s: no samples", p->path);
     return PTR_OK;
+}
+
+/* The value all parts give name, or "mixed"; "" if a part has none (parts
+ * written before ptr recorded it). */
+static void common_attr(const Part *parts, int count, const char *name, char *out, size_t size)
+{
+    const char *first = ptr_image_attr(parts[0].image, name);
+    for (int i = 0; first && i < count; i++) {
+        const char *value = ptr_image_attr(parts[i].image, name);
+        if (!value)
+            first = NULL;
+        else if (strcmp(value, first))
+            first = "mixed";
+    }
+    snprintf(out, size, "%s", first ? first : "");
 }
 
 static int overlap(const PtrImageLayout *a, const PtrImageLayout *b)
@@ -131,10 +146,11 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     if (fewest != most)
         fprintf(stderr, "ptr: warning: %s: pixels hold %ld to %ld samples\n", output, fewest, most);
 
-    int same_kernel = 1;
-    for (int i = 1; i < count; i++)
-        same_kernel = same_kernel && !strcmp(parts[i].kernel, parts[0].kernel);
-    snprintf(report->kernel, sizeof report->kernel, "%s", same_kernel ? parts[0].kernel : "mixed");
+    common_attr(parts, count, "ptr:kernel", report->kernel, sizeof report->kernel);
+    common_attr(parts, count, "ptr:accel", report->accel, sizeof report->accel);
+    char spheres[24];
+    common_attr(parts, count, "ptr:spheres", spheres, sizeof spheres);
+    report->spheres = strtoull(spheres, NULL, 10);
     report->width = w;
     report->height = h;
     report->sample_first = (uint32_t)first;
@@ -143,7 +159,8 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     const PtrImageLayout full = { w, h, 0, 0, w, h };
     PtrOutputInfo info = {
         .scene_path = parts[0].scene, .scene_hash = strtoull(parts[0].hash, NULL, 16),
-        .kernel = report->kernel, .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
+        .kernel = report->kernel, .accel = report->accel, .spheres = report->spheres,
+        .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
         .seed = report->seed, .max_depth = (int)parts[0].max_depth, .depth = o->depth,
         .color = color, .exposure = o->exposure, .bake_view = o->bake_view, .dither = o->dither,
     };

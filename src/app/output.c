@@ -106,7 +106,8 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         }
     }
 
-    char seed[24], exposure[32], hash[24];
+    char seed[24], exposure[32], hash[24], spheres[24];
+    snprintf(spheres, sizeof spheres, "%zu", info->spheres);
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
     snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
     snprintf(exposure, sizeof exposure, "%g", info->exposure);
@@ -124,6 +125,12 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         { .name = "ptr:seed", .type = PTR_ATTR_STRING, .string_value = seed },
         { .name = "ptr:max_depth", .type = PTR_ATTR_INT, .int_value = info->max_depth },
         { .name = "ptr:kernel", .type = PTR_ATTR_STRING, .string_value = info->kernel },
+        { .name = "ptr:accel", .type = PTR_ATTR_STRING, .string_value = info->accel },
+        { .name = "ptr:spheres", .type = PTR_ATTR_STRING, .string_value = spheres },
+        { .name = "ptr:import_seconds", .type = PTR_ATTR_FLOAT,
+          .float_value = (float)info->import_seconds },
+        { .name = "ptr:build_seconds", .type = PTR_ATTR_FLOAT,
+          .float_value = (float)info->build_seconds },
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->render_seconds },
         { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,

@@ -23,6 +23,9 @@ typedef struct PtrOutputInfo {
     const char *scene_path;
     uint64_t scene_hash;   /* ptr_scene_hash: merge refuses parts of other scenes */
     const char *kernel;
+    const char *accel;     /* "brute" or "bvh" */
+    size_t spheres;
+    double import_seconds, build_seconds;
     uint32_t sample_first; /* the samples taken: first .. first + samples - 1 */
     uint32_t samples;
     int interrupted;       /* the render stopped before all samples asked for */

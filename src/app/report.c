@@ -55,12 +55,12 @@ void ptr_progress_done(PtrProgressPrinter *printer)
 void ptr_report_stats_line(FILE *out, const PtrJobReport *r)
 {
     fprintf(out,
-            "ptr: %s: %dx%d, %" PRIu32 " spp%s, %s intersector: %.3f s, %.2f Mrays/s (%" PRIu64
-            " rays)\n",
+            "ptr: %s: %dx%d, %" PRIu32 " spp%s, %zu spheres, %s, %s intersector: import %.3f s, "
+            "build %.3f s, render %.3f s, %.2f Mrays/s (%" PRIu64 " rays)\n",
             r->output, r->width, r->height, r->samples,
             r->interrupted ? " (interrupted)" : r->samples < r->samples_requested ? " (time budget)" : "",
-            r->kernel, r->seconds, r->seconds > 0 ? (double)r->rays / r->seconds * 1e-6 : 0.0,
-            r->rays);
+            r->spheres, r->accel, r->kernel, r->import_seconds, r->build_seconds, r->seconds,
+            r->seconds > 0 ? (double)r->rays / r->seconds * 1e-6 : 0.0, r->rays);
 }
 
 void ptr_json_string(FILE *out, const char *s)
@@ -95,6 +95,12 @@ void ptr_report_json(FILE *out, const PtrJobReport *r)
             ", \"samples_requested\": %" PRIu32 ", \"seed\": %" PRIu64 ", \"kernel\": ",
             r->width, r->height, r->samples, r->sample_first, r->samples_requested, r->seed);
     ptr_json_string(out, r->kernel);
+    fputs(", \"accel\": ", out);
+    ptr_json_string(out, r->accel);
+    fprintf(out,
+            ", \"spheres\": %zu, \"import_seconds\": %.6f, \"build_seconds\": %.6f, "
+            "\"render_seconds\": %.6f",
+            r->spheres, r->import_seconds, r->build_seconds, r->seconds);
     fprintf(out,
             ", \"seconds\": %.6f, \"rays\": %" PRIu64 ", \"rays_per_second\": %.0f, "
             "\"interrupted\": %s, \"warnings\": [",

@@ -19,7 +19,10 @@ typedef struct PtrJobReport {
     uint32_t sample_first, samples, samples_requested;
     uint64_t seed;
     char kernel[16];
-    double seconds;
+    char accel[8];              /* "brute" or "bvh" */
+    size_t spheres;
+    double import_seconds, build_seconds;
+    double seconds;             /* rendering */
     uint64_t rays;
     int interrupted;
     PtrStrings warnings;

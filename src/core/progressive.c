@@ -2,7 +2,8 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <time.h>
+
+#include "accel/cpu.h"
 
 typedef struct PassWatch {
     const PtrProgressiveOptions *options;
@@ -11,23 +12,16 @@ typedef struct PassWatch {
     double start;
 } PassWatch;
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void on_tick(void *user, double pass_fraction)
 {
     PassWatch *w = user;
     PtrProgress p = w->progress;
     p.fraction = ((double)p.samples_done + pass_fraction * w->pass_samples) / p.samples_total;
-    p.elapsed = now_seconds() - w->start;
+    p.elapsed = ptr_now_seconds() - w->start;
     w->options->report(w->options->user, &p);
 }
 
-PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
                                  PtrProgressiveResult *result, PtrError *err)
@@ -44,7 +38,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *ise
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image", r.x1 - r.x0,
                              r.y1 - r.y0);
 
-    PassWatch watch = { .options = options, .start = now_seconds() };
+    PassWatch watch = { .options = options, .start = ptr_now_seconds() };
     watch.progress.samples_total = options->samples;
     *result = (PtrProgressiveResult){ 0 };
     PtrResult res = PTR_OK;
@@ -56,14 +50,14 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *ise
     while (done < options->samples) {
         watch.pass_samples = pass;
         PtrRenderStats stats;
-        res = ptr_render_samples(scene, isect, settings, options->first_sample + done, pass, sums,
+        res = ptr_render_samples(scene, accel, settings, options->first_sample + done, pass, sums,
                                  options->report ? on_tick : NULL, &watch, &stats, err);
         if (res != PTR_OK)
             break;
         done += pass;
         result->stats.rays += stats.rays;
         result->stats.threads = stats.threads;
-        double elapsed = now_seconds() - watch.start;
+        double elapsed = ptr_now_seconds() - watch.start;
         watch.progress.samples_done = done;
         watch.progress.rays = result->stats.rays;
         watch.progress.rays_seconds = elapsed;
@@ -80,7 +74,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *ise
         pass = next < 1 ? 1 : next > options->samples - done ? options->samples - done : (uint32_t)next;
     }
     result->samples_done = done;
-    result->stats.seconds = now_seconds() - watch.start;
+    result->stats.seconds = ptr_now_seconds() - watch.start;
     for (size_t i = 0; res == PTR_OK && i < values; i++)
         rgb[i] = (float)(sums[i] / (double)done);
     free(sums);

@@ -36,7 +36,7 @@ typedef struct PtrProgressiveResult {
  * passes sized to take about a second each. Writes the means of the samples
  * done into rgb (3 floats a pixel of the region), the same bits as one pass
  * of that many samples would give. */
-PtrResult ptr_render_progressive(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
                                  PtrProgressiveResult *result, PtrError *err);

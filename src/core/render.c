@@ -5,8 +5,8 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <time.h>
-#include <unistd.h>
 
+#include "accel/cpu.h"
 #include "accel/huge.h"
 #include "core/camera.h"
 #include "core/material.h"
@@ -40,29 +40,8 @@ PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHi
     return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
 }
 
-/* The closest hit in the scene: the huge spheres in double, then the rest
- * through the intersector up to that distance (ties included, so that the
- * lowest id wins as it would among spheres of one kind). */
-static int closest_hit(const PtrScene *scene, const PtrIsectTable *isect, const PtrRay *ray,
-                       PtrHit *hit)
-{
-    const PtrSpheres *s = &scene->spheres;
-    if (!scene->huge.count)
-        return isect->closest_hit(ray, s, s->count, hit);
-    PtrHit huge;
-    PtrRay rest = *ray;
-    if (ptr_huge_closest_hit(ray, scene, &huge))
-        rest.tmax = nextafterf(huge.t, INFINITY);
-    if (isect->closest_hit(&rest, s, s->count - scene->huge.count, hit) &&
-        (huge.sphere == PTR_NO_HIT || hit->t < huge.t ||
-         (hit->t == huge.t && s->id[hit->sphere] < s->id[huge.sphere])))
-        return 1;
-    *hit = huge;
-    return huge.sphere != PTR_NO_HIT;
-}
-
 /* The radiance one camera ray carries back. */
-static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, PtrRay ray,
+static PtrVec3 trace_path(const PtrScene *scene, const PtrAccel *accel, PtrRay ray,
                           const PtrRenderSettings *settings, PtrRng *rng, uint64_t *rays)
 {
     const PtrSpheres *spheres = &scene->spheres;
@@ -73,7 +52,7 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
         PtrHit hit;
         PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
         ++*rays;
-        if (!closest_hit(scene, isect, &ray, &hit)) {
+        if (!ptr_trace(accel, &ray, &hit)) {
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
@@ -106,7 +85,7 @@ static PtrVec3 trace_path(const PtrScene *scene, const PtrIsectTable *isect, Ptr
 
 typedef struct RenderJob {
     const PtrScene *scene;
-    const PtrIsectTable *isect;
+    const PtrAccel *accel;
     const PtrRenderSettings *settings;
     PtrView view;
     PtrRegion region;
@@ -143,7 +122,7 @@ static void render_pixel(const RenderJob *job, int x, int y, uint64_t *rays)
         ptr_view_ray(&job->view, x, y, sx, sy, lens_r * cosf(lens_phi),
                      lens_r * sinf(lens_phi), &o, &d);
         PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
-        PtrVec3 l = trace_path(job->scene, job->isect, ray, s, &rng, rays);
+        PtrVec3 l = trace_path(job->scene, job->accel, ray, s, &rng, rays);
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
@@ -175,19 +154,6 @@ static void *render_worker(void *arg)
     return NULL;
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int online_cpus(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
-}
-
 PtrRegion ptr_render_region(const PtrRenderSettings *s)
 {
     PtrRegion r = s->region;
@@ -199,13 +165,13 @@ PtrRegion ptr_render_region(const PtrRenderSettings *s)
     return r;
 }
 
-PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              const PtrRenderSettings *settings, uint32_t first, uint32_t count,
                              double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err)
 {
     RenderJob job = {
-        .scene = scene, .isect = isect, .settings = settings, .first = first, .count = count,
+        .scene = scene, .accel = accel, .settings = settings, .first = first, .count = count,
         .sums = sums, .region = ptr_render_region(settings),
     };
     if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
@@ -224,14 +190,14 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.tiles_done, 0);
 
-    int threads = settings->threads > 0 ? settings->threads : online_cpus();
+    int threads = settings->threads > 0 ? settings->threads : ptr_online_cpus();
     if (threads > job.tile_count)
         threads = job.tile_count;
     Worker *workers = calloc((size_t)threads, sizeof *workers);
     if (!workers)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate %d render threads", threads);
 
-    double start = now_seconds();
+    double start = ptr_now_seconds();
     int started = 0;
     pthread_mutex_init(&job.lock, NULL);
     pthread_cond_init(&job.all_done, NULL);
@@ -276,7 +242,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
         pthread_join(workers[i].thread, NULL);
         rays += workers[i].rays;
     }
-    double seconds = now_seconds() - start;
+    double seconds = ptr_now_seconds() - start;
     free(workers);
     pthread_cond_destroy(&job.all_done);
     pthread_mutex_destroy(&job.lock);
@@ -288,7 +254,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
     return PTR_OK;
 }
 
-PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err)
 {
@@ -300,7 +266,7 @@ PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
     if (!sums)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image",
                              r.x1 - r.x0, r.y1 - r.y0);
-    PtrResult res = ptr_render_samples(scene, isect, settings, 0, settings->samples, sums, NULL,
+    PtrResult res = ptr_render_samples(scene, accel, settings, 0, settings->samples, sums, NULL,
                                        NULL, stats, err);
     for (size_t i = 0; res == PTR_OK && i < values; i++)
         rgb[i] = (float)(sums[i] / (double)settings->samples);

@@ -4,7 +4,7 @@
 
 #include <stdint.h>
 
-#include "accel/isect.h"
+#include "accel/accel.h"
 #include "core/result.h"
 #include "core/scene.h"
 
@@ -41,19 +41,22 @@ typedef void (*PtrTickFn)(void *user, double fraction_done);
  * all zero if it does not lie inside the image. */
 PtrRegion ptr_render_region(const PtrRenderSettings *settings);
 
+/* The renderer reads the spheres through accel (accel->spheres, which must
+ * be scene->spheres) and finds every hit with ptr_trace. */
+
 /* Adds the radiance of samples first .. first + count - 1 of every pixel of
  * the region to sums (3 doubles a pixel, region rows top to bottom), sample
  * by sample in index order: split into passes of any size, the sums come out
  * bit for bit the same, and never depend on the thread count. tick may be
  * NULL; stats (may be NULL) gets this call's figures. */
-PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              const PtrRenderSettings *settings, uint32_t first, uint32_t count,
                              double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err);
 
 /* The whole region with settings->samples samples, as means in rgb (3 floats
  * a pixel, region rows top to bottom). */
-PtrResult ptr_render(const PtrScene *scene, const PtrIsectTable *isect,
+PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err);
 

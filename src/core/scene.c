@@ -1,5 +1,6 @@
 #include "core/scene.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,14 +16,36 @@ void ptr_scene_init(PtrScene *scene)
     };
 }
 
+/* Every per-sphere array, with the value its padding entries hold: growing,
+ * freeing and reordering go through this list, so a new array is one line. */
+typedef struct SphereArray {
+    void **data;
+    size_t size;     /* of one entry */
+    uint32_t padding; /* bits of a padding entry */
+} SphereArray;
+
+enum { SPHERE_ARRAYS = 6 };
+
+static void sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS])
+{
+    union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
+    SphereArray list[SPHERE_ARRAYS] = {
+        { (void **)&s->cx, sizeof *s->cx, zero.u },
+        { (void **)&s->cy, sizeof *s->cy, zero.u },
+        { (void **)&s->cz, sizeof *s->cz, zero.u },
+        { (void **)&s->radius, sizeof *s->radius, nan_bits.u }, /* never hit */
+        { (void **)&s->material, sizeof *s->material, 0 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX },
+    };
+    memcpy(a, list, sizeof list);
+}
+
 static void spheres_free(PtrSpheres *s)
 {
-    free(s->cx);
-    free(s->cy);
-    free(s->cz);
-    free(s->radius);
-    free(s->material);
-    free(s->id);
+    SphereArray a[SPHERE_ARRAYS];
+    sphere_arrays(s, a);
+    for (int k = 0; k < SPHERE_ARRAYS; k++)
+        free(*a[k].data);
     memset(s, 0, sizeof *s);
 }
 
@@ -34,41 +57,54 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-static float *aligned_floats(size_t n)
+/* Arrays like s's with room for capacity entries, the first keep entries
+ * copied from s in the order given (all of s if order is NULL) and the rest
+ * padding. Every entry is 4 bytes, so that one pass moves them all. */
+static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t capacity,
+                              PtrSpheres *out)
 {
-    return aligned_alloc(PTR_SPHERE_ALIGN, n * sizeof(float));
+    static_assert(sizeof(float) == 4 && sizeof(uint32_t) == 4, "4-byte sphere entries");
+    if (capacity > SIZE_MAX / 2 / sizeof(float))
+        return PTR_ERR_NOMEM;
+    PtrSpheres copy = { .count = s->count, .capacity = capacity };
+    SphereArray from[SPHERE_ARRAYS], to[SPHERE_ARRAYS];
+    sphere_arrays((PtrSpheres *)s, from);
+    sphere_arrays(&copy, to);
+    for (int k = 0; k < SPHERE_ARRAYS; k++) {
+        *to[k].data = aligned_alloc(PTR_SPHERE_ALIGN, capacity * to[k].size);
+        if (!*to[k].data) {
+            spheres_free(&copy);
+            return PTR_ERR_NOMEM;
+        }
+        const uint32_t *src = *from[k].data;
+        uint32_t *dst = *to[k].data;
+        for (size_t i = 0; i < capacity; i++)
+            dst[i] = i >= s->count ? to[k].padding : src[order ? order[i] : i];
+    }
+    *out = copy;
+    return PTR_OK;
 }
 
 static PtrResult spheres_grow(PtrSpheres *s)
 {
-    size_t capacity = s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK;
-    if (capacity > SIZE_MAX / 2 / sizeof(float))
-        return PTR_ERR_NOMEM;
-
-    PtrSpheres grown = { 0 };
-    grown.cx = aligned_floats(capacity);
-    grown.cy = aligned_floats(capacity);
-    grown.cz = aligned_floats(capacity);
-    grown.radius = aligned_floats(capacity);
-    grown.material = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
-    grown.id = aligned_alloc(PTR_SPHERE_ALIGN, capacity * sizeof(uint32_t));
-    if (!grown.cx || !grown.cy || !grown.cz || !grown.radius || !grown.material || !grown.id) {
-        spheres_free(&grown);
-        return PTR_ERR_NOMEM;
-    }
-    grown.count = s->count;
-    grown.capacity = capacity;
-    for (size_t i = 0; i < capacity; i++) {
-        int old = i < s->count;
-        grown.cx[i] = old ? s->cx[i] : 0.0f;
-        grown.cy[i] = old ? s->cy[i] : 0.0f;
-        grown.cz[i] = old ? s->cz[i] : 0.0f;
-        grown.radius[i] = old ? s->radius[i] : NAN;
-        grown.material[i] = old ? s->material[i] : 0;
-        grown.id[i] = old ? s->id[i] : 0;
-    }
+    PtrSpheres grown;
+    PtrResult r = spheres_copy(s, NULL, s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK, &grown);
+    if (r != PTR_OK)
+        return r;
     spheres_free(s);
     *s = grown;
+    return PTR_OK;
+}
+
+PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
+{
+    PtrSpheres permuted;
+    size_t capacity = (s->count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
+    PtrResult r = spheres_copy(s, order, capacity, &permuted);
+    if (r != PTR_OK)
+        return r;
+    spheres_free(s);
+    *s = permuted;
     return PTR_OK;
 }
 
@@ -122,17 +158,41 @@ static uint64_t hash_vec(uint64_t h, PtrVec3 v)
     return hash_bytes(h, f, sizeof f);
 }
 
+/* The entries of a 4-byte per-sphere array in file order: by_id[k] is the
+ * position of the sphere whose id is k (NULL: the arrays are in file order). */
+static uint64_t hash_in_file_order(uint64_t h, const void *array, const uint32_t *by_id,
+                                   size_t count)
+{
+    const uint32_t *a = array;
+    if (!by_id)
+        return hash_bytes(h, a, count * sizeof *a);
+    for (size_t k = 0; k < count; k++)
+        h = hash_bytes(h, &a[by_id[k]], sizeof *a);
+    return h;
+}
+
 uint64_t ptr_scene_hash(const PtrScene *scene)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
+    /* A tree reorders the spheres; the hash takes them in file order, so
+     * that parts rendered with and without one merge. (Out of memory, it
+     * takes them as they are: callers that may be short of memory hash
+     * before building a tree, as the renderer does.) */
+    size_t reordered = 0;
+    while (reordered < s->count && s->id[reordered] == reordered)
+        reordered++;
+    uint32_t *by_id = reordered < s->count ? malloc(s->count * sizeof *by_id) : NULL;
+    for (size_t j = 0; by_id && j < s->count; j++)
+        by_id[s->id[j]] = (uint32_t)j;
     h = hash_bytes(h, scene->origin, sizeof scene->origin);
     h = hash_bytes(h, &s->count, sizeof s->count);
-    h = hash_bytes(h, s->cx, s->count * sizeof *s->cx);
-    h = hash_bytes(h, s->cy, s->count * sizeof *s->cy);
-    h = hash_bytes(h, s->cz, s->count * sizeof *s->cz);
-    h = hash_bytes(h, s->radius, s->count * sizeof *s->radius);
-    h = hash_bytes(h, s->material, s->count * sizeof *s->material);
+    h = hash_in_file_order(h, s->cx, by_id, s->count);
+    h = hash_in_file_order(h, s->cy, by_id, s->count);
+    h = hash_in_file_order(h, s->cz, by_id, s->count);
+    h = hash_in_file_order(h, s->radius, by_id, s->count);
+    h = hash_in_file_order(h, s->material, by_id, s->count);
+    free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {
         const PtrMaterial *m = &scene->materials[i];

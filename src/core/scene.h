@@ -93,6 +93,13 @@ void ptr_scene_free(PtrScene *scene);
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
                                uint32_t material);
 
+/* Reorders every per-sphere array together: entry i becomes old entry
+ * order[i] (order is a permutation of 0 .. count - 1). Afterwards at least
+ * PTR_SPHERE_BLOCK padding entries follow the last sphere, so SIMD code may
+ * read 16 lanes from any sphere on. Returns PTR_ERR_NOMEM (arrays unchanged)
+ * if the new arrays cannot be allocated. */
+PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order);
+
 /* Appends a material and stores its index in *index. */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index);

@@ -11,7 +11,7 @@ int stability_methods(Method *m)
     int n = 0;
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
-    PtrIsectTable naive = { naive_closest_hit, "naive" };
+    PtrIsectTable naive = { .closest_hit = naive_closest_hit, .name = "naive" };
 
     m[n++] = (Method){ "naive, t_min 1e-3", naive, 1e-3f, 0, 0 };
     m[n++] = (Method){ "robust, t_min 1e-3", c, 1e-3f, 0, 0 };

@@ -50,7 +50,8 @@ static float *render(const PtrScene *s, const Method *m, int size, uint32_t samp
                                    .max_depth = 50, .threads = 2, .fixed_tmin = m->fixed_tmin };
     float *rgb = malloc((size_t)size * size * 3 * sizeof *rgb);
     PtrError err = { 0 };
-    CHECK_INT(ptr_render(s, &m->isect, &settings, rgb, NULL, &err), PTR_OK);
+    const PtrAccel accel = ptr_accel_brute(&m->isect, s);
+    CHECK_INT(ptr_render(s, &accel, &settings, rgb, NULL, &err), PTR_OK);
     return rgb;
 }
 

@@ -45,7 +45,7 @@ enum { DECADES = 16, FIRST_DECADE = -6 };
 static void reference_rays(const Method *methods, int n)
 {
     double worst[MAX_METHODS][DECADES] = { { 0 } };
-    PtrIsectTable naive = { naive_closest_hit, "naive" };
+    PtrIsectTable naive = { .closest_hit = naive_closest_hit, .name = "naive" };
     const int rays = 200000;
     PtrRng rng = ptr_rng_for_sample(11, 0, 0);
 

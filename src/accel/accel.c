@@ -1,0 +1,72 @@
+#include "accel/accel.h"
+
+#include "accel/cpu.h"
+
+#include <math.h>
+#include <string.h>
+
+PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene)
+{
+    return (PtrAccel){ .kind = PTR_ACCEL_BRUTE, .scene = scene, .spheres = &scene->spheres,
+                       .searched = scene->spheres.count - scene->huge.count, .isect = *isect };
+}
+
+PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
+                         PtrScene *scene, int threads)
+{
+    *accel = ptr_accel_brute(isect, scene);
+    if (choice == PTR_ACCEL_BRUTE ||
+        (choice == PTR_ACCEL_AUTO && accel->searched < ptr_accel_crossover(isect)))
+        return PTR_OK;
+    double start = ptr_now_seconds();
+    PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads);
+    if (r != PTR_OK)
+        return r;
+    accel->kind = PTR_ACCEL_BVH;
+    accel->build_seconds = ptr_now_seconds() - start;
+    return PTR_OK;
+}
+
+size_t ptr_accel_crossover(const PtrIsectTable *isect)
+{
+    return isect->closest_hit == ptr_closest_hit_c ? PTR_ACCEL_CROSSOVER_C
+                                                   : PTR_ACCEL_CROSSOVER_ASM;
+}
+
+/* The huge spheres in double, then the rest up to that distance (ties
+ * included, so that the lowest id wins as among spheres of one kind). */
+int ptr_trace_huge_first(const PtrAccel *accel, const PtrRay *ray, PtrHit *hit)
+{
+    PtrHit huge;
+    PtrRay rest = *ray;
+    if (ptr_huge_closest_hit(ray, accel->scene, &huge))
+        rest.tmax = nextafterf(huge.t, INFINITY);
+    const uint32_t *id = accel->spheres->id;
+    if (ptr_search(accel, &rest, hit) &&
+        (huge.sphere == PTR_NO_HIT || hit->t < huge.t ||
+         (hit->t == huge.t && id[hit->sphere] < id[huge.sphere])))
+        return 1;
+    *hit = huge;
+    return huge.sphere != PTR_NO_HIT;
+}
+
+void ptr_accel_free(PtrAccel *accel)
+{
+    ptr_bvh_free(&accel->bvh);
+}
+
+const char *ptr_accel_name(const PtrAccel *accel)
+{
+    return accel->kind == PTR_ACCEL_BVH ? "bvh" : "brute";
+}
+
+int ptr_accel_parse(const char *text, PtrAccelChoice *choice)
+{
+    static const char *const names[] = { "auto", "brute", "bvh" };
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(text, names[i])) {
+            *choice = (PtrAccelChoice)i;
+            return 1;
+        }
+    return 0;
+}

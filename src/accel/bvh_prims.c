@@ -1,0 +1,165 @@
+#include "accel/bvh_prims.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A sphere is kept out of the tree if its radius is more than UNBOUNDED_RATIO
+ * times the median radius: a ground of radius 1000 under spheres of 0.2, or
+ * 1e5 under 1, would otherwise make one box span the scene and every ray
+ * visit much of the tree. At most UNBOUNDED_MAX of them (the largest), as
+ * every ray tests them all. */
+enum { UNBOUNDED_RATIO = 100, UNBOUNDED_MAX = 16 };
+
+/* Box padding, relative to the magnitude of the numbers involved: see the
+ * traversal's comment in bvh.c for why 2^-18. */
+#define BOX_PAD_SCALE 0x1.0p-18f
+
+/* The k-th smallest of values[0 .. n - 1] (reorders values). */
+static float select_kth(float *values, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        float a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi];
+        float pivot = a < b ? (b < c ? b : a < c ? c : a) : (a < c ? a : b < c ? c : b);
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (values[i] < pivot)
+                i++;
+            while (values[j] > pivot)
+                j--;
+            if (i <= j) {
+                float t = values[i];
+                values[i] = values[j];
+                values[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return values[k];
+    }
+    return values[k];
+}
+
+/* Whether sphere i comes before sphere j among those kept out: larger
+ * first, then lower id. */
+static int larger(const PtrSpheres *s, uint32_t i, uint32_t j)
+{
+    return s->radius[i] != s->radius[j] ? s->radius[i] > s->radius[j] : s->id[i] < s->id[j];
+}
+
+/* Keeps the UNBOUNDED_MAX largest of list[0 .. n - 1] at its start. */
+static void keep_largest(uint32_t *list, size_t n, const PtrSpheres *s)
+{
+    for (size_t k = 0; k < UNBOUNDED_MAX; k++) {
+        size_t best = k;
+        for (size_t i = k + 1; i < n; i++)
+            if (larger(s, list[i], list[best]))
+                best = i;
+        uint32_t t = list[k];
+        list[k] = list[best];
+        list[best] = t;
+    }
+}
+
+static void sort_by_id(uint32_t *list, size_t n, const PtrSpheres *s)
+{
+    for (size_t i = 1; i < n; i++) {
+        uint32_t v = list[i];
+        size_t j = i;
+        for (; j > 0 && s->id[list[j - 1]] > s->id[v]; j--)
+            list[j] = list[j - 1];
+        list[j] = v;
+    }
+}
+
+/* The threshold above which a radius is kept out of the tree. */
+static float unbounded_radius(const PtrSpheres *s)
+{
+    float *radii = malloc(s->count * sizeof *radii);
+    if (!radii)
+        return NAN;
+    memcpy(radii, s->radius, s->count * sizeof *radii);
+    float median = select_kth(radii, s->count, s->count / 2);
+    free(radii);
+    return median * UNBOUNDED_RATIO;
+}
+
+int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
+                  BvhPrim *prims, size_t *prim_count)
+{
+    *unbounded_count = *prim_count = 0;
+    if (s->count == 0)
+        return 1;
+    float limit = unbounded_radius(s);
+    if (isnan(limit))
+        return 0;
+    size_t u = 0;
+    for (size_t i = 0; i < s->count; i++)
+        if (s->radius[i] > limit)
+            order[u++] = (uint32_t)i;
+    if (u > UNBOUNDED_MAX) {
+        keep_largest(order, u, s);
+        u = UNBOUNDED_MAX;
+    }
+    /* By index, to skip them below; then by id, their order in the arrays. */
+    uint32_t out[UNBOUNDED_MAX + 1];
+    memcpy(out, order, u * sizeof *out);
+    for (size_t i = 1; i < u; i++)
+        for (size_t j = i; j > 0 && out[j - 1] > out[j]; j--) {
+            uint32_t t = out[j];
+            out[j] = out[j - 1];
+            out[j - 1] = t;
+        }
+    out[u] = UINT32_MAX;
+    sort_by_id(order, u, s);
+    /* The largest magnitude in the tree bounds both the spheres' and the
+     * rays' origins (the camera sits at 0, other rays start on spheres). */
+    float magnitude = 0.0f;
+    for (size_t i = 0, k = 0; i < s->count; i++) {
+        float m = fmaxf(fmaxf(fabsf(s->cx[i]), fabsf(s->cy[i])), fabsf(s->cz[i])) + s->radius[i];
+        if (out[k] == i)
+            k++;
+        else if (m > magnitude)
+            magnitude = m;
+    }
+    size_t n = 0;
+    for (size_t i = 0, k = 0; i < s->count; i++) {
+        if (out[k] == i) {
+            k++;
+            continue;
+        }
+        float r = s->radius[i];
+        float extent = r + BOX_PAD_SCALE * (magnitude + r);
+        BvhPrim *p = &prims[n++];
+        p->lower[0] = s->cx[i] - extent;
+        p->lower[1] = s->cy[i] - extent;
+        p->lower[2] = s->cz[i] - extent;
+        p->upper[0] = s->cx[i] + extent;
+        p->upper[1] = s->cy[i] + extent;
+        p->upper[2] = s->cz[i] + extent;
+        p->index = (uint32_t)i;
+        p->id = s->id[i];
+    }
+    *unbounded_count = u;
+    *prim_count = n;
+    return 1;
+}
+
+void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)
+{
+    for (size_t i = 1; i < count; i++) {
+        BvhPrim v = prims[i];
+        size_t j = i;
+        for (; j > 0 && prims[j - 1].id > v.id; j--)
+            prims[j] = prims[j - 1];
+        prims[j] = v;
+    }
+}

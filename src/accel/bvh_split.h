@@ -1,0 +1,51 @@
+/* Splitting a range of prims in two by the binned surface area heuristic:
+ * the building block of the tree's build (bvh_build.c). */
+#ifndef PTR_BVH_SPLIT_H
+#define PTR_BVH_SPLIT_H
+
+#include <stddef.h>
+
+#include "accel/bvh.h"
+#include "accel/bvh_prims.h"
+
+/* The prims being built over, and the threads that may bin large ranges. */
+typedef struct BvhPrimSet {
+    BvhPrim *prims;
+    int threads;
+} BvhPrimSet;
+
+/* A range of prims being split into a node's children: its box, and the
+ * best binned split found for it with the boxes of its two halves. */
+typedef struct BvhCandidate {
+    size_t begin, end;
+    float lower[3], upper[3];
+    int axis;         /* of the best split; -1: split in the middle of the range */
+    int bins;         /* BINS, fewer for small ranges */
+    int split_bin;    /* prims in bins <= split_bin go left */
+    float left_lower[3], left_upper[3], right_lower[3], right_upper[3];
+    /* Binning: a prim's bin on axis a is (lower + upper - bin_base) * bin_scale,
+     * over the candidate's box (cheaper than the box of the centres, which
+     * would need a pass of its own, and as good for spheres of similar size). */
+    float bin_base[3], bin_scale[3];
+} BvhCandidate;
+
+/* Half the surface area of a box: what the heuristic weighs. */
+static inline float bvh_half_area(const float lo[3], const float hi[3])
+{
+    float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/* Sets c to the range begin .. end - 1 with box lower, upper (NULL: find
+ * it) and, if it has more prims than a leaf holds, finds its best split.
+ * Returns 0 if out of memory. */
+int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
+                       const float lower[3], const float upper[3]);
+
+/* Splits c in two (into *left and *right, which may be c): by its best split,
+ * or in the middle of its order if it has none or middle is set. Returns 0 if
+ * out of memory. */
+int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhCandidate *left,
+              BvhCandidate *right);
+
+#endif /* PTR_BVH_SPLIT_H */

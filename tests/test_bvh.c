@@ -1,0 +1,339 @@
+/* The tree: its structure, its determinism, and its traversal against brute
+ * force on hard sphere sets, bit for bit. */
+#include <stdint.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "accel/bvh.h"
+#include "accel/isect.h"
+#include "bvh_scenes.h"
+#include "core/render.h"
+#include "importer.h"
+#include "test.h"
+
+/* Walks the tree: every sphere in the tree is in exactly one leaf, every
+ * box contains its spheres and its subtree's boxes, leaves hold 1 to
+ * PTR_BVH_LEAF_MAX spheres by ascending id, and the depth is as stated. */
+static void check_node(const PtrBvh *bvh, const PtrSpheres *s, uint32_t index, int level,
+                       const float parent_lo[3], const float parent_hi[3], unsigned char *seen,
+                       int *ok)
+{
+    const PtrBvhNode *n = &bvh->nodes[index];
+    const float *lo[3] = { n->lower_x, n->lower_y, n->lower_z };
+    const float *hi[3] = { n->upper_x, n->upper_y, n->upper_z };
+    if (level > bvh->depth)
+        *ok = 0;
+    for (int k = 0; k < PTR_BVH_WIDTH; k++) {
+        if (lo[0][k] == INFINITY) { /* empty lane */
+            for (int a = 0; a < 3; a++)
+                if (lo[a][k] != INFINITY || hi[a][k] != -INFINITY)
+                    *ok = 0;
+            if (n->leaf_count[k] != 0)
+                *ok = 0;
+            continue;
+        }
+        float box_lo[3], box_hi[3];
+        for (int a = 0; a < 3; a++) {
+            box_lo[a] = lo[a][k];
+            box_hi[a] = hi[a][k];
+            if (parent_lo && (box_lo[a] < parent_lo[a] || box_hi[a] > parent_hi[a]))
+                *ok = 0;
+        }
+        uint32_t count = n->leaf_count[k];
+        if (count == 0) {
+            if (n->child[k] <= index || n->child[k] >= bvh->node_count)
+                *ok = 0;
+            else
+                check_node(bvh, s, n->child[k], level + 1, box_lo, box_hi, seen, ok);
+            continue;
+        }
+        uint32_t first = n->child[k];
+        if (count > PTR_BVH_LEAF_MAX || first < bvh->unbounded_count || first + count > s->count) {
+            *ok = 0;
+            continue;
+        }
+        for (uint32_t i = first; i < first + count; i++) {
+            seen[i]++;
+            if (i > first && s->id[i] <= s->id[i - 1])
+                *ok = 0;
+            float c[3] = { s->cx[i], s->cy[i], s->cz[i] };
+            for (int a = 0; a < 3; a++)
+                if (!(c[a] - s->radius[i] >= box_lo[a] && c[a] + s->radius[i] <= box_hi[a]))
+                    *ok = 0;
+        }
+    }
+}
+
+static void check_structure(const PtrBvh *bvh, const PtrSpheres *s, const char *name)
+{
+    unsigned char *seen = calloc(s->count + 1, 1);
+    int ok = seen != NULL;
+    for (size_t i = 0; ok && i < bvh->unbounded_count; i++) {
+        seen[i]++;
+        if (i > 0 && s->id[i] <= s->id[i - 1])
+            ok = 0;
+    }
+    if (ok && bvh->nodes)
+        check_node(bvh, s, 0, 0, NULL, NULL, seen, &ok);
+    for (size_t i = 0; ok && i < s->count; i++)
+        if (seen[i] != 1)
+            ok = 0;
+    /* The ids are a permutation of the file order. */
+    memset(seen, 0, s->count);
+    for (size_t i = 0; ok && i < s->count; i++)
+        if (s->id[i] >= s->count || seen[s->id[i]]++)
+            ok = 0;
+    /* Padding: at least a block of NaN radii past the last sphere. */
+    for (size_t i = s->count; ok && i < s->count + PTR_SPHERE_BLOCK; i++)
+        if (i >= s->capacity || !isnan(s->radius[i]))
+            ok = 0;
+    if (!ok)
+        fprintf(stderr, "%s: tree structure broken\n", name);
+    CHECK(ok);
+    free(seen);
+}
+
+/* Rays against the tree and against brute force on the file-order copy. */
+static void check_rays(const PtrScene *file_order, const PtrScene *built, const PtrBvh *bvh,
+                       int rays, const char *name)
+{
+    PtrRng rng = ptr_rng_for_sample(5, 0, 0);
+    int differences = 0, hits = 0;
+    for (int i = 0; i < rays; i++) {
+        PtrRay ray = bvh_scene_ray(&file_order->spheres, &rng);
+        if (i % 7 == 0)
+            ray.tmin = 1e-3f;
+        PtrHit brute, tree;
+        int brute_found = ptr_closest_hit_c(&ray, &file_order->spheres,
+                                            file_order->spheres.count, &brute);
+        int tree_found = ptr_bvh_closest_hit_c(&ray, bvh, &built->spheres, &tree);
+        hits += brute_found;
+        uint32_t tree_id = tree_found ? built->spheres.id[tree.sphere] : PTR_NO_HIT;
+        if (brute_found != tree_found || memcmp(&brute.t, &tree.t, sizeof brute.t) ||
+            brute.sphere != tree_id) {
+            if (differences++ < 5)
+                fprintf(stderr, "%s: ray %d: brute t %a sphere %u, tree t %a id %u\n", name, i,
+                        brute.t, brute.sphere, tree.t, tree_id);
+        }
+    }
+    CHECK_INT(differences, 0);
+    CHECK(hits > rays / 10); /* the rays do meet the spheres */
+}
+
+static void test_scenes(void)
+{
+    for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++)
+        for (int size = 0; size < 2; size++) {
+            int n = size ? 3000 : 37;
+            PtrScene a, b;
+            ptr_scene_init(&a);
+            ptr_scene_init(&b);
+            CHECK(bvh_scene_make(&a, (BvhSceneKind)kind, n, 1));
+            CHECK(bvh_scene_make(&b, (BvhSceneKind)kind, n, 1));
+            PtrBvh bvh;
+            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0), PTR_OK);
+            check_structure(&bvh, &b.spheres, bvh_scene_names[kind]);
+            check_rays(&a, &b, &bvh, 20000, bvh_scene_names[kind]);
+            ptr_bvh_free(&bvh);
+            ptr_scene_free(&a);
+            ptr_scene_free(&b);
+        }
+}
+
+/* The huge grounds stay out of the tree; ordinary spheres do not. */
+static void test_unbounded(void)
+{
+    const BvhSceneKind kinds[] = { BVH_SCENE_GROUND, BVH_SCENE_BIG_GROUND, BVH_SCENE_RANDOM };
+    for (int k = 0; k < 3; k++) {
+        PtrScene s;
+        ptr_scene_init(&s);
+        CHECK(bvh_scene_make(&s, kinds[k], 500, 2));
+        PtrBvh bvh;
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1), PTR_OK);
+        CHECK_INT(bvh.unbounded_count, k < 2 ? 1 : 0);
+        if (k < 2)
+            CHECK_INT(s.spheres.id[0], 0);
+        ptr_bvh_free(&bvh);
+        ptr_scene_free(&s);
+    }
+}
+
+/* The same tree bytes and sphere order with 1, 2 and 7 threads, on a set
+ * large enough for parallel binning and many tasks. */
+static void test_threads(void)
+{
+    PtrBvh first = { 0 };
+    PtrScene first_scene;
+    for (int t = 0; t < 3; t++) {
+        const int threads[] = { 1, 2, 7 };
+        PtrScene s;
+        ptr_scene_init(&s);
+        CHECK(bvh_scene_make(&s, BVH_SCENE_CLUSTERS, 150000, 3));
+        PtrBvh bvh;
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t]), PTR_OK);
+        if (t == 0) {
+            first = bvh;
+            first_scene = s;
+            CHECK(bvh.node_count > 1000);
+            continue;
+        }
+        CHECK_INT(bvh.node_count, first.node_count);
+        CHECK_INT(bvh.depth, first.depth);
+        CHECK_INT(bvh.unbounded_count, first.unbounded_count);
+        CHECK(bvh.node_count == first.node_count &&
+              !memcmp(bvh.nodes, first.nodes, bvh.node_count * sizeof *bvh.nodes));
+        CHECK(!memcmp(s.spheres.id, first_scene.spheres.id, s.spheres.count * sizeof(uint32_t)));
+        ptr_bvh_free(&bvh);
+        ptr_scene_free(&s);
+    }
+    ptr_bvh_free(&first);
+    ptr_scene_free(&first_scene);
+}
+
+/* No spheres, one sphere: nothing to build, and the traversal still answers. */
+static void test_small(void)
+{
+    PtrScene s;
+    ptr_scene_init(&s);
+    PtrBvh bvh;
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK(bvh.nodes == NULL);
+    PtrRay ray = { { 0, 0, 0 }, 0.0f, { 0, 0, -1 }, INFINITY };
+    PtrHit hit;
+    CHECK(!ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
+    CHECK_INT(hit.sphere, PTR_NO_HIT);
+    CHECK_FLOAT_EQ(hit.t, INFINITY);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0), PTR_OK);
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK(ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
+    CHECK_FLOAT_EQ(hit.t, 4.0f);
+    CHECK_INT(hit.sphere, 0);
+    ptr_bvh_free(&bvh);
+    ptr_scene_free(&s);
+}
+
+/* Renders scene with the C kernels through the structure chosen; returns
+ * the image (3 floats a pixel) or NULL. */
+static float *render_with(PtrScene *scene, PtrAccelChoice choice, int width, int height,
+                          const char **used)
+{
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    PtrAccel accel;
+    CHECK_INT(ptr_accel_init(&accel, choice, &c, scene, 3), PTR_OK);
+    *used = ptr_accel_name(&accel);
+    PtrRenderSettings settings = { .width = width, .height = height, .samples = 3, .seed = 9,
+                                   .max_depth = 12, .threads = 2 };
+    float *rgb = malloc((size_t)width * (size_t)height * 3 * sizeof *rgb);
+    PtrError err = { 0 };
+    CHECK_INT(ptr_render(scene, &accel, &settings, rgb, NULL, &err), PTR_OK);
+    ptr_accel_free(&accel);
+    return rgb;
+}
+
+/* Brute force and the tree render the same image, bit for bit, and the
+ * scene's hash does not change when the tree reorders the spheres. */
+static void check_same_render(PtrScene *brute, PtrScene *tree, int width, int height,
+                              const char *name)
+{
+    uint64_t hash = ptr_scene_hash(tree);
+    const char *a, *b;
+    float *x = render_with(brute, PTR_ACCEL_BRUTE, width, height, &a);
+    float *y = render_with(tree, PTR_ACCEL_BVH, width, height, &b);
+    CHECK_STR(a, "brute");
+    CHECK_STR(b, "bvh");
+    int same = !memcmp(x, y, (size_t)width * (size_t)height * 3 * sizeof *x);
+    if (!same)
+        fprintf(stderr, "%s: brute force and the tree render differently\n", name);
+    CHECK(same);
+    CHECK(ptr_scene_hash(tree) == hash);
+    CHECK(ptr_scene_hash(brute) == hash);
+    free(x);
+    free(y);
+}
+
+static void test_renders_files(void)
+{
+    const char *files[] = { PTR_SOURCE_DIR "/scenes/seed.gltf", PTR_SOURCE_DIR "/scenes/final.gltf" };
+    for (int f = 0; f < 2; f++) {
+        PtrScene a, b;
+        PtrStrings warnings = { 0 };
+        PtrError err = { 0 };
+        CHECK_INT(ptr_import_scene(files[f], NULL, &a, &warnings, &err), PTR_OK);
+        CHECK_INT(ptr_import_scene(files[f], NULL, &b, &warnings, &err), PTR_OK);
+        ptr_strings_free(&warnings);
+        check_same_render(&a, &b, 48, 27, files[f]);
+        ptr_scene_free(&a);
+        ptr_scene_free(&b);
+    }
+}
+
+/* The hard sets with mixed materials, seen from outside their bounds. */
+static void test_renders_hard(void)
+{
+    const PtrMaterial materials[3] = {
+        { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.6f, 0.4f, 0.3f } },
+        { .kind = PTR_MATERIAL_METAL, .albedo = { 0.9f, 0.9f, 0.9f } },
+        { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = { 1, 1, 1 }, .ior = 1.5f },
+    };
+    for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++) {
+        PtrScene s[2];
+        for (int k = 0; k < 2; k++) {
+            ptr_scene_init(&s[k]);
+            for (int m = 0; m < 3; m++) {
+                uint32_t index;
+                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index), PTR_OK);
+            }
+            CHECK(bvh_scene_make(&s[k], (BvhSceneKind)kind, 600, 4));
+            float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+            PtrSpheres *sp = &s[k].spheres;
+            for (size_t i = 0; i < sp->count; i++) {
+                sp->material[i] = (uint32_t)(i % 3);
+                if (sp->radius[i] > 100.0f) /* a ground: look at what stands on it */
+                    continue;
+                float c[3] = { sp->cx[i], sp->cy[i], sp->cz[i] };
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fminf(lo[a], c[a] - sp->radius[i]);
+                    hi[a] = fmaxf(hi[a], c[a] + sp->radius[i]);
+                }
+            }
+            PtrVec3 centre = v3(0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]), 0.5f * (lo[2] + hi[2]));
+            float size = fmaxf(hi[0] - lo[0], fmaxf(hi[1] - lo[1], hi[2] - lo[2]));
+            s[k].camera = (PtrCamera){ .lookfrom = v3_add(centre, v3(0.3f * size, 0.5f * size, 1.5f * size)),
+                                       .lookat = centre, .up = v3(0, 1, 0), .vfov_deg = 50.0f,
+                                       .focus_distance = 1.0f };
+        }
+        check_same_render(&s[0], &s[1], 40, 30, bvh_scene_names[kind]);
+        ptr_scene_free(&s[0]);
+        ptr_scene_free(&s[1]);
+    }
+}
+
+/* auto: brute force below the crossover, the tree from it on. */
+static void test_auto(void)
+{
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    for (int n = PTR_ACCEL_CROSSOVER_C - 1; n <= PTR_ACCEL_CROSSOVER_C; n++) {
+        PtrScene s;
+        ptr_scene_init(&s);
+        CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
+        PtrAccel accel;
+        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, &s, 0), PTR_OK);
+        CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER_C ? "brute" : "bvh");
+        ptr_accel_free(&accel);
+        ptr_scene_free(&s);
+    }
+}
+
+int main(void)
+{
+    test_small();
+    test_unbounded();
+    test_scenes();
+    test_threads();
+    test_auto();
+    test_renders_files();
+    test_renders_hard();
+    return test_report();
+}
