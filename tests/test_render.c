@@ -87,7 +87,7 @@ static void test_inside_emitter(void)
     s.spheres.radius[0] = 100.0f;
     s.sky.kind = PTR_SKY_BLACK;
     PtrRenderSettings settings = { .width = 16, .height = 16, .samples = 4, .seed = 1,
-                                   .max_depth = 3, .threads = 1 };
+                                   .max_depth = 3, .threads = 1, .roulette = PTR_OFF };
     Image img = render(&s, settings);
     check_centre(&img, 1.75f, "emitter, depth 3");
     free(img.rgb);

@@ -36,7 +36,7 @@ static void test_passes_are_exact(void)
     PtrIsectTable isect;
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
     PtrRenderSettings s = { .width = 40, .height = 40, .seed = 5, .max_depth = 50 };
-    static double one[40 * 40 * 3], parts[40 * 40 * 3];
+    static double one[40 * 40 * PTR_ACCUM_STRIDE], parts[40 * 40 * PTR_ACCUM_STRIDE];
     CHECK_INT(ptr_render_samples(&scene, &isect, &s, 0, 10, one, NULL, NULL, NULL, &err), PTR_OK);
     const uint32_t cuts[] = { 0, 1, 4, 9, 10 };
     for (int i = 0; i < 4; i++)

@@ -106,7 +106,8 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         }
     }
 
-    char seed[24], exposure[32], hash[24];
+    char seed[24], exposure[32], hash[24], threshold[32];
+    snprintf(threshold, sizeof threshold, "%g", info->noise_threshold);
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
     snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
     snprintf(exposure, sizeof exposure, "%g", info->exposure);
@@ -124,6 +125,12 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         { .name = "ptr:seed", .type = PTR_ATTR_STRING, .string_value = seed },
         { .name = "ptr:max_depth", .type = PTR_ATTR_INT, .int_value = info->max_depth },
         { .name = "ptr:kernel", .type = PTR_ATTR_STRING, .string_value = info->kernel },
+        { .name = "ptr:sampler", .type = PTR_ATTR_STRING, .string_value = info->sampler },
+        { .name = "ptr:direct_lighting", .type = PTR_ATTR_STRING,
+          .string_value = info->direct_lighting ? "on" : "off" },
+        { .name = "ptr:roulette", .type = PTR_ATTR_STRING, .string_value = info->roulette ? "on" : "off" },
+        { .name = "ptr:noise_threshold", .type = PTR_ATTR_STRING, .string_value = threshold },
+        { .name = "ptr:min_samples", .type = PTR_ATTR_INT, .int_value = (int)info->min_samples },
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->render_seconds },
         { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,
@@ -140,7 +147,9 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, pixel_formats[depth],
+    const char *dot = strrchr(path, '.');
+    const float *counts = dot && !strcasecmp(dot, ".exr") ? info->sample_counts : NULL;
+    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, counts, pixel_formats[depth],
                                  attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
     free(viewed);
     if (failed)

@@ -28,6 +28,11 @@ typedef struct PtrOutputInfo {
     int interrupted;       /* the render stopped before all samples asked for */
     uint64_t seed;
     int max_depth;
+    const char *sampler;   /* the estimator: ptr_sampler_name, lighting, roulette */
+    int direct_lighting, roulette;
+    float noise_threshold; /* adaptive sampling; 0: off */
+    uint32_t min_samples;
+    const float *sample_counts; /* per pixel, written as an EXR channel (may be NULL) */
     double render_seconds;
     PtrDepth depth;
     const PtrColor *color; /* the display, view, look and exposure in force */

@@ -7,6 +7,10 @@
 #include "accel/isect.h"
 #include "core/result.h"
 #include "core/scene.h"
+#include "sampling/sampler.h"
+
+/* A switch whose zero value, the default, is on. */
+typedef enum PtrSwitch { PTR_ON, PTR_OFF } PtrSwitch;
 
 /* Pixels x0 <= x < x1, y0 <= y < y1 of the full image. */
 typedef struct PtrRegion {
@@ -25,11 +29,19 @@ typedef struct PtrRenderSettings {
      * point with this fixed t_min (0.001 there): the counter-example the
      * stability suite measures against. */
     float fixed_tmin;
+    PtrSamplerKind sampler;
+    PtrSwitch direct_lighting; /* light sampling of emissive spheres, with MIS */
+    PtrSwitch roulette;        /* Russian roulette after the first bounces */
+    /* Adaptive sampling: above 0, a pixel stops once its error estimate
+     * falls below this, checked after min_samples and every 16 samples;
+     * sample indices must then start at 0. */
+    float noise_threshold;
+    uint32_t min_samples;
 } PtrRenderSettings;
 
 typedef struct PtrRenderStats {
     double seconds;
-    uint64_t rays; /* closest-hit queries, camera and scattered */
+    uint64_t rays; /* closest-hit queries: camera, scattered and shadow rays */
     int threads;
 } PtrRenderStats;
 
@@ -41,15 +53,29 @@ typedef void (*PtrTickFn)(void *user, double fraction_done);
  * all zero if it does not lie inside the image. */
 PtrRegion ptr_render_region(const PtrRenderSettings *settings);
 
-/* Adds the radiance of samples first .. first + count - 1 of every pixel of
- * the region to sums (3 doubles a pixel, region rows top to bottom), sample
- * by sample in index order: split into passes of any size, the sums come out
- * bit for bit the same, and never depend on the thread count. tick may be
- * NULL; stats (may be NULL) gets this call's figures. */
+/* What ptr_render_samples keeps of each pixel, in doubles: the sum of its
+ * samples' radiance, the sum over its odd-numbered samples (adaptive
+ * sampling's second half-buffer), how many samples it took, and whether
+ * adaptive sampling stopped it (1) or not (0). */
+enum {
+    PTR_ACCUM_SUM = 0, PTR_ACCUM_ODD = 3, PTR_ACCUM_COUNT = 6, PTR_ACCUM_STOPPED = 7,
+    PTR_ACCUM_STRIDE = 8,
+};
+
+/* Adds samples first .. first + count - 1 of every pixel of the region to
+ * acc (PTR_ACCUM_STRIDE doubles a pixel, region rows top to bottom, zero
+ * before the first call), sample by sample in index order: split into passes
+ * of any size, the sums come out bit for bit the same, and never depend on
+ * the thread count. tick may be NULL; stats (may be NULL) gets this call's
+ * figures. */
 PtrResult ptr_render_samples(const PtrScene *scene, const PtrIsectTable *isect,
                              const PtrRenderSettings *settings, uint32_t first, uint32_t count,
-                             double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
+                             double *acc, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err);
+
+/* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
+ * a pixel), and if sample_counts is not NULL, how many samples each took. */
+void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);
 
 /* The whole region with settings->samples samples, as means in rgb (3 floats
  * a pixel, region rows top to bottom). */
