@@ -6,8 +6,7 @@
 
 static uint32_t reverse_bits(uint32_t x)
 {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = __builtin_bswap32(x);
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
@@ -15,8 +14,9 @@ static uint32_t reverse_bits(uint32_t x)
 }
 
 /* Burley's improved Laine-Karras hash: a bijection in which each bit flips
- * depending only on the bits below it, so applied to a bit-reversed value it
- * is a nested uniform (Owen) scramble of the original. */
+ * depending only on the bits below it. Applied to a bit-reversed fraction it
+ * is a nested uniform (Owen) scramble of it: every bit flips as a hash of
+ * the bits above it decides. */
 static uint32_t laine_karras(uint32_t x, uint32_t seed)
 {
     x += seed;
@@ -27,24 +27,21 @@ static uint32_t laine_karras(uint32_t x, uint32_t seed)
     return x;
 }
 
-/* Owen scrambling of a 32-bit fraction: every bit flips as a hash of the
- * bits above it decides. */
-static uint32_t owen_scramble(uint32_t x, uint32_t seed)
+/* The second Sobol' dimension (primitive polynomial x + 1, m1 = 1), bit
+ * reversed: its direction numbers v(k+1) = v(k) xor v(k) / 2 from v(1) = 1/2
+ * are the rows of Pascal's triangle mod 2, so by Lucas' theorem bit j of
+ * direction number k is set when j's bits are a subset of k's. The sum over
+ * the index's bits is then a superset-sum transform over the 5-bit bit
+ * positions, five butterfly steps. (The first dimension, van der Corput, is
+ * the reversed index itself; the two form a (0,2)-sequence in base 2.) */
+static uint32_t sobol_second_reversed(uint32_t index)
 {
-    return reverse_bits(laine_karras(reverse_bits(x), seed));
-}
-
-/* The second Sobol' dimension (primitive polynomial x + 1, m1 = 1): its
- * direction numbers are v1 = 1/2, v(k+1) = v(k) xor v(k) / 2, the rows of
- * Pascal's triangle mod 2. The first dimension is the van der Corput
- * sequence, reverse_bits. Together they form a (0,2)-sequence in base 2. */
-static uint32_t sobol_second(uint32_t index)
-{
-    uint32_t v = 1u << 31, r = 0;
-    for (; index; index >>= 1, v ^= v >> 1)
-        if (index & 1)
-            r ^= v;
-    return r;
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    index ^= (index >> 16) & 0x0000ffffu;
+    return index;
 }
 
 PtrSampler ptr_sampler_for_sample(PtrSamplerKind kind, uint64_t seed, uint64_t pixel,
@@ -68,9 +65,9 @@ void ptr_sampler_2d_bits(const PtrSampler *s, uint32_t dim, uint32_t out[2])
      * them decide), and any such block of a (0,2)-sequence is a (0,k,2)-net;
      * it decorrelates this pair from the others (padding). */
     uint64_t scramble = ptr_mix64(pair_key);
-    uint32_t i = owen_scramble(s->index, (uint32_t)pair_key);
-    out[0] = owen_scramble(reverse_bits(i), (uint32_t)scramble);
-    out[1] = owen_scramble(sobol_second(i), (uint32_t)(scramble >> 32));
+    uint32_t i = reverse_bits(laine_karras(reverse_bits(s->index), (uint32_t)pair_key));
+    out[0] = reverse_bits(laine_karras(i, (uint32_t)scramble));
+    out[1] = reverse_bits(laine_karras(sobol_second_reversed(i), (uint32_t)(scramble >> 32)));
 }
 
 void ptr_sampler_2d(const PtrSampler *s, uint32_t dim, float out[2])
