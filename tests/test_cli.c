@@ -44,7 +44,7 @@ static int file_count(void)
 static void test_render_seed_exr(void)
 {
     const char *out = test_path("seed.exr");
-    CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "8", "--width", "60", "--seed", "42",
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "32", "--width", "60", "--seed", "42",
                   "--quiet", "--c", NULL), 0);
     char err[256];
     PtrImage *img = ptr_image_read(out, err, sizeof err);
@@ -54,7 +54,7 @@ static void test_render_seed_exr(void)
     /* The scene's camera is square: the height follows the width. */
     CHECK_INT(ptr_image_width(img), 60);
     CHECK_INT(ptr_image_height(img), 60);
-    CHECK_STR(ptr_image_attr(img, "ptr:samples"), "8");
+    CHECK_STR(ptr_image_attr(img, "ptr:samples"), "32");
     CHECK_STR(ptr_image_attr(img, "ptr:seed"), "42");
     CHECK_STR(ptr_image_attr(img, "ptr:kernel"), "c");
     CHECK(ptr_image_attr(img, "Software") && !strncmp(ptr_image_attr(img, "Software"), "ptr ", 4));
