@@ -84,33 +84,50 @@ static double fit_slope(const double *x, const double *y, int n)
     return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
-/* One curve: spp = 1, 2, 4, ... max_spp, the errors and times averaged over
- * seeds 1 .. seeds. */
-static int curve(FILE *csv, const Bench *bench, const char *method, const PtrScene *scene,
-                 const PtrIsectTable *isect, PtrRenderSettings settings, uint32_t max_spp,
-                 int seeds, const float *ref, float *img)
+/* A curve of the chart: an intersector and an estimator. */
+typedef struct Method {
+    const char *name;
+    PtrIsectTable isect;
+    PtrRenderSettings settings;
+} Method;
+
+enum { MAX_METHODS = 8, MAX_POINTS = 24 };
+
+/* Every method at spp = 1, 2, 4, ... max_spp, the errors and times averaged
+ * over seeds 1 .. seeds. The methods take turns at each point, so that the
+ * load of a shared machine weighs on all of them alike. */
+static int curves(FILE *csv, const Bench *bench, const PtrScene *scene, const Method *methods,
+                  int count, uint32_t max_spp, int seeds, const float *ref, float *img)
 {
     size_t n = (size_t)bench->width * bench->height * 3;
-    double x[32], y[32];
+    static double se[MAX_METHODS][MAX_POINTS], rel[MAX_METHODS][MAX_POINTS],
+        seconds[MAX_METHODS][MAX_POINTS];
+    memset(se, 0, sizeof se), memset(rel, 0, sizeof rel), memset(seconds, 0, sizeof seconds);
     int points = 0;
-    for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
-        double se = 0, rel = 0, seconds = 0;
-        for (int s = 1; s <= seeds; s++) {
-            double t;
-            settings.samples = spp;
-            settings.seed = (uint64_t)s;
-            if (!render(scene, isect, settings, img, &t))
-                return 0;
-            Error e = error_of(img, ref, n);
-            se += e.se, rel += e.rel, seconds += t;
+    for (uint32_t spp = 1; spp <= max_spp && points < MAX_POINTS; spp *= 2, points++)
+        for (int s = 1; s <= seeds; s++)
+            for (int m = 0; m < count; m++) {
+                PtrRenderSettings settings = methods[m].settings;
+                double t;
+                settings.samples = spp;
+                settings.seed = (uint64_t)s;
+                if (!render(scene, &methods[m].isect, settings, img, &t))
+                    return 0;
+                Error e = error_of(img, ref, n);
+                se[m][points] += e.se, rel[m][points] += e.rel, seconds[m][points] += t;
+            }
+    for (int m = 0; m < count; m++) {
+        double x[MAX_POINTS], y[MAX_POINTS];
+        for (int p = 0; p < points; p++) {
+            double rmse = sqrt(se[m][p] / seeds / (double)n);
+            fprintf(csv, "%s,%s,%u,%.6f,%.6g,%.6g\n", bench->name, methods[m].name, 1u << p,
+                    seconds[m][p] / seeds, rmse, rel[m][p] / seeds / (double)n);
+            x[p] = log((double)(1u << p)), y[p] = log(rmse);
         }
-        double rmse = sqrt(se / seeds / (double)n);
-        fprintf(csv, "%s,%s,%" PRIu32 ",%.6f,%.6g,%.6g\n", bench->name, method, spp,
-                seconds / seeds, rmse, rel / seeds / (double)n);
-        fflush(csv);
-        x[points] = log((double)spp), y[points] = log(rmse), points++;
+        fprintf(stderr, "%s: %-22s RMSE ~ spp^%.3f\n", bench->name, methods[m].name,
+                fit_slope(x, y, points));
     }
-    fprintf(stderr, "%s: %-22s RMSE ~ spp^%.3f\n", bench->name, method, fit_slope(x, y, points));
+    fflush(csv);
     return 1;
 }
 
@@ -162,26 +179,29 @@ int main(int argc, char **argv)
             return 1;
         fprintf(stderr, "%s: reference, %" PRIu32 " spp, %.1f s\n", bench->name, ref_spp, seconds);
 
+        Method methods[MAX_METHODS];
+        int count = 0;
         for (size_t e = 0; by_estimator && e < sizeof estimators / sizeof estimators[0]; e++) {
             const Estimator *est = &estimators[e];
-            settings.sampler = est->sampler;
-            settings.direct_lighting = est->direct_lighting;
-            settings.roulette = est->roulette;
-            settings.noise_threshold = est->noise_threshold;
-            if (!curve(csv, bench, est->name, &scene, &fastest, settings, max_spp, seeds, ref, img))
-                return 1;
+            Method *m = &methods[count++];
+            *m = (Method){ est->name, fastest, settings };
+            m->settings.sampler = est->sampler;
+            m->settings.direct_lighting = est->direct_lighting;
+            m->settings.roulette = est->roulette;
+            m->settings.noise_threshold = est->noise_threshold;
         }
-        settings.sampler = PTR_SAMPLER_INDEPENDENT;
-        settings.direct_lighting = settings.roulette = PTR_OFF;
-        settings.noise_threshold = 0;
         for (int l = PTR_CPU_NONE; !by_estimator && l <= (int)ptr_cpu_level(); l++) {
-            PtrIsectTable isect;
-            ptr_isect_init_level(&isect, (PtrCpuLevel)l);
             if (l > PTR_CPU_NONE && !ptr_isect_has_asm())
                 break;
-            if (!curve(csv, bench, isect.name, &scene, &isect, settings, max_spp, 1, ref, img))
-                return 1;
+            Method *m = &methods[count++];
+            *m = (Method){ NULL, { 0 }, settings };
+            ptr_isect_init_level(&m->isect, (PtrCpuLevel)l);
+            m->name = m->isect.name;
+            m->settings.sampler = PTR_SAMPLER_INDEPENDENT;
+            m->settings.direct_lighting = m->settings.roulette = PTR_OFF;
         }
+        if (!curves(csv, bench, &scene, methods, count, max_spp, seeds, ref, img))
+            return 1;
         free(ref);
         free(img);
         ptr_scene_free(&scene);
