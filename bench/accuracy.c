@@ -6,7 +6,7 @@
  *   accuracy intersectors OUT.csv [MAX_SPP] [REFERENCE_SPP]
  *       every intersector this machine has (one estimator, seed 1)
  *   accuracy estimators OUT.csv [MAX_SPP] [REFERENCE_SPP] [SEEDS]
- *       the estimators (sampler, light sampling, roulette, adaptive), with
+ *       the estimators (sampler, light sampling, adaptive sampling), with
  *       the fastest intersector; each point averages the squared error and
  *       the time over SEEDS seeds (default 4), since one seed's error
  *       wanders by tens of per cent at low sample counts
@@ -33,17 +33,18 @@ typedef struct Bench {
 typedef struct Estimator {
     const char *name;
     PtrSamplerKind sampler;
-    PtrSwitch direct_lighting, roulette;
+    PtrSwitch direct_lighting;
     float noise_threshold;
 } Estimator;
 
+/* sobol+direct is the default; independent+direct is --sampler independent,
+ * independent alone the estimator before either existed. */
 static const Estimator estimators[] = {
-    { "independent", PTR_SAMPLER_INDEPENDENT, PTR_OFF, PTR_OFF, 0 },
-    { "sobol", PTR_SAMPLER_SOBOL, PTR_OFF, PTR_OFF, 0 },
-    { "independent+direct", PTR_SAMPLER_INDEPENDENT, PTR_ON, PTR_ON, 0 },
-    { "sobol+direct", PTR_SAMPLER_SOBOL, PTR_ON, PTR_OFF, 0 },
-    { "sobol+direct+roulette", PTR_SAMPLER_SOBOL, PTR_ON, PTR_ON, 0 },
-    { "adaptive", PTR_SAMPLER_SOBOL, PTR_ON, PTR_ON, 0.01f },
+    { "independent", PTR_SAMPLER_INDEPENDENT, PTR_OFF, 0 },
+    { "sobol", PTR_SAMPLER_SOBOL, PTR_OFF, 0 },
+    { "independent+direct", PTR_SAMPLER_INDEPENDENT, PTR_ON, 0 },
+    { "sobol+direct", PTR_SAMPLER_SOBOL, PTR_ON, 0 },
+    { "adaptive", PTR_SAMPLER_SOBOL, PTR_ON, 0.01f },
 };
 
 typedef struct Error {
@@ -187,7 +188,6 @@ int main(int argc, char **argv)
             *m = (Method){ est->name, fastest, settings };
             m->settings.sampler = est->sampler;
             m->settings.direct_lighting = est->direct_lighting;
-            m->settings.roulette = est->roulette;
             m->settings.noise_threshold = est->noise_threshold;
         }
         for (int l = PTR_CPU_NONE; !by_estimator && l <= (int)ptr_cpu_level(); l++) {
@@ -198,7 +198,7 @@ int main(int argc, char **argv)
             ptr_isect_init_level(&m->isect, (PtrCpuLevel)l);
             m->name = m->isect.name;
             m->settings.sampler = PTR_SAMPLER_INDEPENDENT;
-            m->settings.direct_lighting = m->settings.roulette = PTR_OFF;
+            m->settings.direct_lighting = PTR_OFF;
         }
         if (!curves(csv, bench, &scene, methods, count, max_spp, seeds, ref, img))
             return 1;

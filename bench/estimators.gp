@@ -9,7 +9,7 @@ set xlabel "render time (s)"
 set ylabel "RMSE (scene-linear)"
 set grid
 set key bottom left
-methods = "independent sobol independent+direct sobol+direct sobol+direct+roulette adaptive"
+methods = "independent sobol independent+direct sobol+direct adaptive"
 do for [scene in "final lamps"] {
     set title scene eq "final" ? "final.gltf (486 spheres, gradient sky, 200x112)" : "lamps.gltf (24 small emitters, black sky, 200x112)"
     plot for [m in methods] data using \

@@ -249,7 +249,6 @@ static void test_unbiased(void)
     block_stats(&s, settings, 1, m[0], v[0]);
     settings.sampler = PTR_SAMPLER_INDEPENDENT;
     settings.direct_lighting = PTR_OFF;
-    settings.roulette = PTR_OFF;
     block_stats(&s, settings, 101, m[1], v[1]);
     double chi2 = 0, variance_ratio = 0;
     for (int k = 0; k < CELLS; k++) {

@@ -23,7 +23,7 @@ enum {
     OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
     OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION, OPT_JSON, OPT_TIME, OPT_PREVIEW, OPT_WATCH,
     OPT_SAMPLE_RANGE, OPT_REGION, OPT_LOOKFROM, OPT_LOOKAT, OPT_UP, OPT_VFOV, OPT_APERTURE,
-    OPT_FOCUS_DISTANCE, OPT_FIT_ALL, OPT_SAMPLER, OPT_DIRECT_LIGHTING, OPT_ROULETTE,
+    OPT_FOCUS_DISTANCE, OPT_FIT_ALL, OPT_SAMPLER, OPT_DIRECT_LIGHTING,
     OPT_NOISE_THRESHOLD, OPT_MIN_SAMPLES,
 };
 
@@ -38,7 +38,6 @@ static const struct option long_options[] = {
     { "sky", required_argument, NULL, OPT_SKY },
     { "sampler", required_argument, NULL, OPT_SAMPLER },
     { "direct-lighting", required_argument, NULL, OPT_DIRECT_LIGHTING },
-    { "roulette", required_argument, NULL, OPT_ROULETTE },
     { "noise-threshold", required_argument, NULL, OPT_NOISE_THRESHOLD },
     { "min-samples", required_argument, NULL, OPT_MIN_SAMPLES },
     { "camera", required_argument, NULL, OPT_CAMERA },
@@ -102,7 +101,6 @@ static void print_help(FILE *out)
         "                        independent random numbers\n"
         "      --direct-lighting on|off  sample emissive spheres at diffuse surfaces\n"
         "                        (default on)\n"
-        "      --roulette on|off Russian roulette after 3 bounces (default on)\n"
         "      --noise-threshold E  adaptive sampling: a pixel stops once its error\n"
         "                        estimate is below E (e.g. 0.01; default off)\n"
         "      --min-samples N   adaptive sampling: samples before the first check\n"
@@ -320,13 +318,10 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
                 return usage_error(option, optarg, "sobol or independent");
             break;
         case OPT_DIRECT_LIGHTING:
-        case OPT_ROULETTE: {
-            PtrSwitch *sw = c == OPT_ROULETTE ? &o->roulette : &o->direct_lighting;
             if (strcmp(optarg, "on") && strcmp(optarg, "off"))
                 return usage_error(option, optarg, "on or off");
-            *sw = strcmp(optarg, "on") ? PTR_OFF : PTR_ON;
+            o->direct_lighting = strcmp(optarg, "on") ? PTR_OFF : PTR_ON;
             break;
-        }
         case OPT_NOISE_THRESHOLD: {
             char *end;
             errno = 0;

@@ -28,7 +28,7 @@ typedef struct PtrOptions {
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;
-    PtrSwitch direct_lighting, roulette;
+    PtrSwitch direct_lighting;
     float noise_threshold;  /* adaptive sampling; 0: off */
     uint32_t min_samples;
     int threads;

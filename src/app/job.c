@@ -54,7 +54,7 @@ static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, co
 
     PtrRenderSettings settings = {
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
-        .sampler = o->sampler, .direct_lighting = o->direct_lighting, .roulette = o->roulette,
+        .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
     };
     choose_size(o, scene, &settings.width, &settings.height);
@@ -104,7 +104,7 @@ static PtrResult render_and_write(const PtrOptions *o, const PtrScene *scene, co
             .kernel = isect.name, .sample_first = report->sample_first,
             .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
             .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
-            .direct_lighting = o->direct_lighting == PTR_ON, .roulette = o->roulette == PTR_ON,
+            .direct_lighting = o->direct_lighting == PTR_ON,
             .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
             .sample_counts = counts, .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,

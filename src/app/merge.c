@@ -12,7 +12,7 @@ typedef struct Part {
     PtrImage *image;
     PtrImageLayout layout;
     const char *scene, *hash, *seed, *kernel;
-    const char *sampler, *direct_lighting, *roulette, *noise_threshold;
+    const char *sampler, *direct_lighting, *noise_threshold;
     long first, samples, max_depth;
 } Part;
 
@@ -40,7 +40,6 @@ static PtrResult read_part(Part *p, PtrError *err)
         !(space = required(p, "ptr:colorspace", err)) ||
         !(p->sampler = required(p, "ptr:sampler", err)) ||
         !(p->direct_lighting = required(p, "ptr:direct_lighting", err)) ||
-        !(p->roulette = required(p, "ptr:roulette", err)) ||
         !(p->noise_threshold = required(p, "ptr:noise_threshold", err)))
         return PTR_ERR_USAGE;
     if (strcmp(space, "lin_rec709"))
@@ -72,9 +71,8 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
                            : strcmp(a->seed, b->seed) ? "seed"
                            : a->max_depth != b->max_depth ? "depth limit"
                            : strcmp(a->sampler, b->sampler) || strcmp(a->direct_lighting, b->direct_lighting) ||
-                                   strcmp(a->roulette, b->roulette) ||
                                    strcmp(a->noise_threshold, b->noise_threshold)
-                               ? "estimator (sampler, direct lighting, roulette, noise threshold)"
+                               ? "estimator (sampler, direct lighting, noise threshold)"
                            : a->layout.full_width != b->layout.full_width ||
                                    a->layout.full_height != b->layout.full_height
                                ? "image size"
@@ -162,7 +160,6 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .kernel = report->kernel, .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
         .seed = report->seed, .max_depth = (int)parts[0].max_depth, .depth = o->depth,
         .sampler = parts[0].sampler, .direct_lighting = !strcmp(parts[0].direct_lighting, "on"),
-        .roulette = !strcmp(parts[0].roulette, "on"),
         .noise_threshold = strtof(parts[0].noise_threshold, NULL),
         .min_samples = ptr_image_attr(parts[0].image, "ptr:min_samples")
                            ? (uint32_t)atol(ptr_image_attr(parts[0].image, "ptr:min_samples"))

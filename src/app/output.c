@@ -128,7 +128,6 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         { .name = "ptr:sampler", .type = PTR_ATTR_STRING, .string_value = info->sampler },
         { .name = "ptr:direct_lighting", .type = PTR_ATTR_STRING,
           .string_value = info->direct_lighting ? "on" : "off" },
-        { .name = "ptr:roulette", .type = PTR_ATTR_STRING, .string_value = info->roulette ? "on" : "off" },
         { .name = "ptr:noise_threshold", .type = PTR_ATTR_STRING, .string_value = threshold },
         { .name = "ptr:min_samples", .type = PTR_ATTR_INT, .int_value = (int)info->min_samples },
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,

@@ -28,8 +28,8 @@ typedef struct PtrOutputInfo {
     int interrupted;       /* the render stopped before all samples asked for */
     uint64_t seed;
     int max_depth;
-    const char *sampler;   /* the estimator: ptr_sampler_name, lighting, roulette */
-    int direct_lighting, roulette;
+    const char *sampler;   /* the estimator: ptr_sampler_name and light sampling */
+    int direct_lighting;
     float noise_threshold; /* adaptive sampling; 0: off */
     uint32_t min_samples;
     const float *sample_counts; /* per pixel, written as an EXR channel (may be NULL) */

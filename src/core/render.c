@@ -41,10 +41,6 @@ PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHi
     return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
 }
 
-/* Russian roulette starts after this many bounces: the first ones carry
- * most of the light, and killing them costs more variance than it saves. */
-enum { ROULETTE_FIRST_BOUNCE = 3 };
-
 typedef struct PathContext {
     const PtrScene *scene;
     const PtrIsectTable *isect;
@@ -193,7 +189,7 @@ static PtrVec3 trace_path(const PathContext *ctx, const PtrSampler *sampler, Ptr
             radiance = v3_add(radiance, v3_mul(throughput, sample_emitter(ctx, sampler, depth, m,
                                                                           &lit, n, normal)));
 
-        float u[4];
+        float u[4]; /* u[3] is unused: one pair holds the third number */
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF), u);
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF_EXTRA), u + 2);
         PtrVec3 out_dir, attenuation;
@@ -202,14 +198,8 @@ static PtrVec3 trace_path(const PathContext *ctx, const PtrSampler *sampler, Ptr
         if (lit.sampled)
             lit.scatter_pdf = ptr_diffuse_pdf(n, out_dir);
         throughput = v3_mul(throughput, attenuation);
-        float survive = v3_max_comp(throughput);
-        if (survive <= 0.0f)
+        if (v3_max_comp(throughput) <= 0.0f)
             break;
-        if (settings->roulette == PTR_ON && depth + 1 >= ROULETTE_FIRST_BOUNCE && survive < 1.0f) {
-            if (u[3] >= survive)
-                break;
-            throughput = v3_scale(throughput, 1.0f / survive);
-        }
         ray = leave_surface(ctx, hit.sphere, point, normal, out_dir);
     }
     return radiance;

@@ -31,7 +31,6 @@ typedef struct PtrRenderSettings {
     float fixed_tmin;
     PtrSamplerKind sampler;
     PtrSwitch direct_lighting; /* light sampling of emissive spheres, with MIS */
-    PtrSwitch roulette;        /* Russian roulette after the first bounces */
     /* Adaptive sampling: above 0, a pixel stops once its error estimate
      * falls below this, checked after min_samples and every 16 samples;
      * sample indices must then start at 0. */

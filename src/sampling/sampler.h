@@ -29,7 +29,7 @@ enum {
     PTR_DIM_LENS = 1,        /* point on the lens */
     PTR_DIM_FIRST_BOUNCE = 2,
     PTR_SLOT_BSDF = 0,       /* the scattered direction */
-    PTR_SLOT_BSDF_EXTRA = 1, /* Fresnel choice or fuzz radius; Russian roulette */
+    PTR_SLOT_BSDF_EXTRA = 1, /* Fresnel choice or fuzz radius (one of the pair) */
     PTR_SLOT_LIGHT_POINT = 2,/* the point on the chosen emitter */
     PTR_SLOT_LIGHT_PICK = 3, /* which emitter (alias table column, coin) */
     PTR_BOUNCE_SLOTS = 4,
