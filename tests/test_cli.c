@@ -55,6 +55,9 @@ static void test_render_seed_exr(void)
     CHECK_INT(ptr_image_width(img), 60);
     CHECK_INT(ptr_image_height(img), 60);
     CHECK_STR(ptr_image_attr(img, "ptr:samples"), "32");
+    CHECK_STR(ptr_image_attr(img, "ptr:sampler"), "sobol");
+    CHECK_STR(ptr_image_attr(img, "ptr:direct_lighting"), "on");
+    CHECK_STR(ptr_image_attr(img, "ptr:noise_threshold"), "0");
     CHECK_STR(ptr_image_attr(img, "ptr:seed"), "42");
     CHECK_STR(ptr_image_attr(img, "ptr:kernel"), "c");
     CHECK(ptr_image_attr(img, "Software") && !strncmp(ptr_image_attr(img, "Software"), "ptr ", 4));
@@ -132,6 +135,12 @@ static void test_bad_input(void)
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5" } }, /* needs --lookat, --vfov */
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0", "--lookat", "0,0,0", "--vfov", "40" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--vfov", "180" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--sampler", "halton" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--direct-lighting", "yes" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "0" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "nan" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--min-samples", "1" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "0.1", "--sample-range", "4:8" } },
     };
     write_file(out, keep);
     ok_files = file_count();
