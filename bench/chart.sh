@@ -2,6 +2,7 @@
 # Regenerates a speed-against-accuracy chart and its data:
 #   intersectors: docs/images/speed-accuracy.png, docs/speed-accuracy.csv
 #   estimators:   docs/images/estimators.png, docs/estimators.csv
+# The estimators chart also prints its efficiency table (bench/efficiency.py).
 # Needs a build (cmake -B build) and installs gnuplot from Debian's packages
 # if it is missing.
 #
@@ -24,3 +25,6 @@ fi
 "$build/bench/accuracy" "$chart" "$data" "${3:-256}" "${4:-4096}" ${5:-}
 gnuplot -e "data='$data'; out='$image'" "$plot"
 echo "wrote $data and $image"
+if [ "$chart" = estimators ]; then
+    python3 bench/efficiency.py "$data"
+fi
