@@ -22,7 +22,9 @@ typedef struct PtrRenderSettings {
     PtrRegion region;  /* the pixels to render; all zero: the whole image */
     uint32_t samples;  /* per pixel, for ptr_render */
     uint64_t seed;
-    int max_depth;     /* rays per path at most; a path cut there adds nothing */
+    int max_depth;     /* rays per path at most, from the camera or a scattering
+                        * (shadow rays do not count); a path cut there adds
+                        * nothing */
     int threads;       /* 0: one per online CPU */
     /* 0: rays leave a surface by ptr's scaled offset (ptr_spawn_ray). When
      * positive, they leave it the seed renderer's way instead, from the hit
