@@ -5,7 +5,8 @@ JSON scene description (the format of shared/bench-scenes/*.json).
 Every sphere is a node that instances one shared unit UV sphere (bounds exactly
 [-1, 1]^3) with translation = centre and uniform scale = radius, so ptr's
 import (docs/scenes.md) recovers the centre and radius exactly, and other glTF
-viewers show round spheres. The camera node looks from `lookfrom` towards
+viewers show round spheres. A sphere may carry "emission": [r, g, b], its
+emitted radiance. The camera node looks from `lookfrom` towards
 `lookat`; depth of field is carried in the camera's extras.
 
 Usage: make_scenes.py INPUT.json OUTPUT.gltf|OUTPUT.glb
@@ -83,6 +84,18 @@ def look_rotation(lookfrom, lookat, vup):
 
 
 def gltf_material(sphere):
+    mat = base_material(sphere)
+    emission = sphere.get("emission")
+    if emission and max(emission) > 0:
+        # glTF factors stop at 1: the colour, then the strength that scales it.
+        strength = max(emission)
+        mat["emissiveFactor"] = [e / strength for e in emission]
+        mat.setdefault("extensions", {})["KHR_materials_emissive_strength"] = {
+            "emissiveStrength": strength}
+    return mat
+
+
+def base_material(sphere):
     kind = sphere["material"]
     if kind == "lambertian":
         return {"pbrMetallicRoughness": {"baseColorFactor": sphere["albedo"] + [1.0],
@@ -151,8 +164,13 @@ def build(desc):
         ],
         "buffers": [{"byteLength": len(blob)}],
     }
+    used = []
     if any(s["material"] == "dielectric" for s in desc["spheres"]):
-        doc["extensionsUsed"] = ["KHR_materials_transmission", "KHR_materials_ior"]
+        used += ["KHR_materials_transmission", "KHR_materials_ior"]
+    if any(max(s.get("emission", [0])) > 0 for s in desc["spheres"]):
+        used.append("KHR_materials_emissive_strength")
+    if used:
+        doc["extensionsUsed"] = used
     return doc, blob
 
 

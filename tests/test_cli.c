@@ -44,7 +44,7 @@ static int file_count(void)
 static void test_render_seed_exr(void)
 {
     const char *out = test_path("seed.exr");
-    CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "8", "--width", "60", "--seed", "42",
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "32", "--width", "60", "--seed", "42",
                   "--quiet", "--c", NULL), 0);
     char err[256];
     PtrImage *img = ptr_image_read(out, err, sizeof err);
@@ -54,7 +54,10 @@ static void test_render_seed_exr(void)
     /* The scene's camera is square: the height follows the width. */
     CHECK_INT(ptr_image_width(img), 60);
     CHECK_INT(ptr_image_height(img), 60);
-    CHECK_STR(ptr_image_attr(img, "ptr:samples"), "8");
+    CHECK_STR(ptr_image_attr(img, "ptr:samples"), "32");
+    CHECK_STR(ptr_image_attr(img, "ptr:sampler"), "sobol");
+    CHECK_STR(ptr_image_attr(img, "ptr:direct_lighting"), "on");
+    CHECK_STR(ptr_image_attr(img, "ptr:noise_threshold"), "0");
     CHECK_STR(ptr_image_attr(img, "ptr:seed"), "42");
     CHECK_STR(ptr_image_attr(img, "ptr:kernel"), "c");
     CHECK(ptr_image_attr(img, "Software") && !strncmp(ptr_image_attr(img, "Software"), "ptr ", 4));
@@ -132,6 +135,12 @@ static void test_bad_input(void)
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5" } }, /* needs --lookat, --vfov */
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0", "--lookat", "0,0,0", "--vfov", "40" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--vfov", "180" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--sampler", "halton" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--direct-lighting", "yes" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "0" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "nan" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--min-samples", "1" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "0.1", "--sample-range", "4:8" } },
     };
     write_file(out, keep);
     ok_files = file_count();

@@ -49,7 +49,7 @@ static void oracle(const char *config, const char *display, const char *view)
     char err[256], cmd[1024];
     const char *in = test_path("in.exr"), *ours = test_path("ours.png"), *theirs = test_path("theirs.png");
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
-    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
+    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
 
     PtrColor *color = ptr_color_open(config, err, sizeof err);
     CHECK(color != NULL);

@@ -90,6 +90,7 @@ int main(void)
     }
     check_levels(PTR_SOURCE_DIR "/scenes/seed.gltf", 100, 100);
     check_levels(PTR_SOURCE_DIR "/scenes/final.gltf", 160, 90);
+    check_levels(PTR_SOURCE_DIR "/scenes/lamps.gltf", 160, 90); /* shadow rays too */
     check_cli(PTR_SOURCE_DIR "/scenes/seed.gltf");
     check_cli(PTR_SOURCE_DIR "/scenes/final.gltf");
     return test_report();

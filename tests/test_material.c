@@ -1,5 +1,6 @@
 /* Scattering: energy, reflection laws, Fresnel and total internal reflection. */
 #include "core/material.h"
+#include "sampling/rng.h"
 #include "test.h"
 
 static void test_schlick(void)
@@ -11,11 +12,20 @@ static void test_schlick(void)
     CHECK_FLOAT_EQ(ptr_schlick(1.0f, 1.0f), 0.0f);        /* no interface */
 }
 
+/* Three uniform numbers for one scattering. */
+static const float *draw(PtrRng *rng, float u[3])
+{
+    for (int i = 0; i < 3; i++)
+        u[i] = ptr_rng_float(rng);
+    return u;
+}
+
 static int is_unit(PtrVec3 v) { return fabs(v3_length(v) - 1.0) < 1e-5; }
 
 static void test_energy_and_directions(void)
 {
     PtrRng rng = ptr_rng_for_sample(3, 0, 0);
+    float u[3];
     PtrVec3 n = v3(0, 1, 0);
     const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.9f, 0.5f, 0.1f) };
     const PtrMaterial metal = { .kind = PTR_MATERIAL_METAL, .albedo = v3(1, 0.8f, 0.6f),
@@ -31,7 +41,7 @@ static void test_energy_and_directions(void)
                                      ptr_rng_float(&rng) - 0.5f));
         for (int m = 0; m < 3; m++) {
             PtrVec3 out, att;
-            if (!ptr_scatter(all[m], in, n, &rng, &out, &att))
+            if (!ptr_scatter(all[m], in, n, draw(&rng, u), &out, &att))
                 continue;
             bad_dir += !is_unit(out);
             gained += att.x > all[m]->albedo.x || att.y > all[m]->albedo.y ||
@@ -53,9 +63,10 @@ static void test_energy_and_directions(void)
 static void test_mirror(void)
 {
     PtrRng rng = ptr_rng_for_sample(4, 0, 0);
+    float u[3];
     const PtrMaterial mirror = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(0.7f) };
     PtrVec3 in = v3_normalize(v3(1, -2, 0.5f)), out, att;
-    CHECK(ptr_scatter(&mirror, in, v3(0, 1, 0), &rng, &out, &att));
+    CHECK(ptr_scatter(&mirror, in, v3(0, 1, 0), draw(&rng, u), &out, &att));
     CHECK_NEAR(out.x, in.x, 1e-6);
     CHECK_NEAR(out.y, -in.y, 1e-6);
     CHECK_NEAR(out.z, in.z, 1e-6);
@@ -66,13 +77,14 @@ static void test_mirror(void)
     PtrVec3 grazing = v3_normalize(v3(1, -0.05f, 0));
     int absorbed = 0;
     for (int i = 0; i < 1000; i++)
-        absorbed += !ptr_scatter(&rough, grazing, v3(0, 1, 0), &rng, &out, &att);
+        absorbed += !ptr_scatter(&rough, grazing, v3(0, 1, 0), draw(&rng, u), &out, &att);
     CHECK(absorbed > 100 && absorbed < 900);
 }
 
 static void test_dielectric(void)
 {
     PtrRng rng = ptr_rng_for_sample(5, 0, 0);
+    float u[3];
     const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1), .ior = 1.5f };
     PtrVec3 outward = v3(0, 1, 0), out, att;
 
@@ -82,7 +94,7 @@ static void test_dielectric(void)
     PtrVec3 inside = v3(sinf(theta), cosf(theta), 0); /* travelling outward */
     int reflected = 0;
     for (int i = 0; i < 1000; i++) {
-        ptr_scatter(&glass, inside, outward, &rng, &out, &att);
+        ptr_scatter(&glass, inside, outward, draw(&rng, u), &out, &att);
         reflected += out.y < 0 && fabsf(out.x - inside.x) < 1e-6f;
     }
     CHECK_INT(reflected, 1000);
@@ -94,7 +106,7 @@ static void test_dielectric(void)
     int refracted = 0, snell_ok = 0;
     const int n = 100000;
     for (int i = 0; i < n; i++) {
-        ptr_scatter(&glass, in, outward, &rng, &out, &att);
+        ptr_scatter(&glass, in, outward, draw(&rng, u), &out, &att);
         if (out.y < 0) {
             refracted++;
             snell_ok += fabsf(out.x - sinf(theta) / 1.5f) < 1e-6f;
@@ -105,8 +117,36 @@ static void test_dielectric(void)
     CHECK_NEAR((double)(n - refracted) / n, r, 5 * sqrt(r * (1 - r) / n));
 }
 
+/* The diffuse density is the one scattering draws from and eval / pdf is the
+ * attenuation scattering reports, for every sample; and the directions follow
+ * that density: under cos / pi, cos theta < 0.5 has probability 0.25. */
+static void test_diffuse_density(void)
+{
+    PtrRng rng = ptr_rng_for_sample(6, 0, 0);
+    float u[3];
+    const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.9f, 0.5f, 0.1f) };
+    PtrVec3 n = v3_normalize(v3(0.3f, 1, -0.2f)), in = v3_neg(n), out, att;
+    int wrong = 0, below = 0;
+    double under_half = 0;
+    const int count = 100000;
+    for (int i = 0; i < count; i++) {
+        ptr_scatter(&diffuse, in, n, draw(&rng, u), &out, &att);
+        float pdf = ptr_diffuse_pdf(n, out);
+        below += !(pdf > 0.0f);
+        PtrVec3 eval = ptr_diffuse_eval(&diffuse, n, out);
+        wrong += fabsf(eval.x / pdf - att.x) > 1e-6f || fabsf(eval.z / pdf - att.z) > 1e-6f;
+        wrong += fabsf(pdf * PTR_PI - v3_dot(n, out)) > 1e-6f;
+        under_half += v3_dot(n, out) < 0.5f;
+    }
+    CHECK_INT(wrong, 0);
+    CHECK_INT(below, 0);
+    /* P(cos theta > c) = 1 - c^2 (binomial, 5 sigma). */
+    CHECK_NEAR(under_half / count, 0.25, 5 * sqrt(0.25 * 0.75 / count));
+}
+
 int main(void)
 {
+    test_diffuse_density();
     test_schlick();
     test_energy_and_directions();
     test_mirror();

@@ -15,6 +15,7 @@
 
 #define SEED_SCENE PTR_SOURCE_DIR "/scenes/seed.gltf"
 #define FINAL_SCENE PTR_SOURCE_DIR "/scenes/final.gltf"
+#define LAMPS_SCENE PTR_SOURCE_DIR "/scenes/lamps.gltf"
 
 static PtrImage *load(const char *path)
 {
@@ -25,26 +26,99 @@ static PtrImage *load(const char *path)
     return img;
 }
 
-/* Passes of any size sum to exactly the bits of one pass. */
-static void test_passes_are_exact(void)
+/* Passes of any size sum to exactly the bits of one pass: on seed.gltf,
+ * and on lamps.gltf (light sampling) with and without adaptive sampling,
+ * which must then stop some pixels and not others. */
+static void check_passes(const char *path, float noise_threshold)
 {
     PtrScene scene;
     PtrStrings warnings = { 0 };
     PtrError err = { 0 };
-    CHECK_INT(ptr_import_scene(SEED_SCENE, NULL, &scene, &warnings, &err), PTR_OK);
+    CHECK_INT(ptr_import_scene(path, NULL, &scene, &warnings, &err), PTR_OK);
     ptr_strings_free(&warnings);
     PtrIsectTable isect;
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
     const PtrAccel accel = ptr_accel_brute(&isect, &scene);
-    PtrRenderSettings s = { .width = 40, .height = 40, .seed = 5, .max_depth = 50 };
-    static double one[40 * 40 * 3], parts[40 * 40 * 3];
-    CHECK_INT(ptr_render_samples(&scene, &accel, &s, 0, 10, one, NULL, NULL, NULL, &err), PTR_OK);
-    const uint32_t cuts[] = { 0, 1, 4, 9, 10 };
-    for (int i = 0; i < 4; i++)
+    PtrRenderSettings s = { .width = 40, .height = 40, .seed = 5, .max_depth = 50,
+                            .noise_threshold = noise_threshold, .min_samples = 16 };
+    static double one[40 * 40 * PTR_ACCUM_STRIDE], parts[40 * 40 * PTR_ACCUM_STRIDE];
+    memset(one, 0, sizeof one);
+    memset(parts, 0, sizeof parts);
+    CHECK_INT(ptr_render_samples(&scene, &accel, &s, 0, 48, one, NULL, NULL, NULL, &err), PTR_OK);
+    const uint32_t cuts[] = { 0, 1, 4, 17, 31, 48 };
+    for (int i = 0; i < 5; i++)
         CHECK_INT(ptr_render_samples(&scene, &accel, &s, cuts[i], cuts[i + 1] - cuts[i], parts,
                                      NULL, NULL, NULL, &err), PTR_OK);
     CHECK(!memcmp(one, parts, sizeof one));
+    int stopped = 0;
+    for (int p = 0; p < 40 * 40; p++)
+        stopped += one[p * PTR_ACCUM_STRIDE + PTR_ACCUM_COUNT] < 48;
+    if (noise_threshold > 0) {
+        printf("%s: adaptive sampling stopped %d of %d pixels before 48 samples\n", path, stopped,
+               40 * 40);
+        CHECK(stopped > 0 && stopped < 40 * 40);
+    } else {
+        CHECK_INT(stopped, 0);
+    }
     ptr_scene_free(&scene);
+}
+
+static void test_passes_are_exact(void)
+{
+    check_passes(SEED_SCENE, 0);
+    check_passes(LAMPS_SCENE, 0);
+    check_passes(LAMPS_SCENE, 0.05f);
+}
+
+/* Adaptive sampling: regions merged equal the whole render bit for bit, the
+ * EXR holds each pixel's sample count, and a later sample range or
+ * overlapping adaptive parts are refused. */
+static void test_adaptive_parts(void)
+{
+    const int usage = ptr_result_exit_code(PTR_ERR_USAGE);
+    const char *whole = test_path("adaptive.exr");
+    CHECK_INT(test_ptr(LAMPS_SCENE, "-o", whole, "--width", "80", "--samples", "64",
+                       "--noise-threshold", "0.05", "--min-samples", "16", "--quiet", NULL), 0);
+    const char *regions[] = { "0,0,80,20", "0,20,80,45" };
+    for (int i = 0; i < 2; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "adaptive%d.exr", i);
+        CHECK_INT(test_ptr(LAMPS_SCENE, "-o", test_path(name), "--width", "80", "--samples", "64",
+                           "--noise-threshold", "0.05", "--min-samples", "16", "--region", regions[i],
+                           "--threads", i ? "1" : "2", "--quiet", NULL), 0);
+    }
+    CHECK_INT(test_ptr("merge", test_path("adaptive0.exr"), test_path("adaptive1.exr"), "-o",
+                       test_path("adaptive-tiles.exr"), "--quiet", NULL), 0);
+    PtrImage *a = load(whole), *b = load(test_path("adaptive-tiles.exr"));
+    if (a && b)
+        CHECK(!memcmp(ptr_image_pixels(a), ptr_image_pixels(b), 80 * 45 * 3 * sizeof(float)));
+    if (a)
+        CHECK_STR(ptr_image_attr(a, "ptr:noise_threshold"), "0.05");
+    ptr_image_free(a);
+    ptr_image_free(b);
+
+    /* The samples channel: whole counts from 16 to 64, not all alike. */
+    char command[1024];
+    snprintf(command, sizeof command, "%s %s --ch samples --printinfo:stats=1", OIIOTOOL, whole);
+    FILE *p = popen(command, "r");
+    char line[512];
+    double lo = -1, hi = -1;
+    while (p && fgets(line, sizeof line, p))
+        if (sscanf(line, " Stats Min: %lf", &lo) == 1 || sscanf(line, " Stats Max: %lf", &hi) == 1)
+            continue;
+    if (p)
+        pclose(p);
+    printf("adaptive: per-pixel samples from %g to %g\n", lo, hi);
+    CHECK(lo >= 16 && lo < hi && hi == 64 && lo == floor(lo));
+
+    CHECK_INT(test_ptr(LAMPS_SCENE, "-o", test_path("late.exr"), "--sample-range", "16:32",
+                       "--noise-threshold", "0.05", "--quiet", NULL), usage);
+    CHECK_INT(test_ptr("merge", whole, test_path("adaptive0.exr"), "-o", test_path("no.exr"),
+                       "--quiet", NULL), usage);
+    CHECK_INT(test_ptr(LAMPS_SCENE, "-o", test_path("plain.exr"), "--width", "80",
+                       "--sample-range", "64:65", "--quiet", NULL), 0);
+    CHECK_INT(test_ptr("merge", test_path("plain.exr"), test_path("adaptive-tiles.exr"), "-o",
+                       test_path("no.exr"), "--quiet", NULL), usage);
 }
 
 static double worst_difference(const PtrImage *a, const PtrImage *b)
@@ -192,6 +266,7 @@ int main(void)
     test_passes_are_exact();
     test_split_and_merge();
     test_merge_refuses();
+    test_adaptive_parts();
     test_batch();
     test_time_budget();
     test_dir_remove();

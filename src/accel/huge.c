@@ -54,14 +54,12 @@ int ptr_huge_closest_hit(const PtrRay *ray, const PtrScene *scene, PtrHit *hit)
     return best_index != PTR_NO_HIT;
 }
 
-/* The hit point re-projected onto the sphere, and the outward normal there. */
-static void surface_point(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
-                          double point[3], double normal[3])
+/* p re-projected onto huge sphere s, and the outward normal there. */
+static void reproject(const double *s, const double p[3], double point[3], double normal[3])
 {
-    const double *s = huge_sphere(scene, hit->sphere);
     double length2 = 0;
     for (int k = 0; k < 3; k++) {
-        normal[k] = ((double)ray->org[k] + (double)ray->dir[k] * (double)hit->t) - s[k];
+        normal[k] = p[k] - s[k];
         length2 += normal[k] * normal[k];
     }
     const double inverse = 1.0 / sqrt(length2);
@@ -71,25 +69,29 @@ static void surface_point(const PtrScene *scene, const PtrRay *ray, const PtrHit
     }
 }
 
-PtrVec3 ptr_huge_hit_normal(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit)
+void ptr_huge_surface(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
+                      PtrVec3 *point, PtrVec3 *normal)
 {
-    double point[3], normal[3];
-    surface_point(scene, ray, hit, point, normal);
-    return v3((float)normal[0], (float)normal[1], (float)normal[2]);
+    double p[3], on[3], n[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = (double)ray->org[k] + (double)ray->dir[k] * (double)hit->t;
+    reproject(huge_sphere(scene, hit->sphere), p, on, n);
+    *point = v3((float)on[0], (float)on[1], (float)on[2]);
+    *normal = v3((float)n[0], (float)n[1], (float)n[2]);
 }
 
-PtrRay ptr_huge_spawn_ray(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
-                          PtrVec3 dir)
+PtrRay ptr_huge_spawn_ray(const PtrScene *scene, uint32_t sphere, PtrVec3 point, PtrVec3 dir)
 {
-    double point[3], normal[3];
-    surface_point(scene, ray, hit, point, normal);
-    const double largest = fmax(fabs(point[0]), fmax(fabs(point[1]), fabs(point[2])));
-    double offset = SPAWN_POINT_SCALE * largest +
-                    SPAWN_RADIUS_SCALE * huge_sphere(scene, hit->sphere)[3];
+    const double *s = huge_sphere(scene, sphere);
+    const double p[3] = { point.x, point.y, point.z };
+    double on[3], normal[3];
+    reproject(s, p, on, normal);
+    const double largest = fmax(fabs(on[0]), fmax(fabs(on[1]), fabs(on[2])));
+    double offset = SPAWN_POINT_SCALE * largest + SPAWN_RADIUS_SCALE * s[3];
     if (dir.x * normal[0] + dir.y * normal[1] + dir.z * normal[2] < 0.0)
         offset = -offset;
     PtrRay out = { .tmin = 0.0f, .dir = { dir.x, dir.y, dir.z }, .tmax = INFINITY };
     for (int k = 0; k < 3; k++)
-        out.org[k] = (float)(point[k] + offset * normal[k]);
+        out.org[k] = (float)(on[k] + offset * normal[k]);
     return out;
 }

@@ -27,12 +27,15 @@
  * on a hit. */
 int ptr_huge_closest_hit(const PtrRay *ray, const PtrScene *scene, PtrHit *hit);
 
-/* Where ray met huge sphere hit->sphere: its outward unit normal, and a ray
- * leaving that point along dir, computed in double and pushed off the
- * surface by a bound on the error of rounding the point to float. */
-PtrVec3 ptr_huge_hit_normal(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit);
-PtrRay ptr_huge_spawn_ray(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
-                          PtrVec3 dir);
+/* Where ray met huge sphere hit->sphere, computed in double: the point
+ * re-projected onto the surface, and the outward unit normal there. */
+void ptr_huge_surface(const PtrScene *scene, const PtrRay *ray, const PtrHit *hit,
+                      PtrVec3 *point, PtrVec3 *normal);
+
+/* A ray leaving huge sphere `sphere` along dir from point (on or next to
+ * its surface): the point is re-projected onto the surface in double and
+ * pushed off it by a bound on the error of rounding it to float. */
+PtrRay ptr_huge_spawn_ray(const PtrScene *scene, uint32_t sphere, PtrVec3 point, PtrVec3 dir);
 
 /* Whether sphere i of the scene's arrays is one of the huge ones. */
 static inline int ptr_is_huge(const PtrScene *scene, size_t i)

@@ -13,6 +13,7 @@
 enum {
     DEFAULT_SAMPLES = 100,
     DEFAULT_MAX_DEPTH = 50,
+    DEFAULT_MIN_SAMPLES = 32,
     MAX_THREADS = 1024,
 };
 
@@ -22,7 +23,8 @@ enum {
     OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
     OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION, OPT_JSON, OPT_TIME, OPT_PREVIEW, OPT_WATCH,
     OPT_SAMPLE_RANGE, OPT_REGION, OPT_LOOKFROM, OPT_LOOKAT, OPT_UP, OPT_VFOV, OPT_APERTURE,
-    OPT_FOCUS_DISTANCE, OPT_FIT_ALL,
+    OPT_FOCUS_DISTANCE, OPT_FIT_ALL, OPT_SAMPLER, OPT_DIRECT_LIGHTING,
+    OPT_NOISE_THRESHOLD, OPT_MIN_SAMPLES,
 };
 
 static const struct option long_options[] = {
@@ -34,6 +36,10 @@ static const struct option long_options[] = {
     { "seed", required_argument, NULL, OPT_SEED },
     { "max-depth", required_argument, NULL, OPT_MAX_DEPTH },
     { "sky", required_argument, NULL, OPT_SKY },
+    { "sampler", required_argument, NULL, OPT_SAMPLER },
+    { "direct-lighting", required_argument, NULL, OPT_DIRECT_LIGHTING },
+    { "noise-threshold", required_argument, NULL, OPT_NOISE_THRESHOLD },
+    { "min-samples", required_argument, NULL, OPT_MIN_SAMPLES },
     { "camera", required_argument, NULL, OPT_CAMERA },
     { "c", no_argument, NULL, OPT_C },
     { "accel", required_argument, NULL, OPT_ACCEL },
@@ -90,7 +96,16 @@ static void print_help(FILE *out)
         "      --threads N       render threads, 0 for one per CPU (default 0)\n"
         "      --seed S          random seed (default 1); the image depends only on it,\n"
         "                        never on the thread count\n"
-        "      --max-depth D     rays per path at most (default %d)\n"
+        "      --max-depth D     rays per path at most, shadow rays not counted\n"
+        "                        (default %d)\n"
+        "      --sampler S       sobol (Owen-scrambled Sobol', the default) or\n"
+        "                        independent random numbers\n"
+        "      --direct-lighting on|off  sample emissive spheres at diffuse surfaces\n"
+        "                        (default on)\n"
+        "      --noise-threshold E  adaptive sampling: a pixel stops once its error\n"
+        "                        estimate is below E (e.g. 0.01; default off)\n"
+        "      --min-samples N   adaptive sampling: samples before the first check\n"
+        "                        (default %d; checks every 16 from there)\n"
         "      --sky SKY         gradient, black or R,G,B (overrides the scene's sky)\n"
         "      --camera NAME     the glTF camera (node or camera name) to render through\n"
         "      --lookfrom X,Y,Z --lookat X,Y,Z --vfov DEG [--up X,Y,Z] [--aperture A]\n"
@@ -135,8 +150,8 @@ static void print_help(FILE *out)
         "samples done (exit 8); a second aborts at once, writing nothing (exit 130).\n"
         "\n"
         "Exit codes:\n",
-        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, PTR_ACCEL_CROSSOVER_C,
-        PTR_ACCEL_CROSSOVER_ASM);
+        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, DEFAULT_MIN_SAMPLES,
+        PTR_ACCEL_CROSSOVER_C, PTR_ACCEL_CROSSOVER_ASM);
     for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
         fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
@@ -189,6 +204,7 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         return usage_error("PTR_CPUMASK", env_mask, "none, sse41, avx2 or avx512");
     *o = (PtrOptions){
         .samples = DEFAULT_SAMPLES, .seed = 1, .max_depth = DEFAULT_MAX_DEPTH,
+        .min_samples = DEFAULT_MIN_SAMPLES,
         .kernel = PTR_KERNEL_AUTO, .camera = { .up = { 0, 1, 0 } },
     };
     if (argc > 1 && !strcmp(argv[1], "merge")) {
@@ -303,6 +319,29 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
                 return usage_error(option, optarg, "gradient, black or R,G,B (not negative)");
             o->has_sky = 1;
             break;
+        case OPT_SAMPLER:
+            if (!ptr_sampler_parse(optarg, &o->sampler))
+                return usage_error(option, optarg, "sobol or independent");
+            break;
+        case OPT_DIRECT_LIGHTING:
+            if (strcmp(optarg, "on") && strcmp(optarg, "off"))
+                return usage_error(option, optarg, "on or off");
+            o->direct_lighting = strcmp(optarg, "on") ? PTR_OFF : PTR_ON;
+            break;
+        case OPT_NOISE_THRESHOLD: {
+            char *end;
+            errno = 0;
+            double e = strtod(optarg, &end);
+            if (errno || end == optarg || *end || !(e > 0 && e <= 1e6))
+                return usage_error(option, optarg, "a number above 0");
+            o->noise_threshold = (float)e;
+            break;
+        }
+        case OPT_MIN_SAMPLES:
+            if (!parse_uint(optarg, 2, 1u << 30, &v))
+                return usage_error(option, optarg, "a whole number from 2 to 2^30");
+            o->min_samples = (uint32_t)v;
+            break;
         case OPT_CAMERA: o->camera_name = optarg; break;
         case OPT_C: o->kernel = PTR_KERNEL_C; break;
         case OPT_ACCEL:
@@ -365,6 +404,11 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
                           : !o->output && !o->dump_scene ? "no output given (-o)"
                           : o->watch && o->input_count > 1 ? "--watch takes one scene"
                           : o->merge && o->dump_scene ? "--dump-scene is not for merge"
+                          /* Stopping decisions need every sample of a pixel from
+                           * the first on; a later range cannot know them. */
+                          : o->noise_threshold > 0 && o->sample_first > 0
+                              ? "--noise-threshold needs samples from 0 (not --sample-range A:B "
+                                "with A > 0)"
                                                       : NULL;
     if (problem)
         return usage_error_line(problem);

@@ -28,6 +28,10 @@ typedef struct PtrOptions {
     int width, height;      /* 0: from the scene */
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
+    PtrSamplerKind sampler;
+    PtrSwitch direct_lighting;
+    float noise_threshold;  /* adaptive sampling; 0: off */
+    uint32_t min_samples;
     int threads;
     int has_sky;
     PtrSky sky;

@@ -53,6 +53,8 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
 
     PtrRenderSettings settings = {
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
+        .sampler = o->sampler, .direct_lighting = o->direct_lighting,
+        .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -72,12 +74,18 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
-    float *rgb = malloc((size_t)layout.width * (size_t)layout.height * 3 * sizeof *rgb);
-    if (!rgb)
+    size_t pixels = (size_t)layout.width * (size_t)layout.height;
+    float *rgb = malloc(pixels * 3 * sizeof *rgb);
+    float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
+    if (!rgb || (o->noise_threshold > 0 && !counts)) {
+        free(rgb);
+        free(counts);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
                              report->output, layout.width, layout.height);
+    }
     PtrProgressiveResult done;
-    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, &done, err);
+    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, counts, &done,
+                                           err);
     ptr_progress_done(&printer);
     if (res == PTR_ERR_SCENE_INVALID) {
         /* The renderer does not know where the scene came from. */
@@ -95,13 +103,17 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
             .kernel = accel->isect.name, .accel = report->accel, .spheres = report->spheres,
             .import_seconds = report->import_seconds, .build_seconds = report->build_seconds, .sample_first = report->sample_first,
             .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
-            .max_depth = o->max_depth, .render_seconds = done.stats.seconds, .depth = o->depth,
+            .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
+            .direct_lighting = o->direct_lighting == PTR_ON,
+            .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
+            .sample_counts = counts, .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
             .dither = o->dither,
         };
         res = ptr_output_write(report->output, &layout, rgb, &info, err);
     }
     free(rgb);
+    free(counts);
     if (res == PTR_OK && done.stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted; wrote the %u samples done of %u",

@@ -12,6 +12,7 @@ typedef struct Part {
     PtrImage *image;
     PtrImageLayout layout;
     const char *scene, *hash, *seed;
+    const char *sampler, *direct_lighting, *noise_threshold;
     long first, samples, max_depth;
 } Part;
 
@@ -36,7 +37,10 @@ static PtrResult read_part(Part *p, PtrError *err)
         !(p->seed = required(p, "ptr:seed", err)) || !required(p, "ptr:kernel", err) ||
         !(first = required(p, "ptr:sample_first", err)) ||
         !(samples = required(p, "ptr:samples", err)) || !(depth = required(p, "ptr:max_depth", err)) ||
-        !(space = required(p, "ptr:colorspace", err)))
+        !(space = required(p, "ptr:colorspace", err)) ||
+        !(p->sampler = required(p, "ptr:sampler", err)) ||
+        !(p->direct_lighting = required(p, "ptr:direct_lighting", err)) ||
+        !(p->noise_threshold = required(p, "ptr:noise_threshold", err)))
         return PTR_ERR_USAGE;
     if (strcmp(space, "lin_rec709"))
         return ptr_error_set(err, PTR_ERR_USAGE,
@@ -81,6 +85,9 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
         const char *what = strcmp(a->hash, b->hash)    ? "scene"
                            : strcmp(a->seed, b->seed) ? "seed"
                            : a->max_depth != b->max_depth ? "depth limit"
+                           : strcmp(a->sampler, b->sampler) || strcmp(a->direct_lighting, b->direct_lighting) ||
+                                   strcmp(a->noise_threshold, b->noise_threshold)
+                               ? "estimator (sampler, direct lighting, noise threshold)"
                            : a->layout.full_width != b->layout.full_width ||
                                    a->layout.full_height != b->layout.full_height
                                ? "image size"
@@ -92,6 +99,13 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
     for (int i = 0; i < count; i++)
         for (int j = i + 1; j < count; j++) {
             const Part *p = &parts[i], *q = &parts[j];
+            /* An adaptive pixel's samples are not a plain count: parts of an
+             * adaptive render may only tile the image. */
+            if (overlap(&p->layout, &q->layout) && strcmp(p->noise_threshold, "0"))
+                return ptr_error_set(err, PTR_ERR_USAGE,
+                                     "%s and %s: adaptive parts (--noise-threshold) must not "
+                                     "overlap: split adaptive renders by --region only",
+                                     p->path, q->path);
             if (overlap(&p->layout, &q->layout) && p->first < q->first + q->samples &&
                 q->first < p->first + p->samples)
                 return ptr_error_set(err, PTR_ERR_USAGE,
@@ -162,6 +176,11 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .kernel = report->kernel, .accel = report->accel, .spheres = report->spheres,
         .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
         .seed = report->seed, .max_depth = (int)parts[0].max_depth, .depth = o->depth,
+        .sampler = parts[0].sampler, .direct_lighting = !strcmp(parts[0].direct_lighting, "on"),
+        .noise_threshold = strtof(parts[0].noise_threshold, NULL),
+        .min_samples = ptr_image_attr(parts[0].image, "ptr:min_samples")
+                           ? (uint32_t)atol(ptr_image_attr(parts[0].image, "ptr:min_samples"))
+                           : 0,
         .color = color, .exposure = o->exposure, .bake_view = o->bake_view, .dither = o->dither,
     };
     res = ptr_output_write(output, &full, rgb, &info, err);

@@ -106,8 +106,9 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         }
     }
 
-    char seed[24], exposure[32], hash[24], spheres[24];
+    char seed[24], exposure[32], hash[24], spheres[24], threshold[32];
     snprintf(spheres, sizeof spheres, "%zu", info->spheres);
+    snprintf(threshold, sizeof threshold, "%g", info->noise_threshold);
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
     snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
     snprintf(exposure, sizeof exposure, "%g", info->exposure);
@@ -131,6 +132,11 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
           .float_value = (float)info->import_seconds },
         { .name = "ptr:build_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->build_seconds },
+        { .name = "ptr:sampler", .type = PTR_ATTR_STRING, .string_value = info->sampler },
+        { .name = "ptr:direct_lighting", .type = PTR_ATTR_STRING,
+          .string_value = info->direct_lighting ? "on" : "off" },
+        { .name = "ptr:noise_threshold", .type = PTR_ATTR_STRING, .string_value = threshold },
+        { .name = "ptr:min_samples", .type = PTR_ATTR_INT, .int_value = (int)info->min_samples },
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->render_seconds },
         { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,
@@ -147,7 +153,9 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, pixel_formats[depth],
+    const char *dot = strrchr(path, '.');
+    const float *counts = dot && !strcasecmp(dot, ".exr") ? info->sample_counts : NULL;
+    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, counts, pixel_formats[depth],
                                  attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
     free(viewed);
     if (failed)

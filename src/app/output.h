@@ -31,6 +31,11 @@ typedef struct PtrOutputInfo {
     int interrupted;       /* the render stopped before all samples asked for */
     uint64_t seed;
     int max_depth;
+    const char *sampler;   /* the estimator: ptr_sampler_name and light sampling */
+    int direct_lighting;
+    float noise_threshold; /* adaptive sampling; 0: off */
+    uint32_t min_samples;
+    const float *sample_counts; /* per pixel, written as an EXR channel (may be NULL) */
     double render_seconds;
     PtrDepth depth;
     const PtrColor *color; /* the display, view, look and exposure in force */

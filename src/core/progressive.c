@@ -24,17 +24,17 @@ static void on_tick(void *user, double pass_fraction)
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
-                                 PtrProgressiveResult *result, PtrError *err)
+                                 float *sample_counts, PtrProgressiveResult *result, PtrError *err)
 {
     PtrRegion r = ptr_render_region(settings);
-    size_t values = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0) * 3;
+    size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
     if (options->samples == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive");
-    if (values == 0)
+    if (pixels == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
                              settings->width, settings->height);
-    double *sums = calloc(values, sizeof *sums);
-    if (!sums)
+    double *acc = calloc(pixels * PTR_ACCUM_STRIDE, sizeof *acc);
+    if (!acc)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image", r.x1 - r.x0,
                              r.y1 - r.y0);
 
@@ -50,7 +50,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     while (done < options->samples) {
         watch.pass_samples = pass;
         PtrRenderStats stats;
-        res = ptr_render_samples(scene, accel, settings, options->first_sample + done, pass, sums,
+        res = ptr_render_samples(scene, accel, settings, options->first_sample + done, pass, acc,
                                  options->report ? on_tick : NULL, &watch, &stats, err);
         if (res != PTR_OK)
             break;
@@ -75,8 +75,8 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     }
     result->samples_done = done;
     result->stats.seconds = ptr_now_seconds() - watch.start;
-    for (size_t i = 0; res == PTR_OK && i < values; i++)
-        rgb[i] = (float)(sums[i] / (double)done);
-    free(sums);
+    if (res == PTR_OK)
+        ptr_accum_resolve(acc, pixels, rgb, sample_counts);
+    free(acc);
     return res;
 }

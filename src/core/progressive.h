@@ -35,10 +35,12 @@ typedef struct PtrProgressiveResult {
 /* Renders the settings' region in passes: the first of one sample, then
  * passes sized to take about a second each. Writes the means of the samples
  * done into rgb (3 floats a pixel of the region), the same bits as one pass
- * of that many samples would give. */
+ * of that many samples would give, and if sample_counts is not NULL, how
+ * many samples each pixel took (fewer where adaptive sampling stopped it). */
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
-                                 PtrProgressiveResult *result, PtrError *err);
+                                 float *sample_counts, PtrProgressiveResult *result,
+                                 PtrError *err);
 
 #endif /* PTR_PROGRESSIVE_H */

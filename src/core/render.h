@@ -7,6 +7,10 @@
 #include "accel/accel.h"
 #include "core/result.h"
 #include "core/scene.h"
+#include "sampling/sampler.h"
+
+/* A switch whose zero value, the default, is on. */
+typedef enum PtrSwitch { PTR_ON, PTR_OFF } PtrSwitch;
 
 /* Pixels x0 <= x < x1, y0 <= y < y1 of the full image. */
 typedef struct PtrRegion {
@@ -18,18 +22,27 @@ typedef struct PtrRenderSettings {
     PtrRegion region;  /* the pixels to render; all zero: the whole image */
     uint32_t samples;  /* per pixel, for ptr_render */
     uint64_t seed;
-    int max_depth;     /* rays per path at most; a path cut there adds nothing */
+    int max_depth;     /* rays per path at most, from the camera or a scattering
+                        * (shadow rays do not count); a path cut there adds
+                        * nothing */
     int threads;       /* 0: one per online CPU */
     /* 0: rays leave a surface by ptr's scaled offset (ptr_spawn_ray). When
      * positive, they leave it the seed renderer's way instead, from the hit
      * point with this fixed t_min (0.001 there): the counter-example the
      * stability suite measures against. */
     float fixed_tmin;
+    PtrSamplerKind sampler;
+    PtrSwitch direct_lighting; /* light sampling of emissive spheres, with MIS */
+    /* Adaptive sampling: above 0, a pixel stops once its error estimate
+     * falls below this, checked after min_samples and every 16 samples;
+     * sample indices must then start at 0. */
+    float noise_threshold;
+    uint32_t min_samples;
 } PtrRenderSettings;
 
 typedef struct PtrRenderStats {
     double seconds;
-    uint64_t rays; /* closest-hit queries, camera and scattered */
+    uint64_t rays; /* closest-hit queries: camera, scattered and shadow rays */
     int threads;
 } PtrRenderStats;
 
@@ -41,18 +54,32 @@ typedef void (*PtrTickFn)(void *user, double fraction_done);
  * all zero if it does not lie inside the image. */
 PtrRegion ptr_render_region(const PtrRenderSettings *settings);
 
-/* The renderer reads the spheres through accel (accel->spheres, which must
- * be scene->spheres) and finds every hit with ptr_trace. */
+/* What ptr_render_samples keeps of each pixel, in doubles: the sum of its
+ * samples' radiance, the sum over its odd-numbered samples (adaptive
+ * sampling's second half-buffer), how many samples it took, and whether
+ * adaptive sampling stopped it (1) or not (0). */
+enum {
+    PTR_ACCUM_SUM = 0, PTR_ACCUM_ODD = 3, PTR_ACCUM_COUNT = 6, PTR_ACCUM_STOPPED = 7,
+    PTR_ACCUM_STRIDE = 8,
+};
 
-/* Adds the radiance of samples first .. first + count - 1 of every pixel of
- * the region to sums (3 doubles a pixel, region rows top to bottom), sample
- * by sample in index order: split into passes of any size, the sums come out
- * bit for bit the same, and never depend on the thread count. tick may be
- * NULL; stats (may be NULL) gets this call's figures. */
+/* The renderer reads the spheres through accel (accel->spheres, which must
+ * be scene->spheres) and finds every hit, shadow rays too, with ptr_trace.
+ *
+ * Adds samples first .. first + count - 1 of every pixel of the region to
+ * acc (PTR_ACCUM_STRIDE doubles a pixel, region rows top to bottom, zero
+ * before the first call), sample by sample in index order: split into passes
+ * of any size, the sums come out bit for bit the same, and never depend on
+ * the thread count. tick may be NULL; stats (may be NULL) gets this call's
+ * figures. */
 PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              const PtrRenderSettings *settings, uint32_t first, uint32_t count,
-                             double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
+                             double *acc, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err);
+
+/* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
+ * a pixel), and if sample_counts is not NULL, how many samples each took. */
+void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);
 
 /* The whole region with settings->samples samples, as means in rgb (3 floats
  * a pixel, region rows top to bottom). */

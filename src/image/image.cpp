@@ -68,8 +68,9 @@ extern "C" void ptr_image_discard_partial(void)
 }
 
 extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                               PtrPixelFormat format, const PtrImageAttr *attrs,
-                               size_t attr_count, char *err, size_t err_size)
+                               const float *sample_counts, PtrPixelFormat format,
+                               const PtrImageAttr *attrs, size_t attr_count, char *err,
+                               size_t err_size)
 {
     std::string tmp;
     try {
@@ -80,7 +81,22 @@ extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, c
             ptr_shim_error(err, err_size, std::string(path) + ": no image format for this extension");
             return -1;
         }
-        OIIO::ImageSpec spec(layout->width, layout->height, 3, pixel_type(format));
+        int channels = sample_counts ? 4 : 3;
+        OIIO::ImageSpec spec(layout->width, layout->height, channels, pixel_type(format));
+        std::vector<float> interleaved;
+        if (sample_counts) {
+            // Counts stay whole numbers whatever the colour channels' depth.
+            spec.channelnames = { "R", "G", "B", "samples" };
+            spec.channelformats = { pixel_type(format), pixel_type(format), pixel_type(format),
+                                    OIIO::TypeDesc::FLOAT };
+            spec.alpha_channel = -1;
+            size_t pixels = (size_t)layout->width * (size_t)layout->height;
+            interleaved.resize(pixels * 4);
+            for (size_t p = 0; p < pixels; p++) {
+                std::memcpy(&interleaved[4 * p], &rgb[3 * p], 3 * sizeof(float));
+                interleaved[4 * p + 3] = sample_counts[p];
+            }
+        }
         spec.x = layout->x;
         spec.y = layout->y;
         spec.full_x = 0;
@@ -106,7 +122,7 @@ extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, c
             std::remove(tmp.c_str());
             return -1;
         }
-        bool ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+        bool ok = out->write_image(OIIO::TypeDesc::FLOAT, sample_counts ? interleaved.data() : rgb);
         ok = out->close() && ok;
         if (!ok) {
             ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());

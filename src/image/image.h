@@ -38,13 +38,15 @@ typedef struct PtrImageLayout {
 /* Whether a writer exists for the file's extension. */
 int ptr_image_can_write(const char *path);
 
-/* Writes RGB float pixels (rows top to bottom), stored in the file as format.
+/* Writes RGB float pixels (rows top to bottom), stored in the file as format,
+ * and if sample_counts is not NULL (a format with named channels only), a
+ * fourth float channel "samples" from it.
  * The file is created under a temporary name in the same directory and
  * renamed over path only once complete, so an existing file is replaced by a
  * whole new one or not at all. Returns 0 on success; otherwise fills err with
  * one line and returns -1. */
 int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                    PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
+                    const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
                     char *err, size_t err_size);
 
 /* Removes the temporary file of a write under way, if any. Safe to call from
