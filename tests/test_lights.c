@@ -3,11 +3,10 @@
  * - The alias table picks each emitter with probability power / total.
  * - A sampled direction's density is the one ptr_light_pdf gives it, and it
  *   meets the sphere at the distance reported, from outside and inside.
- * - Closed form: a diffuse ground (albedo a, radius 1000) lit by one sphere
- *   of radiance L and radius r under a black sky shows a L (r/d)^2 cos theta
- *   wherever the emitter is wholly above the horizon (d: distance to its
- *   centre, theta: between the normal and the direction to the centre). At
- *   64 spp every pixel must be within 5% (see test_closed_form for why).
+ * - Closed form (lit_ground.h): a diffuse ground (albedo a, radius 1000) lit
+ *   by one sphere of radiance L and radius r under a black sky shows
+ *   a L (r/d)^2 cos theta wherever the emitter is wholly above the horizon.
+ *   At 64 spp every pixel must be within 2% (see test_closed_form for why).
  * - Unbiasedness: the defaults (Sobol', light sampling, MIS) and the plain
  *   estimator (independent numbers, no light sampling) agree on a scene with
  *   glass, metal, diffuse and emitters (some of them reflective): chi^2 over
@@ -19,6 +18,7 @@
 #include "core/lights.h"
 #include "core/render.h"
 #include "sampling/rng.h"
+#include "lit_ground.h"
 #include "test.h"
 
 static uint32_t add_material(PtrScene *s, PtrMaterial m)
@@ -106,61 +106,6 @@ static float *render(const PtrScene *s, PtrRenderSettings settings)
     return rgb;
 }
 
-/* Worst relative error over the pixels where the closed form holds.
- * Ground albedo 0.5, radius 1000, top at y = 0; the emitter (radius 0.25,
- * radiance 10) 1.5 above it and 3.5 to the side, out of the view of a camera
- * 10 above the origin looking down through 30 degrees. */
-static double closed_form_error(PtrRenderSettings settings)
-{
-    const double a = 0.5, L = 10, r = 0.25, big = 1000;
-    const double ec[3] = { 3.5, 1.5, 0 };
-    PtrScene s;
-    ptr_scene_init(&s);
-    uint32_t ground = add_material(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIFFUSE,
-                                                      .albedo = v3_splat((float)a) });
-    uint32_t lamp = add_material(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIFFUSE,
-                                                    .emission = v3_splat((float)L) });
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, (float)-big, 0), (float)big, ground), PTR_OK);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3((float)ec[0], (float)ec[1], (float)ec[2]), (float)r, lamp),
-              PTR_OK);
-    s.sky.kind = PTR_SKY_BLACK;
-    s.camera = (PtrCamera){ .lookfrom = v3(0, 10, 0), .lookat = v3(0, 0, 0), .up = v3(0, 0, -1),
-                            .vfov_deg = 30, .focus_distance = 10 };
-    float *rgb = render(&s, settings);
-    PtrView view;
-    CHECK(ptr_view_init(&view, &s.camera, SIZE, SIZE));
-    double worst = 0;
-    int pixels = 0;
-    for (int y = 0; y < SIZE; y++)
-        for (int x = 0; x < SIZE; x++) {
-            PtrVec3 o, d;
-            ptr_view_ray(&view, x, y, 0.5f, 0.5f, 0, 0, &o, &d);
-            /* The pixel centre's ground point, in double. */
-            double oc[3] = { o.x, o.y + big, o.z }, dd[3] = { d.x, d.y, d.z };
-            double b = oc[0] * dd[0] + oc[1] * dd[1] + oc[2] * dd[2];
-            double cc = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - big * big;
-            double t = -b - sqrt(b * b - cc), p[3], n[3], to[3], dist = 0, up = 0;
-            for (int i = 0; i < 3; i++)
-                p[i] = (i == 0 ? o.x : i == 1 ? o.y : o.z) + t * dd[i];
-            for (int i = 0; i < 3; i++) {
-                n[i] = (p[i] - (i == 1 ? -big : 0)) / big;
-                to[i] = ec[i] - p[i];
-                dist += to[i] * to[i];
-                up += n[i] * to[i];
-            }
-            dist = sqrt(dist);
-            if (up <= r * 1.01)
-                continue; /* not wholly above the horizon */
-            double expected = a * L * (r / dist) * (r / dist) * (up / dist);
-            worst = fmax(worst, fabs(rgb[3 * (y * SIZE + x)] - expected) / expected);
-            pixels++;
-        }
-    CHECK_INT(pixels, SIZE * SIZE);
-    free(rgb);
-    ptr_scene_free(&s);
-    return worst;
-}
-
 /* The tolerance, 2%: what remains at 64 spp is the pixel footprint (the
  * value varies by a few per cent across a pixel, and the centre stands for
  * the pixel's mean only to second order: about 0.1%), the cosine across the
@@ -170,15 +115,17 @@ static double closed_form_error(PtrRenderSettings settings)
  * bound the estimator was built to meet. */
 static void test_closed_form(void)
 {
-    PtrRenderSettings settings = { .width = SIZE, .height = SIZE, .samples = 64, .max_depth = 50 };
+    PtrIsectTable isect;
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, 2);
+    PtrRenderSettings settings = { .samples = 64, .max_depth = 50 };
     double worst = 0;
     for (uint64_t seed = 1; seed <= 4; seed++) {
         settings.seed = seed;
-        worst = fmax(worst, closed_form_error(settings));
+        worst = fmax(worst, lit_ground_errors(1000, PTR_BUILD_DEFAULT, &isect, settings).worst);
     }
     settings.sampler = PTR_SAMPLER_INDEPENDENT;
     settings.direct_lighting = PTR_OFF;
-    double plain = closed_form_error(settings);
+    double plain = lit_ground_errors(1000, PTR_BUILD_DEFAULT, &isect, settings).worst;
     printf("closed form at 64 spp: worst relative error %.4f (seeds 1-4); without light "
            "sampling %.2f\n", worst, plain);
     CHECK(worst <= 0.02);

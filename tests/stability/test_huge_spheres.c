@@ -13,6 +13,7 @@
 
 #include "accel/accel.h"
 #include "builder.h"
+#include "lit_ground.h"
 #include "methods.h"
 #include "core/render.h"
 #include "test.h"
@@ -63,6 +64,29 @@ static float *render(const Method *m, PtrSky sky, PtrAccelChoice choice)
     return rgb;
 }
 
+/* The closed form of lit_ground.h on a radius-1e5 ground at 256 spp: each
+ * pixel within 1.5% and the image's mean within 0.5% (measured: 0.13% and
+ * 0.04%). Light sampling takes the direction and distance to the emitter
+ * from the point on the surface, so the float ground's lift moves only the
+ * shadow rays' origins and passes too (printed, not asserted). */
+static void lit_ground_table(const Method *methods, int n)
+{
+    PtrRenderSettings settings = { .samples = 256, .seed = 1, .max_depth = 50, .threads = 2 };
+    printf("\nradius-1e5 ground lit by a small emitter, 256 spp: relative error\n"
+           "%-20s %10s %10s\n", "", "worst px", "mean");
+    for (int i = 0; i < n; i++) {
+        if (methods[i].fixed_tmin > 0.0f || !(methods[i].build_flags & PTR_BUILD_RECENTRE))
+            continue;
+        LitGroundErrors e = lit_ground_errors(1e5, methods[i].build_flags, &methods[i].isect,
+                                              settings);
+        printf("%-20s %10.4f %10.4f\n", methods[i].name, e.worst, e.mean);
+        if (methods[i].is_ptr) {
+            CHECK(e.worst <= 0.015);
+            CHECK(e.mean <= 0.005);
+        }
+    }
+}
+
 int main(void)
 {
     Method methods[MAX_METHODS];
@@ -95,5 +119,6 @@ int main(void)
         free(closed);
         free(open);
     }
+    lit_ground_table(methods, n);
     return test_report();
 }
