@@ -107,14 +107,19 @@ static PtrVec3 relative(const double p[3], const double origin[3])
 }
 
 /* Which spheres are huge (see accel/huge.h): those whose radius is more than
- * HUGE_RATIO times the extent of the region the rays live in, taken as the
- * box around the camera and every sphere of a radius within HUGE_RATIO of
- * the smallest. A radius-1e5 ground under spheres of radius 1 is huge; a
- * cloud of like spheres has none. At most PTR_HUGE_MAX, the largest first
- * (every ray tests them all). Testing a sphere in double is never less
- * accurate, only slower, so the rule needs to be right only about cost.
- * Marks them in huge[] (all zero on entry) and returns how many. */
-#define HUGE_RATIO 16.0
+ * HUGE_RATIO times the extent E of the region the rays live in, taken as the
+ * box around the camera and every sphere of a radius within SMALL_RATIO of
+ * the smallest. In float, rays leave a sphere of radius r lifted by about
+ * 2^-20 r; below 256 E that is under 2^-12 E, less than a pixel of a 4K
+ * image of the whole region, and the double test would only cost time (a
+ * quarter of the rays per second on a four-sphere scene). A radius-1e5
+ * ground under a scene a few units (or a room 100) across is huge; the
+ * radius-100 and radius-1000 grounds of seed.gltf and final.gltf are not;
+ * a cloud of like spheres has none. At most PTR_HUGE_MAX, the largest first
+ * (every ray tests them all). Marks them in huge[] (all zero on entry) and
+ * returns how many. */
+#define HUGE_RATIO 256.0
+#define SMALL_RATIO 16.0
 
 static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigned char *huge)
 {
@@ -126,7 +131,7 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigne
     memcpy(hi, eye, sizeof hi);
     for (size_t i = 0; i < b->count; i++) {
         const double *s = &b->spheres[4 * i];
-        if (s[3] > HUGE_RATIO * smallest)
+        if (s[3] > SMALL_RATIO * smallest)
             continue;
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], s[k] - s[3]);
