@@ -124,7 +124,7 @@ static void test_scenes(void)
 {
     for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++)
         for (int size = 0; size < 2; size++) {
-            int n = size ? 3000 : 37;
+            int n = size ? 2000 : 37;
             PtrScene a, b;
             ptr_scene_init(&a);
             ptr_scene_init(&b);
@@ -133,7 +133,7 @@ static void test_scenes(void)
             PtrBvh bvh;
             CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, 0), PTR_OK);
             check_structure(&bvh, &b.spheres, bvh_scene_names[kind]);
-            check_rays(&a, &b, &bvh, 20000, bvh_scene_names[kind]);
+            check_rays(&a, &b, &bvh, size ? 10000 : 20000, bvh_scene_names[kind]);
             ptr_bvh_free(&bvh);
             ptr_scene_free(&a);
             ptr_scene_free(&b);
