@@ -103,6 +103,8 @@ static void check_rays(const PtrScene *file_order, const PtrScene *built, const 
         PtrRay ray = bvh_scene_ray(&file_order->spheres, &rng);
         if (i % 7 == 0)
             ray.tmin = 1e-3f;
+        if (i % 5 == 0) /* a finite tmax, as a shadow ray would have */
+            ray.tmax = bvh_uniform(&rng, 1.0f, 30.0f);
         PtrHit brute, tree;
         int brute_found = ptr_closest_hit_c(&ray, &file_order->spheres,
                                             file_order->spheres.count, &brute);
