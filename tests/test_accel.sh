@@ -1,7 +1,8 @@
 #!/bin/sh
 # --accel brute and --accel bvh give the same pixels, bit for bit, through
 # the command line: on the committed scenes and on sphere sets hard for a
-# tree (tests/hard_scenes.py). Also checks the metadata the choice leaves.
+# tree (tests/hard_scenes.py). Also checks the metadata the choice leaves,
+# and that parts rendered with each merge.
 # Usage: test_accel.sh PTR SOURCE_DIR
 set -u
 ptr=$1
@@ -34,5 +35,23 @@ for scene in $scenes; do
     hashes=$(for accel in brute bvh; do iinfo -v "$dir/$name-$accel.exr" | grep scene_hash; done | sort -u | wc -l)
     [ "$hashes" = 1 ] || { echo "FAIL: $name: the scene hash depends on the structure" >&2; failed=1; }
 done
-[ $failed = 0 ] && echo "all scenes identical"
+# A part rendered with the tree merges with one rendered by brute force (the
+# scene hash does not see the tree's order), into the very image two brute
+# force parts give.
+final="$src/scenes/final.gltf"
+for accel in brute bvh; do
+    "$ptr" "$final" -o "$dir/part-$accel.exr" --accel $accel --sample-range 2:4 --width 64 --quiet ||
+        { echo "FAIL: rendering a part with --accel $accel" >&2; failed=1; }
+done
+"$ptr" "$final" -o "$dir/part0.exr" --accel brute --sample-range 0:2 --width 64 --quiet &&
+"$ptr" merge "$dir/part0.exr" "$dir/part-bvh.exr" -o "$dir/merged.exr" --quiet &&
+"$ptr" merge "$dir/part0.exr" "$dir/part-brute.exr" -o "$dir/merged-brute.exr" --quiet ||
+    { echo "FAIL: merging the parts" >&2; failed=1; }
+if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/merged.exr" "$dir/merged-brute.exr" >/dev/null; then
+    echo "FAIL: parts of brute force and the tree do not merge as brute force parts do" >&2
+    failed=1
+fi
+iinfo -v "$dir/merged.exr" | grep -q 'ptr:accel: "mixed"' ||
+    { echo "FAIL: the merged image does not say its parts used both" >&2; failed=1; }
+[ $failed = 0 ] && echo "all scenes identical, parts merge"
 exit $failed

@@ -32,6 +32,9 @@ meta() { iinfo -v "$1" 2>/dev/null; }
 
 # A first SIGINT or SIGTERM: the pass finishes, its samples are written, exit 8.
 for sig in INT TERM; do
+    # The background job truncates its log only when it starts: remove the last
+    # one first, or its "spp" lets the signal come before the handler is in.
+    rm -f "$dir/stop.log"
     "$ptr" "$src/scenes/final.gltf" -o "$dir/stop.exr" --samples 1000000 --width 80 \
         2>"$dir/stop.log" &
     pid=$!

@@ -124,7 +124,7 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
      * rays' origins (the camera sits at 0, other rays start on spheres). */
     float magnitude = 0.0f;
     for (size_t i = 0, k = 0; i < s->count; i++) {
-        float m = fmaxf(fmaxf(fabsf(s->cx[i]), fabsf(s->cy[i])), fabsf(s->cz[i])) + s->radius[i];
+        float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
         if (out[k] == i)
             k++;
         else if (m > magnitude)

@@ -24,12 +24,14 @@ typedef struct SphereArray {
     uint32_t padding; /* bits of a padding entry */
 } SphereArray;
 
-enum { SPHERE_ARRAYS = 6 };
+enum { SPHERE_ARRAYS_MAX = 16 };
 
-static void sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS])
+/* Fills a with s's arrays; returns how many there are. */
+static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
-    SphereArray list[SPHERE_ARRAYS] = {
+    /* Entries are whole 4-byte words (see spheres_copy). */
+    SphereArray list[] = {
         { (void **)&s->cx, sizeof *s->cx, zero.u },
         { (void **)&s->cy, sizeof *s->cy, zero.u },
         { (void **)&s->cz, sizeof *s->cz, zero.u },
@@ -37,14 +39,16 @@ static void sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS])
         { (void **)&s->material, sizeof *s->material, 0 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX },
     };
+    static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
+    return (int)(sizeof list / sizeof list[0]);
 }
 
 static void spheres_free(PtrSpheres *s)
 {
-    SphereArray a[SPHERE_ARRAYS];
-    sphere_arrays(s, a);
-    for (int k = 0; k < SPHERE_ARRAYS; k++)
+    SphereArray a[SPHERE_ARRAYS_MAX];
+    int arrays = sphere_arrays(s, a);
+    for (int k = 0; k < arrays; k++)
         free(*a[k].data);
     memset(s, 0, sizeof *s);
 }
@@ -59,18 +63,18 @@ void ptr_scene_free(PtrScene *scene)
 
 /* Arrays like s's with room for capacity entries, the first keep entries
  * copied from s in the order given (all of s if order is NULL) and the rest
- * padding. Every entry is 4 bytes, so that one pass moves them all. */
+ * padding. Entries are 4-byte words (an entry of several words, such as a
+ * colour, is moved word by word, its padding the pattern repeated). */
 static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t capacity,
                               PtrSpheres *out)
 {
-    static_assert(sizeof(float) == 4 && sizeof(uint32_t) == 4, "4-byte sphere entries");
-    if (capacity > SIZE_MAX / 2 / sizeof(float))
+    if (capacity > SIZE_MAX / 64)
         return PTR_ERR_NOMEM;
     PtrSpheres copy = { .count = s->count, .capacity = capacity };
-    SphereArray from[SPHERE_ARRAYS], to[SPHERE_ARRAYS];
+    SphereArray from[SPHERE_ARRAYS_MAX], to[SPHERE_ARRAYS_MAX];
     sphere_arrays((PtrSpheres *)s, from);
-    sphere_arrays(&copy, to);
-    for (int k = 0; k < SPHERE_ARRAYS; k++) {
+    int arrays = sphere_arrays(&copy, to);
+    for (int k = 0; k < arrays; k++) {
         *to[k].data = aligned_alloc(PTR_SPHERE_ALIGN, capacity * to[k].size);
         if (!*to[k].data) {
             spheres_free(&copy);
@@ -78,8 +82,14 @@ static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t
         }
         const uint32_t *src = *from[k].data;
         uint32_t *dst = *to[k].data;
-        for (size_t i = 0; i < capacity; i++)
-            dst[i] = i >= s->count ? to[k].padding : src[order ? order[i] : i];
+        const size_t words = to[k].size / sizeof *dst;
+        for (size_t i = 0; i < capacity * words; i++)
+            dst[i] = to[k].padding;
+        for (size_t i = 0; i < s->count; i++) {
+            size_t from_entry = order ? order[i] : i;
+            for (size_t w = 0; w < words; w++)
+                dst[i * words + w] = src[from_entry * words + w];
+        }
     }
     *out = copy;
     return PTR_OK;
