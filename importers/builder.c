@@ -16,8 +16,10 @@ void ptr_builder_free(PtrSceneBuilder *builder)
 {
     free(builder->spheres);
     free(builder->materials);
+    free(builder->colors);
     builder->spheres = NULL;
     builder->materials = NULL;
+    builder->colors = NULL;
     builder->count = builder->capacity = 0;
 }
 
@@ -34,14 +36,37 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
         if (!materials)
             return PTR_ERR_NOMEM;
         b->materials = materials;
+        if (b->colors) {
+            float *colors = realloc(b->colors, capacity * 3 * sizeof *colors);
+            if (!colors)
+                return PTR_ERR_NOMEM;
+            b->colors = colors;
+        }
         b->capacity = capacity;
     }
+    if (b->colors)
+        for (int k = 0; k < 3; k++)
+            b->colors[3 * b->count + k] = 1.0f;
     double *s = &b->spheres[4 * b->count];
     s[0] = centre[0];
     s[1] = centre[1];
     s[2] = centre[2];
     s[3] = radius;
     b->materials[b->count++] = material;
+    return PTR_OK;
+}
+
+PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
+{
+    if (!b->colors) {
+        b->colors = malloc(b->capacity * 3 * sizeof *b->colors);
+        if (!b->colors)
+            return PTR_ERR_NOMEM;
+        for (size_t i = 0; i < 3 * b->capacity; i++)
+            b->colors[i] = 1.0f;
+    }
+    for (int k = 0; k < 3; k++)
+        b->colors[3 * (b->count - 1) + k] = (float)rgb[k];
     return PTR_OK;
 }
 
@@ -169,8 +194,13 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i)
         return PTR_ERR_SCENE_INVALID;
     PtrScene *scene = b->scene;
     PtrResult res = ptr_scene_add_sphere(scene, c, r, b->materials[i]);
+    size_t added = scene->spheres.count - 1;
     if (res == PTR_OK)
-        scene->spheres.id[scene->spheres.count - 1] = (uint32_t)i;
+        scene->spheres.id[added] = (uint32_t)i;
+    if (res == PTR_OK && b->colors) {
+        const float *rgb = &b->colors[3 * i];
+        res = ptr_scene_set_sphere_color(scene, added, v3(rgb[0], rgb[1], rgb[2]));
+    }
     return res;
 }
 

@@ -23,6 +23,7 @@ typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
+    float *colors;    /* r, g, b of each sphere; NULL while none has its own */
     size_t count, capacity;
     int has_camera;
     double eye[3], target[3], up[3];
@@ -36,6 +37,9 @@ void ptr_builder_free(PtrSceneBuilder *builder);
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
                                  double radius, uint32_t material);
+
+/* Gives the sphere added last its own colour (see PtrSpheres.color). */
+PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
 
 /* lens gives everything but the position and orientation. Ignored when the
  * builder has an override. */

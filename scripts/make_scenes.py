@@ -9,7 +9,13 @@ viewers show round spheres. A sphere may carry "emission": [r, g, b], its
 emitted radiance. The camera node looks from `lookfrom` towards
 `lookat`; depth of field is carried in the camera's extras.
 
-Usage: make_scenes.py INPUT.json OUTPUT.gltf|OUTPUT.glb
+With --instanced, the spheres of one material are instead one node with
+EXT_mesh_gpu_instancing (TRANSLATION = centre, SCALE = radius, _COLOR_0 =
+albedo over a white base colour): the compact form for large sets, a few
+dozen bytes a sphere. Without a "camera" the file has none (ptr then frames
+every sphere); "image" and "sky" are optional too.
+
+Usage: make_scenes.py [--instanced] INPUT.json OUTPUT.gltf|OUTPUT.glb
 """
 import base64
 import json
@@ -112,16 +118,48 @@ def base_material(sphere):
     raise SystemExit(f"unknown material kind {kind!r}")
 
 
-def build(desc):
-    verts, tris = unit_sphere()
-    positions = b"".join(struct.pack("<3f", *v) for v in verts)
-    indices = b"".join(struct.pack("<3H", *t) for t in tris)
-    indices += b"\0" * (-len(indices) % 4)
-    blob = positions + indices
+class Buffer:
+    """The one binary buffer, with a view and an accessor per array added."""
 
-    materials, material_index, meshes, nodes = [], {}, [], []
+    def __init__(self):
+        self.blob, self.views, self.accessors = bytearray(), [], []
+
+    def add(self, data, component_type, count, kind, target=None, **extra):
+        view = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data)}
+        if target:
+            view["target"] = target
+        self.blob += data + b"\0" * (-len(data) % 4)
+        self.views.append(view)
+        self.accessors.append(dict(bufferView=len(self.views) - 1, componentType=component_type,
+                                   count=count, type=kind, **extra))
+        return len(self.accessors) - 1
+
+
+def add_instances(buffer, spheres, name):
+    """A node with EXT_mesh_gpu_instancing for spheres of one material."""
+    pack = struct.Struct("<3f").pack
+    n = len(spheres)
+    attributes = {
+        "TRANSLATION": buffer.add(b"".join(pack(*s["center"]) for s in spheres), 5126, n, "VEC3"),
+        "SCALE": buffer.add(b"".join(pack(*[s["radius"]] * 3) for s in spheres), 5126, n, "VEC3"),
+        "_COLOR_0": buffer.add(b"".join(pack(*s.get("albedo", [1.0, 1.0, 1.0])) for s in spheres),
+                               5126, n, "VEC3"),
+    }
+    return {"name": name, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attributes}}}
+
+
+def build(desc, instanced=False):
+    verts, tris = unit_sphere()
+    buffer = Buffer()
+    buffer.add(b"".join(struct.pack("<3f", *v) for v in verts), 5126, len(verts), "VEC3", 34962,
+               min=[-1.0, -1.0, -1.0], max=[1.0, 1.0, 1.0])
+    buffer.add(b"".join(struct.pack("<3H", *t) for t in tris), 5123, 3 * len(tris), "SCALAR",
+               34963)
+
+    materials, material_index, meshes, nodes, groups = [], {}, [], [], {}
     for i, sphere in enumerate(desc["spheres"]):
-        mat = gltf_material(sphere)
+        # Instanced spheres keep their albedo as their own colour.
+        mat = gltf_material(dict(sphere, albedo=[1.0, 1.0, 1.0]) if instanced else sphere)
         key = json.dumps(mat, sort_keys=True)
         if key not in material_index:
             material_index[key] = len(materials)
@@ -129,49 +167,58 @@ def build(desc):
             meshes.append({"name": f"Sphere.{len(meshes):03d}",
                            "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 0},
                                            "indices": 1, "material": material_index[key]}]})
+        if instanced:
+            groups.setdefault(material_index[key], []).append(sphere)
+            continue
         r = sphere["radius"]
         nodes.append({"name": f"Sphere.{i:03d}", "mesh": material_index[key],
                       "translation": sphere["center"], "scale": [r, r, r]})
-
-    cam = desc["camera"]
-    width, height = desc["image"]["width"], desc["image"]["height"]
-    nodes.append({"name": "Camera", "camera": 0,
-                  "translation": cam["lookfrom"],
-                  "rotation": look_rotation(cam["lookfrom"], cam["lookat"], cam["vup"])})
-    camera = {"name": "Camera", "type": "perspective",
-              "perspective": {"yfov": math.radians(cam["vfov_deg"]),
-                              "aspectRatio": width / height, "znear": 0.001},
-              "extras": {"aperture": cam["aperture"], "focus_distance": cam["focus_dist"]}}
+    for mesh, spheres in groups.items():
+        nodes.append(dict(add_instances(buffer, spheres, f"Spheres.{mesh:03d}"), mesh=mesh))
 
     doc = {
         "asset": {"version": "2.0", "generator": "ptr scripts/make_scenes.py"},
         "scene": 0,
-        "scenes": [{"name": desc["name"], "nodes": list(range(len(nodes))),
-                    "extras": {"sky": desc["sky"]["type"], "resolution": [width, height]}}],
+        "scenes": [{"name": desc.get("name", "spheres"), "nodes": [], "extras": {}}],
         "nodes": nodes,
-        "cameras": [camera],
+        "cameras": [],
         "meshes": meshes,
         "materials": materials,
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": len(verts), "type": "VEC3",
-             "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
-            {"bufferView": 1, "componentType": 5123, "count": 3 * len(tris), "type": "SCALAR"},
-        ],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": len(positions), "target": 34962},
-            {"buffer": 0, "byteOffset": len(positions), "byteLength": 6 * len(tris),
-             "target": 34963},
-        ],
-        "buffers": [{"byteLength": len(blob)}],
+        "accessors": buffer.accessors,
+        "bufferViews": buffer.views,
+        "buffers": [{"byteLength": len(buffer.blob)}],
     }
+    extras = doc["scenes"][0]["extras"]
+    if "sky" in desc:
+        extras["sky"] = desc["sky"]["type"]
+    if "image" in desc:
+        extras["resolution"] = [desc["image"]["width"], desc["image"]["height"]]
+    if "camera" in desc:
+        cam = desc["camera"]
+        nodes.append({"name": "Camera", "camera": 0,
+                      "translation": cam["lookfrom"],
+                      "rotation": look_rotation(cam["lookfrom"], cam["lookat"], cam["vup"])})
+        perspective = {"yfov": math.radians(cam["vfov_deg"])}
+        if "image" in desc:
+            perspective["aspectRatio"] = desc["image"]["width"] / desc["image"]["height"]
+        perspective["znear"] = 0.001
+        doc["cameras"].append({"name": "Camera", "type": "perspective", "perspective": perspective,
+                           "extras": {"aperture": cam["aperture"],
+                                      "focus_distance": cam["focus_dist"]}})
+    doc["scenes"][0]["nodes"] = list(range(len(nodes)))
+    if not doc["cameras"]:
+        del doc["cameras"]
     used = []
     if any(s["material"] == "dielectric" for s in desc["spheres"]):
         used += ["KHR_materials_transmission", "KHR_materials_ior"]
     if any(max(s.get("emission", [0])) > 0 for s in desc["spheres"]):
         used.append("KHR_materials_emissive_strength")
+    if instanced:
+        used.append("EXT_mesh_gpu_instancing")
+        doc["extensionsRequired"] = ["EXT_mesh_gpu_instancing"]
     if used:
         doc["extensionsUsed"] = used
-    return doc, blob
+    return doc, bytes(buffer.blob)
 
 
 def write_gltf(doc, blob, path):
@@ -193,16 +240,22 @@ def write_glb(doc, blob, path):
         f.write(struct.pack("<I4s", len(blob), b"BIN\0") + blob)
 
 
-def main():
-    if len(sys.argv) != 3:
-        raise SystemExit(__doc__)
-    with open(sys.argv[1]) as f:
-        desc = json.load(f)
-    doc, blob = build(desc)
-    if sys.argv[2].endswith(".glb"):
-        write_glb(doc, blob, sys.argv[2])
+def write(doc, blob, path):
+    if path.endswith(".glb"):
+        write_glb(doc, blob, path)
     else:
-        write_gltf(doc, blob, sys.argv[2])
+        write_gltf(doc, blob, path)
+
+
+def main():
+    args = sys.argv[1:]
+    instanced = "--instanced" in args
+    args = [a for a in args if a != "--instanced"]
+    if len(args) != 2:
+        raise SystemExit(__doc__)
+    with open(args[0]) as f:
+        desc = json.load(f)
+    write(*build(desc, instanced), args[1])
 
 
 if __name__ == "__main__":

@@ -30,6 +30,45 @@ bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int,
 
 bool in_range(int index, size_t count) { return index >= 0 && size_t(index) < count; }
 
+const char *const instancing_extension = "EXT_mesh_gpu_instancing";
+
+// The node's EXT_mesh_gpu_instancing attributes object, or null.
+const tinygltf::Value *instancing_attributes(const tinygltf::Node &n)
+{
+    auto it = n.extensions.find(instancing_extension);
+    if (it == n.extensions.end() || !it->second.IsObject() || !it->second.Has("attributes"))
+        return nullptr;
+    return &it->second.Get("attributes");
+}
+
+// An accessor index from an attributes object: -1 if absent, -2 if not an
+// integer.
+int attribute(const tinygltf::Value &attributes, const char *name)
+{
+    if (!attributes.Has(name))
+        return -1;
+    const tinygltf::Value &v = attributes.Get(name);
+    return v.IsInt() && v.GetNumberAsInt() >= 0 ? v.GetNumberAsInt() : -2;
+}
+
+int primitive_attribute(const tinygltf::Primitive &p, const char *name)
+{
+    auto it = p.attributes.find(name);
+    return it == p.attributes.end() ? -1 : it->second;
+}
+
+std::string required_extension_fault(const tinygltf::Model &m)
+{
+    for (const std::string &name : m.extensionsRequired) {
+        bool known = false;
+        for (const char *const *e = gltf_implemented_extensions; *e; e++)
+            known = known || name == *e;
+        if (!known)
+            return "requires the glTF extension " + name + ", which ptr does not implement";
+    }
+    return "";
+}
+
 // tinygltf leaves most cross-references unchecked; check every one ptr
 // follows, so the C side can index without looking.
 std::string check_indices(const tinygltf::Model &m)
@@ -47,6 +86,18 @@ std::string check_indices(const tinygltf::Model &m)
             if (!in_range(child, nodes))
                 return "node " + std::to_string(i) + " has child " + std::to_string(child) +
                        ", which does not exist";
+        if (n.extensions.count(instancing_extension)) {
+            const tinygltf::Value *a = instancing_attributes(n);
+            if (!a || !a->IsObject() || n.mesh == -1)
+                return "node " + std::to_string(i) + " has " + instancing_extension +
+                       " without a mesh or without an attributes object";
+            for (const char *name : { "TRANSLATION", "ROTATION", "SCALE", "_COLOR_0" }) {
+                int index = attribute(*a, name);
+                if (index == -2 || (index != -1 && !in_range(index, m.accessors.size())))
+                    return "node " + std::to_string(i) + ": instance attribute " + name +
+                           " refers to an accessor that does not exist";
+            }
+        }
         if (!(n.matrix.empty() || n.matrix.size() == 16) ||
             !(n.rotation.empty() || n.rotation.size() == 4) ||
             !(n.scale.empty() || n.scale.size() == 3) ||
@@ -58,10 +109,11 @@ std::string check_indices(const tinygltf::Model &m)
             if (p.material != -1 && !in_range(p.material, m.materials.size()))
                 return "mesh " + std::to_string(i) + " refers to material " +
                        std::to_string(p.material) + ", which does not exist";
-            auto pos = p.attributes.find("POSITION");
-            if (pos != p.attributes.end() && !in_range(pos->second, m.accessors.size()))
-                return "mesh " + std::to_string(i) + " refers to accessor " +
-                       std::to_string(pos->second) + ", which does not exist";
+            for (const auto &attr : p.attributes)
+                if (!in_range(attr.second, m.accessors.size()))
+                    return "mesh " + std::to_string(i) + " attribute " + attr.first +
+                           " refers to accessor " + std::to_string(attr.second) +
+                           ", which does not exist";
         }
     }
     // Accessors, views and buffers must lie inside one another, even where ptr
@@ -149,6 +201,11 @@ void copy_or(double (&dst)[N], const std::vector<double> &src, const double (&fa
 
 } // namespace
 
+extern "C" const char *const gltf_implemented_extensions[] = {
+    "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength", "KHR_materials_ior",
+    "KHR_materials_transmission", nullptr,
+};
+
 extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
                                   int *unreadable)
 {
@@ -172,7 +229,9 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
                                          (error.empty() ? "not a valid glTF file" : error));
             return nullptr;
         }
-        std::string fault = check_indices(doc->model);
+        std::string fault = required_extension_fault(doc->model);
+        if (fault.empty())
+            fault = check_indices(doc->model);
         if (!fault.empty()) {
             ptr_shim_error(err, err_size, std::string(path) + ": " + fault);
             return nullptr;
@@ -220,6 +279,11 @@ extern "C" void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *out)
     copy_or(out->rotation, n.rotation, unit_quat);
     copy_or(out->scale, n.scale, one3);
     out->has_radius = number_member(n.extras, "radius", &out->radius);
+    if (const tinygltf::Value *a = instancing_attributes(n)) {
+        out->instanced = 1;
+        out->instances = GltfInstancing{ attribute(*a, "TRANSLATION"), attribute(*a, "ROTATION"),
+                                         attribute(*a, "SCALE"), attribute(*a, "_COLOR_0") };
+    }
 }
 
 extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
@@ -227,13 +291,19 @@ extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
     const tinygltf::Mesh &mesh = doc->model.meshes[index];
     *out = GltfMesh{};
     out->name = mesh.name.c_str();
-    out->material = mesh.primitives.empty() ? -1 : mesh.primitives[0].material;
-    out->has_bounds = !mesh.primitives.empty();
+    out->material = -1;
+    out->primitive_count = mesh.primitives.size();
+    out->has_bounds = 1;
     for (int k = 0; k < 3; k++) {
         out->min[k] = HUGE_VAL;
         out->max[k] = -HUGE_VAL;
     }
     for (const tinygltf::Primitive &p : mesh.primitives) {
+        if (p.mode == TINYGLTF_MODE_POINTS)
+            continue;
+        if (!out->has_surface)
+            out->material = p.material;
+        out->has_surface = 1;
         auto pos = p.attributes.find("POSITION");
         if (pos == p.attributes.end()) {
             out->has_bounds = 0;
@@ -249,6 +319,34 @@ extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
             out->max[k] = std::max(out->max[k], a.maxValues[k]);
         }
     }
+}
+
+extern "C" void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index,
+                                   GltfPrimitive *out)
+{
+    const tinygltf::Primitive &p = doc->model.meshes[mesh].primitives[index];
+    *out = GltfPrimitive{ p.mode == TINYGLTF_MODE_POINTS, p.material,
+                          primitive_attribute(p, "POSITION"), primitive_attribute(p, "_RADIUS"),
+                          primitive_attribute(p, "COLOR_0") };
+}
+
+extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *out)
+{
+    const tinygltf::Model &m = doc->model;
+    const tinygltf::Accessor &a = m.accessors[index];
+    *out = GltfAccessor{};
+    out->count = a.count;
+    out->component_type = a.componentType;
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+    out->components = components >= 1 && components <= 4 && a.type != TINYGLTF_TYPE_MAT2
+                          ? components : 0;
+    out->normalized = a.normalized;
+    out->sparse = a.sparse.isSparse;
+    if (a.bufferView == -1 || out->sparse)
+        return;
+    const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+    out->stride = size_t(a.ByteStride(v));
+    out->data = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
 }
 
 extern "C" void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *out)

@@ -12,6 +12,37 @@ extern "C" {
 
 typedef struct GltfDoc GltfDoc;
 
+/* glTF's accessor component types. */
+enum {
+    GLTF_BYTE = 5120, GLTF_UNSIGNED_BYTE = 5121, GLTF_SHORT = 5122,
+    GLTF_UNSIGNED_SHORT = 5123, GLTF_UNSIGNED_INT = 5125, GLTF_FLOAT = 5126,
+};
+
+/* An accessor's elements as the file stores them. Elements lie inside the
+ * buffer (checked when the file loaded); data is NULL where the accessor
+ * has no buffer view (glTF's all-zero accessor) or is sparse. */
+typedef struct GltfAccessor {
+    const unsigned char *data;
+    size_t count;
+    size_t stride;      /* bytes from one element to the next */
+    int component_type; /* GLTF_BYTE ... GLTF_FLOAT */
+    int components;     /* 1 (SCALAR) to 4 (VEC4); 0 for matrices */
+    int normalized;
+    int sparse;
+} GltfAccessor;
+
+/* A POINTS primitive's or an EXT_mesh_gpu_instancing node's attributes:
+ * accessor indices, -1 where absent (all checked to be in range). */
+typedef struct GltfInstancing {
+    int translation, rotation, scale, color; /* color: _COLOR_0 */
+} GltfInstancing;
+
+typedef struct GltfPrimitive {
+    int points;   /* mode 0 (POINTS) */
+    int material; /* -1 if none */
+    int position, radius, color; /* POSITION, _RADIUS, COLOR_0; -1 if absent */
+} GltfPrimitive;
+
 typedef struct GltfNode {
     const char *name;
     int mesh;   /* -1 if none */
@@ -23,13 +54,19 @@ typedef struct GltfNode {
     double translation[3], rotation[4] /* x, y, z, w */, scale[3];
     int has_radius;    /* extras.radius */
     double radius;
+    int instanced;     /* has EXT_mesh_gpu_instancing */
+    GltfInstancing instances;
 } GltfNode;
 
+/* A mesh's surface is what its primitives other than POINTS cover: a node
+ * with the mesh makes one sphere of it. */
 typedef struct GltfMesh {
     const char *name;
-    int has_bounds;    /* every primitive has POSITION with min and max */
-    double min[3], max[3]; /* union over the primitives */
-    int material;      /* first primitive's material, -1 if none */
+    int has_surface;   /* a primitive other than POINTS */
+    int has_bounds;    /* every such primitive has POSITION with min and max */
+    double min[3], max[3]; /* union over them */
+    int material;      /* the first such primitive's material, -1 if none */
+    size_t primitive_count;
 } GltfMesh;
 
 typedef struct GltfMaterial {
@@ -72,6 +109,10 @@ typedef struct GltfScene {
 GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size, int *unreadable);
 void gltf_doc_free(GltfDoc *doc);
 
+/* The extensions ptr implements, for messages: glTF files that require
+ * another are refused when they load. */
+extern const char *const gltf_implemented_extensions[];
+
 /* Files besides the .gltf that were read: external buffers, as paths. */
 size_t gltf_doc_file_count(const GltfDoc *doc);
 const char *gltf_doc_file(const GltfDoc *doc, size_t index);
@@ -85,6 +126,8 @@ void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *node);
 void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *mesh);
 void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *material);
 void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *camera);
+void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index, GltfPrimitive *primitive);
+void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *accessor);
 /* Returns 0 if the file has no scene at all. */
 int gltf_doc_scene(const GltfDoc *doc, GltfScene *scene);
 

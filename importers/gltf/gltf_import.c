@@ -1,5 +1,6 @@
 /* glTF nodes to spheres, following docs/scenes.md. */
 #include <math.h>
+#include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -141,52 +142,295 @@ static PtrResult map_material(Importer *im, int gltf_index, uint32_t *out)
     return PTR_OK;
 }
 
-static PtrResult add_sphere(Importer *im, size_t node_index, const GltfNode *node,
-                            const Mat4 *world)
-{
-    const char *name = label(node->name, "unnamed");
-    GltfMesh mesh;
-    gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
+/* What a sphere is made for, for messages: "node 3 ('Cloud')", with
+ * ", instance 17" or ", point 5" after it. */
+typedef struct Origin {
+    size_t node_index;
+    const char *node_name;
+    const char *part;  /* "instance", "point" or NULL */
+    size_t part_index;
+} Origin;
 
-    double centre[3], radius;
+static void origin_text(const Origin *o, char *out, size_t size)
+{
+    int n = snprintf(out, size, "node %zu ('%s')", o->node_index, o->node_name);
+    if (o->part && n >= 0 && (size_t)n < size)
+        snprintf(out + n, size - (size_t)n, ", %s %zu", o->part, o->part_index);
+}
+
+static double largest_scale(const Mat4 *world, Importer *im, const Origin *o, int *warned)
+{
     double scale[3] = { column_length(world, 0), column_length(world, 1),
                         column_length(world, 2) };
+    double smin = fmin(scale[0], fmin(scale[1], scale[2]));
+    double smax = fmax(scale[0], fmax(scale[1], scale[2]));
+    if (smax - smin > 1e-6 * smax && !*warned) {
+        *warned = 1;
+        ptr_warn(im->warnings,
+                 "%s: node '%s' has a non-uniform scale; its spheres take the largest axis",
+                 im->path, o->node_name);
+    }
+    return smax;
+}
+
+static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3], double radius,
+                            uint32_t material, const double *color)
+{
+    float r = (float)radius;
+    if (!(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3)) {
+        char where[160];
+        origin_text(o, where, sizeof where);
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: %s gives a sphere with a non-finite centre or a radius that "
+                             "is not positive and finite", im->path, where);
+    }
+    if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK ||
+        (color && ptr_builder_set_color(&im->builder, color) != PTR_OK))
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    return PTR_OK;
+}
+
+/* The sphere of a node's mesh surface under world. */
+static PtrResult add_surface_sphere(Importer *im, const Origin *o, const GltfNode *node,
+                                    const GltfMesh *mesh, const Mat4 *world, const double *color,
+                                    int *warned)
+{
+    double centre[3], radius;
     if (node->has_radius) {
         const double origin[3] = { 0, 0, 0 };
         mat4_point(world, origin, centre);
         radius = node->radius;
     } else {
-        if (!mesh.has_bounds)
+        if (!mesh->has_bounds)
             return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                                  "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
-                                 im->path, node_index, name, node->mesh);
+                                 im->path, o->node_index, o->node_name, node->mesh);
         double local[3], extent = 0.0;
         for (int k = 0; k < 3; k++) {
-            local[k] = 0.5 * (mesh.min[k] + mesh.max[k]);
-            extent = fmax(extent, mesh.max[k] - mesh.min[k]);
+            local[k] = 0.5 * (mesh->min[k] + mesh->max[k]);
+            extent = fmax(extent, mesh->max[k] - mesh->min[k]);
         }
         mat4_point(world, local, centre);
-        radius = 0.5 * extent * fmax(scale[0], fmax(scale[1], scale[2]));
-        double smin = fmin(scale[0], fmin(scale[1], scale[2]));
-        double smax = fmax(scale[0], fmax(scale[1], scale[2]));
-        if (smax - smin > 1e-6 * smax)
-            ptr_warn(im->warnings,
-                     "%s: node '%s' has a non-uniform scale; its sphere takes the largest axis",
-                     im->path, name);
+        radius = 0.5 * extent * largest_scale(world, im, o, warned);
     }
-    float r = (float)radius;
-    if (!(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3))
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: node %zu ('%s') gives a sphere with a non-finite centre "
-                             "or a radius that is not positive and finite",
-                             im->path, node_index, name);
     uint32_t material = 0;
-    PtrResult res = map_material(im, mesh.material, &material);
+    PtrResult res = map_material(im, mesh->material, &material);
+    return res != PTR_OK ? res : add_sphere(im, o, centre, radius, material, color);
+}
+
+/* What kinds of stored numbers an attribute accepts. */
+typedef enum Components {
+    FLOATS,              /* float only */
+    FLOATS_OR_SIGNED,    /* float, normalized byte or short */
+    FLOATS_OR_UNSIGNED,  /* float, normalized unsigned byte or short */
+} Components;
+
+/* Checks accessor index as attribute `what` of o's node: its type (between
+ * min_components and max_components numbers an element), its stored numbers,
+ * and, unless *count is 0, that it has *count elements (else sets *count). The
+ * accessor's bounds within its buffer were checked when the file loaded. */
+static PtrResult attribute_accessor(Importer *im, const Origin *o, const char *what, int index,
+                                    int min_components, int max_components, Components kinds,
+                                    size_t *count, GltfAccessor *a)
+{
+    gltf_doc_accessor(im->doc, (size_t)index, a);
+    const int t = a->component_type;
+    int kind_ok = (t == GLTF_FLOAT && !a->normalized) ||
+                  (kinds == FLOATS_OR_SIGNED && a->normalized && (t == GLTF_BYTE || t == GLTF_SHORT)) ||
+                  (kinds == FLOATS_OR_UNSIGNED && a->normalized &&
+                   (t == GLTF_UNSIGNED_BYTE || t == GLTF_UNSIGNED_SHORT));
+    const char *fault = a->sparse ? "is sparse, which ptr does not read"
+                        : !a->data ? "has no buffer view"
+                        : a->components < min_components || a->components > max_components
+                            ? "has the wrong type"
+                        : !kind_ok ? "has a component type its attribute does not allow"
+                        : *count && a->count != *count ? "has a count that differs from the other attributes'"
+                        : a->count == 0 ? "is empty"
+                                        : NULL;
+    if (fault) {
+        char where[160];
+        origin_text(&(Origin){ o->node_index, o->node_name, NULL, 0 }, where, sizeof where);
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: %s: %s accessor %d %s",
+                             im->path, where, what, index, fault);
+    }
+    *count = a->count;
+    return PTR_OK;
+}
+
+/* Element i of an accessor checked by attribute_accessor, as glTF defines
+ * normalized integers. Missing components are 0. */
+static void element(const GltfAccessor *a, size_t i, double out[4])
+{
+    const unsigned char *p = a->data + i * a->stride;
+    for (int c = 0; c < 4; c++) {
+        double v = 0;
+        if (c < a->components) {
+            switch (a->component_type) {
+            case GLTF_FLOAT: { float f; memcpy(&f, p + 4 * c, 4); v = f; break; }
+            case GLTF_UNSIGNED_BYTE: v = p[c] / 255.0; break;
+            case GLTF_BYTE: v = fmax((signed char)p[c] / 127.0, -1.0); break;
+            case GLTF_UNSIGNED_SHORT: { uint16_t u; memcpy(&u, p + 2 * c, 2); v = u / 65535.0; break; }
+            case GLTF_SHORT: { int16_t u; memcpy(&u, p + 2 * c, 2); v = fmax(u / 32767.0, -1.0); break; }
+            }
+        }
+        out[c] = v;
+    }
+}
+
+/* The spheres of a POINTS primitive under world (times color, if any). */
+static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfNode *node,
+                            const GltfPrimitive *prim, const Mat4 *world, const double *color,
+                            int *warned)
+{
+    if (prim->radius < 0 && !node->has_radius)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS without a _RADIUS attribute or an "
+                             "extras.radius", im->path, node_origin->node_index,
+                             node_origin->node_name);
+    if (prim->position < 0)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS without POSITION", im->path,
+                             node_origin->node_index, node_origin->node_name);
+    size_t count = 0;
+    GltfAccessor pos, rad, col;
+    PtrResult res = attribute_accessor(im, node_origin, "POSITION", prim->position, 3, 3, FLOATS,
+                                       &count, &pos);
+    if (res == PTR_OK && prim->radius >= 0)
+        res = attribute_accessor(im, node_origin, "_RADIUS", prim->radius, 1, 1, FLOATS, &count,
+                                 &rad);
+    if (res == PTR_OK && prim->color >= 0)
+        res = attribute_accessor(im, node_origin, "COLOR_0", prim->color, 3, 4,
+                                 FLOATS_OR_UNSIGNED, &count, &col);
+    uint32_t material = 0;
+    if (res == PTR_OK)
+        res = map_material(im, prim->material, &material);
     if (res != PTR_OK)
         return res;
-    if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK)
-        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    return PTR_OK;
+    const double scale = largest_scale(world, im, node_origin, warned);
+    Origin o = *node_origin;
+    o.part = "point";
+    for (size_t i = 0; i < count && res == PTR_OK; i++) {
+        double p[4], r[4], c[4], centre[3], rgb[3];
+        element(&pos, i, p);
+        mat4_point(world, p, centre);
+        if (prim->radius >= 0)
+            element(&rad, i, r);
+        else
+            r[0] = node->radius;
+        if (prim->color >= 0) {
+            element(&col, i, c);
+            for (int k = 0; k < 3; k++)
+                rgb[k] = c[k] * (color ? color[k] : 1.0);
+        }
+        o.part_index = i;
+        res = add_sphere(im, &o, centre, r[0] * scale, material,
+                         prim->color >= 0 ? rgb : color);
+    }
+    return res;
+}
+
+/* A node's spheres under world: its surface's and its points'. */
+static PtrResult add_mesh_spheres(Importer *im, const Origin *o, const GltfNode *node,
+                                  const GltfMesh *mesh, const Mat4 *world, const double *color,
+                                  int *warned)
+{
+    PtrResult res = PTR_OK;
+    if (mesh->has_surface)
+        res = add_surface_sphere(im, o, node, mesh, world, color, warned);
+    for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        if (prim.points)
+            res = add_points(im, o, node, &prim, world, color, warned);
+    }
+    return res;
+}
+
+/* T * R * S of instance i, from the attributes present. */
+static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const GltfAccessor *s,
+                          size_t i, Mat4 *out)
+{
+    GltfNode trs = { .rotation = { 0, 0, 0, 1 }, .scale = { 1, 1, 1 } };
+    double v[4];
+    if (t) {
+        element(t, i, v);
+        memcpy(trs.translation, v, sizeof trs.translation);
+    }
+    if (r) {
+        element(r, i, v);
+        double length = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+        if (!(length > 0) || !isfinite(length))
+            return 0;
+        for (int k = 0; k < 4; k++)
+            trs.rotation[k] = v[k] / length; /* quantized rotations are not quite unit */
+    }
+    if (s) {
+        element(s, i, v);
+        for (int k = 0; k < 3; k++)
+            if (!(v[k] > 0) || !isfinite(v[k]))
+                return 0;
+        memcpy(trs.scale, v, sizeof trs.scale);
+    }
+    *out = node_local(&trs);
+    return all_finite(out->m, 16);
+}
+
+/* EXT_mesh_gpu_instancing: the node's spheres once per instance. */
+static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *node,
+                               const GltfMesh *mesh, const Mat4 *world, int *warned)
+{
+    const GltfInstancing *in = &node->instances;
+    if (in->translation < 0 && in->rotation < 0 && in->scale < 0)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has EXT_mesh_gpu_instancing without "
+                             "TRANSLATION, ROTATION or SCALE", im->path, o->node_index,
+                             o->node_name);
+    size_t count = 0;
+    GltfAccessor t, r, s, c;
+    PtrResult res = PTR_OK;
+    if (in->translation >= 0)
+        res = attribute_accessor(im, o, "TRANSLATION", in->translation, 3, 3, FLOATS, &count, &t);
+    if (res == PTR_OK && in->rotation >= 0)
+        res = attribute_accessor(im, o, "ROTATION", in->rotation, 4, 4, FLOATS_OR_SIGNED, &count,
+                                 &r);
+    if (res == PTR_OK && in->scale >= 0)
+        res = attribute_accessor(im, o, "SCALE", in->scale, 3, 3, FLOATS, &count, &s);
+    if (res == PTR_OK && in->color >= 0)
+        res = attribute_accessor(im, o, "_COLOR_0", in->color, 3, 4, FLOATS_OR_UNSIGNED, &count,
+                                 &c);
+    Origin instance = *o;
+    instance.part = "instance";
+    for (size_t i = 0; i < count && res == PTR_OK; i++) {
+        Mat4 local, instance_world;
+        instance.part_index = i;
+        if (!instance_local(in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
+                            in->scale >= 0 ? &s : NULL, i, &local)) {
+            char where[160];
+            origin_text(&instance, where, sizeof where);
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: %s has a non-finite transform, a zero rotation or a "
+                                 "scale that is not positive", im->path, where);
+        }
+        instance_world = mat4_mul(world, &local);
+        double color[4];
+        if (in->color >= 0)
+            element(&c, i, color);
+        res = add_mesh_spheres(im, &instance, node, mesh, &instance_world,
+                               in->color >= 0 ? color : NULL, warned);
+    }
+    return res;
+}
+
+static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNode *node,
+                                  const Mat4 *world)
+{
+    GltfMesh mesh;
+    gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
+    const Origin o = { node_index, label(node->name, "unnamed"), NULL, 0 };
+    int warned = 0;
+    if (node->instanced)
+        return add_instances(im, &o, node, &mesh, world, &warned);
+    return add_mesh_spheres(im, &o, node, &mesh, world, NULL, &warned);
 }
 
 static PtrResult take_camera(Importer *im, const GltfNode *node, const Mat4 *world)
@@ -270,7 +514,7 @@ static PtrResult walk_nodes(Importer *im, const GltfScene *gs)
                 break;
             }
             if (node.mesh >= 0)
-                res = add_sphere(im, (size_t)index, &node, &world[index]);
+                res = add_node_spheres(im, (size_t)index, &node, &world[index]);
             if (res == PTR_OK && node.camera >= 0)
                 res = take_camera(im, &node, &world[index]);
             for (size_t c = node.child_count; c-- > 0 && res == PTR_OK;) {

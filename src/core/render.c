@@ -189,6 +189,12 @@ static PtrVec3 trace_path(const PathContext *ctx, const PtrSampler *sampler, Ptr
             break;
         }
         const PtrMaterial *m = &scene->materials[spheres->material[hit.sphere]];
+        PtrMaterial tinted;
+        if (spheres->color) {
+            tinted = *m;
+            tinted.albedo = v3_mul(m->albedo, ptr_sphere_color(spheres, hit.sphere));
+            m = &tinted;
+        }
         PtrVec3 normal, point;
         surface_at(ctx, &ray, &hit, &point, &normal);
         if (v3_max_comp(m->emission) > 0.0f) {

@@ -22,6 +22,7 @@ typedef struct SphereArray {
     void **data;
     size_t size;     /* of one entry */
     uint32_t padding; /* bits of a padding entry */
+    int optional;     /* may be NULL: then it stays so */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -32,12 +33,13 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
     /* Entries are whole 4-byte words (see spheres_copy). */
     SphereArray list[] = {
-        { (void **)&s->cx, sizeof *s->cx, zero.u },
-        { (void **)&s->cy, sizeof *s->cy, zero.u },
-        { (void **)&s->cz, sizeof *s->cz, zero.u },
-        { (void **)&s->radius, sizeof *s->radius, nan_bits.u }, /* never hit */
-        { (void **)&s->material, sizeof *s->material, 0 },
-        { (void **)&s->id, sizeof *s->id, UINT32_MAX },
+        { (void **)&s->cx, sizeof *s->cx, zero.u, 0 },
+        { (void **)&s->cy, sizeof *s->cy, zero.u, 0 },
+        { (void **)&s->cz, sizeof *s->cz, zero.u, 0 },
+        { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0 }, /* never hit */
+        { (void **)&s->material, sizeof *s->material, 0, 0 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0 },
+        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1 }, /* white */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -64,7 +66,8 @@ void ptr_scene_free(PtrScene *scene)
 /* Arrays like s's with room for capacity entries, the first keep entries
  * copied from s in the order given (all of s if order is NULL) and the rest
  * padding. Entries are 4-byte words (an entry of several words, such as a
- * colour, is moved word by word, its padding the pattern repeated). */
+ * colour, is moved word by word, its padding the pattern repeated). An
+ * optional array s does not have (the colour) stays absent. */
 static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t capacity,
                               PtrSpheres *out)
 {
@@ -75,6 +78,8 @@ static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t
     sphere_arrays((PtrSpheres *)s, from);
     int arrays = sphere_arrays(&copy, to);
     for (int k = 0; k < arrays; k++) {
+        if (to[k].optional && !*from[k].data)
+            continue;
         *to[k].data = aligned_alloc(PTR_SPHERE_ALIGN, capacity * to[k].size);
         if (!*to[k].data) {
             spheres_free(&copy);
@@ -137,6 +142,21 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     return PTR_OK;
 }
 
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
+{
+    PtrSpheres *s = &scene->spheres;
+    if (!s->color) {
+        s->color = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * 4 * sizeof *s->color);
+        if (!s->color)
+            return PTR_ERR_NOMEM;
+        memset(s->color, 0xff, s->capacity * 4 * sizeof *s->color);
+    }
+    const float channels[3] = { color.x, color.y, color.z };
+    for (int c = 0; c < 3; c++)
+        s->color[4 * i + c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
+    return PTR_OK;
+}
+
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index)
 {
@@ -168,16 +188,17 @@ static uint64_t hash_vec(uint64_t h, PtrVec3 v)
     return hash_bytes(h, f, sizeof f);
 }
 
-/* The entries of a 4-byte per-sphere array in file order: by_id[k] is the
- * position of the sphere whose id is k (NULL: the arrays are in file order). */
-static uint64_t hash_in_file_order(uint64_t h, const void *array, const uint32_t *by_id,
-                                   size_t count)
+/* The entries (size bytes each) of a per-sphere array in file order: by_id[k]
+ * is the position of the sphere whose id is k (NULL: the arrays are in file
+ * order). */
+static uint64_t hash_in_file_order(uint64_t h, const void *array, size_t size,
+                                   const uint32_t *by_id, size_t count)
 {
-    const uint32_t *a = array;
+    const unsigned char *a = array;
     if (!by_id)
-        return hash_bytes(h, a, count * sizeof *a);
+        return hash_bytes(h, a, count * size);
     for (size_t k = 0; k < count; k++)
-        h = hash_bytes(h, &a[by_id[k]], sizeof *a);
+        h = hash_bytes(h, a + by_id[k] * size, size);
     return h;
 }
 
@@ -197,11 +218,13 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
         by_id[s->id[j]] = (uint32_t)j;
     h = hash_bytes(h, scene->origin, sizeof scene->origin);
     h = hash_bytes(h, &s->count, sizeof s->count);
-    h = hash_in_file_order(h, s->cx, by_id, s->count);
-    h = hash_in_file_order(h, s->cy, by_id, s->count);
-    h = hash_in_file_order(h, s->cz, by_id, s->count);
-    h = hash_in_file_order(h, s->radius, by_id, s->count);
-    h = hash_in_file_order(h, s->material, by_id, s->count);
+    h = hash_in_file_order(h, s->cx, sizeof *s->cx, by_id, s->count);
+    h = hash_in_file_order(h, s->cy, sizeof *s->cy, by_id, s->count);
+    h = hash_in_file_order(h, s->cz, sizeof *s->cz, by_id, s->count);
+    h = hash_in_file_order(h, s->radius, sizeof *s->radius, by_id, s->count);
+    h = hash_in_file_order(h, s->material, sizeof *s->material, by_id, s->count);
+    if (s->color)
+        h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
     free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {

@@ -23,6 +23,11 @@ typedef struct PtrSpheres {
      * structure may reorder the arrays; on equal hit distances the lowest id
      * wins, so the order never shows in an image. */
     uint32_t *id;
+    /* Each sphere's own colour, multiplying its material's base colour
+     * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
+     * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
+     * a million colours are a million of these, never a million materials. */
+    uint16_t *color;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
 } PtrSpheres;
@@ -99,6 +104,17 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * read 16 lanes from any sphere on. Returns PTR_ERR_NOMEM (arrays unchanged)
  * if the new arrays cannot be allocated. */
 PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order);
+
+/* Gives sphere i its own colour (each channel in [0, 1]); the first call
+ * creates the colour array, white for every other sphere. */
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
+
+static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
+{
+    const float unit = 1.0f / 65535.0f;
+    const uint16_t *c = &s->color[4 * i];
+    return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
+}
 
 /* Appends a material and stores its index in *index. */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
