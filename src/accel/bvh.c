@@ -46,6 +46,16 @@
 
 #include "accel/sphere_hit.h"
 
+/* The assembly traversal reads these at fixed offsets (asm/ptr.inc). */
+static_assert(offsetof(PtrBvh, nodes) == 0 && offsetof(PtrBvh, unbounded_count) == 16,
+              "PtrBvh layout");
+static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x) == 32 &&
+              offsetof(PtrBvhNode, lower_y) == 64 && offsetof(PtrBvhNode, lower_z) == 128 &&
+              offsetof(PtrBvhNode, child) == 192 && offsetof(PtrBvhNode, leaf_count) == 224 &&
+              sizeof(PtrBvhNode) == 256, "PtrBvhNode layout");
+static_assert(offsetof(PtrSpheres, id) == 40, "PtrSpheres layout");
+static_assert(PTR_BVH_MAX_DEPTH == 64 && PTR_BVH_SLACK == 0x1.00004p0f, "asm/ptr.inc constants");
+
 typedef struct StackEntry {
     uint32_t child, leaf_count;
     float entry;

@@ -3,8 +3,10 @@
  * times them.
  *
  *   checkasm [--rays N] [--seed S]     check (default 1000000 rays per level)
- *   checkasm --bench                   nanoseconds per ray at 4..512 spheres
- */
+ *   checkasm --bench                   nanoseconds per ray at 4..512 spheres,
+ *                                      and of the tree at 10^3..10^6
+ *
+ * The tree traversal's checks are in check_bvh.c. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -12,23 +14,15 @@
 #include <string.h>
 #include <time.h>
 
+#include "checkasm.h"
 #include "accel/cpu.h"
 #include "accel/isect.h"
 #include "sampling/rng.h"
 #include "core/scene.h"
 
-typedef struct CheckedCallStatus {
-    uint32_t check_xinuse;
-    uint32_t failures; /* 1: a callee-saved register changed; 2: no vzeroupper */
-} CheckedCallStatus;
-
-int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray, const PtrSpheres *spheres,
-                     size_t count, PtrHit *hit, CheckedCallStatus *status);
-
-#if defined(__x86_64__)
 #include <cpuid.h>
 /* XGETBV with ECX = 1 (XINUSE) exists when CPUID.(0xD, 1):EAX bit 2 is set. */
-static uint32_t xinuse_supported(void)
+uint32_t xinuse_supported(void)
 {
     unsigned a, b, c, d;
     if (ptr_cpu_detected() < PTR_CPU_AVX2 || __get_cpuid_max(0, NULL) < 0xd)
@@ -36,7 +30,6 @@ static uint32_t xinuse_supported(void)
     __cpuid_count(0xd, 1, a, b, c, d);
     return (a >> 2) & 1;
 }
-#endif
 
 static float uniform(PtrRng *rng, float lo, float hi)
 {
@@ -213,6 +206,7 @@ static int check(uint64_t rays, uint64_t seed)
                status[l].check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
         ok ? passed++ : failed++;
     }
+    failed += check_bvh(seed, &passed);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
@@ -284,6 +278,7 @@ static int bench(void)
         printf("\n");
         ptr_scene_free(&scene);
     }
+    bench_bvh();
     return 0;
 }
 

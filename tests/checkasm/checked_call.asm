@@ -32,7 +32,13 @@ section .text
 ; int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray,
 ;                      const PtrSpheres *spheres, size_t count, PtrHit *hit,
 ;                      CheckedCallStatus *status);
+; int ptr_checked_call_bvh(PtrBvhClosestHitFn fn, const PtrRay *ray,
+;                          const PtrBvh *bvh, const PtrSpheres *spheres,
+;                          PtrHit *hit, CheckedCallStatus *status);
+; the same routine: it only forwards four arguments.
+    global ptr_checked_call_bvh:function hidden
 FUNCTION ptr_checked_call
+ptr_checked_call_bvh:
     push        rbp
     push        rbx
     push        r12
