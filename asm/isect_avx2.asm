@@ -32,18 +32,7 @@ section .text
 %endif
     vtestps     ymm14, ymm14
     jz          %%done                          ; no lane can hit: skip sqrt, div
-    OFFSET_TERM y
-    vsqrtps     ymm12, ymm12
-    vandps      ymm9, ymm11, ymm7
-    vandnps     ymm12, ymm7, ymm12
-    vorps       ymm12, ymm12, ymm9              ; copysign(sqrt(disc), b)
-    vxorps      ymm11, ymm11, ymm7
-    vsubps      ymm11, ymm11, ymm12             ; q = -b - copysign(...)
-    vdivps      ymm8, ymm8, ymm11               ; t0 = c / q
-    vminps      ymm9, ymm8, ymm11               ; near = t0 < q ? t0 : q
-    vmaxps      ymm10, ymm8, ymm11              ; far  = t0 > q ? t0 : q
-    vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
-    vblendvps   ymm9, ymm10, ymm9, ymm12        ; t = near > tmin ? near : far
+    ROOT_AVX2
     vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
     vandps      ymm14, ymm14, ymm12             ; t > tmin
     vcmpps      ymm12, ymm9, ymm4, CMP_LT_OQ

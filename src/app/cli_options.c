@@ -202,6 +202,15 @@ static int usage_error(const char *option, const char *value, const char *expect
     return ptr_result_exit_code(PTR_ERR_USAGE);
 }
 
+/* Reads a whole string as a number; 0 if it is not one (or overflows). */
+static int parse_number(const char *text, double *value)
+{
+    char *end;
+    errno = 0;
+    *value = strtod(text, &end);
+    return !errno && end != text && !*end;
+}
+
 static int usage_error_line(const char *problem)
 {
     fprintf(stderr, "ptr: %s (usage: ptr SCENE... -o OUTPUT [options]; see ptr --help)\n", problem);
@@ -264,10 +273,8 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
             break;
         }
         case OPT_TIME: {
-            char *end;
-            errno = 0;
-            double t = strtod(optarg, &end);
-            if (errno || end == optarg || *end || !(t > 0 && t <= 1e7))
+            double t;
+            if (!parse_number(optarg, &t) || !(t > 0 && t <= 1e7))
                 return usage_error(option, optarg, "a number of seconds above 0");
             o->time_budget = t;
             break;
@@ -287,10 +294,8 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         case OPT_VFOV:
         case OPT_APERTURE:
         case OPT_FOCUS_DISTANCE: {
-            char *end;
-            errno = 0;
-            double x = strtod(optarg, &end);
-            int ok = !errno && end != optarg && !*end && isfinite(x) &&
+            double x;
+            int ok = parse_number(optarg, &x) && isfinite(x) &&
                      (c == OPT_VFOV ? x > 0 && x < 180 : c == OPT_APERTURE ? x >= 0 : x > 0);
             if (!ok)
                 return usage_error(option, optarg,
@@ -342,10 +347,8 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
             o->direct_lighting = strcmp(optarg, "on") ? PTR_OFF : PTR_ON;
             break;
         case OPT_NOISE_THRESHOLD: {
-            char *end;
-            errno = 0;
-            double e = strtod(optarg, &end);
-            if (errno || end == optarg || *end || !(e > 0 && e <= 1e6))
+            double e;
+            if (!parse_number(optarg, &e) || !(e > 0 && e <= 1e6))
                 return usage_error(option, optarg, "a number above 0");
             o->noise_threshold = (float)e;
             break;
@@ -380,10 +383,8 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         case OPT_VIEW: o->view = optarg; break;
         case OPT_LOOK: o->look = optarg; break;
         case OPT_EXPOSURE: {
-            char *end;
-            errno = 0;
-            double stops = strtod(optarg, &end);
-            if (errno || end == optarg || *end || !(fabs(stops) <= 64))
+            double stops;
+            if (!parse_number(optarg, &stops) || !(fabs(stops) <= 64))
                 return usage_error(option, optarg, "a number of stops from -64 to 64");
             o->exposure = (float)stops;
             break;
