@@ -57,8 +57,13 @@ static void load(void)
     if (!module_path(path, sizeof path, load_error, sizeof load_error)) {
         void *handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         if (!handle) {
+            /* dlerror names the file it could not open: the module or a library it needs. */
+            const char *why = dlerror();
+            size_t len = strlen(path);
+            if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
+                why += len + 2;
             snprintf(load_error, sizeof load_error, "%s: cannot load ptr's image module: %s", path,
-                     dlerror());
+                     why);
         } else if (!(m = dlsym(handle, PTR_IMAGE_MODULE_SYMBOL)) || m->size != sizeof *m ||
                    strcmp(m->version, PTR_VERSION)) {
             snprintf(load_error, sizeof load_error, "%s: not the image module of ptr %s", path,
