@@ -126,13 +126,6 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
 static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const PtrColor *color,
                                   PtrJobReport *report, PtrError *err)
 {
-    /* OpenImageIO has loaded while the colour config and the scene did. Its
-     * load holds glibc's lock on thread-local storage, which every new thread
-     * takes: the tree's and the render's threads would wait for it, and their
-     * timings count the wait. Wait here instead, before either starts. */
-    char message[sizeof err->message];
-    if (ptr_image_ready(message, sizeof message))
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
     PtrIsectTable isect;
     ptr_isect_init(&isect, o->kernel, scene->spheres.count);
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
