@@ -29,9 +29,26 @@ static void *count_run(void *arg)
     return NULL;
 }
 
+/* The process's threads, from the kernel's count. */
+static int process_threads(void)
+{
+    FILE *status = fopen("/proc/self/status", "r");
+    char line[256];
+    int threads = -1;
+    while (status && fgets(line, sizeof line, status))
+        if (!strncmp(line, "Threads:", 8))
+            threads = atoi(line + 8);
+    if (status)
+        fclose(status);
+    return threads;
+}
+
 static void test_every_work_once(void)
 {
     ptr_threads_keep(KEPT);
+    CHECK_INT(process_threads(), 1 + KEPT);
+    ptr_threads_keep(KEPT);
+    CHECK_INT(process_threads(), 1 + KEPT);
     Work work[WORK];
     int missed = 0, on_caller = 0;
     for (int round = 0; round < ROUNDS; round++) {
@@ -50,6 +67,8 @@ static void test_every_work_once(void)
     }
     CHECK_INT(missed, 0);
     CHECK_INT(on_caller, 0);
+    /* Never more threads than work at once: the same ones serve every round. */
+    CHECK_INT(process_threads(), 1 + WORK);
 }
 
 int main(void)

@@ -15,6 +15,7 @@ struct PtrThread {
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t changed = PTHREAD_COND_INITIALIZER;
 static PtrThread *waiting;
+static int kept; /* threads started, waiting or working */
 
 static void *run(void *self)
 {
@@ -45,13 +46,14 @@ static PtrThread *spawn_locked(void)
         return NULL;
     }
     pthread_detach(id);
+    kept++;
     return t;
 }
 
 void ptr_threads_keep(int count)
 {
     pthread_mutex_lock(&lock);
-    for (int i = 0; i < count; i++) {
+    while (kept < count) {
         PtrThread *t = spawn_locked();
         if (!t)
             break;

@@ -8,7 +8,8 @@
 
 typedef struct PtrThread PtrThread;
 
-/* Starts count threads that wait for work (fewer if the system refuses). */
+/* Makes sure count threads exist to take work, starting those missing (fewer
+ * if the system refuses): a second call with the same count starts none. */
 void ptr_threads_keep(int count);
 
 /* Runs fn(arg) on a waiting thread, or on a new one (kept afterwards) if none
