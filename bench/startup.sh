@@ -39,3 +39,4 @@ measure --print-dispatch --print-dispatch
 measure --list-views --list-views
 measure render-64 scenes/seed.gltf -o "$out/x.png" --width 64 --height 64 --samples 4
 measure render-500 scenes/seed.gltf -o "$out/y.png" --width 500 --height 500 --samples 20
+measure render-250-t1 scenes/seed.gltf -o "$out/z.png" --width 250 --height 250 --samples 20 --threads 1
