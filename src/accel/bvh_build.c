@@ -19,7 +19,6 @@
 #include "accel/bvh.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +26,7 @@
 #include "accel/bvh_prims.h"
 #include "accel/bvh_split.h"
 #include "accel/cpu.h"
+#include "core/threads.h"
 
 enum {
     /* From this level on ranges are split in the middle, which bounds the
@@ -184,16 +184,16 @@ static void *task_worker(void *arg)
 static int run_tasks(Build *build)
 {
     int threads = build->set.threads;
-    pthread_t *ids = malloc((size_t)threads * sizeof *ids);
+    PtrThread **ids = malloc((size_t)threads * sizeof *ids);
     if (!ids)
         return 0;
     atomic_init(&build->next_task, 0);
     int started = 0;
-    while (started < threads - 1 && pthread_create(&ids[started], NULL, task_worker, build) == 0)
+    while (started < threads - 1 && (ids[started] = ptr_thread_start(task_worker, build)))
         started++;
     task_worker(build);
     for (int i = 0; i < started; i++)
-        pthread_join(ids[i], NULL);
+        ptr_thread_join(ids[i]);
     free(ids);
     for (size_t i = 0; i < build->task_count; i++)
         if (build->tasks[i].failed)

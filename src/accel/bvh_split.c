@@ -1,9 +1,10 @@
 #include "accel/bvh_split.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "core/threads.h"
 
 enum { BINS = 32 };
 
@@ -121,7 +122,7 @@ static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhC
     }
     Bins *per_thread = malloc((size_t)threads * sizeof *per_thread);
     ParallelRun *runs = malloc((size_t)threads * sizeof *runs);
-    pthread_t *ids = malloc((size_t)threads * sizeof *ids);
+    PtrThread **ids = malloc((size_t)threads * sizeof *ids);
     if (!per_thread || !runs || !ids) {
         free(per_thread);
         free(runs);
@@ -131,14 +132,13 @@ static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhC
     int started = 1; /* threads 1 .. started - 1 run; the rest are done here */
     for (int t = 0; t < threads; t++)
         runs[t] = (ParallelRun){ set, begin, end, c, &per_thread[t], t, threads };
-    while (started < threads &&
-           pthread_create(&ids[started], NULL, parallel_bin_worker, &runs[started]) == 0)
+    while (started < threads && (ids[started] = ptr_thread_start(parallel_bin_worker, &runs[started])))
         started++;
     parallel_bin_worker(&runs[0]);
     for (int t = started; t < threads; t++)
         parallel_bin_worker(&runs[t]);
     for (int t = 1; t < started; t++)
-        pthread_join(ids[t], NULL);
+        ptr_thread_join(ids[t]);
     bins_clear(out, bins);
     for (int t = 0; t < threads; t++)
         bins_merge(out, &per_thread[t], bins);

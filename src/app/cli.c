@@ -6,6 +6,8 @@
 #include <sys/stat.h>
 
 #include "app/cli_options.h"
+#include "core/threads.h"
+#include "image/image.h"
 #include "color/color.h"
 #include "accel/cpu.h"
 #include "importer.h"
@@ -192,6 +194,16 @@ int ptr_cli_main(int argc, char **argv)
 
     char message[512];
     PtrError err = { 0 };
+    /* Renders and merges write images: OpenImageIO loads on a thread of its
+     * own while the colour config, the scenes and the render proceed. The
+     * tree's and the render's threads start first: no thread can start
+     * while the load runs. */
+    if (!o.list_views)
+        ptr_threads_keep(o.threads > 0 ? o.threads : ptr_online_cpus());
+    if (!o.list_views && ptr_image_preload(message, sizeof message)) {
+        ptr_error_set(&err, PTR_ERR_INSTALL, "%s", message);
+        return fail(&err);
+    }
     PtrColor *color = ptr_color_open(o.ocio_config, message, sizeof message);
     if (!color) {
         ptr_error_set(&err, PTR_ERR_COLOR, "%s", message);

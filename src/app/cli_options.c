@@ -166,7 +166,7 @@ static void print_help(FILE *out)
         DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, DEFAULT_MIN_SAMPLES,
         PTR_ACCEL_CROSSOVER_C, PTR_ACCEL_CROSSOVER_ASM);
     for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
-        fprintf(out, "  %d  %s\n", ptr_result_exit_code((PtrResult)r),
+        fprintf(out, "  %2d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
 }
 

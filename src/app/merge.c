@@ -28,6 +28,8 @@ static const char *required(const Part *p, const char *name, PtrError *err)
 static PtrResult read_part(Part *p, PtrError *err)
 {
     char message[sizeof err->message];
+    if (ptr_image_ready(message, sizeof message))
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
     p->image = ptr_image_read(p->path, message, sizeof message);
     if (!p->image)
         return ptr_error_set(err, PTR_ERR_USAGE, "%s", message);

@@ -12,18 +12,35 @@
 #include "image/image.h"
 #include "version.h"
 
-/* The depths each format can store; the first is its default. Formats not
- * listed (.bmp, .tga, ...) take 8 bits only. */
-static const struct {
+/* The formats ptr names in its usage, and the depths each can store, the
+ * first its default. OpenImageIO writes all of them (they are among its
+ * required dependencies), so an output in one of them is checked without
+ * waiting for the library to load; any other extension (.bmp, .tga, ...) is
+ * asked of the library, and takes 8 bits only. */
+typedef struct Format {
     const char *extension;
     PtrDepth depths[4];
-} formats[] = {
+} Format;
+
+static const Format formats[] = {
     { ".exr", { PTR_DEPTH_FLOAT, PTR_DEPTH_HALF } },
     { ".hdr", { PTR_DEPTH_FLOAT } },
     { ".png", { PTR_DEPTH_8, PTR_DEPTH_16 } },
+    { ".jpg", { PTR_DEPTH_8 } },
+    { ".jpeg", { PTR_DEPTH_8 } },
     { ".tif", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
     { ".tiff", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
 };
+
+/* The entry for path's extension, or NULL. */
+static const Format *find_format(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    for (size_t f = 0; dot && f < sizeof formats / sizeof formats[0]; f++)
+        if (!strcasecmp(dot, formats[f].extension))
+            return &formats[f];
+    return NULL;
+}
 
 static const char *const depth_names[] = { "default", "8", "16", "half", "float" };
 
@@ -41,14 +58,12 @@ int ptr_depth_parse(const char *text, PtrDepth *depth)
  * one asked for. */
 static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
 {
-    const char *dot = strrchr(path, '.');
-    for (size_t f = 0; dot && f < sizeof formats / sizeof formats[0]; f++) {
-        if (strcasecmp(dot, formats[f].extension))
-            continue;
+    const Format *format = find_format(path);
+    if (format) {
         if (wanted == PTR_DEPTH_DEFAULT)
-            return formats[f].depths[0];
+            return format->depths[0];
         for (int i = 0; i < 4; i++)
-            if (formats[f].depths[i] == wanted)
+            if (format->depths[i] == wanted)
                 return wanted;
         return PTR_DEPTH_DEFAULT;
     }
@@ -57,7 +72,11 @@ static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
 
 PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
 {
-    if (!ptr_image_can_write(path))
+    char message[sizeof err->message];
+    int known = find_format(path) != NULL;
+    if (!known && ptr_image_ready(message, sizeof message))
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
+    if (!known && !ptr_image_can_write(path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);
     if (resolve_depth(path, depth) == PTR_DEPTH_DEFAULT)
@@ -155,10 +174,12 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
     };
     const char *dot = strrchr(path, '.');
     const float *counts = dot && !strcasecmp(dot, ".exr") ? info->sample_counts : NULL;
-    int failed = ptr_image_write(path, layout, viewed ? viewed : rgb, counts, pixel_formats[depth],
-                                 attrs, sizeof attrs / sizeof attrs[0], message, sizeof message);
+    PtrResult res = PTR_OK;
+    if (ptr_image_ready(message, sizeof message))
+        res = ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
+    else if (ptr_image_write(path, layout, viewed ? viewed : rgb, counts, pixel_formats[depth],
+                             attrs, sizeof attrs / sizeof attrs[0], message, sizeof message))
+        res = ptr_error_set(err, PTR_ERR_OUTPUT, "%s", message);
     free(viewed);
-    if (failed)
-        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s", message);
-    return PTR_OK;
+    return res;
 }

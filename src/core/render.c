@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "accel/cpu.h"
+#include "core/threads.h"
 #include "accel/huge.h"
 #include "core/camera.h"
 #include "core/lights.h"
@@ -248,7 +249,7 @@ typedef struct RenderJob {
 
 typedef struct Worker {
     RenderJob *job;
-    pthread_t thread;
+    PtrThread *thread;
     uint64_t rays;
 } Worker;
 
@@ -401,7 +402,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
     job.workers_running = threads;
     for (; started < threads; started++) {
         workers[started].job = &job;
-        if (pthread_create(&workers[started].thread, NULL, render_worker, &workers[started]))
+        if (!(workers[started].thread = ptr_thread_start(render_worker, &workers[started])))
             break;
     }
     pthread_mutex_lock(&job.lock);
@@ -436,7 +437,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
     pthread_mutex_unlock(&job.lock);
     uint64_t rays = started == 0 ? workers[0].rays : 0;
     for (int i = 0; i < started; i++) {
-        pthread_join(workers[i].thread, NULL);
+        ptr_thread_join(workers[i].thread);
         rays += workers[i].rays;
     }
     double seconds = ptr_now_seconds() - start;

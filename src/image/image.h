@@ -1,4 +1,6 @@
-/* Image files through OpenImageIO, behind a C interface. */
+/* Image files through OpenImageIO, behind a C interface. The library lives in
+ * a module loaded at run time (image.c), so that a process which writes no
+ * image never loads it; every function here loads it on first use. */
 #ifndef PTR_IMAGE_H
 #define PTR_IMAGE_H
 
@@ -34,6 +36,16 @@ typedef struct PtrImageLayout {
     int x, y;                    /* their top-left corner in the full image */
     int full_width, full_height; /* the full image */
 } PtrImageLayout;
+
+/* Starts loading the module on a thread of its own, for the first image to
+ * come, and returns at once: 0, or -1 with one line in err if the module file
+ * is missing (a broken installation). Loading or not, the process waits for
+ * that thread before it exits. */
+int ptr_image_preload(char *err, size_t err_size);
+
+/* Loads the module, or waits for ptr_image_preload's thread: 0 once the
+ * functions below work, else -1 with one line in err (they then fail). */
+int ptr_image_ready(char *err, size_t err_size);
 
 /* Whether a writer exists for the file's extension. */
 int ptr_image_can_write(const char *path);

@@ -1,5 +1,7 @@
-#include "image.h"
+/* The image module: image.h through OpenImageIO, loaded at run time by image.c. */
+#include "image/image_module.h"
 #include "shim_error.h"
+#include "version.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -11,6 +13,13 @@
 #include <string>
 #include <unistd.h>
 #include <vector>
+
+struct PtrImage {
+    PtrImageLayout layout = {};
+    int width = 0, height = 0;
+    std::vector<float> rgb;
+    std::map<std::string, std::string> attrs;
+};
 
 namespace {
 
@@ -38,21 +47,12 @@ std::string temporary_name(const std::string &path)
            std::to_string(getpid()) + path.substr(dot);
 }
 
-} // namespace
-
 // The temporary file of the write under way, for ptr_image_discard_partial:
 // plain storage a signal handler may read.
-static char partial_path[4096];
-static volatile std::sig_atomic_t partial_active;
+char partial_path[4096];
+volatile std::sig_atomic_t partial_active;
 
-struct PtrImage {
-    PtrImageLayout layout = {};
-    int width = 0, height = 0;
-    std::vector<float> rgb;
-    std::map<std::string, std::string> attrs;
-};
-
-extern "C" int ptr_image_can_write(const char *path)
+int can_write(const char *path)
 {
     try {
         return OIIO::ImageOutput::create(path) != nullptr;
@@ -61,16 +61,15 @@ extern "C" int ptr_image_can_write(const char *path)
     }
 }
 
-extern "C" void ptr_image_discard_partial(void)
+void discard_partial(void)
 {
     if (partial_active)
         unlink(partial_path);
 }
 
-extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                               const float *sample_counts, PtrPixelFormat format,
-                               const PtrImageAttr *attrs, size_t attr_count, char *err,
-                               size_t err_size)
+int write_image(const char *path, const PtrImageLayout *layout, const float *rgb,
+                const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs,
+                size_t attr_count, char *err, size_t err_size)
 {
     std::string tmp;
     try {
@@ -150,7 +149,7 @@ extern "C" int ptr_image_write(const char *path, const PtrImageLayout *layout, c
     return -1;
 }
 
-extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size)
+PtrImage *read_image(const char *path, char *err, size_t err_size)
 {
     try {
         auto in = OIIO::ImageInput::open(path);
@@ -186,14 +185,21 @@ extern "C" PtrImage *ptr_image_read(const char *path, char *err, size_t err_size
     return nullptr;
 }
 
-extern "C" void ptr_image_free(PtrImage *image) { delete image; }
-extern "C" int ptr_image_width(const PtrImage *image) { return image->width; }
-extern "C" int ptr_image_height(const PtrImage *image) { return image->height; }
-extern "C" PtrImageLayout ptr_image_layout(const PtrImage *image) { return image->layout; }
-extern "C" const float *ptr_image_pixels(const PtrImage *image) { return image->rgb.data(); }
+void free_image(PtrImage *image) { delete image; }
+int image_width(const PtrImage *image) { return image->width; }
+int image_height(const PtrImage *image) { return image->height; }
+PtrImageLayout image_layout(const PtrImage *image) { return image->layout; }
+const float *image_pixels(const PtrImage *image) { return image->rgb.data(); }
 
-extern "C" const char *ptr_image_attr(const PtrImage *image, const char *name)
+const char *image_attr(const PtrImage *image, const char *name)
 {
     auto it = image->attrs.find(name);
     return it == image->attrs.end() ? nullptr : it->second.c_str();
 }
+
+} // namespace
+
+extern "C" __attribute__((visibility("default"))) const PtrImageModule ptr_image_module = {
+    sizeof(PtrImageModule), PTR_VERSION, can_write, write_image, discard_partial, read_image,
+    free_image, image_width, image_height, image_layout, image_pixels, image_attr,
+};

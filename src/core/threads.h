@@ -1,0 +1,22 @@
+/* Threads that outlive their work, started once and reused: a render starts
+ * its workers again at every pass, and starting a thread takes glibc's lock
+ * on thread-local storage, which a dlopen holds for its whole load (the image
+ * module's 260 libraries, a quarter of a second). Threads kept from before the
+ * load start work without that lock. */
+#ifndef PTR_THREADS_H
+#define PTR_THREADS_H
+
+typedef struct PtrThread PtrThread;
+
+/* Makes sure count threads exist to take work, starting those missing (fewer
+ * if the system refuses): a second call with the same count starts none. */
+void ptr_threads_keep(int count);
+
+/* Runs fn(arg) on a waiting thread, or on a new one (kept afterwards) if none
+ * waits. Returns NULL if no thread could be started. */
+PtrThread *ptr_thread_start(void *(*fn)(void *), void *arg);
+
+/* Waits until fn has returned; the thread then waits for other work. */
+void ptr_thread_join(PtrThread *thread);
+
+#endif /* PTR_THREADS_H */

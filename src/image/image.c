@@ -1,0 +1,190 @@
+/* The C side of image.h: finds the image module beside the executable, loads
+ * it (on a thread, when asked early enough to overlap other work) and hands
+ * every call to it. */
+#include "image/image_module.h"
+
+#include <dlfcn.h>
+#include <errno.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "version.h"
+
+enum { PATH_SIZE = 4096 };
+
+static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_t loader;
+static int loader_running;  /* started by ptr_image_preload and not joined yet */
+static int load_tried;      /* load() ran: module, else load_error, says how it went */
+static int exit_waits;      /* join_loader is registered with atexit */
+static char load_error[PATH_SIZE + 512]; /* a path and a line about it */
+/* Set once the module works. Atomic because the signal handler reads it
+ * (ptr_image_discard_partial). */
+static const PtrImageModule *_Atomic module;
+
+/* PTR_IMAGE_MODULE_PATH ("../lib/ptr/NAME.so") from the executable's folder,
+ * each leading "../" taken off that folder, so that messages show a plain
+ * path. */
+static int module_path(char *path, size_t size, char *err, size_t err_size)
+{
+    ssize_t n = readlink("/proc/self/exe", path, size);
+    if (n <= 0 || (size_t)n >= size) {
+        snprintf(err, err_size, "/proc/self/exe: cannot find ptr's own folder, where its image "
+                                "module lives: %s", n < 0 ? strerror(errno) : "path too long");
+        return -1;
+    }
+    path[n] = '\0';
+    const char *relative = PTR_IMAGE_MODULE_PATH;
+    *strrchr(path, '/') = '\0'; /* the kernel gives an absolute path */
+    for (char *slash; !strncmp(relative, "../", 3) && (slash = strrchr(path, '/')); relative += 3)
+        *slash = '\0';
+    size_t used = strlen(path);
+    if ((size_t)snprintf(path + used, size - used, "/%s", relative) >= size - used) {
+        snprintf(err, err_size, "%s: path too long for ptr's image module", path);
+        return -1;
+    }
+    return 0;
+}
+
+static void load(void)
+{
+    char path[PATH_SIZE];
+    const PtrImageModule *m = NULL;
+    if (!module_path(path, sizeof path, load_error, sizeof load_error)) {
+        /* Lazy binding, as when a program links the libraries: binding all of
+         * their functions up front costs a tenth more. */
+        void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
+        if (!handle) {
+            /* dlerror names the file it could not open: the module or a library it needs. */
+            const char *why = dlerror();
+            size_t len = strlen(path);
+            if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
+                why += len + 2;
+            snprintf(load_error, sizeof load_error, "%s: cannot load ptr's image module: %s", path,
+                     why);
+        } else if (!(m = dlsym(handle, PTR_IMAGE_MODULE_SYMBOL)) || m->size != sizeof *m ||
+                   strcmp(m->version, PTR_VERSION)) {
+            snprintf(load_error, sizeof load_error, "%s: not the image module of ptr %s", path,
+                     PTR_VERSION);
+            m = NULL;
+            dlclose(handle);
+        }
+    }
+    load_tried = 1;
+    atomic_store(&module, m);
+}
+
+static void *load_on_thread(void *unused)
+{
+    (void)unused;
+    load();
+    return NULL;
+}
+
+/* With the lock held. */
+static void join_loader_locked(void)
+{
+    if (loader_running) {
+        pthread_join(loader, NULL);
+        loader_running = 0;
+    }
+}
+
+/* Exiting while the thread runs the libraries' constructors would race
+ * their destructors. */
+static void join_loader(void)
+{
+    pthread_mutex_lock(&lock);
+    join_loader_locked();
+    pthread_mutex_unlock(&lock);
+}
+
+int ptr_image_preload(char *err, size_t err_size)
+{
+    char path[PATH_SIZE];
+    if (module_path(path, sizeof path, err, err_size))
+        return -1;
+    if (access(path, R_OK)) {
+        snprintf(err, err_size, "%s: ptr's image module is missing: %s", path, strerror(errno));
+        return -1;
+    }
+    pthread_mutex_lock(&lock);
+    /* A thread that cannot start leaves the load to the first use. */
+    if (!loader_running && !load_tried && !pthread_create(&loader, NULL, load_on_thread, NULL)) {
+        loader_running = 1;
+        if (!exit_waits)
+            exit_waits = !atexit(join_loader);
+    }
+    pthread_mutex_unlock(&lock);
+    return 0;
+}
+
+int ptr_image_ready(char *err, size_t err_size)
+{
+    pthread_mutex_lock(&lock);
+    join_loader_locked();
+    if (!load_tried)
+        load();
+    pthread_mutex_unlock(&lock);
+    if (atomic_load(&module))
+        return 0;
+    snprintf(err, err_size, "%s", load_error);
+    return -1;
+}
+
+/* The module, loaded now if need be; NULL if it cannot be, with the reason
+ * in err. */
+static const PtrImageModule *loaded(char *err, size_t err_size)
+{
+    return ptr_image_ready(err, err_size) ? NULL : atomic_load(&module);
+}
+
+int ptr_image_can_write(const char *path)
+{
+    const PtrImageModule *m = loaded(NULL, 0);
+    return m && m->can_write(path);
+}
+
+int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
+                    const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs,
+                    size_t attr_count, char *err, size_t err_size)
+{
+    const PtrImageModule *m = loaded(err, err_size);
+    return m ? m->write(path, layout, rgb, sample_counts, format, attrs, attr_count, err, err_size)
+             : -1;
+}
+
+void ptr_image_discard_partial(void)
+{
+    /* Without a module there is no write under way. */
+    const PtrImageModule *m = atomic_load(&module);
+    if (m)
+        m->discard_partial();
+}
+
+PtrImage *ptr_image_read(const char *path, char *err, size_t err_size)
+{
+    const PtrImageModule *m = loaded(err, err_size);
+    return m ? m->read(path, err, err_size) : NULL;
+}
+
+/* An image exists only once the module works: the accessors need no check. */
+void ptr_image_free(PtrImage *image)
+{
+    if (image)
+        atomic_load(&module)->free(image);
+}
+
+int ptr_image_width(const PtrImage *image) { return atomic_load(&module)->width(image); }
+int ptr_image_height(const PtrImage *image) { return atomic_load(&module)->height(image); }
+PtrImageLayout ptr_image_layout(const PtrImage *image) { return atomic_load(&module)->layout(image); }
+const float *ptr_image_pixels(const PtrImage *image) { return atomic_load(&module)->pixels(image); }
+
+const char *ptr_image_attr(const PtrImage *image, const char *name)
+{
+    return atomic_load(&module)->attr(image, name);
+}
