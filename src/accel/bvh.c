@@ -54,7 +54,8 @@ static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x
               offsetof(PtrBvhNode, child) == 192 && offsetof(PtrBvhNode, leaf_count) == 224 &&
               sizeof(PtrBvhNode) == 256, "PtrBvhNode layout");
 static_assert(offsetof(PtrSpheres, id) == 40, "PtrSpheres layout");
-static_assert(PTR_BVH_MAX_DEPTH == 64 && PTR_BVH_SLACK == 0x1.00004p0f, "asm/ptr.inc constants");
+/* asm/ptr.inc repeats PTR_BVH_SLACK as the float bits 0x3f800020. */
+static_assert(PTR_BVH_MAX_DEPTH == 64, "asm/ptr.inc's stack size");
 
 typedef struct StackEntry {
     uint32_t child, leaf_count;
