@@ -1,5 +1,6 @@
 #!/bin/sh
-# --accel brute and --accel bvh give the same pixels, bit for bit, through
+# --accel brute and --accel bvh (C, and the fastest kernels the CPU has) give
+# the same pixels, bit for bit, through
 # the command line: on the committed scenes and on sphere sets hard for a
 # tree (tests/hard_scenes.py). Also checks the metadata the choice leaves,
 # and that parts rendered with each merge.
@@ -24,6 +25,14 @@ for scene in $scenes; do
     done
     if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/$name-brute.exr" "$dir/$name-bvh.exr" >/dev/null; then
         echo "FAIL: $name: --accel brute and --accel bvh differ" >&2
+        failed=1
+    fi
+    # The fastest kernels the machine has (brute force and traversal in
+    # assembly where there are), against brute force in C.
+    "$ptr" "$scene" -o "$dir/$name-fastest.exr" --accel bvh --samples 3 --width 96 --threads 2 \
+        --quiet || { echo "FAIL: $name: ptr --accel bvh failed" >&2; failed=1; }
+    if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/$name-brute.exr" "$dir/$name-fastest.exr" >/dev/null; then
+        echo "FAIL: $name: --accel brute --c and --accel bvh with the fastest kernels differ" >&2
         failed=1
     fi
     for accel in brute bvh; do
