@@ -1,0 +1,31 @@
+#!/bin/sh
+# ptr against the Embree 3 peer (../shared/peers/embree_pt.c) on the same
+# neutral scene descriptions, runs alternated: build + render seconds of each
+# (ptr's from --json; Embree's bvh= + render=), and Embree's best over ptr's.
+# Usage: bench/embree.sh PTR SCENE.json SPP [RUNS [ptr options]]
+# ($EMBREE_PT_SOURCE: the peer's source, if not beside the repository)
+#   e.g. bench/embree.sh build/src/ptr ../shared/bench-scenes/final.json 100 2
+# The scene is written for ptr as an instanced .glb (scripts/make_scenes.py).
+set -eu
+ptr=$1 json=$2 spp=$3 runs=${4:-2}
+shift 3; [ $# -gt 0 ] && shift
+src=$(cd "$(dirname "$0")/.." && pwd)
+peer=${EMBREE_PT_SOURCE:-$src/../shared/peers/embree_pt.c}
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+gcc -O3 -march=native "$peer" -o "$dir/embree_pt" -lembree3 -lcjson -lpthread -lm
+python3 "$src/scripts/make_scenes.py" --instanced "$json" "$dir/scene.glb"
+for run in $(seq "$runs"); do
+    ptr_s=$("$ptr" "$dir/scene.glb" -o "$dir/out.exr" --samples "$spp" --quiet --json "$@" |
+        python3 -c 'import json,sys; r=json.load(sys.stdin); print("%.3f" % (r["build_seconds"] + r["render_seconds"]))')
+    times=
+    for mode in "-m 1" "-m 16 -g user"; do
+        # shellcheck disable=SC2086
+        line=$("$dir/embree_pt" "$json" -t 2 -spp "$spp" $mode)
+        s=$(echo "$line" | sed 's/.*bvh=\([0-9.]*\)s render=\([0-9.]*\)s.*/\1 \2/' | awk '{printf "%.3f", $1 + $2}')
+        echo "run $run: embree $mode: $s s"
+        times="$times $s"
+    done
+    best=$(printf '%s\n' $times | sort -g | head -n 1)
+    echo "run $run: ptr: $ptr_s s; Embree best / ptr = $(echo "$best $ptr_s" | awk '{printf "%.2f", $1 / $2}')x"
+done
