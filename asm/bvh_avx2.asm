@@ -47,12 +47,7 @@ FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32
 ; [rbp + BEST_UP] updated.
 ; Clobbers rdx, rcx, ymm8-15.
 test_leaf:
-    vbroadcastss ymm8, [rdi + RAY_ORG_X]
-    vsubps      ymm8, ymm8, [r8 + rax*4]        ; fx = ox - cx
-    vbroadcastss ymm9, [rdi + RAY_ORG_Y]
-    vsubps      ymm9, ymm9, [r9 + rax*4]        ; fy
-    vbroadcastss ymm10, [rdi + RAY_ORG_Z]
-    vsubps      ymm10, ymm10, [r10 + rax*4]     ; fz
+    OFFSETS_AVX2
     DISCRIMINANT y
     vxorps      ymm14, ymm14, ymm14
     vcmpps      ymm14, ymm12, ymm14, CMP_GE_OQ  ; disc >= 0
