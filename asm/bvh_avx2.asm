@@ -48,7 +48,7 @@ FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32
 ; Clobbers rdx, rcx, ymm8-15.
 test_leaf:
     OFFSETS_AVX2
-    DISCRIMINANT y
+    DISCRIMINANT y, vmovups
     vxorps      ymm14, ymm14, ymm14
     vcmpps      ymm14, ymm12, ymm14, CMP_GE_OQ  ; disc >= 0
     vmovd       xmm15, ecx

@@ -16,7 +16,7 @@ section .text
 ; lanes at or past the count are masked off.
 %macro STEP 1
     OFFSETS_AVX2
-    DISCRIMINANT y
+    DISCRIMINANT y, vmovups
     vxorps      ymm14, ymm14, ymm14
     vcmpps      ymm14, ymm12, ymm14, CMP_GE_OQ  ; disc >= 0 (NaN radius: no)
 %if %1

@@ -19,7 +19,7 @@ section .text
     vsubps      zmm8, zmm16, [r8 + rax*4]       ; fx = ox - cx
     vsubps      zmm9, zmm17, [r9 + rax*4]       ; fy
     vsubps      zmm10, zmm18, [r10 + rax*4]     ; fz
-    DISCRIMINANT z
+    DISCRIMINANT z, vmovups
     vcmpps      k1, zmm12, zmm20, CMP_GE_OQ     ; disc >= 0 (NaN radius: no)
 %if %1
     vpcmpgtd    k2, zmm19, zmm6                 ; index < count

@@ -13,6 +13,9 @@ static_assert(offsetof(PtrSpheres, cx) == 0 && offsetof(PtrSpheres, cy) == 8 &&
               offsetof(PtrSpheres, cz) == 16 && offsetof(PtrSpheres, radius) == 24,
               "PtrSpheres layout");
 static_assert(offsetof(PtrHit, t) == 0 && offsetof(PtrHit, sphere) == 4, "PtrHit layout");
+static_assert(offsetof(PtrRayPacket, tmin) == 96 && offsetof(PtrRayPacket, dir) == 128 &&
+              offsetof(PtrRayPacket, tmax) == 224 && offsetof(PtrHitPacket, sphere) == 32 &&
+              PTR_PACKET_LANES == 8, "PtrRayPacket and PtrHitPacket layout");
 
 #ifndef PTR_HAVE_ASM
 #define PTR_HAVE_ASM 0
@@ -23,6 +26,7 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_sse41);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx2);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx512);
 PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_avx2);
+PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_avx2);
 #endif
 
 /* The arithmetic is ptr_sphere_hit's (sphere_hit.h), which says what the
@@ -49,13 +53,29 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c)
     return best_index != PTR_NO_HIT;
 }
 
+/* Lane by lane, the one-ray reference: the definition the packet kernels
+ * must match. */
+PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c)
+{
+    for (int k = 0; k < PTR_PACKET_LANES; k++) {
+        PtrRay ray = { { rays->org[0][k], rays->org[1][k], rays->org[2][k] }, rays->tmin[k],
+                       { rays->dir[0][k], rays->dir[1][k], rays->dir[2][k] }, rays->tmax[k] };
+        PtrHit hit;
+        ptr_closest_hit_c(&ray, spheres, count, &hit);
+        hits->t[k] = hit.t;
+        hits->sphere[k] = hit.sphere;
+    }
+}
+
 /* The tree traversal has an AVX2 version, which the AVX-512 level keeps:
  * no AVX-512 machine was at hand to check one (docs/intersectors.md). */
 void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
 {
     table->closest_hit = ptr_closest_hit_c;
     table->bvh_closest_hit = ptr_bvh_closest_hit_c;
+    table->closest_hit_packet = ptr_closest_hit_packet_c;
     table->name = "c";
+    table->level = level;
 #if PTR_HAVE_ASM
     if (level < PTR_CPU_SSE41)
         return;
@@ -65,6 +85,7 @@ void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
         return;
     table->closest_hit = ptr_closest_hit_avx2;
     table->bvh_closest_hit = ptr_bvh_closest_hit_avx2;
+    table->closest_hit_packet = ptr_closest_hit_packet_avx2;
     table->name = "avx2";
     if (level < PTR_CPU_AVX512)
         return;
@@ -87,21 +108,31 @@ static PtrCpuLevel widest_useful_level(size_t sphere_count)
     return sphere_count <= 4 ? PTR_CPU_SSE41 : sphere_count <= 8 ? PTR_CPU_AVX2 : PTR_CPU_AVX512;
 }
 
+/* The one-ray brute-force kernel no wider than the scene; everything else
+ * (packets, the tree) at the CPU's level. */
+static void init_for_scene(PtrIsectTable *table, size_t sphere_count)
+{
+    PtrCpuLevel level = ptr_cpu_level(), useful = widest_useful_level(sphere_count);
+    ptr_isect_init_level(table, level);
+    if (level > useful) {
+        PtrIsectTable narrow;
+        ptr_isect_init_level(&narrow, useful);
+        table->closest_hit = narrow.closest_hit;
+        table->name = narrow.name;
+    }
+}
+
 int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, size_t sphere_count)
 {
-    PtrCpuLevel level = ptr_cpu_level();
-    PtrCpuLevel useful = widest_useful_level(sphere_count);
-    if (level > useful)
-        level = useful;
     switch (kernel) {
     case PTR_KERNEL_C:
         ptr_isect_init_level(table, PTR_CPU_NONE);
         return 1;
     case PTR_KERNEL_AUTO:
-        ptr_isect_init_level(table, level);
+        init_for_scene(table, sphere_count);
         return 1;
     case PTR_KERNEL_ASM:
-        ptr_isect_init_level(table, level);
+        init_for_scene(table, sphere_count);
         return table->closest_hit != ptr_closest_hit_c;
     }
     return 0;

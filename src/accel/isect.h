@@ -31,6 +31,30 @@
 
 typedef PTR_DECL_CLOSEST_HIT((*PtrClosestHitFn));
 
+/* Bundles of paths (core/bundle.c) trace their rays together: lane k of a
+ * packet is one ray, and lane k of the answer is exactly what the one-ray
+ * kernel answers for it. Tests the first count spheres, with the one-ray
+ * kernel's preconditions in every lane. */
+enum { PTR_PACKET_LANES = 8 };
+
+typedef struct PtrRayPacket {
+    _Alignas(32) float org[3][PTR_PACKET_LANES];
+    float tmin[PTR_PACKET_LANES];
+    float dir[3][PTR_PACKET_LANES];
+    float tmax[PTR_PACKET_LANES];
+} PtrRayPacket;
+
+typedef struct PtrHitPacket {
+    _Alignas(32) float t[PTR_PACKET_LANES];
+    uint32_t sphere[PTR_PACKET_LANES];
+} PtrHitPacket;
+
+#define PTR_DECL_CLOSEST_HIT_PACKET(name)                                     \
+    void name(const PtrRayPacket *rays, const PtrSpheres *spheres,            \
+              size_t count, PtrHitPacket *hits)
+
+typedef PTR_DECL_CLOSEST_HIT_PACKET((*PtrClosestHitPacketFn));
+
 typedef enum PtrKernel {
     PTR_KERNEL_AUTO, /* the fastest at the CPU level in force */
     PTR_KERNEL_C,    /* the portable reference */
@@ -40,7 +64,10 @@ typedef enum PtrKernel {
 typedef struct PtrIsectTable {
     PtrClosestHitFn closest_hit;
     PtrBvhClosestHitFn bvh_closest_hit;
-    const char *name; /* which implementation closest_hit is: "c", "avx2", ... */
+    PtrClosestHitPacketFn closest_hit_packet;
+    const char *name;  /* which implementation closest_hit is: "c", "avx2", ... */
+    PtrCpuLevel level; /* the CPU level the table is for (closest_hit may be
+                        * narrower: see ptr_isect_init) */
 } PtrIsectTable;
 
 /* Fills the table for the requested kernel at the CPU level in force
@@ -56,7 +83,8 @@ void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level);
 /* Whether this build contains the assembly kernels. */
 int ptr_isect_has_asm(void);
 
-/* The reference implementation. */
+/* The reference implementations. */
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c);
+PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c);
 
 #endif /* PTR_ISECT_H */

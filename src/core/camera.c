@@ -39,15 +39,3 @@ int ptr_view_init(PtrView *view, const PtrCamera *camera, int width, int height)
     };
     return 1;
 }
-
-void ptr_view_ray(const PtrView *view, int x, int y, float sx, float sy,
-                  float lx, float ly, PtrVec3 *origin, PtrVec3 *dir)
-{
-    PtrVec3 target = v3_add(view->pixel00,
-                            v3_add(v3_scale(view->pixel_du, (float)x + sx - 0.5f),
-                                   v3_scale(view->pixel_dv, (float)y + sy - 0.5f)));
-    PtrVec3 o = v3_add(view->origin,
-                       v3_add(v3_scale(view->lens_u, lx), v3_scale(view->lens_v, ly)));
-    *origin = o;
-    *dir = v3_normalize(v3_sub(target, o));
-}

@@ -22,7 +22,16 @@ int ptr_view_init(PtrView *view, const PtrCamera *camera, int width, int height)
 /* A primary ray through pixel (x, y) at the sub-pixel offset (sx, sy) in
  * [0, 1)^2 from the pixel's corner, leaving the lens at (lx, ly) in the unit
  * disc. The direction is normalised. */
-void ptr_view_ray(const PtrView *view, int x, int y, float sx, float sy,
-                  float lx, float ly, PtrVec3 *origin, PtrVec3 *dir);
+static inline void ptr_view_ray(const PtrView *view, int x, int y, float sx, float sy,
+                                float lx, float ly, PtrVec3 *origin, PtrVec3 *dir)
+{
+    PtrVec3 target = v3_add(view->pixel00,
+                            v3_add(v3_scale(view->pixel_du, (float)x + sx - 0.5f),
+                                   v3_scale(view->pixel_dv, (float)y + sy - 0.5f)));
+    PtrVec3 o = v3_add(view->origin,
+                       v3_add(v3_scale(view->lens_u, lx), v3_scale(view->lens_v, ly)));
+    *origin = o;
+    *dir = v3_normalize(v3_sub(target, o));
+}
 
 #endif /* PTR_CAMERA_H */

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "core/material.h"
+#include "core/trig.h"
 
 /* Proportional to the flux a sphere emits: radiance (summed over channels)
  * times its area. */
@@ -20,6 +21,12 @@ static int is_emitter(const PtrScene *scene, uint32_t i)
            scene->spheres.radius[i] > 0.0f;
 }
 
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
 PtrResult ptr_lights_init(PtrLights *l, const PtrScene *scene, PtrError *err)
 {
     *l = (PtrLights){ 0 };
@@ -33,17 +40,24 @@ PtrResult ptr_lights_init(PtrLights *l, const PtrScene *scene, PtrError *err)
     l->alias = malloc(n * sizeof *l->alias);
     double *scaled = malloc(n * sizeof *scaled);
     uint32_t *small = malloc(n * sizeof *small), *large = malloc(n * sizeof *large);
-    if (!l->sphere || !l->keep || !l->alias || !scaled || !small || !large) {
-        free(scaled), free(small), free(large);
+    uint64_t *by_id = malloc(n * sizeof *by_id);
+    if (!l->sphere || !l->keep || !l->alias || !scaled || !small || !large || !by_id) {
+        free(scaled), free(small), free(large), free(by_id);
         ptr_lights_free(l);
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a table of %zu emitters", n);
     }
+    /* The table is built in the scene file's order (sphere ids), not the
+     * arrays' (which the tree reorders): the same emitter then answers the
+     * same random numbers whatever the acceleration structure. */
     for (size_t i = 0; i < scene->spheres.count; i++)
-        if (is_emitter(scene, (uint32_t)i)) {
-            l->sphere[l->count] = (uint32_t)i;
-            l->total_power += sphere_power(scene, (uint32_t)i);
-            l->count++;
-        }
+        if (is_emitter(scene, (uint32_t)i))
+            by_id[l->count++] = (uint64_t)scene->spheres.id[i] << 32 | i;
+    qsort(by_id, l->count, sizeof *by_id, compare_u64);
+    for (uint32_t i = 0; i < l->count; i++) {
+        l->sphere[i] = (uint32_t)by_id[i];
+        l->total_power += sphere_power(scene, l->sphere[i]);
+    }
+    free(by_id);
     /* Vose's construction: columns below the mean are topped up from one
      * above it, which then counts as below or above in its turn. */
     size_t ns = 0, nl = 0;
@@ -129,7 +143,7 @@ int ptr_light_sample(PtrLightView view, PtrVec3 p, PtrVec3 c, float r, const flo
                      PtrVec3 *dir, float *distance, float *pdf)
 {
     if (view == PTR_LIGHT_FROM_INSIDE) {
-        PtrVec3 n = ptr_uniform_sphere(u);
+        PtrVec3 n = ptr_uniform_sphere(u[0], u[1]);
         PtrVec3 to = v3_sub(v3_madd(c, n, r), p);
         float d2 = v3_dot(to, to), d = sqrtf(d2);
         if (!(d > 0.0f))
@@ -150,12 +164,13 @@ int ptr_light_sample(PtrLightView view, PtrVec3 p, PtrVec3 c, float r, const flo
     float one_minus_cos = u[0] * width;
     float cos_theta = 1.0f - one_minus_cos;
     float sin_theta = sqrtf(ptr_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
-    float phi = 2.0f * PTR_PI * u[1];
+    float sin_phi, cos_phi;
+    ptr_sincos_turns(u[1], &sin_phi, &cos_phi);
     PtrVec3 w = v3_scale(to, 1.0f / d), t, b;
     basis(w, &t, &b);
     *dir = v3_normalize(v3_add(v3_scale(w, cos_theta),
-                               v3_add(v3_scale(t, sin_theta * cosf(phi)),
-                                      v3_scale(b, sin_theta * sinf(phi)))));
+                               v3_add(v3_scale(t, sin_theta * cos_phi),
+                                      v3_scale(b, sin_theta * sin_phi))));
     /* The near intersection; at the cone's rim the root vanishes. */
     *distance = d * cos_theta - sqrtf(ptr_maxf(0.0f, r * r - d2 * sin_theta * sin_theta));
     *pdf = 1.0f / (2.0f * PTR_PI * width);

@@ -1,10 +1,17 @@
 /* Scattering at a surface, as the seed's renderer models it: Lambertian
  * diffuse, metal with fuzz, and dielectric with Fresnel (Schlick)
- * reflect-or-refract and total internal reflection. */
+ * reflect-or-refract and total internal reflection.
+ *
+ * The pieces are inline and branch-free where they can be: the path tracer
+ * calls them one path at a time, and its bundles (core/bundle.c) call them
+ * lane by lane in loops the compiler vectorises; both compute the same bits. */
 #ifndef PTR_MATERIAL_H
 #define PTR_MATERIAL_H
 
+#include <math.h>
+
 #include "core/scene.h"
+#include "core/trig.h"
 
 /* Samples an outgoing direction for a ray arriving along unit in_dir at a
  * surface whose outward unit normal is outward_normal, from three uniform
@@ -16,25 +23,79 @@
 int ptr_scatter(const PtrMaterial *material, PtrVec3 in_dir, PtrVec3 outward_normal,
                 const float u[3], PtrVec3 *out_dir, PtrVec3 *attenuation);
 
-/* For diffuse materials, with n the unit normal on the side the light
- * arrives from: the density (per solid angle) with which ptr_scatter picks
- * out_dir, cos / pi, and the BSDF times the cosine, albedo cos / pi. Their
- * ratio is the attenuation ptr_scatter reports, so light sampling and
- * scattering weigh a direction alike (multiple importance sampling). */
-float ptr_diffuse_pdf(PtrVec3 n, PtrVec3 out_dir);
-PtrVec3 ptr_diffuse_eval(const PtrMaterial *material, PtrVec3 n, PtrVec3 out_dir);
-
 /* A uniformly distributed unit vector from two uniform numbers. */
-PtrVec3 ptr_uniform_sphere(const float u[2]);
+static inline PtrVec3 ptr_uniform_sphere(float u0, float u1)
+{
+    /* Archimedes: z is uniform on [-1, 1] for a uniform point on the sphere. */
+    float z = 1.0f - 2.0f * u0;
+    float r = sqrtf(ptr_maxf(0.0f, 1.0f - z * z));
+    float sin_phi, cos_phi;
+    ptr_sincos_turns(u1, &sin_phi, &cos_phi);
+    return v3(r * cos_phi, r * sin_phi, z);
+}
 
 /* Schlick's approximation of Fresnel reflectance for the cosine of the angle
  * of incidence and the ratio of refractive indices (incident / transmitted). */
-float ptr_schlick(float cosine, float eta_ratio);
+static inline float ptr_schlick(float cosine, float eta_ratio)
+{
+    float r0 = (1.0f - eta_ratio) / (1.0f + eta_ratio);
+    r0 = r0 * r0;
+    float m = 1.0f - cosine;
+    return r0 + (1.0f - r0) * (m * m) * (m * m) * m;
+}
 
 /* Mirror reflection of d about the unit normal n. */
 static inline PtrVec3 ptr_reflect(PtrVec3 d, PtrVec3 n)
 {
     return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n)));
+}
+
+/* Diffuse: the normal n (on the side the ray arrives from) plus a uniform
+ * unit vector is cosine-distributed about it, the density ptr_diffuse_pdf
+ * gives. */
+static inline PtrVec3 ptr_scatter_diffuse(PtrVec3 n, float u0, float u1)
+{
+    PtrVec3 dir = v3_add(n, ptr_uniform_sphere(u0, u1));
+    /* The sample can cancel the normal; fall back to it then. */
+    return v3_max_abs(dir) < 1e-6f ? n : v3_normalize(dir);
+}
+
+/* Dielectric of index ior, n on the side the ray arrives from: reflect or
+ * refract as the Fresnel coin u decides. */
+static inline PtrVec3 ptr_scatter_dielectric(float ior, PtrVec3 d, PtrVec3 n, int entering,
+                                             float u)
+{
+    float eta_ratio = entering ? 1.0f / ior : ior;
+    float cos_theta = ptr_minf(-v3_dot(d, n), 1.0f);
+    float sin_theta = sqrtf(ptr_maxf(0.0f, 1.0f - cos_theta * cos_theta));
+    int reflects = eta_ratio * sin_theta > 1.0f || ptr_schlick(cos_theta, eta_ratio) > u;
+    PtrVec3 perp = v3_scale(v3_madd(d, n, cos_theta), eta_ratio);
+    float parallel = -sqrtf(fabsf(1.0f - v3_dot(perp, perp)));
+    PtrVec3 refracted = v3_normalize(v3_madd(perp, n, parallel));
+    return reflects ? ptr_reflect(d, n) : refracted;
+}
+
+/* Metal's fuzz: a uniform point in the ball of radius fuzz (uniform
+ * direction, radius the cube root of a uniform number), added to the mirror
+ * direction. */
+static inline PtrVec3 ptr_fuzz_offset(float fuzz, const float u[3])
+{
+    return v3_scale(v3_scale(ptr_uniform_sphere(u[0], u[1]), cbrtf(u[2])), fuzz);
+}
+
+/* For diffuse materials, with n the unit normal on the side the light
+ * arrives from: the density (per solid angle) with which ptr_scatter picks
+ * out_dir, cos / pi, and the BSDF times the cosine, albedo cos / pi. Their
+ * ratio is the attenuation ptr_scatter reports, so light sampling and
+ * scattering weigh a direction alike (multiple importance sampling). */
+static inline float ptr_diffuse_pdf(PtrVec3 n, PtrVec3 out_dir)
+{
+    return ptr_maxf(0.0f, v3_dot(n, out_dir)) * (1.0f / PTR_PI);
+}
+
+static inline PtrVec3 ptr_diffuse_eval(const PtrMaterial *material, PtrVec3 n, PtrVec3 out_dir)
+{
+    return v3_scale(material->albedo, ptr_diffuse_pdf(n, out_dir));
 }
 
 #endif /* PTR_MATERIAL_H */

@@ -142,6 +142,68 @@ static void make_case(Case *c, PtrRng *rng)
     c->count = ptr_rng_float(rng) < 0.8f ? n : (size_t)(ptr_rng_float(rng) * (float)(n + 1)) % (n + 1);
 }
 
+/* Eight rays against the case's spheres: its own ray in some lanes, in the
+ * others rays from near it aimed at one of its spheres (or anywhere), with
+ * the case's distribution of tmin and tmax. */
+static void fill_packet(const Case *c, PtrRng *rng, PtrRayPacket *p)
+{
+    const PtrSpheres *s = &c->scene.spheres;
+    for (int k = 0; k < PTR_PACKET_LANES; k++) {
+        Case lane = { .ray = c->ray };
+        if (k && ptr_rng_float(rng) < 0.7f) {
+            PtrVec3 o = v3(c->ray.org[0], c->ray.org[1], c->ray.org[2]), d = random_unit(rng);
+            if (s->count) {
+                size_t i = (size_t)(ptr_rng_float(rng) * (float)s->count) % s->count;
+                o = v3_add(o, v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng)));
+                PtrVec3 to = v3_sub(v3_add(ptr_sphere_centre(s, i),
+                                           v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng))),
+                                    o);
+                if (v3_max_abs(to) > 0 && ptr_rng_float(rng) < 0.8f)
+                    d = to;
+            }
+            set_ray(&lane, o, d, rng);
+        }
+        const PtrRay *r = &lane.ray;
+        for (int a = 0; a < 3; a++) {
+            p->org[a][k] = r->org[a];
+            p->dir[a][k] = r->dir[a];
+        }
+        p->tmin[k] = r->tmin;
+        p->tmax[k] = r->tmax;
+    }
+}
+
+/* Every level's packet kernel against the C packet kernel, which is the
+ * one-ray reference lane by lane; returns the lanes that differ. */
+static uint64_t check_packets(const PtrIsectTable *tables, PtrCpuLevel top, const Case *c,
+                              PtrRng *rng, uint64_t *mismatches, CheckedCallStatus *status)
+{
+    PtrRayPacket rays;
+    PtrHitPacket ref;
+    fill_packet(c, rng, &rays);
+    memset(&ref, 0xaa, sizeof ref);
+    ptr_closest_hit_packet_c(&rays, &c->scene.spheres, c->count, &ref);
+    uint64_t hits = 0;
+    for (int k = 0; k < PTR_PACKET_LANES; k++)
+        hits += ref.sphere[k] != PTR_NO_HIT;
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+        if (tables[l].closest_hit_packet == ptr_closest_hit_packet_c)
+            continue;
+        PtrHitPacket got;
+        memset(&got, 0x55, sizeof got);
+        ptr_checked_call_packet(tables[l].closest_hit_packet, &rays, &c->scene.spheres, c->count,
+                                &got, &status[l]);
+        for (int k = 0; k < PTR_PACKET_LANES; k++)
+            if (got.t[k] != ref.t[k] || got.sphere[k] != ref.sphere[k] ||
+                memcmp(&got.t[k], &ref.t[k], sizeof got.t[k])) {
+                if (mismatches[l]++ < 5)
+                    fprintf(stderr, "%s packet lane %d differs from c: t %a sphere %u, c: t %a sphere %u\n",
+                            tables[l].name, k, got.t[k], got.sphere[k], ref.t[k], ref.sphere[k]);
+            }
+    }
+    return hits;
+}
+
 static void print_hit(const char *who, int ret, const PtrHit *h)
 {
     fprintf(stderr, "    %-7s returned %d, t = %.9g (%a), sphere = %" PRIu32 "\n", who, ret, h->t,
@@ -152,12 +214,14 @@ static int check(uint64_t rays, uint64_t seed)
 {
     PtrIsectTable tables[PTR_CPU_LEVEL_COUNT];
     uint64_t mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, hits = 0;
+    uint64_t packet_mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, packet_hits = 0;
     CheckedCallStatus status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
+    CheckedCallStatus packet_status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
     PtrCpuLevel top = ptr_cpu_level();
     int levels = 0;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
         ptr_isect_init_level(&tables[l], (PtrCpuLevel)l);
-        status[l].check_xinuse = xinuse_supported();
+        status[l].check_xinuse = packet_status[l].check_xinuse = xinuse_supported();
         levels += tables[l].closest_hit != ptr_closest_hit_c;
     }
     if (!levels) {
@@ -191,6 +255,8 @@ static int check(uint64_t rays, uint64_t seed)
                 print_hit(tables[l].name, ret, &got);
             }
         }
+        if (i % PTR_PACKET_LANES == 0)
+            packet_hits += check_packets(tables, top, &c, &rng, packet_mismatches, packet_status);
         ptr_scene_free(&c.scene);
     }
 
@@ -204,6 +270,16 @@ static int check(uint64_t rays, uint64_t seed)
                status[l].failures & 1 ? "; a callee-saved register was clobbered" : "",
                status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
                status[l].check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
+        ok ? passed++ : failed++;
+    }
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
+        if (tables[l].closest_hit_packet == ptr_closest_hit_packet_c)
+            continue;
+        int ok = !packet_mismatches[l] && !packet_status[l].failures;
+        printf("packet %-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s\n",
+               tables[l].name, rays, packet_hits, packet_mismatches[l],
+               packet_status[l].failures & 1 ? "; a callee-saved register was clobbered" : "",
+               packet_status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "");
         ok ? passed++ : failed++;
     }
     failed += check_bvh(seed, &passed);

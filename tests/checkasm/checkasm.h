@@ -15,12 +15,16 @@ typedef struct CheckedCallStatus {
 } CheckedCallStatus;
 
 /* Calls fn with every callee-saved register holding a sentinel and reports
- * in status what did not survive. One routine, two signatures of 4 pointer
+ * in status what did not survive. One routine, three signatures of 4
  * arguments. */
 int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray, const PtrSpheres *spheres,
                      size_t count, PtrHit *hit, CheckedCallStatus *status);
 int ptr_checked_call_bvh(PtrBvhClosestHitFn fn, const PtrRay *ray, const PtrBvh *bvh,
                          const PtrSpheres *spheres, PtrHit *hit, CheckedCallStatus *status);
+
+void ptr_checked_call_packet(PtrClosestHitPacketFn fn, const PtrRayPacket *rays,
+                             const PtrSpheres *spheres, size_t count, PtrHitPacket *hits,
+                             CheckedCallStatus *status);
 
 /* Whether XGETBV(1) can tell a dirty upper YMM state. */
 uint32_t xinuse_supported(void);

@@ -35,10 +35,15 @@ section .text
 ; int ptr_checked_call_bvh(PtrBvhClosestHitFn fn, const PtrRay *ray,
 ;                          const PtrBvh *bvh, const PtrSpheres *spheres,
 ;                          PtrHit *hit, CheckedCallStatus *status);
+; void ptr_checked_call_packet(PtrClosestHitPacketFn fn,
+;                              const PtrRayPacket *rays, const PtrSpheres *spheres,
+;                              size_t count, PtrHitPacket *hits, CheckedCallStatus *status);
 ; the same routine: it only forwards four arguments.
     global ptr_checked_call_bvh:function hidden
+    global ptr_checked_call_packet:function hidden
 FUNCTION ptr_checked_call
 ptr_checked_call_bvh:
+ptr_checked_call_packet:
     push        rbp
     push        rbx
     push        r12

@@ -1,0 +1,426 @@
+/* Bundles of paths: eight paths at a time, one per lane, with their state in
+ * structure-of-arrays form. Each bounce is a few loops over the lanes, which
+ * the compiler turns into vector code: camera rays, the packet intersector
+ * (accel/isect.h) or the tree lane by lane, hit points and normals, the sky
+ * and emission, and scattering (all three materials computed, the lane's own
+ * selected). Lanes whose paths end take the next camera sample at once, so the
+ * vector stays full. What few paths need (light sampling, fuzzy metal, huge
+ * spheres) runs lane by lane through the path tracer's own functions
+ * (path.h) after the vector loops.
+ *
+ * Every lane computes exactly the operations render.c's trace_path computes
+ * for its path, in the same order, through the same inline functions; no
+ * FMA contraction and IEEE operations throughout make the vector code's
+ * results the scalar code's, bit for bit, at every instruction set this file
+ * is compiled for (PTR_BUNDLE_ENTRY names the copy). Results go to a buffer
+ * and are added to the pixels in sample order, as the path tracer adds them. */
+#include <math.h>
+#include <stdint.h>
+
+#include "accel/huge.h"
+#include "core/material.h"
+#include "core/path.h"
+
+enum { LANES = PTR_PACKET_LANES, FREE = -1 };
+
+/* The paths in flight. */
+typedef struct Lanes {
+    PtrRayPacket ray;
+    PtrHitPacket hit;
+    float throughput[3][LANES], radiance[3][LANES];
+    uint64_t key[LANES];   /* the sampler's pixel key */
+    uint32_t index[LANES]; /* the sample index */
+    int depth[LANES];
+    int slot[LANES];       /* the result the path fills, or FREE */
+    PtrLitVertex lit[LANES];
+} Lanes;
+
+/* One bounce's findings for every lane. */
+typedef struct Vertex {
+    int hit[LANES];
+    uint32_t sphere[LANES]; /* 0 for a miss */
+    uint32_t kind[LANES];
+    float albedo[3][LANES], emission[3][LANES], ior[LANES];
+    float point[3][LANES], normal[3][LANES];
+    float out[3][LANES]; /* the scattered direction */
+    int scattered[LANES];
+} Vertex;
+
+/* A round: samples [first, first + span) of every pixel still sampling. */
+typedef struct Round {
+    int x[PTR_TILE_PIXELS], y[PTR_TILE_PIXELS];
+    uint64_t key[PTR_TILE_PIXELS];
+    double *sums[PTR_TILE_PIXELS];
+    int pixels;
+    uint32_t first, span, items; /* item k: pixel k / span, sample first + k % span */
+} Round;
+
+/* Camera rays for items [first, first + LANES), made together. */
+typedef struct CameraBatch {
+    uint32_t first;
+    float org[3][LANES], dir[3][LANES];
+    uint64_t key[LANES];
+    uint32_t index[LANES];
+} CameraBatch;
+
+static inline PtrVec3 lane_v3(const float a[3][LANES], int l)
+{
+    return v3(a[0][l], a[1][l], a[2][l]);
+}
+
+static inline void set_lane_v3(float a[3][LANES], int l, PtrVec3 v)
+{
+    a[0][l] = v.x, a[1][l] = v.y, a[2][l] = v.z;
+}
+
+static PtrRay lane_ray(const Lanes *lanes, int l)
+{
+    const PtrRayPacket *r = &lanes->ray;
+    return (PtrRay){ { r->org[0][l], r->org[1][l], r->org[2][l] }, r->tmin[l],
+                     { r->dir[0][l], r->dir[1][l], r->dir[2][l] }, r->tmax[l] };
+}
+
+static void set_lane_ray(Lanes *lanes, int l, PtrRay ray)
+{
+    PtrRayPacket *r = &lanes->ray;
+    for (int a = 0; a < 3; a++) {
+        r->org[a][l] = ray.org[a];
+        r->dir[a][l] = ray.dir[a];
+    }
+    r->tmin[l] = ray.tmin;
+    r->tmax[l] = ray.tmax;
+}
+
+static void make_camera_batch(const PtrPathJob *job, const Round *round, uint32_t first,
+                              CameraBatch *batch)
+{
+    batch->first = first;
+    for (int l = 0; l < LANES; l++) {
+        uint32_t item = first + (uint32_t)l < round->items ? first + (uint32_t)l : first;
+        uint32_t p = item / round->span, index = round->first + item % round->span;
+        PtrVec3 o, d;
+        ptr_path_camera_ray(job, round->key[p], index, round->x[p], round->y[p], &o, &d);
+        set_lane_v3(batch->org, l, o);
+        set_lane_v3(batch->dir, l, d);
+        batch->key[l] = round->key[p];
+        batch->index[l] = index;
+    }
+}
+
+/* Gives free lanes the round's next items; returns the lanes in flight. */
+static int refill(const PtrPathJob *job, const Round *round, Lanes *lanes, CameraBatch *batch,
+                  uint32_t *next)
+{
+    int active = 0;
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE && *next < round->items) {
+            if (*next - batch->first >= LANES)
+                make_camera_batch(job, round, *next, batch);
+            int b = (int)(*next - batch->first);
+            set_lane_ray(lanes, l,
+                         (PtrRay){ { batch->org[0][b], batch->org[1][b], batch->org[2][b] }, 0.0f,
+                                   { batch->dir[0][b], batch->dir[1][b], batch->dir[2][b] },
+                                   INFINITY });
+            lanes->key[l] = batch->key[b];
+            lanes->index[l] = batch->index[b];
+            lanes->depth[l] = 0;
+            lanes->slot[l] = (int)(*next)++;
+            lanes->lit[l].sampled = 0;
+            set_lane_v3(lanes->throughput, l, v3_splat(1.0f));
+            set_lane_v3(lanes->radiance, l, v3_splat(0.0f));
+        }
+        active += lanes->slot[l] != FREE;
+    }
+    return active;
+}
+
+/* Closest hits of the lanes in flight: the packet kernel for brute force,
+ * else ptr_trace lane by lane (the tree, huge spheres). */
+static void trace(const PtrPathJob *job, Lanes *lanes)
+{
+    const PtrAccel *accel = job->accel;
+    if (accel->kind == PTR_ACCEL_BRUTE && !job->scene->huge.count) {
+        accel->isect.closest_hit_packet(&lanes->ray, accel->spheres, accel->searched, &lanes->hit);
+        return;
+    }
+    for (int l = 0; l < LANES; l++)
+        if (lanes->slot[l] != FREE) {
+            PtrRay ray = lane_ray(lanes, l);
+            PtrHit hit;
+            ptr_trace(accel, &ray, &hit);
+            lanes->hit.t[l] = hit.t;
+            lanes->hit.sphere[l] = hit.sphere;
+        }
+}
+
+/* The material (tinted by the sphere's colour) and the surface each lane
+ * hit; the sky and emission it found. */
+static void find_surfaces(const PtrPathJob *job, Lanes *lanes, Vertex *v)
+{
+    const PtrScene *scene = job->scene;
+    const PtrSpheres *spheres = &scene->spheres;
+    if (!spheres->count) {
+        for (int l = 0; l < LANES; l++)
+            v->hit[l] = 0;
+    } else {
+        for (int l = 0; l < LANES; l++) {
+            v->hit[l] = lanes->hit.sphere[l] != PTR_NO_HIT;
+            uint32_t s = v->hit[l] ? lanes->hit.sphere[l] : 0;
+            const PtrMaterial *m = &scene->materials[spheres->material[s]];
+            v->sphere[l] = s;
+            v->kind[l] = m->kind;
+            v->ior[l] = m->ior;
+            set_lane_v3(v->albedo, l, m->albedo);
+            set_lane_v3(v->emission, l, m->emission);
+            PtrVec3 c = ptr_sphere_centre(spheres, s);
+            PtrVec3 p = v3_madd(lane_v3(lanes->ray.org, l), lane_v3(lanes->ray.dir, l),
+                                lanes->hit.t[l]);
+            PtrVec3 normal = v3_normalize(v3_sub(p, c));
+            set_lane_v3(v->normal, l, normal);
+            set_lane_v3(v->point, l, v3_madd(c, normal, spheres->radius[s]));
+        }
+        if (spheres->color)
+            for (int l = 0; l < LANES; l++)
+                set_lane_v3(v->albedo, l, v3_mul(lane_v3(v->albedo, l),
+                                                 ptr_sphere_color(spheres, v->sphere[l])));
+    }
+    if (scene->huge.count)
+        for (int l = 0; l < LANES; l++)
+            if (lanes->slot[l] != FREE && v->hit[l] && ptr_is_huge(scene, v->sphere[l])) {
+                PtrRay ray = lane_ray(lanes, l);
+                PtrHit hit = { lanes->hit.t[l], lanes->hit.sphere[l] };
+                PtrVec3 point, normal;
+                ptr_path_surface(job, &ray, &hit, &point, &normal);
+                set_lane_v3(v->point, l, point);
+                set_lane_v3(v->normal, l, normal);
+            }
+}
+
+/* Emission found after light sampling is weighed against that sample. */
+static void emission_weights(const PtrPathJob *job, const Lanes *lanes, const Vertex *v,
+                             float weight[LANES])
+{
+    for (int l = 0; l < LANES; l++) {
+        weight[l] = 1.0f;
+        if (job->sample_lights && lanes->slot[l] != FREE && v->hit[l] && lanes->lit[l].sampled &&
+            v3_max_comp(lane_v3(v->emission, l)) > 0.0f) {
+            PtrVec3 point = lane_v3(v->point, l);
+            weight[l] = ptr_path_emission_weight(job, &lanes->lit[l], v->sphere[l],
+                                                 lane_v3(lanes->ray.dir, l),
+                                                 v3_length(v3_sub(point, lanes->lit[l].point)),
+                                                 lane_v3(v->normal, l));
+        }
+    }
+}
+
+static void add_sky_and_emission(const PtrPathJob *job, Lanes *lanes, const Vertex *v,
+                                 const float weight[LANES])
+{
+    const PtrSky *sky = &job->scene->sky;
+    for (int l = 0; l < LANES; l++) {
+        PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
+        PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
+                                  : v3_mul(throughput, ptr_sky_radiance(sky, lane_v3(lanes->ray.dir, l)));
+        int adds = !v->hit[l] || v3_max_comp(emission) > 0.0f;
+        PtrVec3 radiance = lane_v3(lanes->radiance, l);
+        set_lane_v3(lanes->radiance, l, adds ? v3_add(radiance, found) : radiance);
+    }
+}
+
+static inline PtrVec3 facing_normal(PtrVec3 dir, PtrVec3 normal)
+{
+    return v3_dot(dir, normal) < 0.0f ? normal : v3_neg(normal);
+}
+
+/* Light sampling at the diffuse vertices, lane by lane. */
+static void sample_emitters(const PtrPathJob *job, Lanes *lanes, const Vertex *v, uint64_t *rays)
+{
+    const PtrScene *scene = job->scene;
+    int max_depth = job->settings->max_depth;
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE || !v->hit[l])
+            continue;
+        PtrVec3 dir = lane_v3(lanes->ray.dir, l), normal = lane_v3(v->normal, l);
+        int entering = v3_dot(dir, normal) < 0.0f;
+        PtrLitVertex *lit = &lanes->lit[l];
+        *lit = (PtrLitVertex){ .sampled = v->kind[l] == PTR_MATERIAL_DIFFUSE &&
+                                          lanes->depth[l] + 1 < max_depth,
+                               .point = lane_v3(v->point, l), .sphere = v->sphere[l],
+                               .side = entering ? 1 : -1 };
+        if (!lit->sampled)
+            continue;
+        PtrMaterial m = scene->materials[scene->spheres.material[v->sphere[l]]];
+        m.albedo = lane_v3(v->albedo, l);
+        PtrSampler sampler = { job->settings->sampler, lanes->key[l], lanes->index[l] };
+        PtrVec3 light = ptr_path_sample_emitter(job, &sampler, lanes->depth[l], &m, lit,
+                                                facing_normal(dir, normal), normal, rays);
+        set_lane_v3(lanes->radiance, l,
+                    v3_add(lane_v3(lanes->radiance, l), v3_mul(lane_v3(lanes->throughput, l), light)));
+    }
+}
+
+static inline void bsdf_numbers(const PtrPathJob *job, const Lanes *lanes, int l, float u[3])
+{
+    uint32_t bits[2], extra[2];
+    PtrSamplerKind kind = job->settings->sampler;
+    ptr_sampler_pair_bits(kind, lanes->key[l], lanes->index[l],
+                          ptr_bounce_dim(lanes->depth[l], PTR_SLOT_BSDF), bits);
+    ptr_sampler_pair_bits(kind, lanes->key[l], lanes->index[l],
+                          ptr_bounce_dim(lanes->depth[l], PTR_SLOT_BSDF_EXTRA), extra);
+    u[0] = ptr_sample_float(bits[0]);
+    u[1] = ptr_sample_float(bits[1]);
+    u[2] = ptr_sample_float(extra[0]);
+}
+
+/* ptr_scatter's directions, every material's computed and the lane's kept;
+ * fuzzy metal lane by lane after. */
+static void scatter(const PtrPathJob *job, Lanes *lanes, Vertex *v)
+{
+    const PtrScene *scene = job->scene;
+    for (int l = 0; l < LANES; l++) {
+        float u[3];
+        bsdf_numbers(job, lanes, l, u);
+        PtrVec3 d = lane_v3(lanes->ray.dir, l), normal = lane_v3(v->normal, l);
+        int entering = v3_dot(d, normal) < 0.0f;
+        PtrVec3 n = entering ? normal : v3_neg(normal);
+        PtrVec3 diffuse = ptr_scatter_diffuse(n, u[0], u[1]);
+        PtrVec3 mirror = ptr_reflect(d, n);
+        PtrVec3 glass = ptr_scatter_dielectric(v->ior[l], d, n, entering, u[2]);
+        uint32_t kind = v->kind[l];
+        PtrVec3 out = kind == PTR_MATERIAL_DIFFUSE ? diffuse
+                      : kind == PTR_MATERIAL_METAL ? v3_normalize(mirror)
+                                                   : glass;
+        set_lane_v3(v->out, l, out);
+        v->scattered[l] = kind != PTR_MATERIAL_METAL || v3_dot(mirror, n) > 0.0f;
+    }
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE || !v->hit[l] || v->kind[l] != PTR_MATERIAL_METAL)
+            continue;
+        float fuzz = scene->materials[scene->spheres.material[v->sphere[l]]].fuzz;
+        if (!(fuzz > 0.0f))
+            continue;
+        float u[3];
+        bsdf_numbers(job, lanes, l, u);
+        PtrVec3 n = facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l));
+        PtrVec3 dir = v3_add(ptr_reflect(lane_v3(lanes->ray.dir, l), n), ptr_fuzz_offset(fuzz, u));
+        v->scattered[l] = v3_dot(dir, n) > 0.0f;
+        set_lane_v3(v->out, l, v3_normalize(dir));
+    }
+    if (job->sample_lights)
+        for (int l = 0; l < LANES; l++)
+            if (lanes->slot[l] != FREE && v->hit[l] && lanes->lit[l].sampled)
+                lanes->lit[l].scatter_pdf = ptr_diffuse_pdf(
+                    facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l)),
+                    lane_v3(v->out, l));
+}
+
+/* The next ray of every path that goes on; the result of every path that
+ * ends, which frees its lane. */
+static void continue_or_end(const PtrPathJob *job, Lanes *lanes, const Vertex *v,
+                            PtrVec3 *results)
+{
+    const PtrScene *scene = job->scene;
+    const PtrSpheres *spheres = &scene->spheres;
+    int max_depth = job->settings->max_depth;
+    int go_on[LANES];
+    if (spheres->count)
+        for (int l = 0; l < LANES; l++) {
+            PtrVec3 throughput = v3_mul(lane_v3(lanes->throughput, l), lane_v3(v->albedo, l));
+            go_on[l] = v->hit[l] && v->scattered[l] && !(v3_max_comp(throughput) <= 0.0f) &&
+                       lanes->depth[l] + 1 < max_depth;
+            set_lane_v3(lanes->throughput, l, throughput);
+            uint32_t s = v->sphere[l];
+            PtrRay next = ptr_spawn_ray(ptr_sphere_centre(spheres, s), spheres->radius[s],
+                                        lane_v3(v->normal, l), lane_v3(v->out, l));
+            for (int a = 0; a < 3; a++) {
+                lanes->ray.org[a][l] = next.org[a];
+                lanes->ray.dir[a][l] = next.dir[a];
+            }
+            lanes->ray.tmin[l] = next.tmin;
+            lanes->ray.tmax[l] = next.tmax;
+        }
+    else
+        for (int l = 0; l < LANES; l++)
+            go_on[l] = 0;
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE)
+            continue;
+        if (!go_on[l]) {
+            results[lanes->slot[l]] = lane_v3(lanes->radiance, l);
+            lanes->slot[l] = FREE;
+            continue;
+        }
+        if (scene->huge.count && ptr_is_huge(scene, v->sphere[l]))
+            set_lane_ray(lanes, l, ptr_path_leave(job, v->sphere[l], lane_v3(v->point, l),
+                                                  lane_v3(v->normal, l), lane_v3(v->out, l)));
+        lanes->depth[l]++;
+    }
+}
+
+static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *results,
+                         uint64_t *rays)
+{
+    Lanes lanes;
+    Vertex vertex;
+    float weight[LANES];
+    CameraBatch batch = { .first = 0 };
+    uint32_t next = 0;
+    for (int l = 0; l < LANES; l++) {
+        lanes.slot[l] = FREE;
+        set_lane_ray(&lanes, l, (PtrRay){ { 0, 0, 0 }, 0.0f, { 0, 0, 1 }, INFINITY });
+    }
+    if (round->items)
+        make_camera_batch(job, round, 0, &batch);
+    for (;;) {
+        int active = refill(job, round, &lanes, &batch, &next);
+        if (!active)
+            break;
+        *rays += (uint64_t)active;
+        trace(job, &lanes);
+        find_surfaces(job, &lanes, &vertex);
+        emission_weights(job, &lanes, &vertex, weight);
+        add_sky_and_emission(job, &lanes, &vertex, weight);
+        if (job->sample_lights)
+            sample_emitters(job, &lanes, &vertex, rays);
+        scatter(job, &lanes, &vertex);
+        continue_or_end(job, &lanes, &vertex, results);
+    }
+}
+
+PTR_DECL_RENDER_TILE(PTR_BUNDLE_ENTRY)
+{
+    const PtrRenderSettings *s = job->settings;
+    Round round;
+    PtrVec3 results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    uint64_t end = (uint64_t)job->first + job->count;
+    /* Rounds end where adaptive sampling may stop a pixel, so a round's
+     * samples are all ones the path tracer would take too. */
+    for (uint64_t a = job->first; a < end;) {
+        uint64_t b = (a / PTR_ADAPTIVE_STEP + 1) * PTR_ADAPTIVE_STEP;
+        b = b < end ? b : end;
+        round.pixels = 0;
+        round.first = (uint32_t)a;
+        round.span = (uint32_t)(b - a);
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                double *acc = ptr_path_pixel_sums(job, x, y);
+                if (acc[PTR_ACCUM_STOPPED])
+                    continue;
+                round.x[round.pixels] = x;
+                round.y[round.pixels] = y;
+                round.key[round.pixels] = ptr_path_pixel_key(job, x, y);
+                round.sums[round.pixels++] = acc;
+            }
+        round.items = (uint32_t)round.pixels * round.span;
+        if (s->max_depth > 0)
+            render_round(job, &round, results, rays);
+        else
+            for (uint32_t i = 0; i < round.items; i++)
+                results[i] = v3_splat(0.0f);
+        for (int p = 0; p < round.pixels; p++)
+            for (uint32_t i = 0; i < round.span; i++)
+                ptr_path_accumulate(s, round.sums[p], round.first + i,
+                                    results[(uint32_t)p * round.span + i]);
+        a = b;
+    }
+}

@@ -1,0 +1,118 @@
+/* What every way of tracing a path shares: the job a render's paths belong
+ * to, and the steps of a path that the path tracer takes one path at a time
+ * (render.c) and its bundles take eight at a time (bundle.c). Both call these
+ * same functions, so a path is the same path either way, bit for bit. */
+#ifndef PTR_PATH_H
+#define PTR_PATH_H
+
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "core/camera.h"
+#include "core/lights.h"
+#include "core/render.h"
+#include "core/trig.h"
+#include "sampling/sampler.h"
+
+typedef struct PtrPathJob {
+    const PtrScene *scene;
+    const PtrAccel *accel;
+    const PtrRenderSettings *settings;
+    PtrView view;
+    PtrLights lights;
+    int sample_lights; /* light sampling is on and there is an emitter */
+    PtrRegion region;
+    uint32_t first, count; /* the sample indices of this call */
+    double *sums;          /* PTR_ACCUM_STRIDE doubles a pixel of the region */
+} PtrPathJob;
+
+/* Threads take the image in tiles of this many pixels square. */
+enum { PTR_TILE_SIZE = 16, PTR_TILE_PIXELS = PTR_TILE_SIZE * PTR_TILE_SIZE };
+
+/* Adaptive sampling looks at a pixel only after sample counts that are
+ * multiples of this (from the minimum on): the decision depends on the
+ * pixel's own samples alone, never on passes or threads, and Sobol' points
+ * are complete nets at these counts. */
+enum { PTR_ADAPTIVE_STEP = 16 };
+
+/* A diffuse vertex where an emitter was sampled: what the next vertex needs
+ * to weigh the emission the scattered ray finds against that sample. */
+typedef struct PtrLitVertex {
+    int sampled;       /* 0: the emission found next counts fully */
+    PtrVec3 point;
+    uint32_t sphere;   /* the sphere it lies on */
+    int side;          /* 1 on its outside, -1 on its inside */
+    float scatter_pdf; /* of the direction taken */
+} PtrLitVertex;
+
+static inline double *ptr_path_pixel_sums(const PtrPathJob *job, int x, int y)
+{
+    const PtrRegion *r = &job->region;
+    return job->sums + PTR_ACCUM_STRIDE * ((size_t)(y - r->y0) * (size_t)(r->x1 - r->x0) +
+                                           (size_t)(x - r->x0));
+}
+
+/* The sampler key of pixel (x, y). Keyed by full-image pixel, so a region
+ * renders the very samples the whole image would. */
+static inline uint64_t ptr_path_pixel_key(const PtrPathJob *job, int x, int y)
+{
+    const PtrRenderSettings *s = job->settings;
+    uint64_t pixel = (uint64_t)y * (uint64_t)s->width + (uint64_t)x;
+    return ptr_sampler_for_sample(s->sampler, s->seed, pixel, 0).pixel_key;
+}
+
+/* The camera ray of sample index of pixel (x, y). */
+static inline void ptr_path_camera_ray(const PtrPathJob *job, uint64_t pixel_key, uint32_t index,
+                                       int x, int y, PtrVec3 *origin, PtrVec3 *dir)
+{
+    PtrSamplerKind kind = job->settings->sampler;
+    uint32_t pixel_bits[2], lens_bits[2];
+    ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_PIXEL, pixel_bits);
+    ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_LENS, lens_bits);
+    float lens_r = sqrtf(ptr_sample_float(lens_bits[0])), sin_phi, cos_phi;
+    ptr_sincos_turns(ptr_sample_float(lens_bits[1]), &sin_phi, &cos_phi);
+    ptr_view_ray(&job->view, x, y, ptr_sample_float(pixel_bits[0]),
+                 ptr_sample_float(pixel_bits[1]), lens_r * cos_phi, lens_r * sin_phi, origin,
+                 dir);
+}
+
+/* Where ray met the sphere hit names: the point on its surface and the
+ * outward normal there (for the stability suite's fixed t_min, the point
+ * along the ray, as the seed renderer took it). */
+void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hit,
+                      PtrVec3 *point, PtrVec3 *normal);
+
+/* A ray leaving the surface of sphere at point (outward normal there) along
+ * dir, by the settings' method. */
+PtrRay ptr_path_leave(const PtrPathJob *job, uint32_t sphere, PtrVec3 point,
+                      PtrVec3 outward_normal, PtrVec3 dir);
+
+/* Light sampling at diffuse vertex at of material m (n: the normal on the
+ * side the path arrives from): one emitter picked by power, one direction
+ * towards it, one shadow ray (counted in *rays), weighed against
+ * scattering. */
+PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler, int bounce,
+                                const PtrMaterial *m, const PtrLitVertex *at, PtrVec3 n,
+                                PtrVec3 outward_normal, uint64_t *rays);
+
+/* The weight of emission a scattered ray found on emitter (at distance t
+ * along dir, outward normal there) after light sampling at vertex from. */
+float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
+                               PtrVec3 dir, float t, PtrVec3 normal);
+
+/* Adds radiance as sample index of the pixel whose sums acc are, and
+ * decides whether adaptive sampling stops the pixel there. */
+void ptr_path_accumulate(const PtrRenderSettings *settings, double *acc, uint32_t index,
+                         PtrVec3 radiance);
+
+/* The bundles' entry, compiled once per instruction set (bundle.c): renders
+ * the job's samples of the pixels of [x0, x1) x [y0, y1), counting rays. */
+#define PTR_DECL_RENDER_TILE(name)                                            \
+    void name(const PtrPathJob *job, int x0, int y0, int x1, int y1, uint64_t *rays)
+
+typedef PTR_DECL_RENDER_TILE((*PtrRenderTileFn));
+
+PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_portable);
+PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2);
+
+#endif /* PTR_PATH_H */
