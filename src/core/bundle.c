@@ -58,9 +58,10 @@ typedef struct Round {
 /* Camera rays for items [first, first + LANES), made together. */
 typedef struct CameraBatch {
     uint32_t first;
-    float org[3][LANES], dir[3][LANES];
+    int x[LANES], y[LANES];
     uint64_t key[LANES];
     uint32_t index[LANES];
+    float org[3][LANES], dir[3][LANES];
 } CameraBatch;
 
 static inline PtrVec3 lane_v3(const float a[3][LANES], int l)
@@ -91,20 +92,29 @@ static void set_lane_ray(Lanes *lanes, int l, PtrRay ray)
     r->tmax[l] = ray.tmax;
 }
 
+static void camera_rays(const PtrPathJob *job, CameraBatch *batch)
+{
+    for (int l = 0; l < LANES; l++) {
+        PtrVec3 o, d;
+        ptr_path_camera_ray(job, batch->key[l], batch->index[l], batch->x[l], batch->y[l], &o, &d);
+        set_lane_v3(batch->org, l, o);
+        set_lane_v3(batch->dir, l, d);
+    }
+}
+
 static void make_camera_batch(const PtrPathJob *job, const Round *round, uint32_t first,
                               CameraBatch *batch)
 {
     batch->first = first;
     for (int l = 0; l < LANES; l++) {
         uint32_t item = first + (uint32_t)l < round->items ? first + (uint32_t)l : first;
-        uint32_t p = item / round->span, index = round->first + item % round->span;
-        PtrVec3 o, d;
-        ptr_path_camera_ray(job, round->key[p], index, round->x[p], round->y[p], &o, &d);
-        set_lane_v3(batch->org, l, o);
-        set_lane_v3(batch->dir, l, d);
+        uint32_t p = item / round->span;
+        batch->x[l] = round->x[p];
+        batch->y[l] = round->y[p];
         batch->key[l] = round->key[p];
-        batch->index[l] = index;
+        batch->index[l] = round->first + item % round->span;
     }
+    camera_rays(job, batch);
 }
 
 /* Gives free lanes the round's next items; returns the lanes in flight. */
@@ -163,21 +173,28 @@ static void find_surfaces(const PtrPathJob *job, Lanes *lanes, Vertex *v)
         for (int l = 0; l < LANES; l++)
             v->hit[l] = 0;
     } else {
+        /* Local restrict pointers: the arrays do not alias v, so the
+         * loop's loads become gathers. */
+        const PtrMaterial *restrict materials = scene->materials;
+        const uint32_t *restrict material = spheres->material;
+        const float *restrict cx = spheres->cx, *restrict cy = spheres->cy,
+                    *restrict cz = spheres->cz, *restrict radius = spheres->radius;
         for (int l = 0; l < LANES; l++) {
             v->hit[l] = lanes->hit.sphere[l] != PTR_NO_HIT;
-            uint32_t s = v->hit[l] ? lanes->hit.sphere[l] : 0;
-            const PtrMaterial *m = &scene->materials[spheres->material[s]];
+            /* Sphere 0 stands in for a miss (masked, not selected: a
+             * select would become a pointer the gathers cannot use). */
+            uint32_t s = lanes->hit.sphere[l] & (0u - (uint32_t)v->hit[l]), m = material[s];
             v->sphere[l] = s;
-            v->kind[l] = m->kind;
-            v->ior[l] = m->ior;
-            set_lane_v3(v->albedo, l, m->albedo);
-            set_lane_v3(v->emission, l, m->emission);
-            PtrVec3 c = ptr_sphere_centre(spheres, s);
+            v->kind[l] = materials[m].kind;
+            v->ior[l] = materials[m].ior;
+            set_lane_v3(v->albedo, l, materials[m].albedo);
+            set_lane_v3(v->emission, l, materials[m].emission);
+            PtrVec3 c = v3(cx[s], cy[s], cz[s]);
             PtrVec3 p = v3_madd(lane_v3(lanes->ray.org, l), lane_v3(lanes->ray.dir, l),
                                 lanes->hit.t[l]);
             PtrVec3 normal = v3_normalize(v3_sub(p, c));
             set_lane_v3(v->normal, l, normal);
-            set_lane_v3(v->point, l, v3_madd(c, normal, spheres->radius[s]));
+            set_lane_v3(v->point, l, v3_madd(c, normal, radius[s]));
         }
         if (spheres->color)
             for (int l = 0; l < LANES; l++)
@@ -221,7 +238,7 @@ static void add_sky_and_emission(const PtrPathJob *job, Lanes *lanes, const Vert
         PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
         PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
                                   : v3_mul(throughput, ptr_sky_radiance(sky, lane_v3(lanes->ray.dir, l)));
-        int adds = !v->hit[l] || v3_max_comp(emission) > 0.0f;
+        int adds = !v->hit[l] | (v3_max_comp(emission) > 0.0f);
         PtrVec3 radiance = lane_v3(lanes->radiance, l);
         set_lane_v3(lanes->radiance, l, adds ? v3_add(radiance, found) : radiance);
     }
@@ -323,15 +340,17 @@ static void continue_or_end(const PtrPathJob *job, Lanes *lanes, const Vertex *v
     const PtrSpheres *spheres = &scene->spheres;
     int max_depth = job->settings->max_depth;
     int go_on[LANES];
-    if (spheres->count)
+    if (spheres->count) {
+        const float *restrict cx = spheres->cx, *restrict cy = spheres->cy,
+                    *restrict cz = spheres->cz, *restrict radius = spheres->radius;
         for (int l = 0; l < LANES; l++) {
             PtrVec3 throughput = v3_mul(lane_v3(lanes->throughput, l), lane_v3(v->albedo, l));
-            go_on[l] = v->hit[l] && v->scattered[l] && !(v3_max_comp(throughput) <= 0.0f) &&
-                       lanes->depth[l] + 1 < max_depth;
+            go_on[l] = v->hit[l] & v->scattered[l] & !(v3_max_comp(throughput) <= 0.0f) &
+                       (lanes->depth[l] + 1 < max_depth);
             set_lane_v3(lanes->throughput, l, throughput);
             uint32_t s = v->sphere[l];
-            PtrRay next = ptr_spawn_ray(ptr_sphere_centre(spheres, s), spheres->radius[s],
-                                        lane_v3(v->normal, l), lane_v3(v->out, l));
+            PtrRay next = ptr_spawn_ray(v3(cx[s], cy[s], cz[s]), radius[s], lane_v3(v->normal, l),
+                                        lane_v3(v->out, l));
             for (int a = 0; a < 3; a++) {
                 lanes->ray.org[a][l] = next.org[a];
                 lanes->ray.dir[a][l] = next.dir[a];
@@ -339,7 +358,7 @@ static void continue_or_end(const PtrPathJob *job, Lanes *lanes, const Vertex *v
             lanes->ray.tmin[l] = next.tmin;
             lanes->ray.tmax[l] = next.tmax;
         }
-    else
+    } else
         for (int l = 0; l < LANES; l++)
             go_on[l] = 0;
     for (int l = 0; l < LANES; l++) {

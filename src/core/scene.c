@@ -244,21 +244,6 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     return hash_vec(h, scene->sky.radiance);
 }
 
-PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
-{
-    switch (sky->kind) {
-    case PTR_SKY_GRADIENT: {
-        float a = 0.5f * (unit_dir.y + 1.0f);
-        return v3_add(v3_splat(1.0f - a), v3_scale(v3(0.5f, 0.7f, 1.0f), a));
-    }
-    case PTR_SKY_CONSTANT:
-        return sky->radiance;
-    case PTR_SKY_BLACK:
-        break;
-    }
-    return v3_splat(0.0f);
-}
-
 int ptr_sky_parse(const char *text, PtrSky *sky)
 {
     if (!strcmp(text, "gradient")) {
