@@ -130,14 +130,19 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
  * of different scenes almost surely do not. */
 uint64_t ptr_scene_hash(const PtrScene *scene);
 
+/* The gradient sky's radiance along a unit direction. */
+static inline PtrVec3 ptr_sky_gradient(PtrVec3 unit_dir)
+{
+    float a = 0.5f * (unit_dir.y + 1.0f);
+    return v3_add(v3_splat(1.0f - a), v3_scale(v3(0.5f, 0.7f, 1.0f), a));
+}
+
 /* Radiance arriving from the sky along a unit direction. */
 static inline PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
 {
     switch (sky->kind) {
-    case PTR_SKY_GRADIENT: {
-        float a = 0.5f * (unit_dir.y + 1.0f);
-        return v3_add(v3_splat(1.0f - a), v3_scale(v3(0.5f, 0.7f, 1.0f), a));
-    }
+    case PTR_SKY_GRADIENT:
+        return ptr_sky_gradient(unit_dir);
     case PTR_SKY_CONSTANT:
         return sky->radiance;
     case PTR_SKY_BLACK:
