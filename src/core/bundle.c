@@ -11,9 +11,9 @@
  * Every lane computes exactly the operations render.c's trace_path computes
  * for its path, in the same order, through the same inline functions; no
  * FMA contraction and IEEE operations throughout make the vector code's
- * results the scalar code's, bit for bit, at every instruction set this file
- * is compiled for (PTR_BUNDLE_ENTRY names the copy). Results go to a buffer
- * and are added to the pixels in sample order, as the path tracer adds them. */
+ * results the scalar code's, bit for bit (the file is built with -mavx2:
+ * src/CMakeLists.txt). Results go to a buffer and are added to the pixels in
+ * sample order, as the path tracer adds them. */
 #include <math.h>
 #include <stdint.h>
 
@@ -424,7 +424,7 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
     }
 }
 
-PTR_DECL_RENDER_TILE(PTR_BUNDLE_ENTRY)
+PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
 {
     const PtrRenderSettings *s = job->settings;
     Round round;

@@ -105,14 +105,14 @@ float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, 
 void ptr_path_accumulate(const PtrRenderSettings *settings, double *acc, uint32_t index,
                          PtrVec3 radiance);
 
-/* The bundles' entry, compiled once per instruction set (bundle.c): renders
- * the job's samples of the pixels of [x0, x1) x [y0, y1), counting rays. */
+/* Renders the job's samples of the pixels of [x0, x1) x [y0, y1), counting
+ * rays: a path at a time (render.c) or in bundles (bundle.c, built for AVX2
+ * on x86-64). */
 #define PTR_DECL_RENDER_TILE(name)                                            \
     void name(const PtrPathJob *job, int x0, int y0, int x1, int y1, uint64_t *rays)
 
 typedef PTR_DECL_RENDER_TILE((*PtrRenderTileFn));
 
-PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_portable);
 PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2);
 
 #endif /* PTR_PATH_H */

@@ -125,17 +125,19 @@ void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *samp
     }
 }
 
-/* Paths one at a time with the C reference kernels (--c) and for the
- * stability suite's fixed t_min; else in bundles, vectorised for the CPU. */
+/* Bundles of paths where the table is for an AVX2 CPU; paths one at a time
+ * with the C reference kernels (--c), below AVX2, and for the stability
+ * suite's fixed t_min. */
 static PtrRenderTileFn choose_render_tile(const PtrAccel *accel, const PtrRenderSettings *s)
 {
-    if (accel->isect.closest_hit == ptr_closest_hit_c || s->fixed_tmin > 0.0f)
-        return render_tile_by_path;
-#if PTR_HAVE_AVX2_BUNDLES
-    if (accel->isect.level >= PTR_CPU_AVX2)
+#if PTR_HAVE_BUNDLES
+    if (accel->isect.closest_hit != ptr_closest_hit_c && accel->isect.level >= PTR_CPU_AVX2 &&
+        s->fixed_tmin == 0.0f)
         return ptr_render_tile_bundled_avx2;
+#else
+    (void)accel, (void)s;
 #endif
-    return ptr_render_tile_bundled_portable;
+    return render_tile_by_path;
 }
 
 static void *render_worker(void *arg)
