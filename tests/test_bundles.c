@@ -1,0 +1,170 @@
+/* Bundles of paths (core/bundle.c) against paths one at a time (render.c's
+ * trace_path, the reference): the same sums for every pixel, bit for bit,
+ * and the same number of rays, on scenes that take every branch a path can
+ * take (each material, fuzz, colours, emitters with light sampling, a huge
+ * sphere, the tree, no sphere at all) under every setting that changes a
+ * path (sampler, light sampling, depth limit, adaptive sampling, regions,
+ * sample ranges split into passes, threads). On a CPU without AVX2 both sides
+ * take paths one at a time, which the test says. */
+#include "test.h"
+
+#include "accel/accel.h"
+#include "accel/cpu.h"
+#include "builder.h"
+#include "core/render.h"
+#include "sampling/rng.h"
+
+enum { WIDTH = 48, HEIGHT = 32 };
+
+typedef enum SceneKind { CLUSTER, HUGE_GROUND, CLOUD, EMPTY, SCENE_KINDS } SceneKind;
+static const char *const scene_names[] = { "cluster", "huge ground", "cloud", "empty" };
+
+static uint32_t add(PtrScene *s, PtrMaterial m)
+{
+    uint32_t index = 0;
+    CHECK_INT(ptr_scene_add_material(s, &m, &index), PTR_OK);
+    return index;
+}
+
+/* Spheres of every material (some coloured, some emitting, glass inside
+ * glass, overlaps) over a ground, seen through a lens. */
+static PtrScene make_scene(SceneKind kind)
+{
+    PtrScene s;
+    ptr_scene_init(&s);
+    uint32_t materials[6] = {
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.7f, 0.6f, 0.5f) }),
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_METAL, .albedo = v3(0.8f, 0.8f, 0.9f) }),
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_METAL, .albedo = v3(0.9f, 0.6f, 0.3f),
+                               .fuzz = 0.3f }),
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1.0f),
+                               .ior = 1.5f }),
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.0f),
+                               .emission = v3(4.0f, 3.0f, 2.0f) }),
+        add(&s, (PtrMaterial){ .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3(0.9f, 1.0f, 0.9f),
+                               .ior = 1.0f / 1.5f }),
+    };
+    PtrSceneBuilder b;
+    ptr_builder_init(&b, &s, NULL);
+    PtrRng rng = ptr_rng_for_sample(kind, 7, 0);
+    int n = kind == CLUSTER ? 60 : kind == CLOUD ? 3000 : kind == HUGE_GROUND ? 12 : 0;
+    for (int i = 0; i < n; i++) {
+        double spread = kind == CLOUD ? 12.0 : 4.0;
+        double c[3] = { spread * (ptr_rng_float(&rng) - 0.5), 1.5 * ptr_rng_float(&rng),
+                        spread * (ptr_rng_float(&rng) - 0.5) };
+        double r = (kind == CLOUD ? 0.08 : 0.2) + 0.4 * ptr_rng_float(&rng);
+        CHECK_INT(ptr_builder_add_sphere(&b, c, r, materials[i % 6]), PTR_OK);
+        if (i % 5 == 1) {
+            const double rgb[3] = { ptr_rng_float(&rng), ptr_rng_float(&rng), ptr_rng_float(&rng) };
+            CHECK_INT(ptr_builder_set_color(&b, rgb), PTR_OK);
+        }
+        if (i % 9 == 3) /* glass inside glass */
+            CHECK_INT(ptr_builder_add_sphere(&b, c, 0.5 * r, materials[3]), PTR_OK);
+    }
+    if (kind != EMPTY) {
+        double radius = kind == HUGE_GROUND ? 1e5 : 100.0;
+        const double ground[3] = { 0, -radius, 0 };
+        CHECK_INT(ptr_builder_add_sphere(&b, ground, radius, materials[0]), PTR_OK);
+    }
+    const double eye[3] = { 0, 2, 7 }, target[3] = { 0, 0.5, 0 }, up[3] = { 0, 1, 0 };
+    const PtrCamera lens = { .vfov_deg = 50.0f, .aperture = 0.1f, .focus_distance = 7.0f };
+    ptr_builder_set_camera(&b, eye, target, up, &lens);
+    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT), PTR_OK);
+    s.sky = kind == HUGE_GROUND ? (PtrSky){ PTR_SKY_CONSTANT, v3(0.3f, 0.4f, 0.5f) }
+                                : (PtrSky){ PTR_SKY_GRADIENT, v3_splat(0.0f) };
+    return s;
+}
+
+typedef struct Sums {
+    double *acc;
+    uint64_t rays;
+} Sums;
+
+/* Samples [first, first + count) of the region in passes of pass samples. */
+static Sums render(PtrScene *scene, PtrKernel kernel, const PtrRenderSettings *settings,
+                   uint32_t first, uint32_t count, uint32_t pass)
+{
+    PtrIsectTable isect;
+    PtrAccel accel;
+    PtrError err = { 0 };
+    PtrRegion r = ptr_render_region(settings);
+    size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
+    Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
+    CHECK(ptr_isect_init(&isect, kernel, scene->spheres.count));
+    CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, scene, 0), PTR_OK);
+    for (uint32_t done = 0; done < count; done += pass) {
+        PtrRenderStats stats;
+        uint32_t n = count - done < pass ? count - done : pass;
+        CHECK_INT(ptr_render_samples(scene, &accel, settings, first + done, n, sums.acc, NULL,
+                                     NULL, &stats, &err),
+                  PTR_OK);
+        sums.rays += stats.rays;
+    }
+    ptr_accel_free(&accel);
+    return sums;
+}
+
+static int compare(const char *what, Sums a, Sums b, size_t pixels)
+{
+    size_t differ = 0;
+    for (size_t i = 0; i < pixels * PTR_ACCUM_STRIDE; i++)
+        differ += memcmp(&a.acc[i], &b.acc[i], sizeof(double)) != 0;
+    if (differ || a.rays != b.rays)
+        fprintf(stderr, "%s: %zu sums differ, rays %llu against %llu\n", what, differ,
+                (unsigned long long)a.rays, (unsigned long long)b.rays);
+    CHECK_INT(differ, 0);
+    CHECK_INT(a.rays, b.rays);
+    free(a.acc);
+    free(b.acc);
+    return differ == 0;
+}
+
+int main(void)
+{
+    int bundles = ptr_cpu_level() >= PTR_CPU_AVX2;
+    printf("test_bundles: %s\n", bundles ? "bundles (AVX2) against paths one at a time"
+                                         : "no AVX2: paths one at a time on both sides");
+    typedef struct Variant {
+        const char *name;
+        PtrRenderSettings settings;
+        uint32_t first, count, pass;
+    } Variant;
+    const PtrRenderSettings base = { .width = WIDTH, .height = HEIGHT, .seed = 5, .max_depth = 50,
+                                     .threads = 2 };
+    Variant variants[] = {
+        { "default", base, 0, 12, 12 },
+        { "independent sampler, no light sampling", base, 0, 9, 9 },
+        { "depth 0", base, 0, 3, 3 },
+        { "depth 1", base, 0, 5, 5 },
+        { "depth 3", base, 0, 5, 5 },
+        { "adaptive", base, 0, 48, 48 },
+        { "region, samples 7..26 in passes of 5, one thread", base, 7, 19, 5 },
+    };
+    variants[1].settings.sampler = PTR_SAMPLER_INDEPENDENT;
+    variants[1].settings.direct_lighting = PTR_OFF;
+    variants[2].settings.max_depth = 0;
+    variants[3].settings.max_depth = 1;
+    variants[4].settings.max_depth = 3;
+    variants[5].settings.noise_threshold = 0.05f;
+    variants[5].settings.min_samples = 16;
+    variants[6].settings.region = (PtrRegion){ 5, 3, 37, 29 };
+    variants[6].settings.threads = 1;
+    for (int k = 0; k < SCENE_KINDS; k++) {
+        PtrScene scene = make_scene((SceneKind)k);
+        for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
+            const Variant *var = &variants[v];
+            PtrRegion r = ptr_render_region(&var->settings);
+            size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
+            Sums reference = render(&scene, PTR_KERNEL_C, &var->settings, var->first, var->count,
+                                    var->count);
+            Sums bundled = render(&scene, PTR_KERNEL_AUTO, &var->settings, var->first,
+                                  var->count, var->pass);
+            char what[160];
+            snprintf(what, sizeof what, "%s, %s", scene_names[k], var->name);
+            if (compare(what, reference, bundled, pixels))
+                printf("  %-62s identical\n", what);
+        }
+        ptr_scene_free(&scene);
+    }
+    return test_report();
+}
