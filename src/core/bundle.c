@@ -402,9 +402,13 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
     float weight[LANES];
     CameraBatch batch = { .first = 0 };
     uint32_t next = 0;
+    /* Free lanes still go through the vector loops: they hold a valid ray
+     * and a miss. */
     for (int l = 0; l < LANES; l++) {
         lanes.slot[l] = FREE;
         set_lane_ray(&lanes, l, (PtrRay){ { 0, 0, 0 }, 0.0f, { 0, 0, 1 }, INFINITY });
+        lanes.hit.t[l] = INFINITY;
+        lanes.hit.sphere[l] = PTR_NO_HIT;
     }
     if (round->items)
         make_camera_batch(job, round, 0, &batch);
