@@ -134,7 +134,7 @@ static void print_help(FILE *out)
         "      --asm             use the fastest assembly intersector; an error if none\n"
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
         "                        (also $PTR_CPUMASK; default: the best the CPU has)\n"
-        "      --print-dispatch  print which intersector each level uses, and exit\n"
+        "      --print-dispatch  print each level's intersector and path tracer, and exit\n"
         "\n"
         "Colour (OpenColorIO):\n"
         "      --ocio-config F   config file (default: $OCIO, else ptr's own)\n"
@@ -176,7 +176,8 @@ static void print_dispatch(void)
     for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
         PtrIsectTable table;
         ptr_isect_init_level(&table, (PtrCpuLevel)l);
-        printf("%-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+        printf("%-7s %-7s %-19s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+               ptr_render_bundles(&table) ? "bundles of 8 paths" : "paths one at a time",
                l > (int)detected ? "  (not on this CPU)" : "",
                l == (int)level ? "  <- in use" : "");
     }

@@ -125,14 +125,20 @@ void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *samp
     }
 }
 
-/* Bundles of paths where the table is for an AVX2 CPU; paths one at a time
- * with the C reference kernels (--c), below AVX2, and for the stability
- * suite's fixed t_min. */
+int ptr_render_bundles(const PtrIsectTable *isect)
+{
+#if PTR_HAVE_BUNDLES
+    return isect->closest_hit != ptr_closest_hit_c && isect->level >= PTR_CPU_AVX2;
+#else
+    (void)isect;
+    return 0;
+#endif
+}
+
 static PtrRenderTileFn choose_render_tile(const PtrAccel *accel, const PtrRenderSettings *s)
 {
 #if PTR_HAVE_BUNDLES
-    if (accel->isect.closest_hit != ptr_closest_hit_c && accel->isect.level >= PTR_CPU_AVX2 &&
-        s->fixed_tmin == 0.0f)
+    if (ptr_render_bundles(&accel->isect) && s->fixed_tmin == 0.0f)
         return ptr_render_tile_bundled_avx2;
 #else
     (void)accel, (void)s;

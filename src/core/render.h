@@ -54,6 +54,12 @@ typedef void (*PtrTickFn)(void *user, double fraction_done);
  * all zero if it does not lie inside the image. */
 PtrRegion ptr_render_region(const PtrRenderSettings *settings);
 
+/* Whether renders with this kernel table trace bundles of paths
+ * (core/bundle.c: the assembly kernels on an AVX2 CPU) rather than one path
+ * at a time (the C reference kernels, below AVX2, and always with a fixed
+ * t_min). The image is the same either way. */
+int ptr_render_bundles(const PtrIsectTable *isect);
+
 /* What ptr_render_samples keeps of each pixel, in doubles: the sum of its
  * samples' radiance, the sum over its odd-numbered samples (adaptive
  * sampling's second half-buffer), how many samples it took, and whether
