@@ -28,12 +28,7 @@ section .text
     vtestps     ymm14, ymm14
     jz          %%done                          ; no lane can hit: skip sqrt, div
     ROOT_AVX2
-    vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
-    vandps      ymm14, ymm14, ymm12             ; t > tmin
-    vcmpps      ymm12, ymm9, ymm4, CMP_LT_OQ
-    vandps      ymm14, ymm14, ymm12             ; t < best (strict: first index wins)
-    vblendvps   ymm4, ymm4, ymm9, ymm14
-    vblendvps   ymm5, ymm5, ymm6, ymm14
+    KEEP_NEARER_AVX2
 %%done:
     vpaddd      ymm6, ymm6, [lane_step]
 %endmacro

@@ -210,6 +210,18 @@ static void print_hit(const char *who, int ret, const PtrHit *h)
             h->t, h->sphere);
 }
 
+/* One kernel's line of the result; whether it passed. */
+static int report(const char *kind, const char *name, uint64_t rays, uint64_t hits,
+                  uint64_t mismatches, const CheckedCallStatus *status)
+{
+    printf("%s%-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s%s\n", kind,
+           name, rays, hits, mismatches,
+           status->failures & 1 ? "; a callee-saved register was clobbered" : "",
+           status->failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
+           status->check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
+    return !mismatches && !status->failures;
+}
+
 static int check(uint64_t rays, uint64_t seed)
 {
     PtrIsectTable tables[PTR_CPU_LEVEL_COUNT];
@@ -261,27 +273,13 @@ static int check(uint64_t rays, uint64_t seed)
     }
 
     int passed = 0, failed = 0;
-    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-        if (tables[l].closest_hit == ptr_closest_hit_c)
-            continue;
-        int ok = !mismatches[l] && !status[l].failures;
-        printf("%-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s%s\n",
-               tables[l].name, rays, hits, mismatches[l],
-               status[l].failures & 1 ? "; a callee-saved register was clobbered" : "",
-               status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
-               status[l].check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
-        ok ? passed++ : failed++;
-    }
-    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-        if (tables[l].closest_hit_packet == ptr_closest_hit_packet_c)
-            continue;
-        int ok = !packet_mismatches[l] && !packet_status[l].failures;
-        printf("packet %-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s\n",
-               tables[l].name, rays, packet_hits, packet_mismatches[l],
-               packet_status[l].failures & 1 ? "; a callee-saved register was clobbered" : "",
-               packet_status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "");
-        ok ? passed++ : failed++;
-    }
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
+        if (tables[l].closest_hit != ptr_closest_hit_c)
+            report("", tables[l].name, rays, hits, mismatches[l], &status[l]) ? passed++ : failed++;
+    for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
+        if (tables[l].closest_hit_packet != ptr_closest_hit_packet_c)
+            report("packet ", tables[l].name, rays, packet_hits, packet_mismatches[l],
+                   &packet_status[l]) ? passed++ : failed++;
     failed += check_bvh(seed, &passed);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
