@@ -21,11 +21,12 @@ fastest() {
     scene=$1; shift
     best=
     for _ in $(seq "$runs"); do
-        # ptr: OUT: WxH, N spp, T threads, K intersector: S s, R Mrays/s (N rays)
+        # ptr: OUT: WxH, N spp, S spheres, A, K intersector: import I s, build B s,
+        # render R s, M Mrays/s (N rays)
         # shellcheck disable=SC2086
         line=$("$ptr" "scenes/$scene.gltf" -o "$out/$scene.exr" --samples 10 $extra "$@" 2>&1 >/dev/null |
-               grep 'Mrays/s')
-        secs=$(echo "$line" | sed -E 's/.*: ([0-9.]+) s, .*/\1/')
+               grep ' intersector: ')
+        secs=$(echo "$line" | sed -E 's/.* render ([0-9.]+) s, .*/\1/')
         if [ -z "$best" ] || awk "BEGIN { exit !($secs < $best) }"; then
             best=$secs
             mrays=$(echo "$line" | sed -E 's/.* ([0-9.]+) Mrays\/s.*/\1/')
