@@ -62,5 +62,16 @@ if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/merged.exr" "$dir/merged-brut
 fi
 iinfo -v "$dir/merged.exr" | grep -q 'ptr:accel: "mixed"' ||
     { echo "FAIL: the merged image does not say its parts used both" >&2; failed=1; }
-[ $failed = 0 ] && echo "all scenes identical, parts merge"
+# The JSON names the path tracer: one path at a time with --c, and by default
+# what --print-dispatch shows for the level in use (bundles on AVX2).
+paths_of() {
+    "$ptr" "$src/scenes/seed.gltf" -o "$dir/p.exr" --samples 1 --width 16 --quiet --json "$@" |
+        sed -E 's/.*"paths": "([a-z ]*)".*/\1/'
+}
+[ "$(paths_of --c)" = "one at a time" ] ||
+    { echo "FAIL: --c does not report paths one at a time" >&2; failed=1; }
+expected=$("$ptr" --print-dispatch | grep 'in use' | grep -q 'bundles' && echo bundles || echo "one at a time")
+[ "$(paths_of)" = "$expected" ] ||
+    { echo "FAIL: the JSON's paths is not what --print-dispatch shows in use ($expected)" >&2; failed=1; }
+[ $failed = 0 ] && echo "all scenes identical, parts merge, path tracer reported"
 exit $failed

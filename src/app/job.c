@@ -129,6 +129,7 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     PtrIsectTable isect;
     ptr_isect_init(&isect, o->kernel, scene->spheres.count);
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
+    report->bundles = ptr_render_bundles(&isect);
     /* Before the tree reorders the spheres: the hash does not depend on
      * their order, but there is no need to find the file order again. */
     uint64_t scene_hash = ptr_scene_hash(scene);
