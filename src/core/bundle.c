@@ -168,8 +168,8 @@ STAGE void trace(const PtrPathJob *job, Lanes *lanes)
         }
 }
 
-/* The material (tinted by the sphere's colour) and the surface each lane
- * hit; the sky and emission it found. */
+/* Each lane's hit: its sphere's material (tinted by the sphere's colour),
+ * the point on its surface and the outward normal there. */
 STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restrict v)
 {
     const PtrScene *scene = job->scene;
@@ -219,8 +219,8 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
 }
 
 /* Emission found after light sampling is weighed against that sample. */
-STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes, const Vertex *restrict v,
-                             float weight[LANES])
+STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes,
+                            const Vertex *restrict v, float weight[LANES])
 {
     for (int l = 0; l < LANES; l++) {
         weight[l] = 1.0f;
@@ -235,16 +235,16 @@ STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes, 
     }
 }
 
-STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
-                                 const float weight[LANES])
+STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
+                                const Vertex *restrict v, const float weight[LANES])
 {
     const PtrSky *sky = &job->scene->sky;
     /* The sky's kind chosen once, not per lane: a select the loop vectorises. */
     int gradient = sky->kind == PTR_SKY_GRADIENT;
-    PtrVec3 uniform = ptr_sky_radiance(sky, v3(0.0f, 1.0f, 0.0f));
+    PtrVec3 uniform_sky = ptr_sky_radiance(sky, v3(0.0f, 1.0f, 0.0f));
     for (int l = 0; l < LANES; l++) {
         PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
-        PtrVec3 sky_l = gradient ? ptr_sky_gradient(lane_v3(lanes->ray.dir, l)) : uniform;
+        PtrVec3 sky_l = gradient ? ptr_sky_gradient(lane_v3(lanes->ray.dir, l)) : uniform_sky;
         PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
                                   : v3_mul(throughput, sky_l);
         int adds = !v->hit[l] | (v3_max_comp(emission) > 0.0f);
@@ -259,7 +259,8 @@ static inline PtrVec3 facing_normal(PtrVec3 dir, PtrVec3 normal)
 }
 
 /* Light sampling at the diffuse vertices, lane by lane. */
-STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v, uint64_t *rays)
+STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
+                           uint64_t *rays)
 {
     const PtrScene *scene = job->scene;
     int max_depth = job->settings->max_depth;
@@ -280,8 +281,9 @@ STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const V
         PtrSampler sampler = { job->settings->sampler, lanes->key[l], lanes->index[l] };
         PtrVec3 light = ptr_path_sample_emitter(job, &sampler, lanes->depth[l], &m, lit,
                                                 facing_normal(dir, normal), normal, rays);
+        PtrVec3 radiance = lane_v3(lanes->radiance, l);
         set_lane_v3(lanes->radiance, l,
-                    v3_add(lane_v3(lanes->radiance, l), v3_mul(lane_v3(lanes->throughput, l), light)));
+                    v3_add(radiance, v3_mul(lane_v3(lanes->throughput, l), light)));
     }
 }
 

@@ -21,9 +21,10 @@ static inline void ptr_sincos_turns(float u, float *sin_out, float *cos_out)
     float x = (quarters - (float)k) * (0.5f * PTR_PI); /* in [-pi/4, pi/4] */
     float x2 = x * x;
     /* Minimax polynomials on [-pi/4, pi/4] (Cephes' sinf and cosf). */
-    float s = x + x * x2 * (-1.6666654611e-1f + x2 * (8.3321608736e-3f + x2 * -1.9515295891e-4f));
-    float c = 1.0f - 0.5f * x2 +
-              x2 * x2 * (4.166664568298827e-2f + x2 * (-1.388731625493765e-3f + x2 * 2.443315711809948e-5f));
+    const float s1 = -1.6666654611e-1f, s2 = 8.3321608736e-3f, s3 = -1.9515295891e-4f;
+    const float c1 = 4.166664568298827e-2f, c2 = -1.388731625493765e-3f, c3 = 2.443315711809948e-5f;
+    float s = x + x * x2 * (s1 + x2 * (s2 + x2 * s3));
+    float c = 1.0f - 0.5f * x2 + x2 * x2 * (c1 + x2 * (c2 + x2 * c3));
     /* Turning by k quarters: odd k swaps sine and cosine, and the signs
      * follow the quadrant. */
     float s_k = (k & 1) ? c : s, c_k = (k & 1) ? s : c;

@@ -112,7 +112,8 @@ static inline void ptr_sampler_pair_bits(PtrSamplerKind kind, uint64_t pixel_key
     uint64_t scramble = ptr_mix64(pair_key);
     uint32_t i = ptr_reverse_bits(ptr_laine_karras(ptr_reverse_bits(index), (uint32_t)pair_key));
     out[0] = ptr_reverse_bits(ptr_laine_karras(i, (uint32_t)scramble));
-    out[1] = ptr_reverse_bits(ptr_laine_karras(ptr_sobol_second_reversed(i), (uint32_t)(scramble >> 32)));
+    out[1] = ptr_reverse_bits(
+        ptr_laine_karras(ptr_sobol_second_reversed(i), (uint32_t)(scramble >> 32)));
 }
 
 /* A 32-bit fraction as a float in [0, 1) with 24 bits, exact. */

@@ -155,9 +155,9 @@ static void fill_packet(const Case *c, PtrRng *rng, PtrRayPacket *p)
             if (s->count) {
                 size_t i = (size_t)(ptr_rng_float(rng) * (float)s->count) % s->count;
                 o = v3_add(o, v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng)));
-                PtrVec3 to = v3_sub(v3_add(ptr_sphere_centre(s, i),
-                                           v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng))),
-                                    o);
+                PtrVec3 target = v3_add(ptr_sphere_centre(s, i),
+                                        v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng)));
+                PtrVec3 to = v3_sub(target, o);
                 if (v3_max_abs(to) > 0 && ptr_rng_float(rng) < 0.8f)
                     d = to;
             }
@@ -194,12 +194,10 @@ static uint64_t check_packets(const PtrIsectTable *tables, PtrCpuLevel top, cons
         ptr_checked_call_packet(tables[l].closest_hit_packet, &rays, &c->scene.spheres, c->count,
                                 &got, &status[l]);
         for (int k = 0; k < PTR_PACKET_LANES; k++)
-            if (got.t[k] != ref.t[k] || got.sphere[k] != ref.sphere[k] ||
-                memcmp(&got.t[k], &ref.t[k], sizeof got.t[k])) {
-                if (mismatches[l]++ < 5)
-                    fprintf(stderr, "%s packet lane %d differs from c: t %a sphere %u, c: t %a sphere %u\n",
-                            tables[l].name, k, got.t[k], got.sphere[k], ref.t[k], ref.sphere[k]);
-            }
+            if ((got.sphere[k] != ref.sphere[k] || memcmp(&got.t[k], &ref.t[k], sizeof got.t[k])) &&
+                mismatches[l]++ < 5)
+                fprintf(stderr, "%s packet lane %d differs from c: t %a sphere %u, c: t %a sphere %u\n",
+                        tables[l].name, k, got.t[k], got.sphere[k], ref.t[k], ref.sphere[k]);
     }
     return hits;
 }
