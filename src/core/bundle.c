@@ -24,7 +24,7 @@
 enum { LANES = PTR_PACKET_LANES, FREE = -1 };
 
 /* Each stage of a bounce stays a function of its own: inlined into one body,
- * the loops lost their vector code (seed.gltf rendered 1.8x slower), and kept
+ * the loops lost their vector code (seed.gltf took 1.3-1.55x as long), and kept
  * apart they show as the stages of a profile. */
 #define STAGE static __attribute__((noinline))
 
