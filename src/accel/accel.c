@@ -29,8 +29,9 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
 
 size_t ptr_accel_crossover(const PtrIsectTable *isect)
 {
-    return isect->closest_hit == ptr_closest_hit_c ? PTR_ACCEL_CROSSOVER_C
-                                                   : PTR_ACCEL_CROSSOVER_ASM;
+    if (isect->closest_hit == ptr_closest_hit_c)
+        return PTR_ACCEL_CROSSOVER_C;
+    return isect->level >= PTR_CPU_AVX2 ? PTR_ACCEL_CROSSOVER_AVX2 : PTR_ACCEL_CROSSOVER_SSE41;
 }
 
 /* The huge spheres in double, then the rest up to that distance (ties

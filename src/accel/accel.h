@@ -20,14 +20,19 @@ typedef enum PtrAccelChoice {
 } PtrAccelChoice;
 
 /* The sphere counts from which the tree beats brute force, measured with
- * `bench/bvh --crossover` (cloud scenes, 200x113, 4 spp, 2 threads; see
- * docs/intersectors.md, "Choosing"), on an AVX2 machine. With the C
- * kernels the C traversal overtakes brute force between 16 spheres (5.5
- * against 5.2 Mrays/s) and 32 (3.7 against 4.6); the AVX2 brute-force
- * kernel holds out against the C traversal up to between 256 (3.9 against
- * 3.2) and 512 (1.7 against 2.3), and against the AVX2 traversal up to the
- * same place (256: 5.8 against 3.9; 512: 2.5 against 3.4, 2 spp). */
-enum { PTR_ACCEL_CROSSOVER_C = 24, PTR_ACCEL_CROSSOVER_ASM = 384 };
+ * `bench/bvh --crossover 200 113 8` (cloud scenes, 2 threads; see
+ * docs/intersectors.md, "Choosing"), on an AVX2 machine. With the C kernels
+ * (paths one at a time) the C traversal overtakes brute force between 16
+ * and 32 spheres. With the SSE4.1 kernel (paths one at a time) against the
+ * C traversal: 64 spheres 8.4 against 8.2 Mrays/s, 128 6.0 against 7.7. On
+ * an AVX2 CPU (bundles of paths: the packet kernel against the AVX2
+ * traversal lane by lane): 128 spheres 12.9 against 12.0, 256 6.7 against
+ * 11.1. */
+enum {
+    PTR_ACCEL_CROSSOVER_C = 24,
+    PTR_ACCEL_CROSSOVER_SSE41 = 96,
+    PTR_ACCEL_CROSSOVER_AVX2 = 192,
+};
 
 /* The crossover for brute force with isect's kernel. */
 size_t ptr_accel_crossover(const PtrIsectTable *isect);

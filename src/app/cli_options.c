@@ -128,8 +128,8 @@ static void print_help(FILE *out)
         "Intersection:\n"
         "      --accel A         auto, brute or bvh: test every sphere, or build a\n"
         "                        tree over them first (default auto: the tree from\n"
-        "                        %d spheres on with --c, %d with assembly); the\n"
-        "                        image is the same\n"
+        "                        %d spheres on with --c, %d with SSE4.1, %d with\n"
+        "                        AVX2); the image is the same\n"
         "      --c               use the portable C intersector (the reference)\n"
         "      --asm             use the fastest assembly intersector; an error if none\n"
         "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
@@ -164,7 +164,7 @@ static void print_help(FILE *out)
         "\n"
         "Exit codes:\n",
         DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, DEFAULT_MIN_SAMPLES,
-        PTR_ACCEL_CROSSOVER_C, PTR_ACCEL_CROSSOVER_ASM);
+        PTR_ACCEL_CROSSOVER_C, PTR_ACCEL_CROSSOVER_SSE41, PTR_ACCEL_CROSSOVER_AVX2);
     for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
         fprintf(out, "  %2d  %s\n", ptr_result_exit_code((PtrResult)r),
                 ptr_result_description((PtrResult)r));
