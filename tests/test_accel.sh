@@ -8,9 +8,9 @@
 set -u
 ptr=$1
 src=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failed=0
+. "$src/tests/shell_test.sh"
+# Whether two images hold the same pixels, bit for bit.
+same_pixels() { idiff -q -fail 0 -failpercent 0 -warn 0 "$1" "$2" >/dev/null; }
 python3 "$src/tests/hard_scenes.py" "$dir" || exit 1
 scenes="$src/scenes/seed.gltf $src/scenes/final.gltf"
 for json in "$dir"/*.json; do
@@ -21,28 +21,22 @@ for scene in $scenes; do
     name=$(basename "$scene" .gltf)
     for accel in brute bvh; do
         "$ptr" "$scene" -o "$dir/$name-$accel.exr" --accel $accel --c --samples 3 --width 96 \
-            --threads 2 --quiet || { echo "FAIL: $name: ptr --accel $accel failed" >&2; failed=1; }
+            --threads 2 --quiet || fail "$name: ptr --accel $accel failed"
     done
-    if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/$name-brute.exr" "$dir/$name-bvh.exr" >/dev/null; then
-        echo "FAIL: $name: --accel brute and --accel bvh differ" >&2
-        failed=1
-    fi
+    same_pixels "$dir/$name-brute.exr" "$dir/$name-bvh.exr" ||
+        fail "$name: --accel brute and --accel bvh differ"
     # The fastest kernels the machine has (brute force and traversal in
     # assembly where there are), against brute force in C.
     "$ptr" "$scene" -o "$dir/$name-fastest.exr" --accel bvh --samples 3 --width 96 --threads 2 \
-        --quiet || { echo "FAIL: $name: ptr --accel bvh failed" >&2; failed=1; }
-    if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/$name-brute.exr" "$dir/$name-fastest.exr" >/dev/null; then
-        echo "FAIL: $name: --accel brute --c and --accel bvh with the fastest kernels differ" >&2
-        failed=1
-    fi
+        --quiet || fail "$name: ptr --accel bvh failed"
+    same_pixels "$dir/$name-brute.exr" "$dir/$name-fastest.exr" ||
+        fail "$name: --accel brute --c and --accel bvh with the fastest kernels differ"
     for accel in brute bvh; do
-        if ! iinfo -v "$dir/$name-$accel.exr" | grep -q "ptr:accel: \"$accel\""; then
-            echo "FAIL: $name: no ptr:accel \"$accel\" in the metadata" >&2
-            failed=1
-        fi
+        iinfo -v "$dir/$name-$accel.exr" | grep -q "ptr:accel: \"$accel\"" ||
+            fail "$name: no ptr:accel \"$accel\" in the metadata"
     done
     hashes=$(for accel in brute bvh; do iinfo -v "$dir/$name-$accel.exr" | grep scene_hash; done | sort -u | wc -l)
-    [ "$hashes" = 1 ] || { echo "FAIL: $name: the scene hash depends on the structure" >&2; failed=1; }
+    [ "$hashes" = 1 ] || fail "$name: the scene hash depends on the structure"
 done
 # A part rendered with the tree merges with one rendered by brute force (the
 # scene hash does not see the tree's order), into the very image two brute
@@ -50,18 +44,16 @@ done
 final="$src/scenes/final.gltf"
 for accel in brute bvh; do
     "$ptr" "$final" -o "$dir/part-$accel.exr" --accel $accel --sample-range 2:4 --width 64 --quiet ||
-        { echo "FAIL: rendering a part with --accel $accel" >&2; failed=1; }
+        fail "rendering a part with --accel $accel"
 done
 "$ptr" "$final" -o "$dir/part0.exr" --accel brute --sample-range 0:2 --width 64 --quiet &&
 "$ptr" merge "$dir/part0.exr" "$dir/part-bvh.exr" -o "$dir/merged.exr" --quiet &&
 "$ptr" merge "$dir/part0.exr" "$dir/part-brute.exr" -o "$dir/merged-brute.exr" --quiet ||
-    { echo "FAIL: merging the parts" >&2; failed=1; }
-if ! idiff -q -fail 0 -failpercent 0 -warn 0 "$dir/merged.exr" "$dir/merged-brute.exr" >/dev/null; then
-    echo "FAIL: parts of brute force and the tree do not merge as brute force parts do" >&2
-    failed=1
-fi
+    fail "merging the parts"
+same_pixels "$dir/merged.exr" "$dir/merged-brute.exr" ||
+    fail "parts of brute force and the tree do not merge as brute force parts do"
 iinfo -v "$dir/merged.exr" | grep -q 'ptr:accel: "mixed"' ||
-    { echo "FAIL: the merged image does not say its parts used both" >&2; failed=1; }
+    fail "the merged image does not say its parts used both"
 # The JSON names the path tracer: one path at a time with --c, and by default
 # what --print-dispatch shows for the level in use (bundles on AVX2).
 paths_of() {
@@ -69,9 +61,8 @@ paths_of() {
         sed -E 's/.*"paths": "([a-z ]*)".*/\1/'
 }
 [ "$(paths_of --c)" = "one at a time" ] ||
-    { echo "FAIL: --c does not report paths one at a time" >&2; failed=1; }
+    fail "--c does not report paths one at a time"
 expected=$("$ptr" --print-dispatch | grep 'in use' | grep -q 'bundles' && echo bundles || echo "one at a time")
 [ "$(paths_of)" = "$expected" ] ||
-    { echo "FAIL: the JSON's paths is not what --print-dispatch shows in use ($expected)" >&2; failed=1; }
-[ $failed = 0 ] && echo "all scenes identical, parts merge, path tracer reported"
-exit $failed
+    fail "the JSON's paths is not what --print-dispatch shows in use ($expected)"
+finish "all scenes identical, parts merge, path tracer reported"

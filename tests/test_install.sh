@@ -8,10 +8,7 @@ set -u
 cmake=$1
 build=$2
 src=$3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failed=0
-fail() { echo "FAIL: $1" >&2; failed=1; }
+. "$src/tests/shell_test.sh"
 
 prefix=$dir/prefix
 "$cmake" --install "$build" --prefix "$prefix" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }
@@ -46,5 +43,4 @@ expect_broken "module missing"
 echo "not a shared object" >"$module"
 expect_broken "module broken"
 
-[ $failed = 0 ] && echo "install: passed"
-exit $failed
+finish "install: passed"

@@ -7,10 +7,7 @@
 set -u
 ptr=$1
 src=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failed=0
-fail() { echo "FAIL: $1" >&2; failed=1; }
+. "$src/tests/shell_test.sh"
 
 # loads NAME: how many times the log names NAME as loaded.
 loads() { grep -c "file=[^ ]*$1.* generating link map" "$dir/log"; }
@@ -31,5 +28,4 @@ LD_DEBUG=files "$ptr" "$src/scenes/seed.gltf" -o "$dir/a.exr" --width 8 --height
 [ "$(loads ptr_image_oiio)" = 1 ] || fail "render: the image module was not loaded once"
 [ "$(loads libOpenImageIO.so)" = 1 ] || fail "render: OpenImageIO was not loaded once"
 
-[ $failed = 0 ] && echo "startup: passed"
-exit $failed
+finish "startup: passed"
