@@ -93,7 +93,12 @@ typedef struct Method {
     PtrRenderSettings settings;
 } Method;
 
-enum { MAX_METHODS = 8, MAX_POINTS = 24 };
+/* A chart compares either the estimators or the CPU levels. */
+#define ESTIMATOR_COUNT ((int)(sizeof estimators / sizeof estimators[0]))
+enum {
+    MAX_METHODS = ESTIMATOR_COUNT > PTR_CPU_LEVEL_COUNT ? ESTIMATOR_COUNT : PTR_CPU_LEVEL_COUNT,
+    MAX_POINTS = 24,
+};
 
 /* Every method at spp = 1, 2, 4, ... max_spp, the errors and times averaged
  * over seeds 1 .. seeds. The methods take turns at each point, so that the
@@ -183,7 +188,7 @@ int main(int argc, char **argv)
 
         Method methods[MAX_METHODS];
         int count = 0;
-        for (size_t e = 0; by_estimator && e < sizeof estimators / sizeof estimators[0]; e++) {
+        for (int e = 0; by_estimator && e < ESTIMATOR_COUNT; e++) {
             const Estimator *est = &estimators[e];
             Method *m = &methods[count++];
             *m = (Method){ est->name, fastest, settings };

@@ -1,9 +1,12 @@
 #!/bin/sh
-# Installs the dependencies, then builds and runs the whole test suite three
-# times: a Release build; the same build with the assembly intersectors
-# disabled through PTR_CPUMASK=none; and a build under AddressSanitizer and
-# UndefinedBehaviorSanitizer. Then fuzzes both importers for a minute each. On x86-64 the assembly is required: a build
-# that silently fell back to C only would test less than it claims.
+# Installs the dependencies, then builds and runs the whole test suite, in a
+# Release build and again under AddressSanitizer and UndefinedBehaviorSanitizer;
+# in each, at this CPU's level, then with the assembly intersectors disabled
+# (PTR_CPUMASK=none), then the tests whose code depends on the CPU level (ctest
+# label cpu_level) at every level between. Then fuzzes both importers for a
+# minute each. On x86-64 the assembly is required: a build that silently fell
+# back to C only would test less than it claims. The last lines say which CPU
+# levels the run covered and which ones this CPU cannot reach.
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -15,14 +18,46 @@ esac
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPTR_REQUIRE_ASM=$require_asm
 cmake --build build -j "$jobs"
-ctest --test-dir build --output-on-failure -j "$jobs"
 
-echo "== again with the assembly intersectors disabled (PTR_CPUMASK=none)"
-PTR_CPUMASK=none ctest --test-dir build --output-on-failure -j "$jobs"
+# ptr's levels, lowest first; this CPU's own is the one --print-dispatch
+# marks in use when nothing caps it.
+native=$(env -u PTR_CPUMASK build/src/ptr --print-dispatch | sed -n 's/^\([a-z0-9]*\) .*<- in use.*/\1/p')
+below=
+above=
+for level in $(build/src/ptr --print-dispatch | cut -d' ' -f1); do
+    if [ "$level" = "$native" ]; then
+        seen=1
+    elif [ -n "${seen:-}" ]; then
+        above="$above $level"
+    else
+        below="$below $level"
+    fi
+done
 
+# Build $1's suite at this CPU's level, then at each level below: the whole
+# suite again without the assembly (none), the level-dependent tests alone
+# at the levels between.
+suite_at_every_level() {
+    echo "== $1: the whole suite at this CPU's level ($native)"
+    ctest --test-dir "$1" --output-on-failure -j "$jobs"
+    for level in $below; do
+        if [ "$level" = none ]; then
+            echo "== $1: the whole suite with the assembly disabled (PTR_CPUMASK=none)"
+            PTR_CPUMASK=none ctest --test-dir "$1" --output-on-failure -j "$jobs"
+        else
+            echo "== $1: the CPU-level tests at PTR_CPUMASK=$level"
+            PTR_CPUMASK=$level ctest --test-dir "$1" --output-on-failure -j "$jobs" -L cpu_level
+        fi
+    done
+}
+
+suite_at_every_level build
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DPTR_SANITIZE=ON -DPTR_REQUIRE_ASM=$require_asm
 cmake --build build-sanitize -j "$jobs"
-ctest --test-dir build-sanitize --output-on-failure -j "$jobs"
+suite_at_every_level build-sanitize
 
 echo "== fuzzing the importers, a minute each"
 scripts/fuzz.sh 60
+
+echo "== CPU levels tested:$below $native"
+echo "== CPU levels this CPU cannot reach, not tested here:${above:- none}"

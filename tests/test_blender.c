@@ -100,9 +100,9 @@ static void test_same_image(void)
     CHECK_INT(test_ptr(BLENDER("spheres.obj"), "-o", test_path("obj.exr"), "--width", "64",
                        "--height", "48", "--samples", "64", cam[0], cam[1], cam[2], cam[3], cam[4],
                        cam[5], "--quiet", NULL), 0);
-    char err[256];
-    PtrImage *a = ptr_image_read(test_path("gltf.exr"), err, sizeof err);
-    PtrImage *b = ptr_image_read(test_path("obj.exr"), err, sizeof err);
+    PtrError err;
+    PtrImage *a = ptr_image_read(test_path("gltf.exr"), &err);
+    PtrImage *b = ptr_image_read(test_path("obj.exr"), &err);
     CHECK(a && b);
     if (!a || !b)
         return;

@@ -46,8 +46,8 @@ static void test_render_seed_exr(void)
     const char *out = test_path("seed.exr");
     CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "32", "--width", "60", "--seed", "42",
                   "--quiet", "--c", NULL), 0);
-    char err[256];
-    PtrImage *img = ptr_image_read(out, err, sizeof err);
+    PtrError err;
+    PtrImage *img = ptr_image_read(out, &err);
     CHECK(img != NULL);
     if (!img)
         return;
@@ -89,8 +89,8 @@ static void test_png_and_options(void)
     const char *png = test_path("seed.png");
     CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "2", "--width", "40", "--height", "20",
                   "--sky", "black", "--threads", "1", "--max-depth", "5", "--quiet", NULL), 0);
-    char err[256];
-    PtrImage *img = ptr_image_read(png, err, sizeof err);
+    PtrError err;
+    PtrImage *img = ptr_image_read(png, &err);
     CHECK(img != NULL);
     if (!img)
         return;
@@ -106,7 +106,7 @@ static void test_png_and_options(void)
     /* A constant sky of 0.5 seen directly encodes to sRGB 0.735 -> code 188. */
     CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
                   "--camera", "Camera", "--quiet", NULL), 0);
-    img = ptr_image_read(png, err, sizeof err);
+    img = ptr_image_read(png, &err);
     CHECK_NEAR(ptr_image_pixels(img)[0] * 255.0f, 188.0, 1e-3);
     ptr_image_free(img);
 }

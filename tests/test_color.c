@@ -36,26 +36,27 @@ static PtrOutputInfo info_for(const PtrColor *color)
 
 static PtrImage *read_image(const char *path)
 {
-    char err[256];
-    PtrImage *img = ptr_image_read(path, err, sizeof err);
+    PtrError err;
+    PtrImage *img = ptr_image_read(path, &err);
     if (!img)
-        TEST_FAIL_("%s", err);
+        TEST_FAIL_("%s", err.message);
     return img;
 }
 
 /* ptr's 8-bit output against oiiotool's for one display and view. */
 static void oracle(const char *config, const char *display, const char *view)
 {
-    char err[256], cmd[1024];
+    PtrError err;
+    char cmd[1024];
     const char *in = test_path("in.exr"), *ours = test_path("ours.png"), *theirs = test_path("theirs.png");
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
-    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, PTR_PIXEL_FLOAT, NULL, 0, err, sizeof err), 0);
+    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, PTR_PIXEL_FLOAT, NULL, 0, &err), 0);
 
-    PtrColor *color = ptr_color_open(config, err, sizeof err);
+    PtrColor *color = ptr_color_open(config, &err);
     CHECK(color != NULL);
     if (!color)
         return;
-    CHECK_INT(ptr_color_select(color, display, view, NULL, 0, err, sizeof err), 0);
+    CHECK_INT(ptr_color_select(color, display, view, NULL, 0, &err), 0);
     PtrOutputInfo info = info_for(color);
     PtrError perr = { 0 };
     CHECK_INT(ptr_output_write(ours, &row, &inputs[0][0], &info, &perr), PTR_OK);
@@ -91,8 +92,8 @@ static void test_oracle(void)
     unsetenv("OCIO");
     const char *ptr_views[] = { "Standard", "ACES 1.0 SDR-video", "Raw" };
     for (int v = 0; v < 3; v++) {
-        char err[256];
-        PtrColor *embedded = ptr_color_open(NULL, err, sizeof err);
+        PtrError err;
+        PtrColor *embedded = ptr_color_open(NULL, &err);
         CHECK_STR(ptr_color_source(embedded), "embedded");
         ptr_color_close(embedded);
         oracle(PTR_CONFIG, "sRGB", ptr_views[v]);
@@ -116,44 +117,46 @@ static void test_embedded_matches_file(void)
 
 static void test_lookup_order(void)
 {
-    char err[256];
+    PtrError err;
     unsetenv("OCIO");
-    PtrColor *c = ptr_color_open(NULL, err, sizeof err);
+    PtrColor *c = ptr_color_open(NULL, &err);
     CHECK_STR(ptr_color_source(c), "embedded");
     ptr_color_close(c);
 
     setenv("OCIO", SECOND_CONFIG, 1);
-    c = ptr_color_open(NULL, err, sizeof err);
+    c = ptr_color_open(NULL, &err);
     CHECK_STR(ptr_color_source(c), SECOND_CONFIG);
-    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0, err, sizeof err), 0);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0, &err), 0);
     CHECK_STR(ptr_color_view(c), "Gamma"); /* that config's default */
     ptr_color_close(c);
 
-    c = ptr_color_open(PTR_CONFIG, err, sizeof err); /* --ocio-config beats $OCIO */
+    c = ptr_color_open(PTR_CONFIG, &err); /* --ocio-config beats $OCIO */
     CHECK_STR(ptr_color_source(c), PTR_CONFIG);
     ptr_color_close(c);
 
     /* A broken $OCIO is an error, not a fallback to the embedded config. */
     setenv("OCIO", BROKEN_CONFIG, 1);
-    CHECK(ptr_color_open(NULL, err, sizeof err) == NULL);
-    CHECK(strstr(err, BROKEN_CONFIG) != NULL && strstr(err, "$OCIO") != NULL);
+    CHECK(ptr_color_open(NULL, &err) == NULL);
+    CHECK(strstr(err.message, BROKEN_CONFIG) != NULL && strstr(err.message, "$OCIO") != NULL);
     unsetenv("OCIO");
 }
 
 static void test_errors(void)
 {
-    char err[256];
-    CHECK(ptr_color_open(BROKEN_CONFIG, err, sizeof err) == NULL);
-    CHECK(strstr(err, BROKEN_CONFIG) != NULL);
-    CHECK(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", err, sizeof err) == NULL);
+    PtrError err;
+    CHECK(ptr_color_open(BROKEN_CONFIG, &err) == NULL);
+    CHECK(strstr(err.message, BROKEN_CONFIG) != NULL);
+    CHECK(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", &err) == NULL);
+    CHECK_INT(err.code, PTR_ERR_COLOR);
 
-    PtrColor *c = ptr_color_open(NULL, err, sizeof err);
-    CHECK_INT(ptr_color_select(c, NULL, "Filmic", NULL, 0, err, sizeof err), 1);
-    CHECK(strstr(err, "'Filmic'") && strstr(err, "'Standard'") && strstr(err, "'Raw'"));
-    CHECK_INT(ptr_color_select(c, "Projector", NULL, NULL, 0, err, sizeof err), 1);
-    CHECK(strstr(err, "'sRGB'") != NULL);
-    CHECK_INT(ptr_color_select(c, NULL, NULL, "Sepia", 0, err, sizeof err), 1);
-    CHECK(strstr(err, "'Punchy'") != NULL);
+    PtrColor *c = ptr_color_open(NULL, &err);
+    CHECK_INT(ptr_color_select(c, NULL, "Filmic", NULL, 0, &err), PTR_ERR_USAGE);
+    CHECK(strstr(err.message, "'Filmic'") && strstr(err.message, "'Standard'") &&
+          strstr(err.message, "'Raw'"));
+    CHECK_INT(ptr_color_select(c, "Projector", NULL, NULL, 0, &err), PTR_ERR_USAGE);
+    CHECK(strstr(err.message, "'sRGB'") != NULL);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, "Sepia", 0, &err), PTR_ERR_USAGE);
+    CHECK(strstr(err.message, "'Punchy'") != NULL);
     ptr_color_close(c);
 
     /* Through the command line: exit codes, and the output left alone. */
@@ -173,8 +176,8 @@ static void test_errors(void)
 /* Exposure, looks, depths and what the files say about themselves. */
 static void test_output_path(void)
 {
-    char err[256];
-    PtrColor *c = ptr_color_open(NULL, err, sizeof err);
+    PtrError err;
+    PtrColor *c = ptr_color_open(NULL, &err);
     const float grey[3] = { 0.18f, 0.18f, 0.18f }, doubled[3] = { 0.36f, 0.36f, 0.36f };
     const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
 
@@ -182,20 +185,20 @@ static void test_output_path(void)
     float a[3], b[3];
     memcpy(a, grey, sizeof a);
     memcpy(b, doubled, sizeof b);
-    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 1.0f, err, sizeof err), 0);
-    ptr_color_apply(c, a, 1, err, sizeof err);
-    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0.0f, err, sizeof err), 0);
-    ptr_color_apply(c, b, 1, err, sizeof err);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 1.0f, &err), 0);
+    ptr_color_apply(c, a, 1, &err);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0.0f, &err), 0);
+    ptr_color_apply(c, b, 1, &err);
     CHECK_NEAR(a[0], b[0], 1e-6);
 
     /* The look changes the image; Punchy's CDL darkens mid grey (power 1.2). */
     float looked[3] = { 0.18f, 0.18f, 0.18f };
-    CHECK_INT(ptr_color_select(c, NULL, NULL, "Punchy", 0.0f, err, sizeof err), 0);
-    ptr_color_apply(c, looked, 1, err, sizeof err);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, "Punchy", 0.0f, &err), 0);
+    ptr_color_apply(c, looked, 1, &err);
     CHECK_NEAR(looked[0], 0.461356 * pow(0.18, 0.2 / 2.4), 0.01); /* 0.18^1.2 encoded */
 
     /* 16-bit PNG: 0.18 grey through Standard is sRGB 0.461356, code 30235. */
-    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0.0f, err, sizeof err), 0);
+    CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0.0f, &err), 0);
     PtrOutputInfo info = info_for(c);
     PtrError perr = { 0 };
     info.depth = PTR_DEPTH_16;

@@ -54,8 +54,8 @@ static PtrImage *render_file(const char *scene, const char *out, const char *ker
     char *argv[] = { "ptr", (char *)scene, "-o", (char *)out, "--width", "96", "--samples", "3",
                      "--quiet", (char *)kernel, NULL };
     CHECK_INT(ptr_cli_main(10, argv), 0);
-    char err[256];
-    PtrImage *img = ptr_image_read(out, err, sizeof err);
+    PtrError err;
+    PtrImage *img = ptr_image_read(out, &err);
     CHECK(img != NULL);
     return img;
 }

@@ -19,10 +19,10 @@
 
 static PtrImage *load(const char *path)
 {
-    char err[256];
-    PtrImage *img = ptr_image_read(path, err, sizeof err);
+    PtrError err;
+    PtrImage *img = ptr_image_read(path, &err);
     if (!img)
-        TEST_FAIL_("%s", err);
+        TEST_FAIL_("%s", err.message);
     return img;
 }
 

@@ -206,16 +206,13 @@ extern "C" const char *const gltf_implemented_extensions[] = {
     "KHR_materials_transmission", nullptr,
 };
 
-extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
-                                  int *unreadable)
+extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
 {
-    *unreadable = 0;
     try {
         bool readable = false;
         bool binary = is_binary_gltf(path, &readable);
         if (!readable) {
-            *unreadable = 1;
-            ptr_shim_error(err, err_size, std::string(path) + ": " + std::strerror(errno));
+            ptr_shim_error(err, PTR_ERR_SCENE_UNREADABLE, std::string(path) + ": " + std::strerror(errno));
             return nullptr;
         }
         auto doc = std::make_unique<GltfDoc>();
@@ -225,15 +222,15 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
         bool ok = binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
                          : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path);
         if (!ok) {
-            ptr_shim_error(err, err_size, std::string(path) + ": " +
-                                         (error.empty() ? "not a valid glTF file" : error));
+            ptr_shim_error(err, PTR_ERR_SCENE_INVALID,
+                           std::string(path) + ": " + (error.empty() ? "not a valid glTF file" : error));
             return nullptr;
         }
         std::string fault = required_extension_fault(doc->model);
         if (fault.empty())
             fault = check_indices(doc->model);
         if (!fault.empty()) {
-            ptr_shim_error(err, err_size, std::string(path) + ": " + fault);
+            ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": " + fault);
             return nullptr;
         }
         const tinygltf::Model &m = doc->model;
@@ -246,10 +243,8 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size,
             if (!b.uri.empty() && b.uri.compare(0, 5, "data:") != 0)
                 doc->files.push_back(b.uri[0] == '/' ? b.uri : dir + b.uri);
         return doc.release();
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
     } catch (...) {
-        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while parsing");
+        ptr_shim_caught(err, PTR_ERR_SCENE_INVALID, path);
     }
     return nullptr;
 }

@@ -6,6 +6,8 @@
 
 #include <stddef.h>
 
+#include "core/result.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -102,11 +104,12 @@ typedef struct GltfScene {
     int resolution_invalid; /* extras.resolution present but not two integers */
 } GltfScene;
 
-/* Loads .gltf or .glb (chosen by the file's first bytes). Returns NULL and
- * writes one line to err on failure; *unreadable is set when the file could
- * not be read at all (as opposed to read and found malformed). Warnings from
- * the parser are ignored: ptr reports what it drops itself. */
-GltfDoc *gltf_doc_load(const char *path, char *err, size_t err_size, int *unreadable);
+/* Loads .gltf or .glb (chosen by the file's first bytes). Returns NULL on
+ * failure, with err filled: PTR_ERR_SCENE_UNREADABLE when the file could not
+ * be read at all, PTR_ERR_SCENE_INVALID when it was read and found
+ * malformed, PTR_ERR_NOMEM. Warnings from the parser are ignored: ptr
+ * reports what it drops itself. */
+GltfDoc *gltf_doc_load(const char *path, PtrError *err);
 void gltf_doc_free(GltfDoc *doc);
 
 /* The extensions ptr implements, for messages: glTF files that require

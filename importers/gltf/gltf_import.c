@@ -574,12 +574,9 @@ static PtrResult read_scene_extras(Importer *im, const GltfScene *gs)
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                           PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {
-    char message[sizeof err->message];
-    int unreadable;
-    GltfDoc *doc = gltf_doc_load(path, message, sizeof message, &unreadable);
+    GltfDoc *doc = gltf_doc_load(path, err);
     if (!doc)
-        return ptr_error_set(err, unreadable ? PTR_ERR_SCENE_UNREADABLE : PTR_ERR_SCENE_INVALID,
-                             "%s", message);
+        return err->code;
 
     Importer im = {
         .path = path, .doc = doc, .scene = scene, .warnings = warnings, .err = err,
@@ -608,9 +605,8 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                             im.camera_name);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
-    if (res == PTR_OK && ptr_builder_finish(&im.builder, PTR_BUILD_DEFAULT) != PTR_OK)
-        res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                            "%s: a sphere lies too far from the camera for single precision", path);
+    if (res == PTR_OK)
+        res = ptr_import_finish(&im.builder, path, err);
     ptr_builder_free(&im.builder);
     free(im.material_index);
     gltf_doc_free(doc);

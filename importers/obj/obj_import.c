@@ -432,9 +432,8 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
     if (res == PTR_OK && fitted == 0 && r->nv == 0)
         res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: no vertices: not an OBJ file?",
                             r->path);
-    if (res == PTR_OK && ptr_builder_finish(&builder, PTR_BUILD_DEFAULT) != PTR_OK)
-        res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
-                            "%s: a sphere lies too far from the camera for single precision", r->path);
+    if (res == PTR_OK)
+        res = ptr_import_finish(&builder, r->path, r->err);
     ptr_builder_free(&builder);
     return res;
 }

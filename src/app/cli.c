@@ -79,8 +79,9 @@ static int dump_scenes(const PtrOptions *o)
         if (res == PTR_OK) {
             if (o->has_sky)
                 scene.sky = o->sky;
-            if (ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings) != PTR_OK)
-                res = ptr_error_set(&err, PTR_ERR_NOMEM, "%s: out of memory", o->inputs[i]);
+            res = ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings);
+            if (res != PTR_OK)
+                ptr_error_set(&err, res, "%s: %s", o->inputs[i], ptr_result_description(res));
         }
         if (res != PTR_OK) {
             int failed = fail(&err);
@@ -192,7 +193,6 @@ int ptr_cli_main(int argc, char **argv)
     if (o.dump_scene)
         return dump_scenes(&o);
 
-    char message[512];
     PtrError err = { 0 };
     /* Renders and merges write images: OpenImageIO loads on a thread of its
      * own while the colour config, the scenes and the render proceed. The
@@ -200,22 +200,15 @@ int ptr_cli_main(int argc, char **argv)
      * while the load runs. */
     if (!o.list_views)
         ptr_threads_keep(o.threads > 0 ? o.threads : ptr_online_cpus());
-    if (!o.list_views && ptr_image_preload(message, sizeof message)) {
-        ptr_error_set(&err, PTR_ERR_INSTALL, "%s", message);
+    if (!o.list_views && ptr_image_preload(&err) != PTR_OK)
         return fail(&err);
-    }
-    PtrColor *color = ptr_color_open(o.ocio_config, message, sizeof message);
-    if (!color) {
-        ptr_error_set(&err, PTR_ERR_COLOR, "%s", message);
+    PtrColor *color = ptr_color_open(o.ocio_config, &err);
+    if (!color)
         return fail(&err);
-    }
-    int bad = ptr_color_select(color, o.display, o.view, o.look, o.exposure, message, sizeof message);
-    if (bad) {
-        ptr_error_set(&err, bad > 0 ? PTR_ERR_USAGE : PTR_ERR_COLOR, "%s", message);
+    if (ptr_color_select(color, o.display, o.view, o.look, o.exposure, &err) != PTR_OK) {
         code = fail(&err);
     } else if (o.list_views) {
-        ptr_color_list(color, stdout);
-        code = 0;
+        code = ptr_color_list(color, stdout, &err) == PTR_OK ? 0 : fail(&err);
     } else if (o.merge) {
         PtrJobReport report;
         ptr_merge(o.inputs, o.input_count, o.output, &o, color, &report);

@@ -134,9 +134,10 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
      * their order, but there is no need to find the file order again. */
     uint64_t scene_hash = ptr_scene_hash(scene);
     PtrAccel accel;
-    if (ptr_accel_init(&accel, o->accel, &isect, scene, o->threads) != PTR_OK)
-        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate the tree over %zu spheres",
-                             report->scene, scene->spheres.count);
+    PtrResult built = ptr_accel_init(&accel, o->accel, &isect, scene, o->threads);
+    if (built != PTR_OK)
+        return ptr_error_set(err, built, "%s: cannot build the tree over %zu spheres: %s",
+                             report->scene, scene->spheres.count, ptr_result_description(built));
     snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&accel));
     report->spheres = scene->spheres.count;
     report->build_seconds = accel.build_seconds;

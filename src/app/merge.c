@@ -27,12 +27,9 @@ static const char *required(const Part *p, const char *name, PtrError *err)
 
 static PtrResult read_part(Part *p, PtrError *err)
 {
-    char message[sizeof err->message];
-    if (ptr_image_ready(message, sizeof message))
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
-    p->image = ptr_image_read(p->path, message, sizeof message);
+    p->image = ptr_image_read(p->path, err);
     if (!p->image)
-        return ptr_error_set(err, PTR_ERR_USAGE, "%s", message);
+        return err->code;
     p->layout = ptr_image_layout(p->image);
     const char *first, *samples, *depth, *space;
     if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||

@@ -72,10 +72,9 @@ static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
 
 PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
 {
-    char message[sizeof err->message];
     int known = find_format(path) != NULL;
-    if (!known && ptr_image_ready(message, sizeof message))
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
+    if (!known && ptr_image_ready(err) != PTR_OK)
+        return err->code;
     if (!known && !ptr_image_can_write(path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);
@@ -111,7 +110,6 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
     int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
     int display_referred = !is_float || info->bake_view;
     size_t pixels = (size_t)layout->width * (size_t)layout->height;
-    char message[sizeof err->message];
 
     float *viewed = NULL;
     if (display_referred) {
@@ -119,9 +117,10 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         if (!viewed)
             return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
         memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
-        if (ptr_color_apply(info->color, viewed, pixels, message, sizeof message)) {
+        PtrError color_err;
+        if (ptr_color_apply(info->color, viewed, pixels, &color_err) != PTR_OK) {
             free(viewed);
-            return ptr_error_set(err, PTR_ERR_COLOR, "%s: %s", path, message);
+            return ptr_error_set(err, color_err.code, "%s: %s", path, color_err.message);
         }
     }
 
@@ -174,12 +173,8 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
     };
     const char *dot = strrchr(path, '.');
     const float *counts = dot && !strcasecmp(dot, ".exr") ? info->sample_counts : NULL;
-    PtrResult res = PTR_OK;
-    if (ptr_image_ready(message, sizeof message))
-        res = ptr_error_set(err, PTR_ERR_INSTALL, "%s", message);
-    else if (ptr_image_write(path, layout, viewed ? viewed : rgb, counts, pixel_formats[depth],
-                             attrs, sizeof attrs / sizeof attrs[0], message, sizeof message))
-        res = ptr_error_set(err, PTR_ERR_OUTPUT, "%s", message);
+    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, counts,
+                                    pixel_formats[depth], attrs, sizeof attrs / sizeof attrs[0], err);
     free(viewed);
     return res;
 }

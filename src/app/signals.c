@@ -28,5 +28,6 @@ void ptr_signals_install(void)
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, NULL);
     sigaction(SIGTERM, &action, NULL);
+    ptr_uncaught_install();
     ptr_stop_requested = 0;
 }

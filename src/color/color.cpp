@@ -31,7 +31,7 @@ std::string join(const std::string &label, int count, const std::function<const 
 
 } // namespace
 
-extern "C" PtrColor *ptr_color_open(const char *path, char *err, size_t err_size)
+extern "C" PtrColor *ptr_color_open(const char *path, PtrError *err)
 {
     const char *env = std::getenv("OCIO");
     const bool from_env = !path && env && *env;
@@ -54,10 +54,8 @@ extern "C" PtrColor *ptr_color_open(const char *path, char *err, size_t err_size
             throw OCIO::Exception("the config has no display");
         color->source = source;
         return color.release();
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, label + ": " + e.what());
     } catch (...) {
-        ptr_shim_error(err, err_size, label + ": unexpected error");
+        ptr_shim_caught(err, PTR_ERR_COLOR, label);
     }
     return nullptr;
 }
@@ -69,8 +67,8 @@ extern "C" const char *ptr_color_view(const PtrColor *c) { return c->view.c_str(
 extern "C" const char *ptr_color_look(const PtrColor *c) { return c->look.c_str(); }
 extern "C" const char *ptr_color_view_space(const PtrColor *c) { return c->view_space.c_str(); }
 
-extern "C" int ptr_color_select(PtrColor *color, const char *display, const char *view,
-                                const char *look, float exposure_stops, char *err, size_t err_size)
+extern "C" PtrResult ptr_color_select(PtrColor *color, const char *display, const char *view,
+                                      const char *look, float exposure_stops, PtrError *err)
 {
     try {
         const OCIO::ConstConfigRcPtr &config = color->config;
@@ -79,27 +77,26 @@ extern "C" int ptr_color_select(PtrColor *color, const char *display, const char
         for (int i = 0; i < config->getNumDisplays(); i++)
             known = known || d == config->getDisplay(i);
         if (!known) {
-            ptr_shim_error(err, err_size,
-                      join("unknown display '" + d + "'; " + color->source + " has",
-                           config->getNumDisplays(), [&](int i) { return config->getDisplay(i); }));
-            return 1;
+            return ptr_shim_error(
+                err, PTR_ERR_USAGE,
+                join("unknown display '" + d + "'; " + color->source + " has",
+                     config->getNumDisplays(), [&](int i) { return config->getDisplay(i); }));
         }
         std::string v = view ? view : config->getDefaultView(d.c_str());
         known = false;
         for (int i = 0; i < config->getNumViews(d.c_str()); i++)
             known = known || v == config->getView(d.c_str(), i);
         if (!known) {
-            ptr_shim_error(err, err_size,
-                      join("unknown view '" + v + "' for display '" + d + "'; it has",
-                           config->getNumViews(d.c_str()),
-                           [&](int i) { return config->getView(d.c_str(), i); }));
-            return 1;
+            return ptr_shim_error(err, PTR_ERR_USAGE,
+                                  join("unknown view '" + v + "' for display '" + d + "'; it has",
+                                       config->getNumViews(d.c_str()),
+                                       [&](int i) { return config->getView(d.c_str(), i); }));
         }
         if (look && *look && !config->getLook(look)) {
-            ptr_shim_error(err, err_size,
-                      join(std::string("unknown look '") + look + "'; " + color->source + " has",
-                           config->getNumLooks(), [&](int i) { return config->getLookNameByIndex(i); }));
-            return 1;
+            return ptr_shim_error(
+                err, PTR_ERR_USAGE,
+                join(std::string("unknown look '") + look + "'; " + color->source + " has",
+                     config->getNumLooks(), [&](int i) { return config->getLookNameByIndex(i); }));
         }
 
         auto transform = OCIO::DisplayViewTransform::Create();
@@ -124,32 +121,26 @@ extern "C" int ptr_color_select(PtrColor *color, const char *display, const char
         color->view = v;
         color->look = look ? look : "";
         color->view_space = config->getDisplayViewColorSpaceName(d.c_str(), v.c_str());
-        return 0;
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, "OCIO config " + color->source + ": " + e.what());
+        return PTR_OK;
     } catch (...) {
-        ptr_shim_error(err, err_size, "OCIO config " + color->source + ": unexpected error");
+        return ptr_shim_caught(err, PTR_ERR_COLOR, "OCIO config " + color->source);
     }
-    return -1;
 }
 
-extern "C" int ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels, char *err,
-                               size_t err_size)
+extern "C" PtrResult ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels,
+                                     PtrError *err)
 {
     try {
         OCIO::PackedImageDesc image(rgb, long(pixels), 1, 3);
         color->cpu->apply(image);
-        return 0;
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, std::string("OCIO: ") + e.what());
+        return PTR_OK;
     } catch (...) {
-        ptr_shim_error(err, err_size, "OCIO: unexpected error");
+        return ptr_shim_caught(err, PTR_ERR_COLOR, "OCIO");
     }
-    return -1;
 }
 
-extern "C" void ptr_color_list(const PtrColor *color, FILE *out)
-{
+extern "C" PtrResult ptr_color_list(const PtrColor *color, FILE *out, PtrError *err)
+try {
     const OCIO::ConstConfigRcPtr &config = color->config;
     std::fprintf(out, "config: %s\n", color->source.c_str());
     const char *default_display = config->getDefaultDisplay();
@@ -164,4 +155,7 @@ extern "C" void ptr_color_list(const PtrColor *color, FILE *out)
     }
     for (int i = 0; i < config->getNumLooks(); i++)
         std::fprintf(out, "look: %s\n", config->getLookNameByIndex(i));
+    return PTR_OK;
+} catch (...) {
+    return ptr_shim_caught(err, PTR_ERR_COLOR, "OCIO config " + color->source);
 }

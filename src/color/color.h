@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "core/result.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -15,9 +17,9 @@ typedef struct PtrColor PtrColor;
 
 /* Loads a config: the file at path if given, else the one $OCIO names, else
  * ptr's embedded one. A config that cannot be loaded, fails validation or has
- * no scene_linear role is an error (NULL, err filled, naming the file): never
- * a silent fallback to another config. */
-PtrColor *ptr_color_open(const char *path, char *err, size_t err_size);
+ * no scene_linear role is an error (NULL, err filled with PTR_ERR_COLOR and a
+ * line naming the file): never a silent fallback to another config. */
+PtrColor *ptr_color_open(const char *path, PtrError *err);
 void ptr_color_close(PtrColor *color);
 
 /* Where the config came from: its path, or "embedded". */
@@ -25,10 +27,10 @@ const char *ptr_color_source(const PtrColor *color);
 
 /* Chooses the display and view (NULL: the config's defaults), an optional
  * look, and an exposure in stops applied in scene-linear before the view.
- * Returns 0; 1 for an unknown name, with err listing the valid ones; -1 if
- * OpenColorIO fails, with err saying why. */
-int ptr_color_select(PtrColor *color, const char *display, const char *view, const char *look,
-                     float exposure_stops, char *err, size_t err_size);
+ * Returns PTR_OK; PTR_ERR_USAGE for an unknown name, with err listing the
+ * valid ones; PTR_ERR_COLOR if OpenColorIO fails, with err saying why. */
+PtrResult ptr_color_select(PtrColor *color, const char *display, const char *view,
+                           const char *look, float exposure_stops, PtrError *err);
 
 const char *ptr_color_display(const PtrColor *color);
 const char *ptr_color_view(const PtrColor *color);
@@ -37,11 +39,11 @@ const char *ptr_color_look(const PtrColor *color); /* "" for none */
 const char *ptr_color_view_space(const PtrColor *color);
 
 /* Transforms RGB pixels in place from scene-linear to the selected view.
- * Returns 0, or -1 with err filled. */
-int ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels, char *err, size_t err_size);
+ * Returns PTR_OK, or the failure, with err filled. */
+PtrResult ptr_color_apply(const PtrColor *color, float *rgb, size_t pixels, PtrError *err);
 
 /* Prints the displays with their views, and the looks. */
-void ptr_color_list(const PtrColor *color, FILE *out);
+PtrResult ptr_color_list(const PtrColor *color, FILE *out, PtrError *err);
 
 /* ptr's embedded config, as text. */
 extern const char ptr_embedded_ocio_config[];

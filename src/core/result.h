@@ -4,6 +4,10 @@
 #ifndef PTR_RESULT_H
 #define PTR_RESULT_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /*        name                  exit  description */
 #define PTR_RESULT_MAP(X)                                                     \
     X(PTR_OK,                   0,   "success")                               \
@@ -42,5 +46,9 @@ typedef struct PtrError {
  * into a space so the message stays one line. Returns code. */
 PtrResult ptr_error_set(PtrError *err, PtrResult code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* PTR_RESULT_H */

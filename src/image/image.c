@@ -21,7 +21,7 @@ static pthread_t loader;
 static int loader_running;  /* started by ptr_image_preload and not joined yet */
 static int load_tried;      /* load() ran: module, else load_error, says how it went */
 static int exit_waits;      /* join_loader is registered with atexit */
-static char load_error[PATH_SIZE + 512]; /* a path and a line about it */
+static PtrError load_error; /* why the load failed */
 /* Set once the module works. Atomic because the signal handler reads it
  * (ptr_image_discard_partial). */
 static const PtrImageModule *_Atomic module;
@@ -29,24 +29,37 @@ static const PtrImageModule *_Atomic module;
 /* PTR_IMAGE_MODULE_PATH ("../lib/ptr/NAME.so") from the executable's folder,
  * each leading "../" taken off that folder, so that messages show a plain
  * path. */
-static int module_path(char *path, size_t size, char *err, size_t err_size)
+static PtrResult module_path(char *path, size_t size, PtrError *err)
 {
     ssize_t n = readlink("/proc/self/exe", path, size);
-    if (n <= 0 || (size_t)n >= size) {
-        snprintf(err, err_size, "/proc/self/exe: cannot find ptr's own folder, where its image "
-                                "module lives: %s", n < 0 ? strerror(errno) : "path too long");
-        return -1;
-    }
+    if (n <= 0 || (size_t)n >= size)
+        return ptr_error_set(err, PTR_ERR_INSTALL,
+                             "/proc/self/exe: cannot find ptr's own folder, where its image "
+                             "module lives: %s", n < 0 ? strerror(errno) : "path too long");
     path[n] = '\0';
     const char *relative = PTR_IMAGE_MODULE_PATH;
     *strrchr(path, '/') = '\0'; /* the kernel gives an absolute path */
     for (char *slash; !strncmp(relative, "../", 3) && (slash = strrchr(path, '/')); relative += 3)
         *slash = '\0';
     size_t used = strlen(path);
-    if ((size_t)snprintf(path + used, size - used, "/%s", relative) >= size - used) {
-        snprintf(err, err_size, "%s: path too long for ptr's image module", path);
-        return -1;
-    }
+    if ((size_t)snprintf(path + used, size - used, "/%s", relative) >= size - used)
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: path too long for ptr's image module",
+                             path);
+    return PTR_OK;
+}
+
+/* Whether dlopen failed for want of memory. It reports text alone (errno
+ * does not survive it), so this knows glibc's words for the cases: a mapping
+ * refused (a segment, the zero-filled pages) or an allocation failed. */
+static int dl_out_of_memory(const char *why)
+{
+    static const char *const signs[] = {
+        "failed to map segment", "cannot map zero-fill pages", "cannot allocate",
+        "Cannot allocate memory", "out of memory",
+    };
+    for (size_t i = 0; i < sizeof signs / sizeof signs[0]; i++)
+        if (strstr(why, signs[i]))
+            return 1;
     return 0;
 }
 
@@ -54,7 +67,7 @@ static void load(void)
 {
     char path[PATH_SIZE];
     const PtrImageModule *m = NULL;
-    if (!module_path(path, sizeof path, load_error, sizeof load_error)) {
+    if (module_path(path, sizeof path, &load_error) == PTR_OK) {
         /* Lazy binding, as when a program links the libraries: binding all of
          * their functions up front costs a tenth more. */
         void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
@@ -64,12 +77,16 @@ static void load(void)
             size_t len = strlen(path);
             if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
                 why += len + 2;
-            snprintf(load_error, sizeof load_error, "%s: cannot load ptr's image module: %s", path,
-                     why);
+            if (dl_out_of_memory(why))
+                ptr_error_set(&load_error, PTR_ERR_NOMEM,
+                              "%s: out of memory: cannot load ptr's image module: %s", path, why);
+            else
+                ptr_error_set(&load_error, PTR_ERR_INSTALL,
+                              "%s: cannot load ptr's image module: %s", path, why);
         } else if (!(m = dlsym(handle, PTR_IMAGE_MODULE_SYMBOL)) || m->size != sizeof *m ||
                    strcmp(m->version, PTR_VERSION)) {
-            snprintf(load_error, sizeof load_error, "%s: not the image module of ptr %s", path,
-                     PTR_VERSION);
+            ptr_error_set(&load_error, PTR_ERR_INSTALL, "%s: not the image module of ptr %s", path,
+                          PTR_VERSION);
             m = NULL;
             dlclose(handle);
         }
@@ -103,15 +120,14 @@ static void join_loader(void)
     pthread_mutex_unlock(&lock);
 }
 
-int ptr_image_preload(char *err, size_t err_size)
+PtrResult ptr_image_preload(PtrError *err)
 {
     char path[PATH_SIZE];
-    if (module_path(path, sizeof path, err, err_size))
-        return -1;
-    if (access(path, R_OK)) {
-        snprintf(err, err_size, "%s: ptr's image module is missing: %s", path, strerror(errno));
-        return -1;
-    }
+    if (module_path(path, sizeof path, err) != PTR_OK)
+        return err->code;
+    if (access(path, R_OK))
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: ptr's image module is missing: %s", path,
+                             strerror(errno));
     pthread_mutex_lock(&lock);
     /* A thread that cannot start leaves the load to the first use. */
     if (!loader_running && !load_tried && !pthread_create(&loader, NULL, load_on_thread, NULL)) {
@@ -120,10 +136,10 @@ int ptr_image_preload(char *err, size_t err_size)
             exit_waits = !atexit(join_loader);
     }
     pthread_mutex_unlock(&lock);
-    return 0;
+    return PTR_OK;
 }
 
-int ptr_image_ready(char *err, size_t err_size)
+PtrResult ptr_image_ready(PtrError *err)
 {
     pthread_mutex_lock(&lock);
     join_loader_locked();
@@ -131,31 +147,32 @@ int ptr_image_ready(char *err, size_t err_size)
         load();
     pthread_mutex_unlock(&lock);
     if (atomic_load(&module))
-        return 0;
-    snprintf(err, err_size, "%s", load_error);
-    return -1;
+        return PTR_OK;
+    if (err)
+        *err = load_error;
+    return load_error.code;
 }
 
 /* The module, loaded now if need be; NULL if it cannot be, with the reason
  * in err. */
-static const PtrImageModule *loaded(char *err, size_t err_size)
+static const PtrImageModule *loaded(PtrError *err)
 {
-    return ptr_image_ready(err, err_size) ? NULL : atomic_load(&module);
+    return ptr_image_ready(err) == PTR_OK ? atomic_load(&module) : NULL;
 }
 
 int ptr_image_can_write(const char *path)
 {
-    const PtrImageModule *m = loaded(NULL, 0);
+    const PtrImageModule *m = loaded(NULL);
     return m && m->can_write(path);
 }
 
-int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                    const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs,
-                    size_t attr_count, char *err, size_t err_size)
+PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
+                          const float *sample_counts, PtrPixelFormat format,
+                          const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
-    const PtrImageModule *m = loaded(err, err_size);
-    return m ? m->write(path, layout, rgb, sample_counts, format, attrs, attr_count, err, err_size)
-             : -1;
+    const PtrImageModule *m = loaded(err);
+    return m ? m->write(path, layout, rgb, sample_counts, format, attrs, attr_count, err)
+             : err->code;
 }
 
 void ptr_image_discard_partial(void)
@@ -166,10 +183,10 @@ void ptr_image_discard_partial(void)
         m->discard_partial();
 }
 
-PtrImage *ptr_image_read(const char *path, char *err, size_t err_size)
+PtrImage *ptr_image_read(const char *path, PtrError *err)
 {
-    const PtrImageModule *m = loaded(err, err_size);
-    return m ? m->read(path, err, err_size) : NULL;
+    const PtrImageModule *m = loaded(err);
+    return m ? m->read(path, err) : NULL;
 }
 
 /* An image exists only once the module works: the accessors need no check. */

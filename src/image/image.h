@@ -6,6 +6,8 @@
 
 #include <stddef.h>
 
+#include "core/result.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -38,14 +40,17 @@ typedef struct PtrImageLayout {
 } PtrImageLayout;
 
 /* Starts loading the module on a thread of its own, for the first image to
- * come, and returns at once: 0, or -1 with one line in err if the module file
- * is missing (a broken installation). Loading or not, the process waits for
- * that thread before it exits. */
-int ptr_image_preload(char *err, size_t err_size);
+ * come, and returns at once: PTR_OK, or PTR_ERR_INSTALL with one line in err
+ * if the module file is missing (a broken installation). Loading or not, the
+ * process waits for that thread before it exits. */
+PtrResult ptr_image_preload(PtrError *err);
 
-/* Loads the module, or waits for ptr_image_preload's thread: 0 once the
- * functions below work, else -1 with one line in err (they then fail). */
-int ptr_image_ready(char *err, size_t err_size);
+/* Loads the module, or waits for ptr_image_preload's thread: PTR_OK once
+ * the functions below work, else (and they then fail alike) PTR_ERR_NOMEM
+ * if the module or a library it needs could not be mapped for want of
+ * memory, PTR_ERR_INSTALL if it cannot be loaded otherwise, with one line in
+ * err. */
+PtrResult ptr_image_ready(PtrError *err);
 
 /* Whether a writer exists for the file's extension. */
 int ptr_image_can_write(const char *path);
@@ -55,11 +60,12 @@ int ptr_image_can_write(const char *path);
  * fourth float channel "samples" from it.
  * The file is created under a temporary name in the same directory and
  * renamed over path only once complete, so an existing file is replaced by a
- * whole new one or not at all. Returns 0 on success; otherwise fills err with
- * one line and returns -1. */
-int ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                    const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
-                    char *err, size_t err_size);
+ * whole new one or not at all. Returns PTR_OK; otherwise fills err with one
+ * line and returns its code: PTR_ERR_OUTPUT, PTR_ERR_NOMEM, or what
+ * ptr_image_ready says. */
+PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
+                          const float *sample_counts, PtrPixelFormat format,
+                          const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
 
 /* Removes the temporary file of a write under way, if any. Safe to call from
  * a signal handler: for a process that is about to _exit mid-write. */
@@ -68,7 +74,10 @@ void ptr_image_discard_partial(void);
 /* An image read back as float RGB (extra channels dropped, grey replicated). */
 typedef struct PtrImage PtrImage;
 
-PtrImage *ptr_image_read(const char *path, char *err, size_t err_size);
+/* NULL on failure, with err filled: PTR_ERR_USAGE for a file that is not an
+ * image the module can read (images are read only as files the command line
+ * names), PTR_ERR_NOMEM, or what ptr_image_ready says. */
+PtrImage *ptr_image_read(const char *path, PtrError *err);
 void ptr_image_free(PtrImage *image);
 int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);

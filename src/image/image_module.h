@@ -19,11 +19,11 @@ typedef struct PtrImageModule {
     const char *version;
 
     int (*can_write)(const char *path);
-    int (*write)(const char *path, const PtrImageLayout *layout, const float *rgb,
-                 const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs,
-                 size_t attr_count, char *err, size_t err_size);
+    PtrResult (*write)(const char *path, const PtrImageLayout *layout, const float *rgb,
+                       const float *sample_counts, PtrPixelFormat format,
+                       const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
     void (*discard_partial)(void);
-    PtrImage *(*read)(const char *path, char *err, size_t err_size);
+    PtrImage *(*read)(const char *path, PtrError *err);
     void (*free)(PtrImage *image);
     int (*width)(const PtrImage *image);
     int (*height)(const PtrImage *image);

@@ -67,19 +67,18 @@ void discard_partial(void)
         unlink(partial_path);
 }
 
-int write_image(const char *path, const PtrImageLayout *layout, const float *rgb,
-                const float *sample_counts, PtrPixelFormat format, const PtrImageAttr *attrs,
-                size_t attr_count, char *err, size_t err_size)
+PtrResult write_image(const char *path, const PtrImageLayout *layout, const float *rgb,
+                      const float *sample_counts, PtrPixelFormat format,
+                      const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
     std::string tmp;
     try {
         // The writer is chosen from the real name; the temporary name only
         // receives the bytes.
         auto out = OIIO::ImageOutput::create(path);
-        if (!out) {
-            ptr_shim_error(err, err_size, std::string(path) + ": no image format for this extension");
-            return -1;
-        }
+        if (!out)
+            return ptr_shim_error(err, PTR_ERR_OUTPUT,
+                                  std::string(path) + ": no image format for this extension");
         int channels = sample_counts ? 4 : 3;
         OIIO::ImageSpec spec(layout->width, layout->height, channels, pixel_type(format));
         std::vector<float> interleaved;
@@ -117,50 +116,45 @@ int write_image(const char *path, const PtrImageLayout *layout, const float *rgb
         }
         if (!out->open(tmp, spec)) {
             partial_active = 0;
-            ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
-            return -1;
+            return ptr_shim_error(err, PTR_ERR_OUTPUT, std::string(path) + ": " + out->geterror());
         }
         bool ok = out->write_image(OIIO::TypeDesc::FLOAT, sample_counts ? interleaved.data() : rgb);
         ok = out->close() && ok;
         if (!ok) {
-            ptr_shim_error(err, err_size, std::string(path) + ": " + out->geterror());
             std::remove(tmp.c_str());
             partial_active = 0;
-            return -1;
+            return ptr_shim_error(err, PTR_ERR_OUTPUT, std::string(path) + ": " + out->geterror());
         }
         if (std::rename(tmp.c_str(), path) != 0) {
-            ptr_shim_error(err, err_size, std::string(path) + ": cannot replace file: " +
-                                         std::strerror(errno));
+            const std::string why = std::strerror(errno);
             std::remove(tmp.c_str());
             partial_active = 0;
-            return -1;
+            return ptr_shim_error(err, PTR_ERR_OUTPUT,
+                                  std::string(path) + ": cannot replace file: " + why);
         }
         partial_active = 0;
-        return 0;
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
+        return PTR_OK;
     } catch (...) {
-        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while writing");
+        if (!tmp.empty())
+            std::remove(tmp.c_str());
+        partial_active = 0;
+        return ptr_shim_caught(err, PTR_ERR_OUTPUT, path);
     }
-    if (!tmp.empty())
-        std::remove(tmp.c_str());
-    partial_active = 0;
-    return -1;
 }
 
-PtrImage *read_image(const char *path, char *err, size_t err_size)
+PtrImage *read_image(const char *path, PtrError *err)
 {
     try {
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
-            ptr_shim_error(err, err_size, std::string(path) + ": " + OIIO::geterror());
+            ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + OIIO::geterror());
             return nullptr;
         }
         const OIIO::ImageSpec &spec = in->spec();
         std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
         if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
-            ptr_shim_error(err, err_size, std::string(path) + ": " + in->geterror());
+            ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + in->geterror());
             return nullptr;
         }
         auto image = std::make_unique<PtrImage>();
@@ -177,10 +171,8 @@ PtrImage *read_image(const char *path, char *err, size_t err_size)
             image->attrs[param.name().string()] = param.get_string();
         in->close();
         return image.release();
-    } catch (const std::exception &e) {
-        ptr_shim_error(err, err_size, std::string(path) + ": " + e.what());
     } catch (...) {
-        ptr_shim_error(err, err_size, std::string(path) + ": unexpected error while reading");
+        ptr_shim_caught(err, PTR_ERR_USAGE, path);
     }
     return nullptr;
 }

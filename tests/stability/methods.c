@@ -1,23 +1,32 @@
 #include "methods.h"
 
-#include "accel/cpu.h"
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "builder.h"
 #include "naive.h"
 
-int stability_methods(Method *m)
+static void add(Method *methods, int capacity, int *count, Method m)
+{
+    if (*count >= capacity) {
+        fprintf(stderr, "stability_methods: more than %d methods (at \"%s\")\n", capacity, m.name);
+        exit(2);
+    }
+    methods[(*count)++] = m;
+}
+
+int stability_methods(Method *m, int capacity)
 {
     int n = 0;
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     PtrIsectTable naive = { .closest_hit = naive_closest_hit, .name = "naive" };
 
-    m[n++] = (Method){ "naive, t_min 1e-3", naive, 1e-3f, 0, 0 };
-    m[n++] = (Method){ "robust, t_min 1e-3", c, 1e-3f, 0, 0 };
-    m[n++] = (Method){ "robust, offset", c, 0.0f, 0, 0 };
-    m[n++] = (Method){ "huge in float", c, 0.0f, PTR_BUILD_RECENTRE, 0 };
-    m[n++] = (Method){ "ptr (c)", c, 0.0f, PTR_BUILD_DEFAULT, 1 };
+    add(m, capacity, &n, (Method){ "naive, t_min 1e-3", naive, 1e-3f, 0, 0 });
+    add(m, capacity, &n, (Method){ "robust, t_min 1e-3", c, 1e-3f, 0, 0 });
+    add(m, capacity, &n, (Method){ "robust, offset", c, 0.0f, 0, 0 });
+    add(m, capacity, &n, (Method){ "huge in float", c, 0.0f, PTR_BUILD_RECENTRE, 0 });
+    add(m, capacity, &n, (Method){ "ptr (c)", c, 0.0f, PTR_BUILD_DEFAULT, 1 });
     for (int l = PTR_CPU_SSE41; l <= (int)ptr_cpu_level(); l++) {
         PtrIsectTable t;
         ptr_isect_init_level(&t, (PtrCpuLevel)l);
@@ -25,7 +34,7 @@ int stability_methods(Method *m)
             continue;
         static char names[PTR_CPU_LEVEL_COUNT][16];
         snprintf(names[l], sizeof names[l], "ptr (%s)", t.name);
-        m[n++] = (Method){ names[l], t, 0.0f, PTR_BUILD_DEFAULT, 1 };
+        add(m, capacity, &n, (Method){ names[l], t, 0.0f, PTR_BUILD_DEFAULT, 1 });
     }
     return n;
 }

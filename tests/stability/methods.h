@@ -3,6 +3,7 @@
 #ifndef PTR_TEST_METHODS_H
 #define PTR_TEST_METHODS_H
 
+#include "accel/cpu.h"
 #include "accel/isect.h"
 
 typedef struct Method {
@@ -13,9 +14,12 @@ typedef struct Method {
     int is_ptr;       /* ptr's own method: it must pass everything */
 } Method;
 
-enum { MAX_METHODS = 8 };
+/* The counter-examples and ptr's C method, then one method a CPU level above
+ * none: the most there can be, whatever the CPU. */
+enum { FIXED_METHODS = 5, MAX_METHODS = FIXED_METHODS + PTR_CPU_LEVEL_COUNT - 1 };
 
-/* Fills methods; returns how many. */
-int stability_methods(Method *methods);
+/* Fills methods, which holds capacity of them; returns how many. Exits with
+ * a message if they do not fit, rather than writing past the array. */
+int stability_methods(Method *methods, int capacity);
 
 #endif

@@ -212,7 +212,7 @@ static int resting_sphere_row(const Method *methods, int n)
 int main(void)
 {
     Method methods[MAX_METHODS];
-    int n = stability_methods(methods);
+    int n = stability_methods(methods, MAX_METHODS);
     const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.5f) };
     const PtrMaterial mirror = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(0.7f) };
     const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1.0f), .ior = 1.5f };

@@ -90,7 +90,7 @@ static void lit_ground_table(const Method *methods, int n)
 int main(void)
 {
     Method methods[MAX_METHODS];
-    int n = stability_methods(methods);
+    int n = stability_methods(methods, MAX_METHODS);
     const PtrSky black = { .kind = PTR_SKY_BLACK };
     const PtrSky bright = { .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(1000.0f) };
 

@@ -44,7 +44,8 @@ enum { DECADES = 16, FIRST_DECADE = -6 };
 
 static void reference_rays(const Method *methods, int n)
 {
-    double worst[MAX_METHODS][DECADES] = { { 0 } };
+    /* Row m < n: methods[m] (n <= MAX_METHODS); row n: the naive method. */
+    double worst[MAX_METHODS + 1][DECADES] = { { 0 } };
     PtrIsectTable naive = { .closest_hit = naive_closest_hit, .name = "naive" };
     const int rays = 200000;
     PtrRng rng = ptr_rng_for_sample(11, 0, 0);
@@ -174,7 +175,7 @@ static int leave_surfaces(const PtrIsectTable *isect, int cases, uint64_t seed, 
 int main(int argc, char **argv)
 {
     Method methods[MAX_METHODS];
-    int n = stability_methods(methods);
+    int n = stability_methods(methods, MAX_METHODS);
     int cases = argc > 1 ? atoi(argv[1]) : 300000;
     reference_rays(methods, n);
     for (int m = 0; m < n; m++)
