@@ -5,5 +5,5 @@ run() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 run apt-get update -qq
 DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends \
     build-essential cmake pkg-config python3 nasm \
-    libopenimageio-dev openimageio-tools libopencolorio-dev opencolorio-tools \
+    libopenexr-dev libopenimageio-dev openimageio-tools libopencolorio-dev opencolorio-tools \
     libtinygltf-dev parallel >/dev/null

@@ -1,8 +1,9 @@
 #!/bin/sh
 # An installed tree renders on its own: `cmake --install` puts the image
 # module where the installed ptr looks for it (PREFIX/lib/ptr), and without a
-# working module a render fails with one line and exit code 10 while the
-# commands that write no image still work.
+# working module a render to PNG fails with one line and exit code 10 while
+# a render to EXR (OpenEXR, linked in) and the commands that write no image
+# still work.
 # Usage: test_install.sh CMAKE BUILD_DIR SOURCE_DIR
 set -u
 cmake=$1
@@ -23,7 +24,7 @@ LD_DEBUG=files render "$dir/a.png" 2>"$dir/log" || fail "installed render: exit 
 grep -q "file=$module .*dynamically loaded" "$dir/log" || fail "the installed module was not the one loaded"
 
 # expect_broken WHAT: a render and a merge fail with exit 10 and one line
-# naming the module, writing nothing; --version and --dump-scene still work.
+# naming the module, writing nothing; EXR, --version and --dump-scene still work.
 expect_broken() {
     render "$dir/b.png" 2>"$dir/err"
     code=$?
@@ -34,6 +35,7 @@ expect_broken() {
     "$ptr" merge "$dir/a.png" -o "$dir/c.exr" --quiet 2>"$dir/err"
     code=$?
     [ $code = 10 ] || fail "$1: merge exit code $code, not 10"
+    render "$dir/d.exr" || fail "$1: a render to EXR failed"
     "$ptr" --version >/dev/null || fail "$1: --version failed"
     "$ptr" --dump-scene "$src/scenes/seed.gltf" >/dev/null || fail "$1: --dump-scene failed"
 }

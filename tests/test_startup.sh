@@ -1,7 +1,7 @@
 #!/bin/sh
 # The commands that write no image never load OpenImageIO (whose 260 shared
-# libraries cost a quarter of a second and 128 MB before anything else); a
-# render does, once. The dynamic loader's own log (LD_DEBUG=files) says which
+# libraries cost a quarter of a second and 128 MB before anything else), nor
+# does a render to EXR (OpenEXR is linked); a render to PNG loads it once. The dynamic loader's own log (LD_DEBUG=files) says which
 # objects a process loaded, whatever the timings.
 # Usage: test_startup.sh PTR SOURCE_DIR
 set -u
@@ -22,10 +22,17 @@ for args in "--version" "--help" "--dump-scene $src/scenes/seed.gltf" "--print-d
     [ "$(loads ptr_image_oiio)" = 0 ] || fail "ptr $args loaded the image module"
 done
 
-LD_DEBUG=files "$ptr" "$src/scenes/seed.gltf" -o "$dir/a.exr" --width 8 --height 8 --samples 1 \
-    --quiet 2>"$dir/log" || fail "render: exit code $?"
-[ -s "$dir/a.exr" ] || fail "render: no image"
-[ "$(loads ptr_image_oiio)" = 1 ] || fail "render: the image module was not loaded once"
-[ "$(loads libOpenImageIO.so)" = 1 ] || fail "render: OpenImageIO was not loaded once"
+# A render to EXR writes through OpenEXR alone; one to PNG loads the module once.
+for ext in exr png; do
+    LD_DEBUG=files "$ptr" "$src/scenes/seed.gltf" -o "$dir/a.$ext" --width 8 --height 8 \
+        --samples 1 --quiet 2>"$dir/log" || fail "render to .$ext: exit code $?"
+    [ -s "$dir/a.$ext" ] || fail "render to .$ext: no image"
+    want=$([ $ext = exr ] && echo 0 || echo 1)
+    [ "$(loads ptr_image_oiio)" = "$want" ] ||
+        fail "render to .$ext: the image module was not loaded $want times"
+    [ "$(loads libOpenImageIO.so)" = "$want" ] ||
+        fail "render to .$ext: OpenImageIO was not loaded $want times"
+    [ "$(loads libOpenEXR-)" = 1 ] || fail "render to .$ext: OpenEXR was not loaded once"
+done
 
 finish "startup: passed"

@@ -194,14 +194,20 @@ int ptr_cli_main(int argc, char **argv)
         return dump_scenes(&o);
 
     PtrError err = { 0 };
-    /* Renders and merges write images: OpenImageIO loads on a thread of its
-     * own while the colour config, the scenes and the render proceed. The
-     * tree's and the render's threads start first: no thread can start
-     * while the load runs. */
-    if (!o.list_views)
+    /* Renders and merges write images. For any format but EXR, OpenImageIO
+     * loads on a thread of its own while the colour config, the scenes and
+     * the render proceed. The tree's and the render's threads start first:
+     * no thread can start while the load runs. */
+    char first_output[PATH_SIZE];
+    if (!o.list_views) {
         ptr_threads_keep(o.threads > 0 ? o.threads : ptr_online_cpus());
-    if (!o.list_views && ptr_image_preload(&err) != PTR_OK)
-        return fail(&err);
+        const char *output = o.merge ? o.output
+                             : output_for(&o, o.inputs[0], first_output, &err) == PTR_OK
+                                 ? first_output
+                                 : NULL;
+        if (output && ptr_image_preload(output, &err) != PTR_OK)
+            return fail(&err);
+    }
     PtrColor *color = ptr_color_open(o.ocio_config, &err);
     if (!color)
         return fail(&err);

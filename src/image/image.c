@@ -1,207 +1,117 @@
-/* The C side of image.h: finds the image module beside the executable, loads
- * it (on a thread, when asked early enough to overlap other work) and hands
- * every call to it. */
-#include "image/image_module.h"
+/* The C side of image.h: EXR goes to OpenEXR (image_exr.cpp), every other
+ * format to the OpenImageIO module (oiio_loader.c). Writes go to a
+ * temporary file renamed into place, whichever library writes them. */
+#include "image/image_backend.h"
 
-#include <dlfcn.h>
 #include <errno.h>
-#include <pthread.h>
-#include <stdatomic.h>
+#include <signal.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
-
-#include "version.h"
 
 enum { PATH_SIZE = 4096 };
 
-static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
-static pthread_t loader;
-static int loader_running;  /* started by ptr_image_preload and not joined yet */
-static int load_tried;      /* load() ran: module, else load_error, says how it went */
-static int exit_waits;      /* join_loader is registered with atexit */
-static PtrError load_error; /* why the load failed */
-/* Set once the module works. Atomic because the signal handler reads it
- * (ptr_image_discard_partial). */
-static const PtrImageModule *_Atomic module;
+/* The temporary file of the write under way, for ptr_image_discard_partial:
+ * plain storage a signal handler may read. */
+static char partial_path[PATH_SIZE];
+static volatile sig_atomic_t partial_active;
 
-/* PTR_IMAGE_MODULE_PATH ("../lib/ptr/NAME.so") from the executable's folder,
- * each leading "../" taken off that folder, so that messages show a plain
- * path. */
-static PtrResult module_path(char *path, size_t size, PtrError *err)
+static int is_exr(const char *path)
 {
-    ssize_t n = readlink("/proc/self/exe", path, size);
-    if (n <= 0 || (size_t)n >= size)
-        return ptr_error_set(err, PTR_ERR_INSTALL,
-                             "/proc/self/exe: cannot find ptr's own folder, where its image "
-                             "module lives: %s", n < 0 ? strerror(errno) : "path too long");
-    path[n] = '\0';
-    const char *relative = PTR_IMAGE_MODULE_PATH;
-    *strrchr(path, '/') = '\0'; /* the kernel gives an absolute path */
-    for (char *slash; !strncmp(relative, "../", 3) && (slash = strrchr(path, '/')); relative += 3)
-        *slash = '\0';
-    size_t used = strlen(path);
-    if ((size_t)snprintf(path + used, size - used, "/%s", relative) >= size - used)
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: path too long for ptr's image module",
-                             path);
-    return PTR_OK;
+    const char *dot = strrchr(path, '.');
+    return dot && !strcasecmp(dot, ".exr");
 }
 
-/* Whether dlopen failed for want of memory. It reports text alone (errno
- * does not survive it), so this knows glibc's words for the cases: a mapping
- * refused (a segment, the zero-filled pages) or an allocation failed. */
-static int dl_out_of_memory(const char *why)
+int ptr_image_needs_module(const char *path)
 {
-    static const char *const signs[] = {
-        "failed to map segment", "cannot map zero-fill pages", "cannot allocate",
-        "Cannot allocate memory", "out of memory",
-    };
-    for (size_t i = 0; i < sizeof signs / sizeof signs[0]; i++)
-        if (strstr(why, signs[i]))
-            return 1;
-    return 0;
-}
-
-static void load(void)
-{
-    char path[PATH_SIZE];
-    const PtrImageModule *m = NULL;
-    if (module_path(path, sizeof path, &load_error) == PTR_OK) {
-        /* Lazy binding, as when a program links the libraries: binding all of
-         * their functions up front costs a tenth more. */
-        void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
-        if (!handle) {
-            /* dlerror names the file it could not open: the module or a library it needs. */
-            const char *why = dlerror();
-            size_t len = strlen(path);
-            if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
-                why += len + 2;
-            if (dl_out_of_memory(why))
-                ptr_error_set(&load_error, PTR_ERR_NOMEM,
-                              "%s: out of memory: cannot load ptr's image module: %s", path, why);
-            else
-                ptr_error_set(&load_error, PTR_ERR_INSTALL,
-                              "%s: cannot load ptr's image module: %s", path, why);
-        } else if (!(m = dlsym(handle, PTR_IMAGE_MODULE_SYMBOL)) || m->size != sizeof *m ||
-                   strcmp(m->version, PTR_VERSION)) {
-            ptr_error_set(&load_error, PTR_ERR_INSTALL, "%s: not the image module of ptr %s", path,
-                          PTR_VERSION);
-            m = NULL;
-            dlclose(handle);
-        }
-    }
-    load_tried = 1;
-    atomic_store(&module, m);
-}
-
-static void *load_on_thread(void *unused)
-{
-    (void)unused;
-    load();
-    return NULL;
-}
-
-/* With the lock held. */
-static void join_loader_locked(void)
-{
-    if (loader_running) {
-        pthread_join(loader, NULL);
-        loader_running = 0;
-    }
-}
-
-/* Exiting while the thread runs the libraries' constructors would race
- * their destructors. */
-static void join_loader(void)
-{
-    pthread_mutex_lock(&lock);
-    join_loader_locked();
-    pthread_mutex_unlock(&lock);
-}
-
-PtrResult ptr_image_preload(PtrError *err)
-{
-    char path[PATH_SIZE];
-    if (module_path(path, sizeof path, err) != PTR_OK)
-        return err->code;
-    if (access(path, R_OK))
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: ptr's image module is missing: %s", path,
-                             strerror(errno));
-    pthread_mutex_lock(&lock);
-    /* A thread that cannot start leaves the load to the first use. */
-    if (!loader_running && !load_tried && !pthread_create(&loader, NULL, load_on_thread, NULL)) {
-        loader_running = 1;
-        if (!exit_waits)
-            exit_waits = !atexit(join_loader);
-    }
-    pthread_mutex_unlock(&lock);
-    return PTR_OK;
+    return !is_exr(path);
 }
 
 PtrResult ptr_image_ready(PtrError *err)
 {
-    pthread_mutex_lock(&lock);
-    join_loader_locked();
-    if (!load_tried)
-        load();
-    pthread_mutex_unlock(&lock);
-    if (atomic_load(&module))
+    PtrError why;
+    if (ptr_oiio_module(&why))
         return PTR_OK;
     if (err)
-        *err = load_error;
-    return load_error.code;
-}
-
-/* The module, loaded now if need be; NULL if it cannot be, with the reason
- * in err. */
-static const PtrImageModule *loaded(PtrError *err)
-{
-    return ptr_image_ready(err) == PTR_OK ? atomic_load(&module) : NULL;
+        *err = why;
+    return why.code;
 }
 
 int ptr_image_can_write(const char *path)
 {
-    const PtrImageModule *m = loaded(NULL);
-    return m && m->can_write(path);
+    const PtrImageModule *m;
+    return is_exr(path) || ((m = ptr_oiio_module(NULL)) && m->can_write(path));
+}
+
+/* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
+ * and keeping the extension for tools that look at it. Returns 0 if it does
+ * not fit. */
+static int temporary_name(const char *path, char *tmp, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    int stem = (int)(dot ? dot - base : (ptrdiff_t)strlen(base));
+    int n = snprintf(tmp, size, "%.*s.%.*s.ptr-%ld%s", (int)(base - path), path, stem, base,
+                     (long)getpid(), dot ? dot : "");
+    return n > 0 && (size_t)n < size;
 }
 
 PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                           const float *sample_counts, PtrPixelFormat format,
                           const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
-    const PtrImageModule *m = loaded(err);
-    return m ? m->write(path, layout, rgb, sample_counts, format, attrs, attr_count, err)
-             : err->code;
+    PtrImageWriteFn write = ptr_exr_write;
+    if (!is_exr(path)) {
+        const PtrImageModule *m = ptr_oiio_module(err);
+        if (!m)
+            return err->code;
+        write = m->write;
+    }
+    char tmp[PATH_SIZE];
+    if (!temporary_name(path, tmp, sizeof tmp))
+        return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
+    memcpy(partial_path, tmp, sizeof tmp);
+    partial_active = 1;
+    PtrResult res = write(tmp, path, layout, rgb, sample_counts, format, attrs, attr_count, err);
+    if (res == PTR_OK && rename(tmp, path) != 0)
+        res = ptr_error_set(err, PTR_ERR_OUTPUT, "%s: cannot replace file: %s", path,
+                            strerror(errno));
+    if (res != PTR_OK)
+        unlink(tmp);
+    partial_active = 0;
+    return res;
 }
 
 void ptr_image_discard_partial(void)
 {
-    /* Without a module there is no write under way. */
-    const PtrImageModule *m = atomic_load(&module);
-    if (m)
-        m->discard_partial();
+    if (partial_active)
+        unlink(partial_path);
 }
 
 PtrImage *ptr_image_read(const char *path, PtrError *err)
 {
-    const PtrImageModule *m = loaded(err);
+    if (is_exr(path))
+        return ptr_exr_read(path, err);
+    const PtrImageModule *m = ptr_oiio_module(err);
     return m ? m->read(path, err) : NULL;
 }
 
-/* An image exists only once the module works: the accessors need no check. */
 void ptr_image_free(PtrImage *image)
 {
-    if (image)
-        atomic_load(&module)->free(image);
+    ptr_image_release(image);
 }
 
-int ptr_image_width(const PtrImage *image) { return atomic_load(&module)->width(image); }
-int ptr_image_height(const PtrImage *image) { return atomic_load(&module)->height(image); }
-PtrImageLayout ptr_image_layout(const PtrImage *image) { return atomic_load(&module)->layout(image); }
-const float *ptr_image_pixels(const PtrImage *image) { return atomic_load(&module)->pixels(image); }
+int ptr_image_width(const PtrImage *image) { return image->layout.width; }
+int ptr_image_height(const PtrImage *image) { return image->layout.height; }
+PtrImageLayout ptr_image_layout(const PtrImage *image) { return image->layout; }
+const float *ptr_image_pixels(const PtrImage *image) { return image->rgb; }
 
 const char *ptr_image_attr(const PtrImage *image, const char *name)
 {
-    return atomic_load(&module)->attr(image, name);
+    for (size_t i = 0; i < image->attr_count; i++)
+        if (!strcmp(image->attr_names[i], name))
+            return image->attr_values[i];
+    return NULL;
 }

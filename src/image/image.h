@@ -1,6 +1,7 @@
-/* Image files through OpenImageIO, behind a C interface. The library lives in
- * a module loaded at run time (image.c), so that a process which writes no
- * image never loads it; every function here loads it on first use. */
+/* Image files behind a C interface: EXR through OpenEXR, linked in; every
+ * other format through OpenImageIO, in a module loaded at run time, so that a
+ * process which writes or reads no such image never loads it (260 shared
+ * libraries); the functions here load it on first use. */
 #ifndef PTR_IMAGE_H
 #define PTR_IMAGE_H
 
@@ -39,17 +40,20 @@ typedef struct PtrImageLayout {
     int full_width, full_height; /* the full image */
 } PtrImageLayout;
 
-/* Starts loading the module on a thread of its own, for the first image to
- * come, and returns at once: PTR_OK, or PTR_ERR_INSTALL with one line in err
- * if the module file is missing (a broken installation). Loading or not, the
- * process waits for that thread before it exits. */
-PtrResult ptr_image_preload(PtrError *err);
+/* Whether a file of this name is written and read through the OpenImageIO
+ * module (any format but EXR). */
+int ptr_image_needs_module(const char *path);
 
-/* Loads the module, or waits for ptr_image_preload's thread: PTR_OK once
- * the functions below work, else (and they then fail alike) PTR_ERR_NOMEM
- * if the module or a library it needs could not be mapped for want of
- * memory, PTR_ERR_INSTALL if it cannot be loaded otherwise, with one line in
- * err. */
+/* If writing output needs the module, starts loading it on a thread of its
+ * own and returns at once: PTR_OK, or PTR_ERR_INSTALL with one line in err if
+ * the module file is missing (a broken installation). Loading or not, the
+ * process waits for that thread before it exits. */
+PtrResult ptr_image_preload(const char *output, PtrError *err);
+
+/* Loads the module, or waits for ptr_image_preload's thread: PTR_OK once it
+ * works, else (and the formats it serves then fail alike) PTR_ERR_NOMEM if
+ * the module or a library it needs could not be mapped for want of memory,
+ * PTR_ERR_INSTALL if it cannot be loaded otherwise, with one line in err. */
 PtrResult ptr_image_ready(PtrError *err);
 
 /* Whether a writer exists for the file's extension. */

@@ -1,0 +1,76 @@
+#!/bin/sh
+# EXR files are the same whichever library writes them. tests/fixtures/exr holds
+# renders written through OpenImageIO, before ptr wrote EXR through OpenEXR
+# (made by this script with --write-fixtures, ptr 0.1.0 at commit 3f97619).
+# Every case is rendered again and read back by OpenImageIO: the same pixels,
+# bit for bit, and the same attributes (but for those that change from run to
+# run: the date, the timings, the kernel this CPU picked). ptr merge takes
+# the old parts. (test_startup.sh checks that they load no OpenImageIO.)
+# Usage: test_exr.sh PTR SOURCE_DIR [--write-fixtures]
+set -u
+ptr=$1
+src=$2
+. "$src/tests/shell_test.sh"
+fixtures=$src/tests/fixtures/exr
+
+# render_cases DIR: every EXR feature, one file each (the scene path as the
+# attribute ptr:scene records it, relative to the source folder).
+render_cases() {
+    common="scenes/seed.gltf --width 16 --samples 4 --quiet"
+    # shellcheck disable=SC2086 # $common is split on purpose
+    (cd "$src" &&
+        "$ptr" $common -o "$1/float.exr" &&
+        "$ptr" $common -o "$1/half_region.exr" --depth half --region 2,3,10,12 &&
+        "$ptr" $common -o "$1/adaptive.exr" --noise-threshold 0.05 --min-samples 2 &&
+        "$ptr" $common -o "$1/part0.exr" --sample-range 0:2 &&
+        "$ptr" $common -o "$1/part1.exr" --sample-range 2:4 --depth half)
+}
+
+if [ "${3:-}" = --write-fixtures ]; then
+    mkdir -p "$fixtures" && render_cases "$fixtures" && exit 0
+    exit 1
+fi
+
+# What OpenImageIO reads of a file's header, less what changes between runs.
+header() {
+    iinfo -v "$1" | tail -n +2 |
+        grep -v -e DateTime -e '_seconds:' -e 'ptr:kernel:' -e 'Software:'
+}
+
+render_cases "$dir" || fail "render: exit code $?"
+for file in "$fixtures"/*.exr; do
+    name=$(basename "$file")
+    idiff -q -a -fail 0 -failpercent 0 "$file" "$dir/$name" >"$dir/idiff" 2>&1 ||
+        fail "$name: the pixels differ from the OpenImageIO-written file: $(cat "$dir/idiff")"
+    header "$file" >"$dir/old.txt"
+    header "$dir/$name" >"$dir/new.txt"
+    diff "$dir/old.txt" "$dir/new.txt" >"$dir/diff" ||
+        fail "$name: the header reads differently: $(cat "$dir/diff")"
+    iinfo -v "$dir/$name" | grep -q 'Software: "ptr ' || fail "$name: no Software attribute"
+    iinfo -v "$dir/$name" | grep -q 'DateTime: "' || fail "$name: no DateTime attribute"
+done
+
+# Parts written by the OpenImageIO build merge into the render of all samples.
+"$ptr" merge "$fixtures/part0.exr" "$fixtures/part1.exr" -o "$dir/merged.exr" --quiet ||
+    fail "merge of old parts: exit code $?"
+"$ptr" merge "$dir/part0.exr" "$dir/part1.exr" -o "$dir/merged_new.exr" --quiet ||
+    fail "merge of new parts: exit code $?"
+idiff -q -a -fail 0 -failpercent 0 "$dir/merged.exr" "$dir/merged_new.exr" >/dev/null 2>&1 ||
+    fail "old parts merge to other pixels than new ones"
+
+# Broken parts: exit 2 and one line naming the file, the output untouched.
+: >"$dir/empty.exr"
+printf 'not an image at all' >"$dir/garbage.exr"
+head -c 400 "$fixtures/float.exr" >"$dir/header_cut.exr"
+head -c 3000 "$fixtures/float.exr" >"$dir/pixels_cut.exr"
+for name in empty garbage header_cut pixels_cut; do
+    echo "an existing image" >"$dir/out.exr"
+    "$ptr" merge "$dir/$name.exr" -o "$dir/out.exr" --quiet 2>"$dir/err"
+    code=$?
+    [ $code = 2 ] || fail "merge $name.exr: exit code $code, not 2"
+    [ "$(wc -l <"$dir/err")" = 1 ] && grep -q "^ptr: $dir/$name.exr: " "$dir/err" ||
+        fail "merge $name.exr: not one line naming the file: $(cat "$dir/err")"
+    [ "$(cat "$dir/out.exr")" = "an existing image" ] || fail "merge $name.exr: output changed"
+done
+
+finish "EXR through OpenEXR: the same files as through OpenImageIO"
