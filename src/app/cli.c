@@ -200,7 +200,10 @@ int ptr_cli_main(int argc, char **argv)
      * no thread can start while the load runs. */
     char first_output[PATH_SIZE];
     if (!o.list_views) {
-        ptr_threads_keep(o.threads > 0 ? o.threads : ptr_online_cpus());
+        int threads = o.threads > 0 ? o.threads : ptr_online_cpus();
+        ptr_threads_keep(threads);
+        if (ptr_image_set_threads(threads, &err) != PTR_OK)
+            return fail(&err);
         const char *output = o.merge ? o.output
                              : output_for(&o, o.inputs[0], first_output, &err) == PTR_OK
                                  ? first_output

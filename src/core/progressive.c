@@ -1,7 +1,6 @@
 #include "core/progressive.h"
 
 #include <math.h>
-#include <stdlib.h>
 
 #include "accel/cpu.h"
 
@@ -33,7 +32,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     if (pixels == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
                              settings->width, settings->height);
-    double *acc = calloc(pixels * PTR_ACCUM_STRIDE, sizeof *acc);
+    double *acc = ptr_accum_alloc(pixels);
     if (!acc)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image", r.x1 - r.x0,
                              r.y1 - r.y0);
@@ -77,6 +76,6 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     result->stats.seconds = ptr_now_seconds() - watch.start;
     if (res == PTR_OK)
         ptr_accum_resolve(acc, pixels, rgb, sample_counts);
-    free(acc);
+    ptr_accum_free(acc, pixels);
     return res;
 }

@@ -114,17 +114,6 @@ typedef struct Worker {
     uint64_t rays;
 } Worker;
 
-void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts)
-{
-    for (size_t p = 0; p < pixels; p++, acc += PTR_ACCUM_STRIDE) {
-        double n = acc[PTR_ACCUM_COUNT];
-        for (int c = 0; c < 3; c++)
-            rgb[3 * p + c] = n > 0 ? (float)(acc[PTR_ACCUM_SUM + c] / n) : 0.0f;
-        if (sample_counts)
-            sample_counts[p] = (float)n;
-    }
-}
-
 int ptr_render_bundles(const PtrIsectTable *isect)
 {
 #if PTR_HAVE_BUNDLES
@@ -289,7 +278,7 @@ PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
         return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive");
     PtrRegion r = ptr_render_region(settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-    double *acc = calloc(pixels ? pixels * PTR_ACCUM_STRIDE : 1, sizeof *acc);
+    double *acc = ptr_accum_alloc(pixels);
     if (!acc)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image",
                              r.x1 - r.x0, r.y1 - r.y0);
@@ -297,6 +286,6 @@ PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
                                        NULL, stats, err);
     if (res == PTR_OK)
         ptr_accum_resolve(acc, pixels, rgb, NULL);
-    free(acc);
+    ptr_accum_free(acc, pixels);
     return res;
 }

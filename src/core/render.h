@@ -83,6 +83,11 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              double *acc, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err);
 
+/* A zeroed accumulation buffer of pixels pixels, or NULL if memory runs out;
+ * ptr_accum_free takes the same count. */
+double *ptr_accum_alloc(size_t pixels);
+void ptr_accum_free(double *acc, size_t pixels);
+
 /* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
  * a pixel), and if sample_counts is not NULL, how many samples each took. */
 void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);

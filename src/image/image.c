@@ -28,6 +28,11 @@ int ptr_image_needs_module(const char *path)
     return !is_exr(path);
 }
 
+PtrResult ptr_image_set_threads(int threads, PtrError *err)
+{
+    return ptr_exr_set_threads(threads, err);
+}
+
 PtrResult ptr_image_ready(PtrError *err)
 {
     PtrError why;

@@ -40,6 +40,12 @@ typedef struct PtrImageLayout {
     int full_width, full_height; /* the full image */
 } PtrImageLayout;
 
+/* How many threads compress and decompress EXR files (default 1). Zip
+ * compression is slow: a 1000x1000 render at 1 sample on two cores took
+ * 0.61-0.67 s with one thread compressing, 0.46-0.49 s with two.
+ * PTR_ERR_NOMEM if they cannot be started. */
+PtrResult ptr_image_set_threads(int threads, PtrError *err);
+
 /* Whether a file of this name is written and read through the OpenImageIO
  * module (any format but EXR). */
 int ptr_image_needs_module(const char *path);

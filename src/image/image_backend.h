@@ -83,6 +83,7 @@ PtrResult ptr_exr_write(const char *file, const char *name, const PtrImageLayout
                         const float *rgb, const float *sample_counts, PtrPixelFormat format,
                         const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
 PtrImage *ptr_exr_read(const char *path, PtrError *err);
+PtrResult ptr_exr_set_threads(int threads, PtrError *err);
 
 #define PTR_IMAGE_MODULE_SYMBOL "ptr_image_module"
 

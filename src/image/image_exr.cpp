@@ -14,6 +14,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfIntAttribute.h>
@@ -54,6 +55,17 @@ Imf::Slice slice(Imf::PixelType type, const char *first, size_t x_stride, size_t
 }
 
 } // namespace
+
+extern "C" PtrResult ptr_exr_set_threads(int threads, PtrError *err)
+{
+    try {
+        // One thread is the caller's own: no pool.
+        Imf::setGlobalThreadCount(threads > 1 ? threads : 0);
+        return PTR_OK;
+    } catch (...) {
+        return ptr_shim_caught(err, PTR_ERR_INTERNAL, "OpenEXR's threads");
+    }
+}
 
 extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
                                    const PtrImageLayout *layout, const float *rgb,
