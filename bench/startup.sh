@@ -40,3 +40,6 @@ measure --list-views --list-views
 measure render-64 scenes/seed.gltf -o "$out/x.png" --width 64 --height 64 --samples 4
 measure render-500 scenes/seed.gltf -o "$out/y.png" --width 500 --height 500 --samples 20
 measure render-250-t1 scenes/seed.gltf -o "$out/z.png" --width 250 --height 250 --samples 20 --threads 1
+measure exr-500 scenes/seed.gltf -o "$out/y.exr" --width 500 --height 500 --samples 20
+measure exr-500-t1 scenes/seed.gltf -o "$out/z.exr" --width 500 --height 500 --samples 20 --threads 1
+measure final-exr-16 scenes/final.gltf -o "$out/f.exr" --samples 16
