@@ -21,9 +21,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "accel/cpu.h"
+#include "base/cpu.h"
 #include "importer.h"
-#include "core/render.h"
+#include "render/render.h"
 
 typedef struct Bench {
     const char *name, *path;

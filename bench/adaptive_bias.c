@@ -15,7 +15,7 @@
 #include <stdlib.h>
 
 #include "importer.h"
-#include "core/render.h"
+#include "render/render.h"
 
 enum { WIDTH = 200, HEIGHT = 112, PIXELS = WIDTH * HEIGHT };
 

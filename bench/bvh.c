@@ -23,8 +23,8 @@
 #include <string.h>
 
 #include "accel/accel.h"
-#include "accel/cpu.h"
-#include "core/render.h"
+#include "base/cpu.h"
+#include "render/render.h"
 #include "sampling/rng.h"
 
 enum { BRUTE_MAX_SPHERES = 20000 };

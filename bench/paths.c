@@ -17,9 +17,9 @@
 #include <string.h>
 
 #include "accel/accel.h"
-#include "accel/cpu.h"
-#include "core/render.h"
+#include "base/cpu.h"
 #include "importer.h"
+#include "render/render.h"
 
 typedef struct Config {
     const char *name;

@@ -15,9 +15,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/result.h"
 #include "importer.h"
-#include "core/result.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */

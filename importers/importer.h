@@ -6,8 +6,8 @@
 
 #include <stddef.h>
 
-#include "core/result.h"
-#include "core/scene.h"
+#include "base/result.h"
+#include "scene/scene.h"
 
 /* A list of lines of text (warnings, file names). */
 typedef struct PtrStrings {

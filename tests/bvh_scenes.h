@@ -9,8 +9,8 @@
 #include <stdint.h>
 
 #include "accel/ray.h"
-#include "core/scene.h"
 #include "sampling/rng.h"
+#include "scene/scene.h"
 
 typedef enum BvhSceneKind {
     BVH_SCENE_RANDOM,        /* uniform in a box, radii 0.05 to 0.5 */

@@ -11,8 +11,8 @@
 #define PTR_TEST_LIT_GROUND_H
 
 #include "builder.h"
-#include "core/camera.h"
-#include "core/render.h"
+#include "render/camera.h"
+#include "render/render.h"
 #include "test.h"
 
 enum { LIT_GROUND_SIZE = 32 };

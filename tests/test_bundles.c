@@ -9,9 +9,9 @@
 #include "test.h"
 
 #include "accel/accel.h"
-#include "accel/cpu.h"
+#include "base/cpu.h"
 #include "builder.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "sampling/rng.h"
 
 enum { WIDTH = 48, HEIGHT = 32 };

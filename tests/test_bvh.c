@@ -7,8 +7,8 @@
 #include "accel/bvh.h"
 #include "accel/isect.h"
 #include "bvh_scenes.h"
-#include "core/render.h"
 #include "importer.h"
+#include "render/render.h"
 #include "test.h"
 
 /* Walks the tree: every sphere in the tree is in exactly one leaf, every

@@ -4,8 +4,8 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "base/result.h"
 #include "image/image.h"
-#include "core/result.h"
 #include "test.h"
 #include "test_files.h"
 

@@ -8,10 +8,10 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "app/output.h"
+#include "base/result.h"
 #include "color/color.h"
 #include "image/image.h"
-#include "app/output.h"
-#include "core/result.h"
 #include "test.h"
 #include "test_files.h"
 

@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #include "importer.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "test.h"
 
 enum { SIZE = 32, BLOCK = 8, GROUP = 16 };

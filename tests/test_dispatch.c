@@ -5,10 +5,10 @@
 #include <unistd.h>
 
 #include "app/cli.h"
-#include "accel/cpu.h"
+#include "base/cpu.h"
 #include "image/image.h"
 #include "importer.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "test.h"
 
 static float *render_with(const PtrScene *scene, const PtrIsectTable *isect,

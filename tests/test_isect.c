@@ -3,7 +3,7 @@
 
 #include "accel/isect.h"
 #include "sampling/rng.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 #include "test.h"
 
 static PtrRay make_ray(PtrVec3 o, PtrVec3 d)

@@ -14,11 +14,11 @@
  *   its 10^-6 tail. */
 #include <stdint.h>
 
-#include "core/camera.h"
-#include "core/lights.h"
-#include "core/render.h"
-#include "sampling/rng.h"
 #include "lit_ground.h"
+#include "render/camera.h"
+#include "render/lights.h"
+#include "render/render.h"
+#include "sampling/rng.h"
 #include "test.h"
 
 static uint32_t add_material(PtrScene *s, PtrMaterial m)

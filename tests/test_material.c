@@ -1,5 +1,5 @@
 /* Scattering: energy, reflection laws, Fresnel and total internal reflection. */
-#include "core/material.h"
+#include "render/material.h"
 #include "sampling/rng.h"
 #include "test.h"
 

@@ -1,10 +1,10 @@
 /* Vector maths, random streams and the camera. */
 #include <stdint.h>
 
-#include "core/camera.h"
+#include "base/vec.h"
+#include "render/camera.h"
 #include "sampling/rng.h"
 #include "test.h"
-#include "core/vec.h"
 
 static void test_vectors(void)
 {

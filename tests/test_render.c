@@ -2,7 +2,7 @@
 #include <stdint.h>
 
 #include "importer.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "test.h"
 
 typedef struct Image {

@@ -2,7 +2,7 @@
 #ifndef PTR_TEST_SCENE_H
 #define PTR_TEST_SCENE_H
 
-#include "core/scene.h"
+#include "scene/scene.h"
 #include "test.h"
 
 /* Sphere i is at (x, y, z) in world coordinates (the scene's origin plus the

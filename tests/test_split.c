@@ -6,10 +6,10 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "base/result.h"
 #include "image/image.h"
 #include "importer.h"
-#include "core/render.h"
-#include "core/result.h"
+#include "render/render.h"
 #include "test.h"
 #include "test_files.h"
 

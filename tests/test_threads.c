@@ -7,7 +7,7 @@
 #include <stdatomic.h>
 #include <time.h>
 
-#include "core/threads.h"
+#include "base/threads.h"
 
 enum { KEPT = 2, WORK = 5, ROUNDS = 200 };
 

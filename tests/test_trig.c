@@ -5,7 +5,7 @@
 
 #include "test.h"
 
-#include "core/trig.h"
+#include "base/trig.h"
 
 int main(void)
 {

@@ -1,5 +1,5 @@
 #include "gltf_doc.h"
-#include "shim_error.h"
+#include "base/shim_error.h"
 
 #include <tiny_gltf.h>
 

@@ -6,7 +6,7 @@
 
 #include <stddef.h>
 
-#include "core/result.h"
+#include "base/result.h"
 
 #ifdef __cplusplus
 extern "C" {

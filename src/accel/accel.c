@@ -1,6 +1,6 @@
 #include "accel/accel.h"
 
-#include "accel/cpu.h"
+#include "base/cpu.h"
 
 #include <math.h>
 #include <string.h>

@@ -10,8 +10,8 @@
 #include "accel/bvh.h"
 #include "accel/huge.h"
 #include "accel/isect.h"
-#include "core/result.h"
-#include "core/scene.h"
+#include "base/result.h"
+#include "scene/scene.h"
 
 typedef enum PtrAccelChoice {
     PTR_ACCEL_AUTO,  /* brute force below the crossover, else the tree */

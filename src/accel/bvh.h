@@ -19,8 +19,8 @@
 #include <stdint.h>
 
 #include "accel/ray.h"
-#include "core/result.h"
-#include "core/scene.h"
+#include "base/result.h"
+#include "scene/scene.h"
 
 enum {
     PTR_BVH_WIDTH = 8,    /* children per node */

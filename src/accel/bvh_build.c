@@ -25,8 +25,8 @@
 
 #include "accel/bvh_prims.h"
 #include "accel/bvh_split.h"
-#include "accel/cpu.h"
-#include "core/threads.h"
+#include "base/cpu.h"
+#include "base/threads.h"
 
 enum {
     /* From this level on ranges are split in the middle, which bounds the

@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "core/scene.h"
+#include "scene/scene.h"
 
 typedef struct BvhPrim {
     float lower[3], upper[3];

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
+#include "base/threads.h"
 
 enum { BINS = 32 };
 

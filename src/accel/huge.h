@@ -19,7 +19,7 @@
 #define PTR_HUGE_H
 
 #include "accel/isect.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 /* Among the huge spheres, the closest hit with tmin < t < tmax, computed in
  * double and rounded to float; on equal distances the lowest id. Writes *hit

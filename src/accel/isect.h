@@ -12,9 +12,9 @@
 #include <stdint.h>
 
 #include "accel/bvh.h"
-#include "accel/cpu.h"
 #include "accel/ray.h"
-#include "core/scene.h"
+#include "base/cpu.h"
+#include "scene/scene.h"
 
 /* One signature for the pointer type, the C reference and every assembly
  * version, so that they cannot drift apart. Tests the first count spheres;

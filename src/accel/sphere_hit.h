@@ -7,7 +7,7 @@
 #include <math.h>
 
 #include "accel/ray.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 /* The distance at which the ray enters sphere i, or leaves it if it starts
  * inside (the far root when the near one is not above tmin); NaN if the

@@ -6,17 +6,17 @@
 #include <sys/stat.h>
 
 #include "app/cli_options.h"
-#include "core/threads.h"
-#include "image/image.h"
-#include "color/color.h"
-#include "accel/cpu.h"
-#include "importer.h"
 #include "app/job.h"
 #include "app/merge.h"
 #include "app/report.h"
 #include "app/scene_json.h"
 #include "app/signals.h"
 #include "app/watch.h"
+#include "base/cpu.h"
+#include "base/threads.h"
+#include "color/color.h"
+#include "image/image.h"
+#include "importer.h"
 
 enum { PATH_SIZE = 4096 };
 

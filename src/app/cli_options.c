@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "accel/cpu.h"
-#include "version.h"
+#include "base/cpu.h"
+#include "base/version.h"
 
 enum {
     DEFAULT_SAMPLES = 100,

@@ -4,12 +4,12 @@
 
 #include <stdint.h>
 
-#include "importer.h"
 #include "accel/accel.h"
 #include "accel/isect.h"
 #include "app/output.h"
-#include "core/render.h"
-#include "core/scene.h"
+#include "importer.h"
+#include "render/render.h"
+#include "scene/scene.h"
 
 enum { PTR_DEFAULT_WIDTH = 800, PTR_MAX_IMAGE_SIZE = 1 << 16 };
 

@@ -4,11 +4,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "importer.h"
-#include "accel/cpu.h"
 #include "app/output.h"
-#include "core/progressive.h"
 #include "app/signals.h"
+#include "base/cpu.h"
+#include "importer.h"
+#include "render/progressive.h"
 
 enum { PREVIEW_SCALE = 4, PREVIEW_SAMPLES = 4 };
 

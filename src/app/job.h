@@ -3,8 +3,8 @@
 #define PTR_JOB_H
 
 #include "app/cli_options.h"
-#include "color/color.h"
 #include "app/report.h"
+#include "color/color.h"
 
 /* Imports the scene, renders it (in passes, with progress, stopping cleanly
  * when ptr_stop_requested is set) and writes output. Always fills report;

@@ -4,8 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "image/image.h"
 #include "app/output.h"
+#include "image/image.h"
 
 typedef struct Part {
     const char *path;

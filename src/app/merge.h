@@ -4,8 +4,8 @@
 #define PTR_MERGE_H
 
 #include "app/cli_options.h"
-#include "color/color.h"
 #include "app/report.h"
+#include "color/color.h"
 
 /* Reads the parts (scene-linear EXRs written by ptr), checks that they belong
  * together (same scene hash, image size, seed and depth limit; overlapping

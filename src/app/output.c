@@ -9,8 +9,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/version.h"
 #include "image/image.h"
-#include "version.h"
 
 /* The formats ptr names in its usage, and the depths each can store, the
  * first its default. OpenImageIO writes all of them (they are among its

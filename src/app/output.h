@@ -4,9 +4,9 @@
 
 #include <stdint.h>
 
+#include "base/result.h"
 #include "color/color.h"
 #include "image/image.h"
-#include "core/result.h"
 
 /* What each channel is stored as. Integer depths always hold the
  * display-referred image (the view applied, clamped to [0, 1], rounded);

@@ -6,9 +6,9 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "base/result.h"
 #include "importer.h"
-#include "core/progressive.h"
-#include "core/result.h"
+#include "render/progressive.h"
 
 /* The outcome of rendering one scene to one image. */
 typedef struct PtrJobReport {

@@ -5,7 +5,7 @@
 #include <stdio.h>
 
 #include "importer.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 /* PTR_ERR_NOMEM if memory runs out before anything is written. */
 PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scene,

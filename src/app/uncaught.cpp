@@ -5,8 +5,8 @@
  * be resumed from, but it can end the process as every other failure does:
  * one line, the documented code, no partial output, no core dump. */
 #include "app/signals.h"
+#include "base/shim_error.h"
 #include "image/image.h"
-#include "shim_error.h"
 
 #include <cstdio>
 #include <exception>

@@ -1,5 +1,5 @@
 #include "color.h"
-#include "shim_error.h"
+#include "base/shim_error.h"
 
 #include <OpenColorIO/OpenColorIO.h>
 

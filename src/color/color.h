@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
-#include "core/result.h"
+#include "base/result.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -5,8 +5,8 @@
  * float "samples" channel of adaptive renders, a data window for regions, the
  * capture date, and every attribute ptr gives but OpenImageIO's own (oiio:*),
  * which it never wrote to EXR. */
+#include "base/shim_error.h"
 #include "image/image_backend.h"
-#include "shim_error.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>

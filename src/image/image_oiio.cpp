@@ -1,8 +1,8 @@
 /* The image module: every format but EXR through OpenImageIO, loaded at run
  * time by image.c when such a file is first written or read. */
+#include "base/shim_error.h"
+#include "base/version.h"
 #include "image/image_backend.h"
-#include "shim_error.h"
-#include "version.h"
 
 #include <OpenImageIO/imageio.h>
 

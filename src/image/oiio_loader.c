@@ -11,7 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "version.h"
+#include "base/version.h"
 
 enum { PATH_SIZE = 4096 };
 

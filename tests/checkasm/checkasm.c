@@ -14,11 +14,11 @@
 #include <string.h>
 #include <time.h>
 
-#include "checkasm.h"
-#include "accel/cpu.h"
 #include "accel/isect.h"
+#include "base/cpu.h"
+#include "checkasm.h"
 #include "sampling/rng.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 #include <cpuid.h>
 /* XGETBV with ECX = 1 (XINUSE) exists when CPUID.(0xD, 1):EAX bit 2 is set. */

@@ -3,8 +3,8 @@
 #ifndef PTR_TEST_METHODS_H
 #define PTR_TEST_METHODS_H
 
-#include "accel/cpu.h"
 #include "accel/isect.h"
+#include "base/cpu.h"
 
 typedef struct Method {
     const char *name;

@@ -20,7 +20,7 @@
  * somewhere, or the suite could not tell them apart. */
 #include "builder.h"
 #include "methods.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "test.h"
 
 enum { SIZE = 16 };

@@ -15,7 +15,7 @@
 #include "builder.h"
 #include "lit_ground.h"
 #include "methods.h"
-#include "core/render.h"
+#include "render/render.h"
 #include "test.h"
 
 enum { SIZE = 32, SAMPLES = 32 };

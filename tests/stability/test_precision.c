@@ -9,9 +9,9 @@
  *   again, and one leaving it inward meets it only at the far side. */
 #include <stdint.h>
 
+#include "accel/spawn.h"
 #include "methods.h"
 #include "naive.h"
-#include "core/render.h"
 #include "sampling/rng.h"
 #include "test.h"
 

@@ -1,4 +1,4 @@
-#include "core/render.h"
+#include "render/render.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -6,11 +6,11 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "accel/cpu.h"
-#include "core/threads.h"
-#include "core/camera.h"
-#include "core/material.h"
-#include "core/path.h"
+#include "base/cpu.h"
+#include "base/threads.h"
+#include "render/camera.h"
+#include "render/material.h"
+#include "render/path.h"
 #include "sampling/sampler.h"
 
 /* The radiance one camera ray carries back, one path at a time: the

@@ -8,10 +8,10 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
-#include "core/camera.h"
-#include "core/lights.h"
-#include "core/render.h"
-#include "core/trig.h"
+#include "base/trig.h"
+#include "render/camera.h"
+#include "render/lights.h"
+#include "render/render.h"
 #include "sampling/sampler.h"
 
 typedef struct PtrPathJob {

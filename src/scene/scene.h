@@ -10,8 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "core/result.h"
-#include "core/vec.h"
+#include "base/result.h"
+#include "base/vec.h"
 
 enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 

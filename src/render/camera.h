@@ -2,8 +2,7 @@
 #ifndef PTR_CAMERA_H
 #define PTR_CAMERA_H
 
-#include "sampling/rng.h"
-#include "core/scene.h"
+#include "scene/scene.h"
 
 typedef struct PtrView {
     PtrVec3 origin;

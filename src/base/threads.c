@@ -1,4 +1,4 @@
-#include "core/threads.h"
+#include "base/threads.h"
 
 #include <pthread.h>
 #include <stdlib.h>

@@ -1,8 +1,8 @@
-#include "core/progressive.h"
+#include "render/progressive.h"
 
 #include <math.h>
 
-#include "accel/cpu.h"
+#include "base/cpu.h"
 
 typedef struct PassWatch {
     const PtrProgressiveOptions *options;

@@ -5,9 +5,10 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
-#include "core/result.h"
-#include "core/scene.h"
+#include "base/result.h"
+#include "render/film.h"
 #include "sampling/sampler.h"
+#include "scene/scene.h"
 
 /* A switch whose zero value, the default, is on. */
 typedef enum PtrSwitch { PTR_ON, PTR_OFF } PtrSwitch;
@@ -60,15 +61,6 @@ PtrRegion ptr_render_region(const PtrRenderSettings *settings);
  * t_min). The image is the same either way. */
 int ptr_render_bundles(const PtrIsectTable *isect);
 
-/* What ptr_render_samples keeps of each pixel, in doubles: the sum of its
- * samples' radiance, the sum over its odd-numbered samples (adaptive
- * sampling's second half-buffer), how many samples it took, and whether
- * adaptive sampling stopped it (1) or not (0). */
-enum {
-    PTR_ACCUM_SUM = 0, PTR_ACCUM_ODD = 3, PTR_ACCUM_COUNT = 6, PTR_ACCUM_STOPPED = 7,
-    PTR_ACCUM_STRIDE = 8,
-};
-
 /* The renderer reads the spheres through accel (accel->spheres, which must
  * be scene->spheres) and finds every hit, shadow rays too, with ptr_trace.
  *
@@ -83,52 +75,10 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              double *acc, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err);
 
-/* A zeroed accumulation buffer of pixels pixels, or NULL if memory runs out;
- * ptr_accum_free takes the same count. */
-double *ptr_accum_alloc(size_t pixels);
-void ptr_accum_free(double *acc, size_t pixels);
-
-/* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
- * a pixel), and if sample_counts is not NULL, how many samples each took. */
-void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);
-
 /* The whole region with settings->samples samples, as means in rgb (3 floats
  * a pixel, region rows top to bottom). */
 PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
                      const PtrRenderSettings *settings, float *rgb,
                      PtrRenderStats *stats, PtrError *err);
-
-/* The outward unit normal where ray met the sphere hit names. */
-static inline PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHit *hit)
-{
-    PtrVec3 p = v3_madd(v3(ray->org[0], ray->org[1], ray->org[2]),
-                        v3(ray->dir[0], ray->dir[1], ray->dir[2]), hit->t);
-    return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
-}
-
-/* A ray leaving the surface of a sphere along dir from the point where
- * outward_normal meets it: its origin is that point pushed off the surface,
- * along the normal and to the side dir goes, by a bound on the float error of
- * locating it, so that it cannot hit the same surface again at t ~ 0.
- *
- * How far: relative to the
- * magnitude of the numbers that locate it (|centre| + radius): the point is
- * re-projected onto the sphere, which leaves a few ulps of that magnitude of
- * error, and the kernel's f.f - r^2 adds a few more. Measured by
- * tests/stability/test_precision.c over 2 million hit points per level
- * (radii 1e-4 to 1e6, centres up to 1e7 away, down to grazing): 2^-23 lets
- * outward rays hit their own sphere again, 2^-22 stops grazing inward rays
- * short of the far side, 2^-21 and above never fail. Smaller is better (the
- * offset shifts contact shadows), so the smallest safe power of two. */
-#define PTR_SPAWN_OFFSET_SCALE 0x1.0p-21f
-
-static inline PtrRay ptr_spawn_ray(PtrVec3 centre, float radius, PtrVec3 outward_normal,
-                                   PtrVec3 dir)
-{
-    float offset = PTR_SPAWN_OFFSET_SCALE * (v3_max_abs(centre) + radius);
-    offset = v3_dot(dir, outward_normal) < 0.0f ? -offset : offset;
-    PtrVec3 o = v3_add(centre, v3_scale(outward_normal, radius + offset));
-    return (PtrRay){ { o.x, o.y, o.z }, 0.0f, { dir.x, dir.y, dir.z }, INFINITY };
-}
 
 #endif /* PTR_RENDER_H */

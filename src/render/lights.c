@@ -1,10 +1,10 @@
-#include "core/lights.h"
+#include "render/lights.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-#include "core/material.h"
-#include "core/trig.h"
+#include "base/trig.h"
+#include "render/material.h"
 
 /* Proportional to the flux a sphere emits: radiance (summed over channels)
  * times its area. */

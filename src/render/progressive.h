@@ -6,7 +6,7 @@
 #include <signal.h>
 #include <stdint.h>
 
-#include "core/render.h"
+#include "render/render.h"
 
 typedef struct PtrProgress {
     uint32_t samples_done, samples_total;

@@ -5,8 +5,8 @@
 
 #include <stdint.h>
 
-#include "core/result.h"
-#include "core/scene.h"
+#include "base/result.h"
+#include "scene/scene.h"
 
 /* Every sphere with an emission above zero, and Walker's alias table over
  * their powers: a pick costs the same for one emitter or a million. */

@@ -1,9 +1,10 @@
-#include "core/path.h"
+#include "render/path.h"
 
 #include <math.h>
 
 #include "accel/huge.h"
-#include "core/material.h"
+#include "accel/spawn.h"
+#include "render/material.h"
 
 void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hit,
                       PtrVec3 *point, PtrVec3 *normal)

@@ -1,7 +1,7 @@
-/* The accumulation buffer of a render (PTR_ACCUM_STRIDE doubles a pixel):
- * where it lives, and what it resolves to. */
+/* The film of a render (PTR_ACCUM_STRIDE doubles a pixel): where it lives,
+ * and what it resolves to. */
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS, madvise */
-#include "core/render.h"
+#include "render/film.h"
 
 #include <stdint.h>
 #include <sys/mman.h>

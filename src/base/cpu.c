@@ -1,4 +1,4 @@
-#include "accel/cpu.h"
+#include "base/cpu.h"
 
 #include <stdlib.h>
 #include <string.h>

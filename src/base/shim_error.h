@@ -15,7 +15,7 @@
 #include <string>
 #include <system_error>
 
-#include "core/result.h"
+#include "base/result.h"
 
 /* Sets err to code and text as one line (line breaks folded, trailing blanks
  * cut). Returns code. */

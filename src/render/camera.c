@@ -1,4 +1,4 @@
-#include "core/camera.h"
+#include "render/camera.h"
 
 #include <math.h>
 

@@ -8,7 +8,7 @@
 #ifndef PTR_TRIG_H
 #define PTR_TRIG_H
 
-#include "core/vec.h"
+#include "base/vec.h"
 
 /* sin and cos of 2 pi u for u in [0, 1), within 2e-7 absolutely (tested
  * against double precision in tests/test_trig.c). Branch-free, so loops over

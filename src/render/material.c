@@ -1,4 +1,4 @@
-#include "core/material.h"
+#include "render/material.h"
 
 int ptr_scatter(const PtrMaterial *material, PtrVec3 in_dir, PtrVec3 outward_normal,
                 const float u[3], PtrVec3 *out_dir, PtrVec3 *attenuation)

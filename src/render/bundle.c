@@ -18,8 +18,9 @@
 #include <stdint.h>
 
 #include "accel/huge.h"
-#include "core/material.h"
-#include "core/path.h"
+#include "accel/spawn.h"
+#include "render/material.h"
+#include "render/path.h"
 
 enum { LANES = PTR_PACKET_LANES, FREE = -1 };
 

@@ -10,8 +10,8 @@
 
 #include <math.h>
 
-#include "core/scene.h"
-#include "core/trig.h"
+#include "base/trig.h"
+#include "scene/scene.h"
 
 /* Samples an outgoing direction for a ray arriving along unit in_dir at a
  * surface whose outward unit normal is outward_normal, from three uniform

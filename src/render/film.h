@@ -1,0 +1,26 @@
+/* The film: what a render keeps of each pixel while samples arrive, and the
+ * image it resolves to. */
+#ifndef PTR_FILM_H
+#define PTR_FILM_H
+
+#include <stddef.h>
+
+/* What ptr_render_samples (render.h) keeps of each pixel, in doubles: the sum of its
+ * samples' radiance, the sum over its odd-numbered samples (adaptive
+ * sampling's second half-buffer), how many samples it took, and whether
+ * adaptive sampling stopped it (1) or not (0). */
+enum {
+    PTR_ACCUM_SUM = 0, PTR_ACCUM_ODD = 3, PTR_ACCUM_COUNT = 6, PTR_ACCUM_STOPPED = 7,
+    PTR_ACCUM_STRIDE = 8,
+};
+
+/* A zeroed accumulation buffer of pixels pixels, or NULL if memory runs out;
+ * ptr_accum_free takes the same count. */
+double *ptr_accum_alloc(size_t pixels);
+void ptr_accum_free(double *acc, size_t pixels);
+
+/* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
+ * a pixel), and if sample_counts is not NULL, how many samples each took. */
+void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);
+
+#endif /* PTR_FILM_H */
