@@ -27,12 +27,10 @@ typedef enum PtrAccelChoice {
  * C traversal: 64 spheres 8.4 against 8.2 Mrays/s, 128 6.0 against 7.7. On
  * an AVX2 CPU (bundles of paths: the packet kernel against the AVX2
  * traversal lane by lane): 128 spheres 12.9 against 12.0, 256 6.7 against
- * 11.1. */
-enum {
-    PTR_ACCEL_CROSSOVER_C = 24,
-    PTR_ACCEL_CROSSOVER_SSE41 = 96,
-    PTR_ACCEL_CROSSOVER_AVX2 = 192,
-};
+ * 11.1. Macros, so that --help can spell them out. */
+#define PTR_ACCEL_CROSSOVER_C 24
+#define PTR_ACCEL_CROSSOVER_SSE41 96
+#define PTR_ACCEL_CROSSOVER_AVX2 192
 
 /* The crossover for brute force with isect's kernel. */
 size_t ptr_accel_crossover(const PtrIsectTable *isect);

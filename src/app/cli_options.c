@@ -7,180 +7,100 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/cli_help.h"
 #include "base/cpu.h"
-#include "base/version.h"
 
 enum {
-    DEFAULT_SAMPLES = 100,
-    DEFAULT_MAX_DEPTH = 50,
-    DEFAULT_MIN_SAMPLES = 32,
+    GO_ON = -1, /* what ptr_options_parse returns to go on rendering */
     MAX_THREADS = 1024,
 };
 
+/* Which of --lookfrom, --lookat and --vfov were given: a camera needs all
+ * three. */
+enum { CAMERA_LOOKFROM = 1, CAMERA_LOOKAT = 2, CAMERA_VFOV = 4, CAMERA_COMPLETE = 7 };
+
+/* The table's headings are --help's alone. */
+#define HEADING(title)
+
+/* The options of cli_options.def, in its order. */
+typedef enum OptionId {
+#define OPTION(id, short_name, name, has_arg, metavar, text) OPT_##id,
+#include "app/cli_options.def"
+#undef OPTION
+} OptionId;
+
+/* Counted apart from OptionId, so that a switch over the options needs no
+ * case for the count. */
 enum {
-    OPT_SAMPLES = 256, OPT_WIDTH, OPT_HEIGHT, OPT_THREADS, OPT_SEED, OPT_MAX_DEPTH,
-    OPT_SKY, OPT_C, OPT_ASM, OPT_ACCEL, OPT_CPUMASK, OPT_PRINT_DISPATCH, OPT_CAMERA, OPT_DEPTH, OPT_DITHER,
-    OPT_OCIO_CONFIG, OPT_DISPLAY, OPT_VIEW, OPT_LOOK, OPT_EXPOSURE, OPT_BAKE_VIEW, OPT_LIST_VIEWS,
-    OPT_QUIET, OPT_DUMP_SCENE, OPT_HELP, OPT_VERSION, OPT_JSON, OPT_TIME, OPT_PREVIEW, OPT_WATCH,
-    OPT_SAMPLE_RANGE, OPT_REGION, OPT_LOOKFROM, OPT_LOOKAT, OPT_UP, OPT_VFOV, OPT_APERTURE,
-    OPT_FOCUS_DISTANCE, OPT_FIT_ALL, OPT_SAMPLER, OPT_DIRECT_LIGHTING,
-    OPT_NOISE_THRESHOLD, OPT_MIN_SAMPLES,
+    OPTION_COUNT = 0
+#define OPTION(id, short_name, name, has_arg, metavar, text) + 1
+#include "app/cli_options.def"
+#undef OPTION
 };
 
-static const struct option long_options[] = {
-    { "output", required_argument, NULL, 'o' },
-    { "samples", required_argument, NULL, OPT_SAMPLES },
-    { "width", required_argument, NULL, OPT_WIDTH },
-    { "height", required_argument, NULL, OPT_HEIGHT },
-    { "threads", required_argument, NULL, OPT_THREADS },
-    { "seed", required_argument, NULL, OPT_SEED },
-    { "max-depth", required_argument, NULL, OPT_MAX_DEPTH },
-    { "sky", required_argument, NULL, OPT_SKY },
-    { "sampler", required_argument, NULL, OPT_SAMPLER },
-    { "direct-lighting", required_argument, NULL, OPT_DIRECT_LIGHTING },
-    { "noise-threshold", required_argument, NULL, OPT_NOISE_THRESHOLD },
-    { "min-samples", required_argument, NULL, OPT_MIN_SAMPLES },
-    { "camera", required_argument, NULL, OPT_CAMERA },
-    { "c", no_argument, NULL, OPT_C },
-    { "accel", required_argument, NULL, OPT_ACCEL },
-    { "asm", no_argument, NULL, OPT_ASM },
-    { "cpumask", required_argument, NULL, OPT_CPUMASK },
-    { "print-dispatch", no_argument, NULL, OPT_PRINT_DISPATCH },
-    { "depth", required_argument, NULL, OPT_DEPTH },
-    { "dither", no_argument, NULL, OPT_DITHER },
-    { "ocio-config", required_argument, NULL, OPT_OCIO_CONFIG },
-    { "display", required_argument, NULL, OPT_DISPLAY },
-    { "view", required_argument, NULL, OPT_VIEW },
-    { "look", required_argument, NULL, OPT_LOOK },
-    { "exposure", required_argument, NULL, OPT_EXPOSURE },
-    { "bake-view", no_argument, NULL, OPT_BAKE_VIEW },
-    { "list-views", no_argument, NULL, OPT_LIST_VIEWS },
-    { "json", no_argument, NULL, OPT_JSON },
-    { "time", required_argument, NULL, OPT_TIME },
-    { "preview", no_argument, NULL, OPT_PREVIEW },
-    { "watch", no_argument, NULL, OPT_WATCH },
-    { "sample-range", required_argument, NULL, OPT_SAMPLE_RANGE },
-    { "region", required_argument, NULL, OPT_REGION },
-    { "lookfrom", required_argument, NULL, OPT_LOOKFROM },
-    { "lookat", required_argument, NULL, OPT_LOOKAT },
-    { "up", required_argument, NULL, OPT_UP },
-    { "vfov", required_argument, NULL, OPT_VFOV },
-    { "aperture", required_argument, NULL, OPT_APERTURE },
-    { "focus-distance", required_argument, NULL, OPT_FOCUS_DISTANCE },
-    { "fit-all-objects", no_argument, NULL, OPT_FIT_ALL },
-    { "quiet", no_argument, NULL, OPT_QUIET },
-    { "dump-scene", no_argument, NULL, OPT_DUMP_SCENE },
-    { "help", no_argument, NULL, OPT_HELP },
-    { "version", no_argument, NULL, OPT_VERSION },
+/* getopt_long answers a short option with its character, a long one with
+ * LONG_OPTION_BASE plus its identifier: above every character. */
+enum { LONG_OPTION_BASE = 256 };
+
+static const struct option long_options[OPTION_COUNT + 1] = {
+#define OPTION(id, short_name, name, has_arg, metavar, text) \
+    { name, has_arg, NULL, LONG_OPTION_BASE + OPT_##id },
+#include "app/cli_options.def"
+#undef OPTION
     { NULL, 0, NULL, 0 },
 };
 
-static void print_help(FILE *out)
+static const char short_names[OPTION_COUNT] = {
+#define OPTION(id, short_name, name, has_arg, metavar, text) short_name,
+#include "app/cli_options.def"
+#undef OPTION
+};
+
+/* getopt's string of short options. It starts with ':' so that a missing
+ * value is told apart from an unknown option. */
+static void short_options(char text[2 * OPTION_COUNT + 2])
 {
-    fprintf(out,
-        "Usage: ptr SCENE... -o OUTPUT [options]\n"
-        "       ptr merge PART.exr... -o OUTPUT [output options]\n"
-        "       ptr --dump-scene SCENE [--camera NAME] [--sky SKY]\n"
-        "       ptr --list-views [--ocio-config FILE]\n"
-        "Renders scenes of spheres with a path tracer. SCENE is glTF (.gltf, .glb:\n"
-        "nodes with meshes, EXT_mesh_gpu_instancing instances, POINTS with _RADIUS)\n"
-        "or OBJ (.obj with its .mtl: objects named *sphere*); scripts/particles_to_glb.py\n"
-        "turns particle files (CSV, PLY) into .glb.\n"
-        "\n"
-        "Image:\n"
-        "  -o, --output FILE     image to write; the extension picks the format:\n"
-        "                        .exr, .hdr (scene-linear float), .png, .jpg, .tif\n"
-        "                        (the display's view of it, 8 bits). With several\n"
-        "                        scenes: a folder (FOLDER/NAME.exr) or a pattern\n"
-        "                        with {name}, e.g. out/{name}.png\n"
-        "      --samples N       samples per pixel (default %d)\n"
-        "      --width W         image width; with only one of width/height the other\n"
-        "      --height H        follows the camera's aspect ratio (default: the scene's\n"
-        "                        resolution, else %d wide)\n"
-        "      --depth D         8, 16, half or float, where the format allows; integer\n"
-        "                        depths hold the view, float ones scene-linear light\n"
-        "      --dither          dither 8-bit output before rounding\n"
-        "\n"
-        "Rendering:\n"
-        "      --threads N       render threads, 0 for one per CPU (default 0)\n"
-        "      --seed S          random seed (default 1); the image depends only on it,\n"
-        "                        never on the thread count\n"
-        "      --max-depth D     rays per path at most, shadow rays not counted\n"
-        "                        (default %d)\n"
-        "      --sampler S       sobol (Owen-scrambled Sobol', the default) or\n"
-        "                        independent random numbers\n"
-        "      --direct-lighting on|off  sample emissive spheres at diffuse surfaces\n"
-        "                        (default on)\n"
-        "      --noise-threshold E  adaptive sampling: a pixel stops once its error\n"
-        "                        estimate is below E (e.g. 0.01; default off)\n"
-        "      --min-samples N   adaptive sampling: samples before the first check\n"
-        "                        (default %d; checks every 16 from there)\n"
-        "\n"
-        "Scene:\n"
-        "      --sky SKY         gradient, black or R,G,B (overrides the scene's sky)\n"
-        "      --camera NAME     the glTF camera (node or camera name) to render through\n"
-        "      --lookfrom X,Y,Z --lookat X,Y,Z --vfov DEG [--up X,Y,Z] [--aperture A]\n"
-        "        [--focus-distance D]  a camera in world coordinates, replacing the\n"
-        "                        scene's (default up 0,1,0; focus at the look-at point)\n"
-        "      --fit-all-objects OBJ: fit every object, not only those named *sphere*\n"
-        "      --dump-scene      print the imported scene as JSON and render nothing\n"
-        "\n"
-        "Intersection:\n"
-        "      --accel A         auto, brute or bvh: test every sphere, or build a\n"
-        "                        tree over them first (default auto: the tree from\n"
-        "                        %d spheres on with --c, %d with SSE4.1, %d with\n"
-        "                        AVX2); the image is the same\n"
-        "      --c               use the portable C intersector (the reference)\n"
-        "      --asm             use the fastest assembly intersector; an error if none\n"
-        "      --cpumask LEVEL   cap the instruction set: none, sse41, avx2 or avx512\n"
-        "                        (also $PTR_CPUMASK; default: the best the CPU has)\n"
-        "      --print-dispatch  print each level's intersector and path tracer, and exit\n"
-        "\n"
-        "Colour (OpenColorIO):\n"
-        "      --ocio-config F   config file (default: $OCIO, else ptr's own)\n"
-        "      --display NAME    display (default: the config's, sRGB in ptr's own)\n"
-        "      --view NAME       view (default: the config's, Standard in ptr's own)\n"
-        "      --look NAME       look applied before the view\n"
-        "      --exposure STOPS  exposure applied in scene-linear before the view\n"
-        "      --bake-view       float outputs too get the view, not scene-linear light\n"
-        "      --list-views      print the config's displays, views and looks, and exit\n"
-        "\n"
-        "Progress, budgets and parts of a render:\n"
-        "      --time SECONDS    stop after the pass that reaches this budget\n"
-        "      --preview         a quick look: a quarter of the size, 4 samples\n"
-        "      --sample-range A:B  render sample indices A to B-1 of every pixel\n"
-        "                        (parts of one render, for `ptr merge`)\n"
-        "      --region X0,Y0,X1,Y1  render pixels X0..X1-1, Y0..Y1-1 (an EXR keeps\n"
-        "                        them as a data window of the full image)\n"
-        "      --watch           render again whenever the scene's files change\n"
-        "      --json            one JSON object per render on stdout\n"
-        "      --quiet           no progress or statistics\n"
-        "\n"
-        "      --help            this text\n"
-        "      --version         version and intersector\n"
-        "\n"
-        "Signals: a first SIGINT/SIGTERM finishes the current pass and writes the\n"
-        "samples done (exit 8); a second aborts at once, writing nothing (exit 130).\n"
-        "\n"
-        "Exit codes:\n",
-        DEFAULT_SAMPLES, PTR_DEFAULT_WIDTH, DEFAULT_MAX_DEPTH, DEFAULT_MIN_SAMPLES,
-        PTR_ACCEL_CROSSOVER_C, PTR_ACCEL_CROSSOVER_SSE41, PTR_ACCEL_CROSSOVER_AVX2);
-    for (int r = PTR_OK; r < PTR_RESULT_COUNT; r++)
-        fprintf(out, "  %2d  %s\n", ptr_result_exit_code((PtrResult)r),
-                ptr_result_description((PtrResult)r));
+    size_t n = 0;
+    text[n++] = ':';
+    for (int id = 0; id < OPTION_COUNT; id++) {
+        if (!short_names[id])
+            continue;
+        text[n++] = short_names[id];
+        if (long_options[id].has_arg == required_argument)
+            text[n++] = ':';
+    }
+    text[n] = '\0';
 }
 
-static void print_dispatch(void)
+/* The option getopt_long answered c for, or -1 for an unknown one. */
+static int option_id(int c)
 {
-    PtrCpuLevel detected = ptr_cpu_detected(), level = ptr_cpu_level();
-    for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
-        PtrIsectTable table;
-        ptr_isect_init_level(&table, (PtrCpuLevel)l);
-        printf("%-7s %-7s %-19s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
-               ptr_render_bundles(&table) ? "bundles of 8 paths" : "paths one at a time",
-               l > (int)detected ? "  (not on this CPU)" : "",
-               l == (int)level ? "  <- in use" : "");
-    }
+    if (c >= LONG_OPTION_BASE)
+        return c - LONG_OPTION_BASE;
+    for (int id = 0; id < OPTION_COUNT; id++)
+        if (short_names[id] == c)
+            return id;
+    return -1;
+}
+
+static int usage_error(const char *option, const char *value, const char *expected)
+{
+    fprintf(stderr, "ptr: %s: '%s' is not %s (see ptr --help)\n", option, value, expected);
+    return ptr_result_exit_code(PTR_ERR_USAGE);
+}
+
+/* Errors name an option by its long name, whichever name was typed. */
+static int bad_value(OptionId id, const char *value, const char *expected)
+{
+    char option[64];
+    snprintf(option, sizeof option, "--%s", long_options[id].name);
+    return usage_error(option, value, expected);
+}
+
+static int usage_error_line(const char *problem)
+{
+    fprintf(stderr, "ptr: %s (usage: ptr SCENE... -o OUTPUT [options]; see ptr --help)\n", problem);
+    return ptr_result_exit_code(PTR_ERR_USAGE);
 }
 
 /* A whole decimal number in [lo, hi], nothing else. */
@@ -197,12 +117,6 @@ static int parse_uint(const char *text, uint64_t lo, uint64_t hi, uint64_t *out)
     return 1;
 }
 
-static int usage_error(const char *option, const char *value, const char *expected)
-{
-    fprintf(stderr, "ptr: %s: '%s' is not %s (see ptr --help)\n", option, value, expected);
-    return ptr_result_exit_code(PTR_ERR_USAGE);
-}
-
 /* Reads a whole string as a number; 0 if it is not one (or overflows). */
 static int parse_number(const char *text, double *value)
 {
@@ -212,13 +126,219 @@ static int parse_number(const char *text, double *value)
     return !errno && end != text && !*end;
 }
 
-static int usage_error_line(const char *problem)
+/* The set_ helpers take an option's value into o. They return GO_ON, else
+ * the exit code of the usage error they reported. */
+static int set_int(OptionId id, const char *value, int lo, int hi, int *out)
 {
-    fprintf(stderr, "ptr: %s (usage: ptr SCENE... -o OUTPUT [options]; see ptr --help)\n", problem);
-    return ptr_result_exit_code(PTR_ERR_USAGE);
+    uint64_t v;
+    if (!parse_uint(value, (uint64_t)lo, (uint64_t)hi, &v)) {
+        char expected[64];
+        snprintf(expected, sizeof expected, "a whole number from %d to %d", lo, hi);
+        return bad_value(id, value, expected);
+    }
+    *out = (int)v;
+    return GO_ON;
 }
 
-/* Returns -1 to go on rendering, else the exit code to return. */
+static int set_point(OptionId id, const char *value, double xyz[3])
+{
+    char tail;
+    if (sscanf(value, "%lf,%lf,%lf%c", &xyz[0], &xyz[1], &xyz[2], &tail) != 3 ||
+        !isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
+        return bad_value(id, value, "X,Y,Z (three finite numbers)");
+    return GO_ON;
+}
+
+static int set_sample_range(OptionId id, const char *value, PtrOptions *o)
+{
+    unsigned long long a, b;
+    char tail;
+    /* %llu alone would take spaces and a sign. */
+    if (sscanf(value, "%llu:%llu%c", &a, &b, &tail) != 2 || b <= a || b > (1u << 30) ||
+        value[0] < '0' || value[0] > '9')
+        return bad_value(id, value, "START:END with 0 <= START < END <= 2^30");
+    o->sample_first = (uint32_t)a;
+    o->samples = (uint32_t)(b - a);
+    return GO_ON;
+}
+
+static int set_region(OptionId id, const char *value, PtrOptions *o)
+{
+    int x0, y0, x1, y1;
+    char tail;
+    if (sscanf(value, "%d,%d,%d,%d%c", &x0, &y0, &x1, &y1, &tail) != 4 || x0 < 0 || y0 < 0 ||
+        x1 <= x0 || y1 <= y0)
+        return bad_value(id, value, "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1");
+    o->region = (PtrRegion){ x0, y0, x1, y1 };
+    return GO_ON;
+}
+
+/* Takes one option (and its value, if it has one) into o. Returns GO_ON,
+ * else the exit code: 0 after printing what replaces the render, a usage
+ * error after reporting it. The cases follow the table; the switch has no
+ * default, so that the compiler names an option left without one. */
+static int apply_option(OptionId id, const char *value, PtrOptions *o)
+{
+    uint64_t v;
+    double x;
+    switch (id) {
+    case OPT_output: o->output = value; break;
+    case OPT_samples:
+        if (!parse_uint(value, 1, 1u << 30, &v))
+            return bad_value(id, value, "a whole number from 1 to 2^30");
+        o->samples = (uint32_t)v;
+        o->sample_first = 0; /* the last of --samples and --sample-range counts */
+        break;
+    case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width);
+    case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height);
+    case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads);
+    case OPT_seed:
+        if (!parse_uint(value, 0, UINT64_MAX, &o->seed))
+            return bad_value(id, value, "a whole number from 0 to 2^64-1");
+        break;
+    case OPT_max_depth: return set_int(id, value, 1, 100000, &o->max_depth);
+    case OPT_sampler:
+        if (!ptr_sampler_parse(value, &o->sampler))
+            return bad_value(id, value, "sobol or independent");
+        break;
+    case OPT_direct_lighting:
+        if (strcmp(value, "on") && strcmp(value, "off"))
+            return bad_value(id, value, "on or off");
+        o->direct_lighting = strcmp(value, "on") ? PTR_OFF : PTR_ON;
+        break;
+    case OPT_noise_threshold:
+        if (!parse_number(value, &x) || !(x > 0 && x <= 1e6))
+            return bad_value(id, value, "a number above 0");
+        o->noise_threshold = (float)x;
+        break;
+    case OPT_min_samples:
+        if (!parse_uint(value, 2, 1u << 30, &v))
+            return bad_value(id, value, "a whole number from 2 to 2^30");
+        o->min_samples = (uint32_t)v;
+        break;
+    case OPT_sky:
+        if (!ptr_sky_parse(value, &o->sky))
+            return bad_value(id, value, "gradient, black or R,G,B (not negative)");
+        o->has_sky = 1;
+        break;
+    case OPT_camera: o->camera_name = value; break;
+    case OPT_lookfrom:
+        o->has_camera |= CAMERA_LOOKFROM;
+        return set_point(id, value, o->camera.lookfrom);
+    case OPT_lookat:
+        o->has_camera |= CAMERA_LOOKAT;
+        return set_point(id, value, o->camera.lookat);
+    case OPT_vfov:
+        if (!parse_number(value, &x) || !(x > 0 && x < 180))
+            return bad_value(id, value, "an angle between 0 and 180 degrees");
+        o->camera.vfov_deg = x;
+        o->has_camera |= CAMERA_VFOV;
+        break;
+    case OPT_up: return set_point(id, value, o->camera.up);
+    case OPT_aperture:
+        if (!parse_number(value, &x) || !(isfinite(x) && x >= 0))
+            return bad_value(id, value, "a diameter, 0 or more");
+        o->camera.aperture = x;
+        break;
+    case OPT_focus_distance:
+        if (!parse_number(value, &x) || !(isfinite(x) && x > 0))
+            return bad_value(id, value, "a distance above 0");
+        o->camera.focus_distance = x;
+        break;
+    case OPT_fit_all_objects: o->fit_all_objects = 1; break;
+    case OPT_accel:
+        if (!ptr_accel_parse(value, &o->accel))
+            return bad_value(id, value, "auto, brute or bvh");
+        break;
+    case OPT_c: o->kernel = PTR_KERNEL_C; break;
+    case OPT_asm: o->kernel = PTR_KERNEL_ASM; break;
+    case OPT_cpumask: {
+        PtrCpuLevel cap;
+        if (!ptr_cpu_parse_level(value, &cap))
+            return bad_value(id, value, "none, sse41, avx2 or avx512");
+        ptr_cpu_set_cap(cap);
+        break;
+    }
+    case OPT_print_dispatch: ptr_print_dispatch(); return 0;
+    case OPT_depth:
+        if (!ptr_depth_parse(value, &o->depth))
+            return bad_value(id, value, "8, 16, half or float");
+        break;
+    case OPT_dither: o->dither = 1; break;
+    case OPT_ocio_config: o->ocio_config = value; break;
+    case OPT_display: o->display = value; break;
+    case OPT_view: o->view = value; break;
+    case OPT_look: o->look = value; break;
+    case OPT_exposure:
+        if (!parse_number(value, &x) || !(fabs(x) <= 64))
+            return bad_value(id, value, "a number of stops from -64 to 64");
+        o->exposure = (float)x;
+        break;
+    case OPT_bake_view: o->bake_view = 1; break;
+    case OPT_list_views: o->list_views = 1; break;
+    case OPT_time:
+        if (!parse_number(value, &x) || !(x > 0 && x <= 1e7))
+            return bad_value(id, value, "a number of seconds above 0");
+        o->time_budget = x;
+        break;
+    case OPT_preview: o->preview = 1; break;
+    case OPT_sample_range: return set_sample_range(id, value, o);
+    case OPT_region: return set_region(id, value, o);
+    case OPT_watch: o->watch = 1; break;
+    case OPT_json: o->json = 1; break;
+    case OPT_quiet: o->quiet = 1; break;
+    case OPT_dump_scene: o->dump_scene = 1; break;
+    case OPT_help: ptr_print_help(); return 0;
+    case OPT_version: ptr_print_version(); return 0;
+    }
+    return GO_ON;
+}
+
+/* Takes argv's options into o, leaving optind at the first operand. Returns
+ * GO_ON, else the exit code. */
+static int read_options(int argc, char **argv, PtrOptions *o)
+{
+    char shorts[2 * OPTION_COUNT + 2];
+    short_options(shorts);
+    optind = 0; /* glibc: restart scanning, so the parser can run more than once */
+    opterr = 0;
+    for (int c; (c = getopt_long(argc, argv, shorts, long_options, NULL)) != -1;) {
+        if (c == ':') {
+            fprintf(stderr, "ptr: %s needs a value (see ptr --help)\n", argv[optind - 1]);
+            return ptr_result_exit_code(PTR_ERR_USAGE);
+        }
+        int id = option_id(c);
+        if (id < 0) {
+            fprintf(stderr, "ptr: unknown option '%s' (see ptr --help)\n", argv[optind - 1]);
+            return ptr_result_exit_code(PTR_ERR_USAGE);
+        }
+        int code = apply_option((OptionId)id, optarg, o);
+        if (code != GO_ON)
+            return code;
+    }
+    return GO_ON;
+}
+
+/* What is wrong with the options taken together, or NULL. */
+static const char *usage_problem(const PtrOptions *o)
+{
+    if (o->has_camera && o->has_camera != CAMERA_COMPLETE)
+        return "a camera needs --lookfrom, --lookat and --vfov together";
+    if (o->input_count == 0)
+        return o->merge ? "no parts given" : "no scene file given";
+    if (!o->output && !o->dump_scene)
+        return "no output given (-o)";
+    if (o->watch && o->input_count > 1)
+        return "--watch takes one scene";
+    if (o->merge && o->dump_scene)
+        return "--dump-scene is not for merge";
+    /* Stopping decisions need every sample of a pixel from the first on; a
+     * later range cannot know them. */
+    if (o->noise_threshold > 0 && o->sample_first > 0)
+        return "--noise-threshold needs samples from 0 (not --sample-range A:B with A > 0)";
+    return NULL;
+}
+
 int ptr_options_parse(int argc, char **argv, PtrOptions *o)
 {
     const char *env_mask = getenv("PTR_CPUMASK");
@@ -226,8 +346,8 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
     if (env_mask && !ptr_cpu_parse_level(env_mask, &env_cap))
         return usage_error("PTR_CPUMASK", env_mask, "none, sse41, avx2 or avx512");
     *o = (PtrOptions){
-        .samples = DEFAULT_SAMPLES, .seed = 1, .max_depth = DEFAULT_MAX_DEPTH,
-        .min_samples = DEFAULT_MIN_SAMPLES,
+        .samples = PTR_DEFAULT_SAMPLES, .seed = 1, .max_depth = PTR_DEFAULT_MAX_DEPTH,
+        .min_samples = PTR_DEFAULT_MIN_SAMPLES,
         .kernel = PTR_KERNEL_AUTO, .camera = { .up = { 0, 1, 0 } },
     };
     if (argc > 1 && !strcmp(argv[1], "merge")) {
@@ -235,199 +355,13 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         argv++;
         argc--;
     }
-    optind = 0; /* glibc: restart scanning, so the parser can run more than once */
-    opterr = 0;
-    int c;
-    uint64_t v;
-    while ((c = getopt_long(argc, argv, ":o:", long_options, NULL)) != -1) {
-        const char *name = long_options[0].name;
-        for (const struct option *lo = long_options; lo->name; lo++)
-            if (lo->val == c)
-                name = lo->name;
-        char option[64];
-        snprintf(option, sizeof option, "--%s", name);
-        switch (c) {
-        case 'o': o->output = optarg; break;
-        case OPT_SAMPLES:
-            if (!parse_uint(optarg, 1, 1u << 30, &v))
-                return usage_error(option, optarg, "a whole number from 1 to 2^30");
-            o->samples = (uint32_t)v;
-            o->sample_first = 0;
-            break;
-        case OPT_SAMPLE_RANGE: {
-            unsigned long long a, b;
-            char tail;
-            if (sscanf(optarg, "%llu:%llu%c", &a, &b, &tail) != 2 || b <= a || b > (1u << 30) ||
-                optarg[0] < '0' || optarg[0] > '9')
-                return usage_error(option, optarg, "START:END with 0 <= START < END <= 2^30");
-            o->sample_first = (uint32_t)a;
-            o->samples = (uint32_t)(b - a);
-            break;
-        }
-        case OPT_REGION: {
-            int x0, y0, x1, y1;
-            char tail;
-            if (sscanf(optarg, "%d,%d,%d,%d%c", &x0, &y0, &x1, &y1, &tail) != 4 || x0 < 0 ||
-                y0 < 0 || x1 <= x0 || y1 <= y0)
-                return usage_error(option, optarg, "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1");
-            o->region = (PtrRegion){ x0, y0, x1, y1 };
-            break;
-        }
-        case OPT_TIME: {
-            double t;
-            if (!parse_number(optarg, &t) || !(t > 0 && t <= 1e7))
-                return usage_error(option, optarg, "a number of seconds above 0");
-            o->time_budget = t;
-            break;
-        }
-        case OPT_LOOKFROM:
-        case OPT_LOOKAT:
-        case OPT_UP: {
-            double *xyz = c == OPT_LOOKFROM ? o->camera.lookfrom : c == OPT_LOOKAT ? o->camera.lookat
-                                                                                : o->camera.up;
-            char tail;
-            if (sscanf(optarg, "%lf,%lf,%lf%c", &xyz[0], &xyz[1], &xyz[2], &tail) != 3 ||
-                !isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
-                return usage_error(option, optarg, "X,Y,Z (three finite numbers)");
-            o->has_camera |= c == OPT_LOOKFROM ? 1 : c == OPT_LOOKAT ? 2 : 0;
-            break;
-        }
-        case OPT_VFOV:
-        case OPT_APERTURE:
-        case OPT_FOCUS_DISTANCE: {
-            double x;
-            int ok = parse_number(optarg, &x) && isfinite(x) &&
-                     (c == OPT_VFOV ? x > 0 && x < 180 : c == OPT_APERTURE ? x >= 0 : x > 0);
-            if (!ok)
-                return usage_error(option, optarg,
-                                   c == OPT_VFOV ? "an angle between 0 and 180 degrees"
-                                   : c == OPT_APERTURE ? "a diameter, 0 or more"
-                                                       : "a distance above 0");
-            *(c == OPT_VFOV ? &o->camera.vfov_deg : c == OPT_APERTURE ? &o->camera.aperture
-                                                                      : &o->camera.focus_distance) = x;
-            o->has_camera |= c == OPT_VFOV ? 4 : 0;
-            break;
-        }
-        case OPT_FIT_ALL: o->fit_all_objects = 1; break;
-        case OPT_PREVIEW: o->preview = 1; break;
-        case OPT_WATCH: o->watch = 1; break;
-        case OPT_JSON: o->json = 1; break;
-        case OPT_WIDTH:
-        case OPT_HEIGHT:
-            if (!parse_uint(optarg, 1, PTR_MAX_IMAGE_SIZE, &v))
-                return usage_error(option, optarg, "a whole number from 1 to 65536");
-            *(c == OPT_WIDTH ? &o->width : &o->height) = (int)v;
-            break;
-        case OPT_THREADS:
-            if (!parse_uint(optarg, 0, MAX_THREADS, &v))
-                return usage_error(option, optarg, "a whole number from 0 to 1024");
-            o->threads = (int)v;
-            break;
-        case OPT_SEED:
-            if (!parse_uint(optarg, 0, UINT64_MAX, &v))
-                return usage_error(option, optarg, "a whole number from 0 to 2^64-1");
-            o->seed = v;
-            break;
-        case OPT_MAX_DEPTH:
-            if (!parse_uint(optarg, 1, 100000, &v))
-                return usage_error(option, optarg, "a whole number from 1 to 100000");
-            o->max_depth = (int)v;
-            break;
-        case OPT_SKY:
-            if (!ptr_sky_parse(optarg, &o->sky))
-                return usage_error(option, optarg, "gradient, black or R,G,B (not negative)");
-            o->has_sky = 1;
-            break;
-        case OPT_SAMPLER:
-            if (!ptr_sampler_parse(optarg, &o->sampler))
-                return usage_error(option, optarg, "sobol or independent");
-            break;
-        case OPT_DIRECT_LIGHTING:
-            if (strcmp(optarg, "on") && strcmp(optarg, "off"))
-                return usage_error(option, optarg, "on or off");
-            o->direct_lighting = strcmp(optarg, "on") ? PTR_OFF : PTR_ON;
-            break;
-        case OPT_NOISE_THRESHOLD: {
-            double e;
-            if (!parse_number(optarg, &e) || !(e > 0 && e <= 1e6))
-                return usage_error(option, optarg, "a number above 0");
-            o->noise_threshold = (float)e;
-            break;
-        }
-        case OPT_MIN_SAMPLES:
-            if (!parse_uint(optarg, 2, 1u << 30, &v))
-                return usage_error(option, optarg, "a whole number from 2 to 2^30");
-            o->min_samples = (uint32_t)v;
-            break;
-        case OPT_CAMERA: o->camera_name = optarg; break;
-        case OPT_C: o->kernel = PTR_KERNEL_C; break;
-        case OPT_ACCEL:
-            if (!ptr_accel_parse(optarg, &o->accel))
-                return usage_error(option, optarg, "auto, brute or bvh");
-            break;
-        case OPT_ASM: o->kernel = PTR_KERNEL_ASM; break;
-        case OPT_CPUMASK: {
-            PtrCpuLevel cap;
-            if (!ptr_cpu_parse_level(optarg, &cap))
-                return usage_error(option, optarg, "none, sse41, avx2 or avx512");
-            ptr_cpu_set_cap(cap);
-            break;
-        }
-        case OPT_PRINT_DISPATCH: print_dispatch(); return 0;
-        case OPT_DEPTH:
-            if (!ptr_depth_parse(optarg, &o->depth))
-                return usage_error(option, optarg, "8, 16, half or float");
-            break;
-        case OPT_DITHER: o->dither = 1; break;
-        case OPT_OCIO_CONFIG: o->ocio_config = optarg; break;
-        case OPT_DISPLAY: o->display = optarg; break;
-        case OPT_VIEW: o->view = optarg; break;
-        case OPT_LOOK: o->look = optarg; break;
-        case OPT_EXPOSURE: {
-            double stops;
-            if (!parse_number(optarg, &stops) || !(fabs(stops) <= 64))
-                return usage_error(option, optarg, "a number of stops from -64 to 64");
-            o->exposure = (float)stops;
-            break;
-        }
-        case OPT_BAKE_VIEW: o->bake_view = 1; break;
-        case OPT_LIST_VIEWS: o->list_views = 1; break;
-        case OPT_QUIET: o->quiet = 1; break;
-        case OPT_DUMP_SCENE: o->dump_scene = 1; break;
-        case OPT_HELP: print_help(stdout); return 0;
-        case OPT_VERSION: {
-            PtrIsectTable table;
-            ptr_isect_init_level(&table, ptr_cpu_level());
-            printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
-            return 0;
-        }
-        case ':':
-            fprintf(stderr, "ptr: %s needs a value (see ptr --help)\n", argv[optind - 1]);
-            return ptr_result_exit_code(PTR_ERR_USAGE);
-        default:
-            fprintf(stderr, "ptr: unknown option '%s' (see ptr --help)\n", argv[optind - 1]);
-            return ptr_result_exit_code(PTR_ERR_USAGE);
-        }
-    }
-    if (o->list_views)
-        return -1;
+    int code = read_options(argc, argv, o);
+    if (code != GO_ON || o->list_views)
+        return code;
     o->inputs = argv + optind;
     o->input_count = argc - optind;
-    const char *problem = o->has_camera && o->has_camera != 7
-                              ? "a camera needs --lookfrom, --lookat and --vfov together"
-                          : o->input_count == 0 ? (o->merge ? "no parts given" : "no scene file given")
-                          : !o->output && !o->dump_scene ? "no output given (-o)"
-                          : o->watch && o->input_count > 1 ? "--watch takes one scene"
-                          : o->merge && o->dump_scene ? "--dump-scene is not for merge"
-                          /* Stopping decisions need every sample of a pixel from
-                           * the first on; a later range cannot know them. */
-                          : o->noise_threshold > 0 && o->sample_first > 0
-                              ? "--noise-threshold needs samples from 0 (not --sample-range A:B "
-                                "with A > 0)"
-                                                      : NULL;
-    if (problem)
-        return usage_error_line(problem);
-    return -1;
+    const char *problem = usage_problem(o);
+    return problem ? usage_error_line(problem) : GO_ON;
 }
 
 PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencies)

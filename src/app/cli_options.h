@@ -11,7 +11,13 @@
 #include "render/render.h"
 #include "scene/scene.h"
 
-enum { PTR_DEFAULT_WIDTH = 800, PTR_MAX_IMAGE_SIZE = 1 << 16 };
+/* Defaults, as macros: the --help text spells them out. */
+#define PTR_DEFAULT_WIDTH 800
+#define PTR_DEFAULT_SAMPLES 100
+#define PTR_DEFAULT_MAX_DEPTH 50
+#define PTR_DEFAULT_MIN_SAMPLES 32
+
+enum { PTR_MAX_IMAGE_SIZE = 1 << 16 };
 
 typedef struct PtrOptions {
     char **inputs;          /* scenes; for `ptr merge`, the parts */
