@@ -6,7 +6,7 @@
  *   checkasm --bench                   nanoseconds per ray at 4..512 spheres,
  *                                      and of the tree at 10^3..10^6
  *
- * The tree traversal's checks are in check_bvh.c. */
+ * The tree traversal's checks are in bvh_closest_hit.c. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
