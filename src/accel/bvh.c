@@ -46,7 +46,7 @@
 
 #include "accel/sphere_hit.h"
 
-/* The assembly traversal reads these at fixed offsets (asm/ptr.inc). */
+/* The assembly traversal reads these at fixed offsets (asm/layout.inc). */
 static_assert(offsetof(PtrBvh, nodes) == 0 && offsetof(PtrBvh, unbounded_count) == 16,
               "PtrBvh layout");
 static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x) == 32 &&
@@ -54,8 +54,8 @@ static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x
               offsetof(PtrBvhNode, child) == 192 && offsetof(PtrBvhNode, leaf_count) == 224 &&
               sizeof(PtrBvhNode) == 256, "PtrBvhNode layout");
 static_assert(offsetof(PtrSpheres, id) == 40, "PtrSpheres layout");
-/* asm/ptr.inc repeats PTR_BVH_SLACK as the float bits 0x3f800020. */
-static_assert(PTR_BVH_MAX_DEPTH == 64, "asm/ptr.inc's stack size");
+/* asm/layout.inc repeats PTR_BVH_SLACK as the float bits 0x3f800020. */
+static_assert(PTR_BVH_MAX_DEPTH == 64, "asm/layout.inc's stack size");
 
 typedef struct StackEntry {
     uint32_t child, leaf_count;

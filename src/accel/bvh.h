@@ -35,7 +35,7 @@ enum {
 #define PTR_BVH_SLACK 0x1.00004p0f
 
 /* 256 bytes, 64-byte aligned: the assembly reads it at fixed offsets
- * (asm/ptr.inc). */
+ * (asm/layout.inc). */
 typedef struct PtrBvhNode {
     /* Child boxes, one lane per child. An empty lane has lower = +inf and
      * upper = -inf, which no ray enters. Boxes are padded so that a sphere

@@ -6,7 +6,7 @@
 
 #include "accel/sphere_hit.h"
 
-/* The assembly kernels read these structures at fixed offsets (asm/ptr.inc). */
+/* The assembly kernels read these structures at fixed offsets (asm/layout.inc). */
 static_assert(offsetof(PtrRay, tmin) == 12 && offsetof(PtrRay, dir) == 16 &&
               offsetof(PtrRay, tmax) == 28 && sizeof(PtrRay) == 32, "PtrRay layout");
 static_assert(offsetof(PtrSpheres, cx) == 0 && offsetof(PtrSpheres, cy) == 8 &&

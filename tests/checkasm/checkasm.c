@@ -6,7 +6,8 @@
  *   checkasm --bench                   nanoseconds per ray at 4..512 spheres,
  *                                      and of the tree at 10^3..10^6
  *
- * The tree traversal's checks are in check_bvh.c. */
+ * This file is the harness (checkasm.h): the checks of each field of the
+ * kernel table are in the file named after it. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -14,11 +15,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "accel/isect.h"
-#include "base/cpu.h"
 #include "checkasm.h"
-#include "sampling/rng.h"
-#include "scene/scene.h"
 
 #include <cpuid.h>
 /* XGETBV with ECX = 1 (XINUSE) exists when CPUID.(0xD, 1):EAX bit 2 is set. */
@@ -31,7 +28,7 @@ uint32_t xinuse_supported(void)
     return (a >> 2) & 1;
 }
 
-static float uniform(PtrRng *rng, float lo, float hi)
+float uniform(PtrRng *rng, float lo, float hi)
 {
     return lo + (hi - lo) * ptr_rng_float(rng);
 }
@@ -42,20 +39,14 @@ static float log_uniform(PtrRng *rng, float lo, float hi)
     return powf(10.0f, uniform(rng, lo, hi));
 }
 
-static PtrVec3 random_unit(PtrRng *rng)
+PtrVec3 random_unit(PtrRng *rng)
 {
     float z = uniform(rng, -1, 1), phi = uniform(rng, 0, 2 * PTR_PI);
     float r = sqrtf(fmaxf(0, 1 - z * z));
     return v3_normalize(v3(r * cosf(phi), r * sinf(phi), z));
 }
 
-typedef struct Case {
-    PtrScene scene;
-    PtrRay ray;
-    size_t count; /* spheres tested: at most scene.spheres.count */
-} Case;
-
-static void set_ray(Case *c, PtrVec3 o, PtrVec3 d, PtrRng *rng)
+void set_ray(Case *c, PtrVec3 o, PtrVec3 d, PtrRng *rng)
 {
     d = v3_normalize(d);
     float tmin = ptr_rng_float(rng) < 0.7f ? 0.0f : log_uniform(rng, -8, 1);
@@ -142,72 +133,6 @@ static void make_case(Case *c, PtrRng *rng)
     c->count = ptr_rng_float(rng) < 0.8f ? n : (size_t)(ptr_rng_float(rng) * (float)(n + 1)) % (n + 1);
 }
 
-/* Eight rays against the case's spheres: its own ray in some lanes, in the
- * others rays from near it aimed at one of its spheres (or anywhere), with
- * the case's distribution of tmin and tmax. */
-static void fill_packet(const Case *c, PtrRng *rng, PtrRayPacket *p)
-{
-    const PtrSpheres *s = &c->scene.spheres;
-    for (int k = 0; k < PTR_PACKET_LANES; k++) {
-        Case lane = { .ray = c->ray };
-        if (k && ptr_rng_float(rng) < 0.7f) {
-            PtrVec3 o = v3(c->ray.org[0], c->ray.org[1], c->ray.org[2]), d = random_unit(rng);
-            if (s->count) {
-                size_t i = (size_t)(ptr_rng_float(rng) * (float)s->count) % s->count;
-                o = v3_add(o, v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng)));
-                PtrVec3 target = v3_add(ptr_sphere_centre(s, i),
-                                        v3_scale(random_unit(rng), s->radius[i] * ptr_rng_float(rng)));
-                PtrVec3 to = v3_sub(target, o);
-                if (v3_max_abs(to) > 0 && ptr_rng_float(rng) < 0.8f)
-                    d = to;
-            }
-            set_ray(&lane, o, d, rng);
-        }
-        const PtrRay *r = &lane.ray;
-        for (int a = 0; a < 3; a++) {
-            p->org[a][k] = r->org[a];
-            p->dir[a][k] = r->dir[a];
-        }
-        p->tmin[k] = r->tmin;
-        p->tmax[k] = r->tmax;
-    }
-}
-
-/* Every level's packet kernel against the C packet kernel, which is the
- * one-ray reference lane by lane; returns the lanes that differ. */
-static uint64_t check_packets(const PtrIsectTable *tables, PtrCpuLevel top, const Case *c,
-                              PtrRng *rng, uint64_t *mismatches, CheckedCallStatus *status)
-{
-    PtrRayPacket rays;
-    PtrHitPacket ref;
-    fill_packet(c, rng, &rays);
-    memset(&ref, 0xaa, sizeof ref);
-    ptr_closest_hit_packet_c(&rays, &c->scene.spheres, c->count, &ref);
-    uint64_t hits = 0;
-    for (int k = 0; k < PTR_PACKET_LANES; k++)
-        hits += ref.sphere[k] != PTR_NO_HIT;
-    for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-        if (tables[l].closest_hit_packet == ptr_closest_hit_packet_c)
-            continue;
-        PtrHitPacket got;
-        memset(&got, 0x55, sizeof got);
-        ptr_checked_call_packet(tables[l].closest_hit_packet, &rays, &c->scene.spheres, c->count,
-                                &got, &status[l]);
-        for (int k = 0; k < PTR_PACKET_LANES; k++)
-            if ((got.sphere[k] != ref.sphere[k] || memcmp(&got.t[k], &ref.t[k], sizeof got.t[k])) &&
-                mismatches[l]++ < 5)
-                fprintf(stderr, "%s packet lane %d differs from c: t %a sphere %u, c: t %a sphere %u\n",
-                        tables[l].name, k, got.t[k], got.sphere[k], ref.t[k], ref.sphere[k]);
-    }
-    return hits;
-}
-
-static void print_hit(const char *who, int ret, const PtrHit *h)
-{
-    fprintf(stderr, "    %-7s returned %d, t = %.9g (%a), sphere = %" PRIu32 "\n", who, ret, h->t,
-            h->t, h->sphere);
-}
-
 /* One kernel's line of the result; whether it passed. */
 static int report(const char *kind, const char *name, uint64_t rays, uint64_t hits,
                   uint64_t mismatches, const CheckedCallStatus *status)
@@ -223,15 +148,12 @@ static int report(const char *kind, const char *name, uint64_t rays, uint64_t hi
 static int check(uint64_t rays, uint64_t seed)
 {
     PtrIsectTable tables[PTR_CPU_LEVEL_COUNT];
-    uint64_t mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, hits = 0;
-    uint64_t packet_mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, packet_hits = 0;
-    CheckedCallStatus status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
-    CheckedCallStatus packet_status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
+    Tally one = { 0 }, packets = { 0 };
     PtrCpuLevel top = ptr_cpu_level();
     int levels = 0;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
         ptr_isect_init_level(&tables[l], (PtrCpuLevel)l);
-        status[l].check_xinuse = packet_status[l].check_xinuse = xinuse_supported();
+        one.status[l].check_xinuse = packets.status[l].check_xinuse = xinuse_supported();
         levels += tables[l].closest_hit != ptr_closest_hit_c;
     }
     if (!levels) {
@@ -241,125 +163,48 @@ static int check(uint64_t rays, uint64_t seed)
         return 0;
     }
 
+    /* One stream of cases for both brute-force fields: every eighth case
+     * also draws a packet around its ray. */
     PtrRng rng = ptr_rng_for_sample(seed, 0, 0);
     for (uint64_t i = 0; i < rays; i++) {
         Case c;
         make_case(&c, &rng);
-        PtrHit ref;
-        memset(&ref, 0xaa, sizeof ref);
-        int ref_ret = ptr_closest_hit_c(&c.ray, &c.scene.spheres, c.count, &ref);
-        hits += ref_ret;
-        for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-            if (tables[l].closest_hit == ptr_closest_hit_c)
-                continue;
-            PtrHit got;
-            memset(&got, 0x55, sizeof got); /* a different sentinel: unwritten shows */
-            int ret = ptr_checked_call(tables[l].closest_hit, &c.ray, &c.scene.spheres, c.count,
-                                       &got, &status[l]);
-            if (ret == ref_ret && !memcmp(&got, &ref, sizeof got))
-                continue;
-            if (mismatches[l]++ < 5) {
-                fprintf(stderr, "%s differs from c on ray %" PRIu64 " (count %zu, tmin %a, tmax %a):\n",
-                        tables[l].name, i, c.count, c.ray.tmin, c.ray.tmax);
-                print_hit("c", ref_ret, &ref);
-                print_hit(tables[l].name, ret, &got);
-            }
-        }
+        check_closest_hit(tables, top, &c, i, &one);
         if (i % PTR_PACKET_LANES == 0)
-            packet_hits += check_packets(tables, top, &c, &rng, packet_mismatches, packet_status);
+            check_closest_hit_packet(tables, top, &c, &rng, &packets);
         ptr_scene_free(&c.scene);
     }
 
     int passed = 0, failed = 0;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
         if (tables[l].closest_hit != ptr_closest_hit_c)
-            report("", tables[l].name, rays, hits, mismatches[l], &status[l]) ? passed++ : failed++;
+            report("", tables[l].name, rays, one.hits, one.mismatches[l], &one.status[l])
+                ? passed++ : failed++;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
         if (tables[l].closest_hit_packet != ptr_closest_hit_packet_c)
-            report("packet ", tables[l].name, rays, packet_hits, packet_mismatches[l],
-                   &packet_status[l]) ? passed++ : failed++;
-    failed += check_bvh(seed, &passed);
+            report("packet ", tables[l].name, rays, packets.hits, packets.mismatches[l],
+                   &packets.status[l]) ? passed++ : failed++;
+    failed += check_bvh_closest_hit(seed, &passed);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
 
-static double now(void)
+double now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Nanoseconds per closest-hit query: random rays from outside a box of
- * spheres into it, as in a scene where most spheres are missed. */
-static double time_kernel(PtrClosestHitFn fn, const PtrScene *scene, const PtrRay *rays,
-                          size_t ray_count)
-{
-    double best = INFINITY;
-    volatile uint32_t sink = 0;
-    for (int rep = 0; rep < 5; rep++) {
-        size_t queries = 0;
-        double start = now(), elapsed;
-        do {
-            for (size_t i = 0; i < ray_count; i++) {
-                PtrHit hit;
-                fn(&rays[i], &scene->spheres, scene->spheres.count, &hit);
-                sink += hit.sphere;
-            }
-            queries += ray_count;
-            elapsed = now() - start;
-        } while (elapsed < 0.05);
-        best = fmin(best, elapsed / (double)queries * 1e9);
-    }
-    (void)sink;
-    return best;
-}
-
-static int bench(void)
-{
-    enum { RAYS = 1024 };
-    static const size_t sizes[] = { 4, 16, 64, 512 };
-    PtrRng rng = ptr_rng_for_sample(7, 0, 0);
-    PtrRay rays[RAYS];
-    PtrCpuLevel top = ptr_cpu_level();
-
-    printf("%-8s %10s", "spheres", "c ns/ray");
-    for (int l = PTR_CPU_SSE41; l <= (int)top; l++)
-        printf("  %7s ns/ray (x c)", ptr_cpu_level_name((PtrCpuLevel)l));
-    printf("\n");
-    for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
-        PtrScene scene;
-        ptr_scene_init(&scene);
-        for (size_t i = 0; i < sizes[s]; i++)
-            ptr_scene_add_sphere(&scene, v3(uniform(&rng, -10, 10), uniform(&rng, -1, 1),
-                                            uniform(&rng, -10, 10)),
-                                 uniform(&rng, 0.2f, 0.5f), 0);
-        for (int i = 0; i < RAYS; i++) {
-            PtrVec3 o = v3(uniform(&rng, -15, 15), uniform(&rng, 0, 3), 15);
-            PtrVec3 d = v3_normalize(v3_sub(v3(uniform(&rng, -10, 10), 0, uniform(&rng, -10, 10)), o));
-            rays[i] = (PtrRay){ { o.x, o.y, o.z }, 0, { d.x, d.y, d.z }, INFINITY };
-        }
-        double c_ns = time_kernel(ptr_closest_hit_c, &scene, rays, RAYS);
-        printf("%-8zu %10.1f", sizes[s], c_ns);
-        for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-            PtrIsectTable t;
-            ptr_isect_init_level(&t, (PtrCpuLevel)l);
-            double ns = time_kernel(t.closest_hit, &scene, rays, RAYS);
-            printf("  %14.1f (%4.1fx)", ns, c_ns / ns);
-        }
-        printf("\n");
-        ptr_scene_free(&scene);
-    }
-    bench_bvh();
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     uint64_t rays = 1000000, seed = 1;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--bench"))
-            return bench();
+        if (!strcmp(argv[i], "--bench")) {
+            bench_closest_hit();
+            bench_bvh_closest_hit();
+            return 0;
+        }
         if (!strcmp(argv[i], "--rays") && i + 1 < argc)
             rays = strtoull(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--seed") && i + 1 < argc)

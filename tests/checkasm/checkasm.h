@@ -1,5 +1,7 @@
-/* What the checker's parts share: the checked call (checked_call.asm) and
- * whether it can see the YMM state. */
+/* What the checker's parts share. checkasm.c is the harness: the generated
+ * cases, the run and the report. Each field of the kernel table
+ * (accel/isect.h) is checked in the file named after it: closest_hit.c,
+ * closest_hit_packet.c, bvh_closest_hit.c. */
 #ifndef PTR_CHECKASM_H
 #define PTR_CHECKASM_H
 
@@ -8,6 +10,9 @@
 
 #include "accel/bvh.h"
 #include "accel/isect.h"
+#include "base/cpu.h"
+#include "sampling/rng.h"
+#include "scene/scene.h"
 
 typedef struct CheckedCallStatus {
     uint32_t check_xinuse;
@@ -29,11 +34,47 @@ void ptr_checked_call_packet(PtrClosestHitPacketFn fn, const PtrRayPacket *rays,
 /* Whether XGETBV(1) can tell a dirty upper YMM state. */
 uint32_t xinuse_supported(void);
 
-/* The tree traversal of every level against the C traversal and against
- * brute force; returns the number of levels that failed. */
-int check_bvh(uint64_t seed, int *passed);
+/* A generated case for the brute-force kernels: a ray and the spheres it is
+ * tested against. */
+typedef struct Case {
+    PtrScene scene;
+    PtrRay ray;
+    size_t count; /* spheres tested: at most scene.spheres.count */
+} Case;
 
-/* Nanoseconds per ray of each level's traversal on cloud scenes. */
-void bench_bvh(void);
+/* Sets the case's ray: from o along d (normalized here), with a random tmin
+ * and tmax (0 and infinity most often). */
+void set_ray(Case *c, PtrVec3 o, PtrVec3 d, PtrRng *rng);
+
+float uniform(PtrRng *rng, float lo, float hi);
+PtrVec3 random_unit(PtrRng *rng);
+
+/* Seconds on the monotonic clock. */
+double now(void);
+
+/* What the checks of one table field have seen, level by level. */
+typedef struct Tally {
+    uint64_t hits; /* of the C reference */
+    uint64_t mismatches[PTR_CPU_LEVEL_COUNT];
+    CheckedCallStatus status[PTR_CPU_LEVEL_COUNT];
+} Tally;
+
+/* closest_hit.c: every level's closest_hit against ptr_closest_hit_c on case
+ * number ray_index, and their times at 4 to 512 spheres. tables is indexed
+ * by level, from PTR_CPU_SSE41 to top. */
+void check_closest_hit(const PtrIsectTable *tables, PtrCpuLevel top, const Case *c,
+                       uint64_t ray_index, Tally *tally);
+void bench_closest_hit(void);
+
+/* closest_hit_packet.c: every level's closest_hit_packet against
+ * ptr_closest_hit_packet_c, on eight rays drawn around the case. */
+void check_closest_hit_packet(const PtrIsectTable *tables, PtrCpuLevel top, const Case *c,
+                              PtrRng *rng, Tally *tally);
+
+/* bvh_closest_hit.c: the tree traversal of every level against the C
+ * traversal and against brute force; returns the number of levels that
+ * failed. Then nanoseconds per ray of each level's traversal on clouds. */
+int check_bvh_closest_hit(uint64_t seed, int *passed);
+void bench_bvh_closest_hit(void);
 
 #endif

@@ -1,7 +1,7 @@
-/* The tree traversal of every assembly level against the C traversal (the
- * same answer to the bit: return value, t and sphere) and the C traversal
- * against brute force over the scene in file order (the same t and the same
- * sphere, by id), on the hard sets of tests/bvh_scenes.h: duplicates,
+/* The table's bvh_closest_hit, the tree traversal: every assembly level's
+ * against the C traversal (the same answer to the bit: return value, t and
+ * sphere) and the C traversal against brute force over the scene in file
+ * order (the same t and the same sphere, by id), on the hard sets of tests/bvh_scenes.h: duplicates,
  * concentric, collinear, one centre, a flat sheet, grounds of radius 1000 and
  * 1e5 under tiny spheres, radii from 1e-4 to 1e3, far from the origin,
  * overlapping clusters, of 1 to 3000 spheres, with rays from the origin, from
@@ -9,7 +9,6 @@
 #include <inttypes.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
 #include "bvh_scenes.h"
 #include "checkasm.h"
@@ -38,7 +37,7 @@ static void print_hit(const char *who, int ret, const PtrHit *h, const PtrSphere
             who, ret, h->t, h->t, h->sphere, h->sphere == PTR_NO_HIT ? h->sphere : s->id[h->sphere]);
 }
 
-int check_bvh(uint64_t seed, int *passed)
+int check_bvh_closest_hit(uint64_t seed, int *passed)
 {
     PtrIsectTable tables[PTR_CPU_LEVEL_COUNT];
     CheckedCallStatus status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
@@ -128,13 +127,6 @@ int check_bvh(uint64_t seed, int *passed)
     return failed;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static double time_traversal(PtrBvhClosestHitFn fn, const PtrBvh *bvh, const PtrSpheres *s,
                              const PtrRay *rays, size_t count)
 {
@@ -155,7 +147,7 @@ static double time_traversal(PtrBvhClosestHitFn fn, const PtrBvh *bvh, const Ptr
 
 /* Clouds of spheres at a fixed volume fraction (as scripts/make_cloud.py
  * builds them, without the ground), rays from a camera in front of them. */
-void bench_bvh(void)
+void bench_bvh_closest_hit(void)
 {
     enum { RAYS = 20000 };
     static PtrRay rays[RAYS];

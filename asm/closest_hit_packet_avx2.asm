@@ -6,6 +6,8 @@
 ; as there: the answers are bit-identical to ptr_closest_hit_packet_c's.
 
 %include "ptr.inc"
+%include "layout.inc"
+%include "sphere_math.inc"
 
 section .rodata
 align 32

@@ -4,6 +4,8 @@
 ; operations, so the results are bit-identical.
 
 %include "ptr.inc"
+%include "layout.inc"
+%include "sphere_math.inc"
 
 section .rodata
 align 64

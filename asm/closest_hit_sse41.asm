@@ -4,6 +4,7 @@
 ; operations, so the results are bit-identical.
 
 %include "ptr.inc"
+%include "layout.inc"
 
 section .rodata
 align 16

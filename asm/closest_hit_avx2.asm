@@ -3,6 +3,8 @@
 ; with the same IEEE operations, so the results are bit-identical.
 
 %include "ptr.inc"
+%include "layout.inc"
+%include "sphere_math.inc"
 
 section .rodata
 align 32

@@ -9,6 +9,8 @@
 ; does, and the others in lane order.
 
 %include "ptr.inc"
+%include "layout.inc"
+%include "sphere_math.inc"
 
 section .rodata
 align 32
