@@ -130,7 +130,7 @@ int main(int argc, char **argv)
             rate[1] = mrays(&scene, &brute_asm, &setup, &seconds[1]);
         }
         PtrAccel tree;
-        if (ptr_accel_init(&tree, PTR_ACCEL_BVH, &c, &scene, 0) != PTR_OK) {
+        if (ptr_accel_init(&tree, PTR_ACCEL_BVH, &c, 0, &scene, 0) != PTR_OK) {
             fprintf(stderr, "bvh: out of memory building the tree over %zu spheres\n", n);
             return 1;
         }

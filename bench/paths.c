@@ -1,6 +1,7 @@
 /* The path tracer's speed by method, in one run: paths one at a time (the C
  * reference, as `ptr --c` renders; and with the SSE4.1 kernel, as an SSE4.1
- * CPU renders) against bundles of paths (AVX2), on 1 and 2 threads, the
+ * CPU renders) against bundles of paths (AVX2, with the C kernels and with
+ * the fastest), on 1 and 2 threads, the
  * configurations taking turns run after run. No image is written, so the
  * image library's load (on a thread of its own in `ptr`) does not share the
  * cores with the render.
@@ -23,28 +24,31 @@
 
 typedef struct Config {
     const char *name;
+    PtrIntegrator integrator;
     PtrKernel kernel;
     PtrCpuLevel cap;
 } Config;
 
 static const Config configs[] = {
-    { "paths one at a time (c)", PTR_KERNEL_C, PTR_CPU_NONE },
-    { "paths one at a time (sse41)", PTR_KERNEL_AUTO, PTR_CPU_SSE41 },
-    { "bundles, avx2", PTR_KERNEL_AUTO, PTR_CPU_AVX2 },
+    { "paths one at a time (c)", PTR_INTEGRATOR_PATHS, PTR_KERNEL_C, PTR_CPU_NONE },
+    { "paths one at a time (sse41)", PTR_INTEGRATOR_PATHS, PTR_KERNEL_AUTO, PTR_CPU_SSE41 },
+    { "bundles, c kernels", PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_C, PTR_CPU_AVX2 },
+    { "bundles, avx2", PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_AUTO, PTR_CPU_AVX2 },
 };
 enum { CONFIGS = sizeof configs / sizeof configs[0], MAX_THREADS = 2 };
 
-static double render(PtrScene *scene, const Config *c, const PtrRenderSettings *settings,
-                     float *rgb)
+static double render(PtrScene *scene, const Config *c, PtrRenderSettings settings, float *rgb)
 {
     ptr_cpu_set_cap(c->cap);
+    settings.integrator = c->integrator;
     PtrIsectTable isect;
     PtrAccel accel;
     PtrRenderStats stats;
     PtrError err = { 0 };
     ptr_isect_init(&isect, c->kernel, scene->spheres.count);
-    if (ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, scene, 0) != PTR_OK ||
-        ptr_render(scene, &accel, settings, rgb, &stats, &err) != PTR_OK) {
+    if (ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, c->integrator == PTR_INTEGRATOR_BUNDLES,
+                       scene, 0) != PTR_OK ||
+        ptr_render(scene, &accel, &settings, rgb, &stats, &err) != PTR_OK) {
         fprintf(stderr, "paths: %s\n", err.message[0] ? err.message : "out of memory");
         exit(2);
     }
@@ -87,7 +91,7 @@ int main(int argc, char **argv)
                 continue;
             for (int threads = 1; threads <= MAX_THREADS; threads++) {
                 settings.threads = threads;
-                double mrays = render(&scene, &configs[c], &settings, have_first ? rgb : first);
+                double mrays = render(&scene, &configs[c], settings, have_first ? rgb : first);
                 if (have_first && memcmp(first, rgb, floats * sizeof *rgb)) {
                     fprintf(stderr, "paths: %s on %d threads: the image differs\n",
                             configs[c].name, threads);

@@ -54,15 +54,30 @@ same_pixels "$dir/merged.exr" "$dir/merged-brute.exr" ||
     fail "parts of brute force and the tree do not merge as brute force parts do"
 iinfo -v "$dir/merged.exr" | grep -q 'ptr:accel: "mixed"' ||
     fail "the merged image does not say its parts used both"
-# The JSON names the path tracer: one path at a time with --c, and by default
-# what --print-dispatch shows for the level in use (bundles on AVX2).
-paths_of() {
+# The JSON names the integrator: by default what --print-dispatch shows for
+# the level in use; --c changes the kernel, not the integrator; --integrator
+# and $PTR_INTEGRATOR choose it, the option first; one the CPU level cannot
+# run is refused before any scene is read.
+integrator_of() {
     "$ptr" "$src/scenes/seed.gltf" -o "$dir/p.exr" --samples 1 --width 16 --quiet --json "$@" |
-        sed -E 's/.*"paths": "([a-z ]*)".*/\1/'
+        sed -E 's/.*"integrator": "([a-z]*)".*/\1/'
 }
-[ "$(paths_of --c)" = "one at a time" ] ||
-    fail "--c does not report paths one at a time"
-expected=$("$ptr" --print-dispatch | grep 'in use' | grep -q 'bundles' && echo bundles || echo "one at a time")
-[ "$(paths_of)" = "$expected" ] ||
-    fail "the JSON's paths is not what --print-dispatch shows in use ($expected)"
-finish "all scenes identical, parts merge, path tracer reported"
+expected=$("$ptr" --print-dispatch | grep 'in use' | awk '{print $3}')
+[ "$(integrator_of)" = "$expected" ] ||
+    fail "the JSON's integrator is not what --print-dispatch shows in use ($expected)"
+[ "$(integrator_of --c)" = "$expected" ] || fail "--c changed the integrator"
+[ "$(integrator_of --integrator paths)" = paths ] || fail "--integrator paths was not used"
+[ "$(PTR_INTEGRATOR=paths integrator_of)" = paths ] || fail "PTR_INTEGRATOR=paths was not used"
+if [ "$expected" = bundles ]; then
+    [ "$(PTR_INTEGRATOR=paths integrator_of --integrator bundles)" = bundles ] ||
+        fail "--integrator does not override \$PTR_INTEGRATOR"
+    [ "$(integrator_of --c --integrator bundles)" = bundles ] ||
+        fail "--integrator bundles with --c was not used"
+else
+    "$ptr" "$src/scenes/seed.gltf" -o "$dir/p.exr" --integrator bundles 2>"$dir/err"
+    [ $? = 2 ] && grep -q -- "--integrator bundles" "$dir/err" ||
+        fail "--integrator bundles below AVX2 is not refused: $(cat "$dir/err")"
+fi
+PTR_INTEGRATOR=sideways "$ptr" "$src/scenes/seed.gltf" -o "$dir/p.exr" 2>/dev/null
+[ $? = 2 ] || fail "a bad PTR_INTEGRATOR is not refused"
+finish "all scenes identical, parts merge, integrator reported and chosen"

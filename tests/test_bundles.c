@@ -1,11 +1,13 @@
-/* Bundles of paths (core/bundle.c) against paths one at a time (render.c's
- * trace_path, the reference): the same sums for every pixel, bit for bit,
+/* Every integrator with every kernel against paths one at a time with the C
+ * kernels (render.c's trace_path, the reference): bundles of paths
+ * (render/bundle.c) with the C kernels and with the fastest, and paths one
+ * at a time with the fastest. The same sums for every pixel, bit for bit,
  * and the same number of rays, on scenes that take every branch a path can
  * take (each material, fuzz, colours, emitters with light sampling, a huge
  * sphere, the tree, no sphere at all) under every setting that changes a
  * path (sampler, light sampling, depth limit, adaptive sampling, regions,
- * sample ranges split into passes, threads). On a CPU without AVX2 both sides
- * take paths one at a time, which the test says. */
+ * sample ranges split into passes, threads). Below AVX2 there are no
+ * bundles, which the test says. */
 #include "test.h"
 
 #include "accel/accel.h"
@@ -81,21 +83,24 @@ typedef struct Sums {
 } Sums;
 
 /* Samples [first, first + count) of the region in passes of pass samples. */
-static Sums render(PtrScene *scene, PtrKernel kernel, const PtrRenderSettings *settings,
-                   uint32_t first, uint32_t count, uint32_t pass)
+static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
+                   PtrRenderSettings settings, uint32_t first, uint32_t count, uint32_t pass)
 {
+    settings.integrator = integrator;
     PtrIsectTable isect;
     PtrAccel accel;
     PtrError err = { 0 };
-    PtrRegion r = ptr_render_region(settings);
+    PtrRegion r = ptr_render_region(&settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
     Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
     CHECK(ptr_isect_init(&isect, kernel, scene->spheres.count));
-    CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, scene, 0), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, integrator == PTR_INTEGRATOR_BUNDLES,
+                             scene, 0),
+              PTR_OK);
     for (uint32_t done = 0; done < count; done += pass) {
         PtrRenderStats stats;
         uint32_t n = count - done < pass ? count - done : pass;
-        CHECK_INT(ptr_render_samples(scene, &accel, settings, first + done, n, sums.acc, NULL,
+        CHECK_INT(ptr_render_samples(scene, &accel, &settings, first + done, n, sums.acc, NULL,
                                      NULL, &stats, &err),
                   PTR_OK);
         sums.rays += stats.rays;
@@ -104,6 +109,7 @@ static Sums render(PtrScene *scene, PtrKernel kernel, const PtrRenderSettings *s
     return sums;
 }
 
+/* Frees b's sums, which must be a's. */
 static int compare(const char *what, Sums a, Sums b, size_t pixels)
 {
     size_t differ = 0;
@@ -114,16 +120,26 @@ static int compare(const char *what, Sums a, Sums b, size_t pixels)
                 (unsigned long long)a.rays, (unsigned long long)b.rays);
     CHECK_INT(differ, 0);
     CHECK_INT(a.rays, b.rays);
-    free(a.acc);
     free(b.acc);
     return differ == 0;
 }
 
 int main(void)
 {
-    int bundles = ptr_cpu_level() >= PTR_CPU_AVX2;
-    printf("test_bundles: %s\n", bundles ? "bundles (AVX2) against paths one at a time"
-                                         : "no AVX2: paths one at a time on both sides");
+    typedef struct Pair {
+        PtrIntegrator integrator;
+        PtrKernel kernel;
+        const char *name;
+    } Pair;
+    const Pair pairs[] = {
+        { PTR_INTEGRATOR_PATHS, PTR_KERNEL_AUTO, "paths, fastest kernel" },
+        { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_C, "bundles, C kernels" },
+        { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_AUTO, "bundles, fastest kernel" },
+    };
+    int bundles = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES);
+    printf("test_bundles: against paths with the C kernels: %s\n",
+           bundles ? "paths with the fastest kernel, bundles with C and the fastest"
+                   : "paths with the fastest kernel (no bundles at this CPU level)");
     typedef struct Variant {
         const char *name;
         PtrRenderSettings settings;
@@ -159,14 +175,20 @@ int main(void)
             const Variant *var = &variants[v];
             PtrRegion r = ptr_render_region(&var->settings);
             size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-            Sums reference = render(&scene, PTR_KERNEL_C, &var->settings, var->first, var->count,
-                                    var->count);
-            Sums bundled = render(&other, PTR_KERNEL_AUTO, &var->settings, var->first,
-                                  var->count, var->pass);
-            char what[160];
-            snprintf(what, sizeof what, "%s, %s", scene_names[k], var->name);
-            if (compare(what, reference, bundled, pixels))
-                printf("  %-62s identical\n", what);
+            Sums reference = render(&scene, PTR_KERNEL_C, PTR_INTEGRATOR_PATHS, var->settings,
+                                    var->first, var->count, var->count);
+            for (size_t p = 0; p < sizeof pairs / sizeof pairs[0]; p++) {
+                if (pairs[p].integrator == PTR_INTEGRATOR_BUNDLES && !bundles)
+                    continue;
+                Sums other_sums = render(&other, pairs[p].kernel, pairs[p].integrator,
+                                         var->settings, var->first, var->count, var->pass);
+                char what[200];
+                snprintf(what, sizeof what, "%s, %s: %s", scene_names[k], var->name,
+                         pairs[p].name);
+                if (compare(what, reference, other_sums, pixels))
+                    printf("  %-90s identical\n", what);
+            }
+            free(reference.acc);
         }
         ptr_scene_free(&scene);
         ptr_scene_free(&other);

@@ -222,7 +222,7 @@ static float *render_with(PtrScene *scene, PtrAccelChoice choice, int width, int
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     PtrAccel accel;
-    CHECK_INT(ptr_accel_init(&accel, choice, &c, scene, 3), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, choice, &c, 0, scene, 3), PTR_OK);
     *used = ptr_accel_name(&accel);
     PtrRenderSettings settings = { .width = width, .height = height, .samples = 3, .seed = 9,
                                    .max_depth = 12, .threads = 2 };
@@ -321,7 +321,7 @@ static void test_auto(void)
         ptr_scene_init(&s);
         CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
         PtrAccel accel;
-        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, &s, 0), PTR_OK);
+        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, 0, &s, 0), PTR_OK);
         CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER_C ? "brute" : "bvh");
         ptr_accel_free(&accel);
         ptr_scene_free(&s);

@@ -1,9 +1,9 @@
 #include "accel/accel.h"
 
-#include "base/cpu.h"
-
 #include <math.h>
 #include <string.h>
+
+#include "base/cpu.h"
 
 PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene)
 {
@@ -12,11 +12,11 @@ PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene)
 }
 
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
-                         PtrScene *scene, int threads)
+                         int packets, PtrScene *scene, int threads)
 {
     *accel = ptr_accel_brute(isect, scene);
     if (choice == PTR_ACCEL_BRUTE ||
-        (choice == PTR_ACCEL_AUTO && accel->searched < ptr_accel_crossover(isect)))
+        (choice == PTR_ACCEL_AUTO && accel->searched < ptr_accel_crossover(isect, packets)))
         return PTR_OK;
     double start = ptr_now_seconds();
     PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads);
@@ -27,11 +27,11 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
     return PTR_OK;
 }
 
-size_t ptr_accel_crossover(const PtrIsectTable *isect)
+size_t ptr_accel_crossover(const PtrIsectTable *isect, int packets)
 {
     if (isect->closest_hit == ptr_closest_hit_c)
         return PTR_ACCEL_CROSSOVER_C;
-    return isect->level >= PTR_CPU_AVX2 ? PTR_ACCEL_CROSSOVER_AVX2 : PTR_ACCEL_CROSSOVER_SSE41;
+    return packets ? PTR_ACCEL_CROSSOVER_AVX2 : PTR_ACCEL_CROSSOVER_SSE41;
 }
 
 /* The huge spheres in double, then the rest up to that distance (ties

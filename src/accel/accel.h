@@ -32,8 +32,9 @@ typedef enum PtrAccelChoice {
 #define PTR_ACCEL_CROSSOVER_SSE41 96
 #define PTR_ACCEL_CROSSOVER_AVX2 192
 
-/* The crossover for brute force with isect's kernel. */
-size_t ptr_accel_crossover(const PtrIsectTable *isect);
+/* The crossover for brute force with isect's kernel, asked one ray at a time
+ * or (packets) eight at a time by bundles of paths. */
+size_t ptr_accel_crossover(const PtrIsectTable *isect, int packets);
 
 typedef struct PtrAccel {
     PtrAccelChoice kind;       /* PTR_ACCEL_BRUTE or PTR_ACCEL_BVH */
@@ -47,10 +48,10 @@ typedef struct PtrAccel {
 
 /* Chooses and prepares the structure for the scene's spheres with the
  * kernels of isect; the tree reorders the spheres (all arrays together; see
- * bvh.h). threads: for the build, 0 for one per CPU. Only PTR_ERR_NOMEM can
- * fail. */
+ * bvh.h); packets as for ptr_accel_crossover. threads: for the build, 0 for
+ * one per CPU. Only PTR_ERR_NOMEM can fail. */
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
-                         PtrScene *scene, int threads);
+                         int packets, PtrScene *scene, int threads);
 
 /* Brute force over the scene's spheres as they are: nothing to build or free. */
 PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene);

@@ -9,12 +9,14 @@
 #include "base/vec.h"
 #include "scene/scene.h"
 
-/* The outward unit normal where ray met the sphere hit names. */
-static inline PtrVec3 ptr_hit_normal(const PtrSpheres *spheres, const PtrRay *ray, const PtrHit *hit)
+/* Where a ray from org along dir meets the sphere of this centre and radius
+ * at distance t: the outward unit normal there, and the point on the surface
+ * (re-projected from the ray's, whose error grows with t). */
+static inline void ptr_sphere_surface(PtrVec3 centre, float radius, PtrVec3 org, PtrVec3 dir,
+                                      float t, PtrVec3 *point, PtrVec3 *normal)
 {
-    PtrVec3 p = v3_madd(v3(ray->org[0], ray->org[1], ray->org[2]),
-                        v3(ray->dir[0], ray->dir[1], ray->dir[2]), hit->t);
-    return v3_normalize(v3_sub(p, ptr_sphere_centre(spheres, hit->sphere)));
+    *normal = v3_normalize(v3_sub(v3_madd(org, dir, t), centre));
+    *point = v3_madd(centre, *normal, radius);
 }
 
 /* A ray leaving the surface of a sphere along dir from the point where

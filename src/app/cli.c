@@ -224,13 +224,20 @@ int ptr_cli_main(int argc, char **argv)
         code = finish_job(&o, &report);
         ptr_job_report_free(&report);
     } else {
-        /* Refuse an unavailable kernel before reading any scene. */
+        /* Refuse an unavailable kernel or integrator before reading any scene. */
         PtrIsectTable isect;
         if (!ptr_isect_init(&isect, o.kernel, SIZE_MAX)) {
             ptr_error_set(&err, PTR_ERR_USAGE,
                           "--asm: no assembly intersector at CPU level '%s' (this build %s)",
                           ptr_cpu_level_name(ptr_cpu_level()),
                           ptr_isect_has_asm() ? "has them" : "was built without them");
+            code = fail(&err);
+        } else if (!ptr_integrator_available(o.integrator)) {
+            ptr_error_set(&err, PTR_ERR_USAGE,
+                          "--integrator %s: not at CPU level '%s' (this build %s)",
+                          ptr_integrator_name(o.integrator), ptr_cpu_level_name(ptr_cpu_level()),
+                          ptr_integrator_for_level(PTR_CPU_LEVEL_COUNT - 1) == PTR_INTEGRATOR_BUNDLES
+                              ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
         } else {
             code = o.watch ? watch_scene(&o, color) : render_all(&o, color);

@@ -91,8 +91,8 @@ void ptr_print_dispatch(void)
     for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
         PtrIsectTable table;
         ptr_isect_init_level(&table, (PtrCpuLevel)l);
-        printf("%-7s %-7s %-19s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
-               ptr_render_bundles(&table) ? "bundles of 8 paths" : "paths one at a time",
+        printf("%-7s %-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+               ptr_integrator_name(ptr_integrator_for_level((PtrCpuLevel)l)),
                l > (int)detected ? "  (not on this CPU)" : "",
                l == (int)level ? "  <- in use" : "");
     }

@@ -252,6 +252,10 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
         break;
     case OPT_c: o->kernel = PTR_KERNEL_C; break;
     case OPT_asm: o->kernel = PTR_KERNEL_ASM; break;
+    case OPT_integrator:
+        if (!ptr_integrator_parse(value, &o->integrator))
+            return bad_value(id, value, "auto, paths or bundles");
+        break;
     case OPT_cpumask: {
         PtrCpuLevel cap;
         if (!ptr_cpu_parse_level(value, &cap))
@@ -350,6 +354,9 @@ int ptr_options_parse(int argc, char **argv, PtrOptions *o)
         .min_samples = PTR_DEFAULT_MIN_SAMPLES,
         .kernel = PTR_KERNEL_AUTO, .camera = { .up = { 0, 1, 0 } },
     };
+    const char *env_integrator = getenv("PTR_INTEGRATOR");
+    if (env_integrator && !ptr_integrator_parse(env_integrator, &o->integrator))
+        return usage_error("PTR_INTEGRATOR", env_integrator, "auto, paths or bundles");
     if (argc > 1 && !strcmp(argv[1], "merge")) {
         o->merge = 1;
         argv++;

@@ -42,6 +42,7 @@ typedef struct PtrOptions {
     int has_sky;
     PtrSky sky;
     PtrKernel kernel;
+    PtrIntegrator integrator; /* --integrator, else $PTR_INTEGRATOR, else auto */
     PtrAccelChoice accel;
     PtrDepth depth;
     const char *ocio_config, *display, *view, *look;

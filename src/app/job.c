@@ -55,6 +55,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
+        .integrator = o->integrator,
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -129,12 +130,14 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     PtrIsectTable isect;
     ptr_isect_init(&isect, o->kernel, scene->spheres.count);
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
-    report->bundles = ptr_render_bundles(&isect);
+    PtrIntegrator integrator = ptr_render_integrator(&(PtrRenderSettings){ .integrator = o->integrator });
+    snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
     /* Before the tree reorders the spheres: the hash does not depend on
      * their order, but there is no need to find the file order again. */
     uint64_t scene_hash = ptr_scene_hash(scene);
     PtrAccel accel;
-    PtrResult built = ptr_accel_init(&accel, o->accel, &isect, scene, o->threads);
+    PtrResult built = ptr_accel_init(&accel, o->accel, &isect,
+                                     integrator == PTR_INTEGRATOR_BUNDLES, scene, o->threads);
     if (built != PTR_OK)
         return ptr_error_set(err, built, "%s: cannot build the tree over %zu spheres: %s",
                              report->scene, scene->spheres.count, ptr_result_description(built));

@@ -97,7 +97,8 @@ void ptr_report_json(FILE *out, const PtrJobReport *r)
     ptr_json_string(out, r->kernel);
     fputs(", \"accel\": ", out);
     ptr_json_string(out, r->accel);
-    fprintf(out, ", \"paths\": \"%s\"", r->bundles ? "bundles" : "one at a time");
+    fputs(", \"integrator\": ", out);
+    ptr_json_string(out, r->integrator);
     fprintf(out,
             ", \"spheres\": %zu, \"import_seconds\": %.6f, \"build_seconds\": %.6f, "
             "\"render_seconds\": %.6f",

@@ -20,7 +20,7 @@ typedef struct PtrJobReport {
     uint64_t seed;
     char kernel[16];
     char accel[8];              /* "brute" or "bvh" */
-    int bundles;                /* paths traced in bundles, else one at a time */
+    char integrator[8];         /* "paths" or "bundles" */
     size_t spheres;
     double import_seconds, build_seconds;
     double seconds;             /* rendering */

@@ -195,17 +195,14 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
             v->ior[l] = materials[m].ior;
             set_lane_v3(v->albedo, l, materials[m].albedo);
             set_lane_v3(v->emission, l, materials[m].emission);
-            PtrVec3 c = v3(cx[s], cy[s], cz[s]);
-            PtrVec3 p = v3_madd(lane_v3(lanes->ray.org, l), lane_v3(lanes->ray.dir, l),
-                                lanes->hit.t[l]);
-            PtrVec3 normal = v3_normalize(v3_sub(p, c));
+            PtrVec3 point, normal;
+            ptr_sphere_surface(v3(cx[s], cy[s], cz[s]), radius[s], lane_v3(lanes->ray.org, l),
+                               lane_v3(lanes->ray.dir, l), lanes->hit.t[l], &point, &normal);
             set_lane_v3(v->normal, l, normal);
-            set_lane_v3(v->point, l, v3_madd(c, normal, radius[s]));
+            set_lane_v3(v->point, l, point);
         }
-        if (spheres->color)
-            for (int l = 0; l < LANES; l++)
-                set_lane_v3(v->albedo, l, v3_mul(lane_v3(v->albedo, l),
-                                                 ptr_sphere_color(spheres, v->sphere[l])));
+        for (int l = 0; l < LANES; l++)
+            set_lane_v3(v->albedo, l, ptr_path_albedo(spheres, v->sphere[l], lane_v3(v->albedo, l)));
     }
     if (scene->huge.count)
         for (int l = 0; l < LANES; l++)
@@ -236,27 +233,41 @@ STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes,
     }
 }
 
-STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
-                                const Vertex *restrict v, const float weight[LANES])
+/* The loop of add_sky_and_emission under one sky: inlined where the sky's
+ * kind is a constant, so that ptr_sky_radiance's switch folds away and the
+ * loop vectorises. */
+static inline __attribute__((always_inline)) void add_found(Lanes *restrict lanes,
+                                                            const Vertex *restrict v,
+                                                            const float weight[LANES], PtrSky sky)
 {
-    const PtrSky *sky = &job->scene->sky;
-    /* The sky's kind chosen once, not per lane: a select the loop vectorises. */
-    int gradient = sky->kind == PTR_SKY_GRADIENT;
-    PtrVec3 uniform_sky = ptr_sky_radiance(sky, v3(0.0f, 1.0f, 0.0f));
     for (int l = 0; l < LANES; l++) {
         PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
-        PtrVec3 sky_l = gradient ? ptr_sky_gradient(lane_v3(lanes->ray.dir, l)) : uniform_sky;
         PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
-                                  : v3_mul(throughput, sky_l);
+                                  : v3_mul(throughput, ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l)));
         int adds = !v->hit[l] | (v3_max_comp(emission) > 0.0f);
         PtrVec3 radiance = lane_v3(lanes->radiance, l);
         set_lane_v3(lanes->radiance, l, adds ? v3_add(radiance, found) : radiance);
     }
 }
 
-static inline PtrVec3 facing_normal(PtrVec3 dir, PtrVec3 normal)
+/* What the lanes found: the sky where they missed, emission where they hit
+ * an emitter. The sky kinds of today each get a loop of their own; any
+ * other takes the loop that looks the kind up lane by lane. */
+STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
+                                const Vertex *restrict v, const float weight[LANES])
 {
-    return v3_dot(dir, normal) < 0.0f ? normal : v3_neg(normal);
+    const PtrSky *sky = &job->scene->sky;
+    switch (sky->kind) {
+    case PTR_SKY_GRADIENT:
+        add_found(lanes, v, weight, (PtrSky){ .kind = PTR_SKY_GRADIENT });
+        break;
+    case PTR_SKY_CONSTANT:
+        add_found(lanes, v, weight, (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = sky->radiance });
+        break;
+    default:
+        add_found(lanes, v, weight, *sky);
+        break;
+    }
 }
 
 /* Light sampling at the diffuse vertices, lane by lane. */
@@ -264,24 +275,20 @@ STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const V
                            uint64_t *rays)
 {
     const PtrScene *scene = job->scene;
-    int max_depth = job->settings->max_depth;
     for (int l = 0; l < LANES; l++) {
         if (lanes->slot[l] == FREE || !v->hit[l])
             continue;
         PtrVec3 dir = lane_v3(lanes->ray.dir, l), normal = lane_v3(v->normal, l);
-        int entering = v3_dot(dir, normal) < 0.0f;
         PtrLitVertex *lit = &lanes->lit[l];
-        *lit = (PtrLitVertex){ .sampled = v->kind[l] == PTR_MATERIAL_DIFFUSE &&
-                                          lanes->depth[l] + 1 < max_depth,
-                               .point = lane_v3(v->point, l), .sphere = v->sphere[l],
-                               .side = entering ? 1 : -1 };
+        *lit = ptr_path_vertex(job, (PtrMaterialKind)v->kind[l], lanes->depth[l],
+                               lane_v3(v->point, l), v->sphere[l], v3_dot(dir, normal) < 0.0f);
         if (!lit->sampled)
             continue;
         PtrMaterial m = scene->materials[scene->spheres.material[v->sphere[l]]];
         m.albedo = lane_v3(v->albedo, l);
         PtrSampler sampler = { job->settings->sampler, lanes->key[l], lanes->index[l] };
         PtrVec3 light = ptr_path_sample_emitter(job, &sampler, lanes->depth[l], &m, lit,
-                                                facing_normal(dir, normal), normal, rays);
+                                                ptr_facing_normal(dir, normal), normal, rays);
         PtrVec3 radiance = lane_v3(lanes->radiance, l);
         set_lane_v3(lanes->radiance, l,
                     v3_add(radiance, v3_mul(lane_v3(lanes->throughput, l), light)));
@@ -320,17 +327,11 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
             u[2][l] = 0.0f;
     for (int l = 0; l < LANES; l++) {
         PtrVec3 d = lane_v3(lanes->ray.dir, l), normal = lane_v3(v->normal, l);
-        int entering = v3_dot(d, normal) < 0.0f;
-        PtrVec3 n = entering ? normal : v3_neg(normal);
-        PtrVec3 diffuse = ptr_scatter_diffuse(n, u[0][l], u[1][l]);
-        PtrVec3 mirror = ptr_reflect(d, n);
-        PtrVec3 glass = ptr_scatter_dielectric(v->ior[l], d, n, entering, u[2][l]);
-        uint32_t kind = v->kind[l];
-        PtrVec3 out = kind == PTR_MATERIAL_DIFFUSE ? diffuse
-                      : kind == PTR_MATERIAL_METAL ? v3_normalize(mirror)
-                                                   : glass;
-        set_lane_v3(v->out, l, out);
-        v->scattered[l] = (kind != PTR_MATERIAL_METAL) | (v3_dot(mirror, n) > 0.0f);
+        const float ul[3] = { u[0][l], u[1][l], u[2][l] };
+        set_lane_v3(v->out, l,
+                    ptr_scatter_direction((PtrMaterialKind)v->kind[l], v->ior[l], d,
+                                          ptr_facing_normal(d, normal), v3_dot(d, normal) < 0.0f,
+                                          ul, &v->scattered[l]));
     }
     for (int l = 0; l < LANES; l++) {
         if (lanes->slot[l] == FREE || !v->hit[l] || v->kind[l] != PTR_MATERIAL_METAL)
@@ -339,16 +340,16 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
         if (!(fuzz > 0.0f))
             continue;
         const float ul[3] = { u[0][l], u[1][l], u[2][l] };
-        PtrVec3 n = facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l));
-        PtrVec3 dir = v3_add(ptr_reflect(lane_v3(lanes->ray.dir, l), n), ptr_fuzz_offset(fuzz, ul));
-        v->scattered[l] = v3_dot(dir, n) > 0.0f;
-        set_lane_v3(v->out, l, v3_normalize(dir));
+        PtrVec3 d = lane_v3(lanes->ray.dir, l);
+        set_lane_v3(v->out, l,
+                    ptr_scatter_fuzzy_metal(fuzz, d, ptr_facing_normal(d, lane_v3(v->normal, l)),
+                                            ul, &v->scattered[l]));
     }
     if (job->sample_lights)
         for (int l = 0; l < LANES; l++)
             if (lanes->slot[l] != FREE && v->hit[l] && lanes->lit[l].sampled)
                 lanes->lit[l].scatter_pdf = ptr_diffuse_pdf(
-                    facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l)),
+                    ptr_facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l)),
                     lane_v3(v->out, l));
 }
 

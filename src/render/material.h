@@ -3,8 +3,10 @@
  * reflect-or-refract and total internal reflection.
  *
  * The pieces are inline and branch-free where they can be: the path tracer
- * calls them one path at a time, and its bundles (core/bundle.c) call them
- * lane by lane in loops the compiler vectorises; both compute the same bits. */
+ * calls them one path at a time, and its bundles (render/bundle.c) call them
+ * lane by lane in loops the compiler vectorises; both compute the same bits.
+ * A new material is a case of ptr_scatter_direction (and, if it has a
+ * density, of the light sampling in path.c). */
 #ifndef PTR_MATERIAL_H
 #define PTR_MATERIAL_H
 
@@ -81,6 +83,42 @@ static inline PtrVec3 ptr_scatter_dielectric(float ior, PtrVec3 d, PtrVec3 n, in
 static inline PtrVec3 ptr_fuzz_offset(float fuzz, const float u[3])
 {
     return v3_scale(v3_scale(ptr_uniform_sphere(u[0], u[1]), cbrtf(u[2])), fuzz);
+}
+
+/* The normal on the side a ray along dir arrives from. */
+static inline PtrVec3 ptr_facing_normal(PtrVec3 dir, PtrVec3 outward_normal)
+{
+    return v3_dot(dir, outward_normal) < 0.0f ? outward_normal : v3_neg(outward_normal);
+}
+
+/* The direction a ray along d leaves a surface of this kind and index of
+ * refraction in, n the normal on the side it arrives from, u as for
+ * ptr_scatter: every material's direction computed and the kind's kept,
+ * without branches, so that the bundles' loops over lanes vectorise (where
+ * the kind is a constant, the compiler drops the others). Fuzzy metal takes
+ * ptr_scatter_fuzzy_metal instead. *scattered is 0 where the ray is
+ * absorbed. */
+static inline PtrVec3 ptr_scatter_direction(PtrMaterialKind kind, float ior, PtrVec3 d,
+                                            PtrVec3 n, int entering, const float u[3],
+                                            int *scattered)
+{
+    PtrVec3 diffuse = ptr_scatter_diffuse(n, u[0], u[1]);
+    PtrVec3 mirror = ptr_reflect(d, n);
+    PtrVec3 glass = ptr_scatter_dielectric(ior, d, n, entering, u[2]);
+    *scattered = (kind != PTR_MATERIAL_METAL) | (v3_dot(mirror, n) > 0.0f);
+    return kind == PTR_MATERIAL_DIFFUSE ? diffuse
+           : kind == PTR_MATERIAL_METAL ? v3_normalize(mirror)
+                                        : glass;
+}
+
+/* Metal with fuzz: the mirror direction plus ptr_fuzz_offset, absorbed
+ * (*scattered 0) where that points into the surface. */
+static inline PtrVec3 ptr_scatter_fuzzy_metal(float fuzz, PtrVec3 d, PtrVec3 n, const float u[3],
+                                              int *scattered)
+{
+    PtrVec3 dir = v3_add(ptr_reflect(d, n), ptr_fuzz_offset(fuzz, u));
+    *scattered = v3_dot(dir, n) > 0.0f;
+    return v3_normalize(dir);
 }
 
 /* For diffuse materials, with n the unit normal on the side the light

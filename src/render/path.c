@@ -16,11 +16,12 @@ void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hi
         ptr_huge_surface(scene, ray, hit, point, normal);
         return;
     }
-    *normal = ptr_hit_normal(spheres, ray, hit);
-    *point = fixed_tmin > 0.0f ? v3_madd(v3(ray->org[0], ray->org[1], ray->org[2]),
-                                         v3(ray->dir[0], ray->dir[1], ray->dir[2]), hit->t)
-                               : v3_madd(ptr_sphere_centre(spheres, hit->sphere), *normal,
-                                         spheres->radius[hit->sphere]);
+    PtrVec3 org = v3(ray->org[0], ray->org[1], ray->org[2]);
+    PtrVec3 dir = v3(ray->dir[0], ray->dir[1], ray->dir[2]);
+    ptr_sphere_surface(ptr_sphere_centre(spheres, hit->sphere), spheres->radius[hit->sphere], org,
+                       dir, hit->t, point, normal);
+    if (fixed_tmin > 0.0f)
+        *point = v3_madd(org, dir, hit->t);
 }
 
 PtrRay ptr_path_leave(const PtrPathJob *job, uint32_t sphere, PtrVec3 point,

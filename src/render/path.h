@@ -45,6 +45,25 @@ typedef struct PtrLitVertex {
     float scatter_pdf; /* of the direction taken */
 } PtrLitVertex;
 
+/* The albedo of material at sphere: tinted by the sphere's own colour where
+ * the scene gives spheres colours. */
+static inline PtrVec3 ptr_path_albedo(const PtrSpheres *spheres, uint32_t sphere, PtrVec3 albedo)
+{
+    return spheres->color ? v3_mul(albedo, ptr_sphere_color(spheres, sphere)) : albedo;
+}
+
+/* The vertex a path makes at point on sphere with a material of this kind,
+ * at this depth, arriving from outside the sphere (entering) or inside: an
+ * emitter is sampled there if light sampling is on, the surface diffuse and
+ * the path may take another ray. */
+static inline PtrLitVertex ptr_path_vertex(const PtrPathJob *job, PtrMaterialKind kind, int depth,
+                                           PtrVec3 point, uint32_t sphere, int entering)
+{
+    return (PtrLitVertex){ .sampled = job->sample_lights && kind == PTR_MATERIAL_DIFFUSE &&
+                                      depth + 1 < job->settings->max_depth,
+                           .point = point, .sphere = sphere, .side = entering ? 1 : -1 };
+}
+
 static inline double *ptr_path_pixel_sums(const PtrPathJob *job, int x, int y)
 {
     const PtrRegion *r = &job->region;

@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "base/cpu.h"
@@ -36,13 +37,9 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
-        const PtrMaterial *m = &scene->materials[spheres->material[hit.sphere]];
-        PtrMaterial tinted;
-        if (spheres->color) {
-            tinted = *m;
-            tinted.albedo = v3_mul(m->albedo, ptr_sphere_color(spheres, hit.sphere));
-            m = &tinted;
-        }
+        PtrMaterial material = scene->materials[spheres->material[hit.sphere]];
+        material.albedo = ptr_path_albedo(spheres, hit.sphere, material.albedo);
+        const PtrMaterial *m = &material;
         PtrVec3 normal, point;
         ptr_path_surface(job, &ray, &hit, &point, &normal);
         if (v3_max_comp(m->emission) > 0.0f) {
@@ -53,11 +50,9 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
             radiance = v3_add(radiance, v3_scale(v3_mul(throughput, m->emission), weight));
         }
 
-        int entering = v3_dot(dir, normal) < 0.0f;
-        lit = (PtrLitVertex){ .sampled = job->sample_lights && m->kind == PTR_MATERIAL_DIFFUSE &&
-                                         depth + 1 < settings->max_depth,
-                              .point = point, .sphere = hit.sphere, .side = entering ? 1 : -1 };
-        PtrVec3 n = entering ? normal : v3_neg(normal);
+        lit = ptr_path_vertex(job, m->kind, depth, point, hit.sphere,
+                              v3_dot(dir, normal) < 0.0f);
+        PtrVec3 n = ptr_facing_normal(dir, normal);
         if (lit.sampled)
             radiance = v3_add(radiance,
                               v3_mul(throughput, ptr_path_sample_emitter(job, sampler, depth, m,
@@ -114,23 +109,58 @@ typedef struct Worker {
     uint64_t rays;
 } Worker;
 
-int ptr_render_bundles(const PtrIsectTable *isect)
+static const char *const integrator_names[] = {
+    [PTR_INTEGRATOR_AUTO] = "auto", [PTR_INTEGRATOR_PATHS] = "paths",
+    [PTR_INTEGRATOR_BUNDLES] = "bundles",
+};
+
+const char *ptr_integrator_name(PtrIntegrator integrator)
 {
-#if PTR_HAVE_BUNDLES
-    return isect->closest_hit != ptr_closest_hit_c && isect->level >= PTR_CPU_AVX2;
-#else
-    (void)isect;
-    return 0;
-#endif
+    return integrator_names[integrator];
 }
 
-static PtrRenderTileFn choose_render_tile(const PtrAccel *accel, const PtrRenderSettings *s)
+int ptr_integrator_parse(const char *text, PtrIntegrator *integrator)
+{
+    for (int i = PTR_INTEGRATOR_AUTO; i <= PTR_INTEGRATOR_BUNDLES; i++)
+        if (!strcmp(text, integrator_names[i])) {
+            *integrator = (PtrIntegrator)i;
+            return 1;
+        }
+    return 0;
+}
+
+PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level)
 {
 #if PTR_HAVE_BUNDLES
-    if (ptr_render_bundles(&accel->isect) && s->fixed_tmin == 0.0f)
+    if (level >= PTR_CPU_AVX2)
+        return PTR_INTEGRATOR_BUNDLES;
+#else
+    (void)level;
+#endif
+    return PTR_INTEGRATOR_PATHS;
+}
+
+int ptr_integrator_available(PtrIntegrator integrator)
+{
+    return integrator != PTR_INTEGRATOR_BUNDLES ||
+           ptr_integrator_for_level(ptr_cpu_level()) == PTR_INTEGRATOR_BUNDLES;
+}
+
+PtrIntegrator ptr_render_integrator(const PtrRenderSettings *s)
+{
+    if (s->fixed_tmin > 0.0f)
+        return PTR_INTEGRATOR_PATHS;
+    return s->integrator == PTR_INTEGRATOR_AUTO ? ptr_integrator_for_level(ptr_cpu_level())
+                                                : s->integrator;
+}
+
+static PtrRenderTileFn render_tile_for(PtrIntegrator integrator)
+{
+#if PTR_HAVE_BUNDLES
+    if (integrator == PTR_INTEGRATOR_BUNDLES)
         return ptr_render_tile_bundled_avx2;
 #else
-    (void)accel, (void)s;
+    (void)integrator;
 #endif
     return render_tile_by_path;
 }
@@ -181,11 +211,15 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
     RenderJob job = {
         .paths = { .scene = scene, .accel = accel, .settings = settings, .first = first,
                    .count = count, .sums = sums, .region = ptr_render_region(settings) },
-        .render_tile = choose_render_tile(accel, settings),
+        .render_tile = render_tile_for(ptr_render_integrator(settings)),
     };
     if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "max depth and fixed t_min must not be negative, samples must fit 32 bits");
+    if (!ptr_integrator_available(ptr_render_integrator(settings)))
+        return ptr_error_set(err, PTR_ERR_USAGE, "the %s integrator cannot run at CPU level %s",
+                             ptr_integrator_name(ptr_render_integrator(settings)),
+                             ptr_cpu_level_name(ptr_cpu_level()));
     if (job.paths.region.x1 == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
                              settings->width, settings->height);

@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
+#include "base/cpu.h"
 #include "base/result.h"
 #include "render/film.h"
 #include "sampling/sampler.h"
@@ -12,6 +13,15 @@
 
 /* A switch whose zero value, the default, is on. */
 typedef enum PtrSwitch { PTR_ON, PTR_OFF } PtrSwitch;
+
+/* How paths are traced, the image the same bit for bit either way: one at a
+ * time (render.c, the reference), or in bundles of eight, one path a lane
+ * (bundle.c, built for AVX2 on x86-64). */
+typedef enum PtrIntegrator {
+    PTR_INTEGRATOR_AUTO,    /* the dispatch ladder's, at the CPU level in force */
+    PTR_INTEGRATOR_PATHS,
+    PTR_INTEGRATOR_BUNDLES,
+} PtrIntegrator;
 
 /* Pixels x0 <= x < x1, y0 <= y < y1 of the full image. */
 typedef struct PtrRegion {
@@ -39,6 +49,7 @@ typedef struct PtrRenderSettings {
      * sample indices must then start at 0. */
     float noise_threshold;
     uint32_t min_samples;
+    PtrIntegrator integrator;
 } PtrRenderSettings;
 
 typedef struct PtrRenderStats {
@@ -55,11 +66,21 @@ typedef void (*PtrTickFn)(void *user, double fraction_done);
  * all zero if it does not lie inside the image. */
 PtrRegion ptr_render_region(const PtrRenderSettings *settings);
 
-/* Whether renders with this kernel table trace bundles of paths
- * (core/bundle.c: the assembly kernels on an AVX2 CPU) rather than one path
- * at a time (the C reference kernels, below AVX2, and always with a fixed
- * t_min). The image is the same either way. */
-int ptr_render_bundles(const PtrIsectTable *isect);
+/* The dispatch ladder's integrator for a CPU level: bundles from AVX2 on,
+ * where the build has them (they lose below: docs/bundles.md), else paths. */
+PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level);
+
+/* Whether the integrator can run at the CPU level in force. */
+int ptr_integrator_available(PtrIntegrator integrator);
+
+/* The integrator a render with these settings uses: theirs, or for
+ * PTR_INTEGRATOR_AUTO the ladder's at the CPU level in force; always paths
+ * with a fixed t_min, which the bundles do not take. */
+PtrIntegrator ptr_render_integrator(const PtrRenderSettings *settings);
+
+/* "paths" or "bundles", and back ("auto" too); parse returns 0 for neither. */
+const char *ptr_integrator_name(PtrIntegrator integrator);
+int ptr_integrator_parse(const char *text, PtrIntegrator *integrator);
 
 /* The renderer reads the spheres through accel (accel->spheres, which must
  * be scene->spheres) and finds every hit, shadow rays too, with ptr_trace.

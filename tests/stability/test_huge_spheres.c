@@ -57,7 +57,7 @@ static float *render(const Method *m, PtrSky sky, PtrAccelChoice choice)
     float *rgb = malloc(SIZE * SIZE * 3 * sizeof *rgb);
     PtrError err = { 0 };
     PtrAccel accel;
-    CHECK_INT(ptr_accel_init(&accel, choice, &m->isect, &s, 0), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, choice, &m->isect, 0, &s, 0), PTR_OK);
     CHECK_INT(ptr_render(&s, &accel, &settings, rgb, NULL, &err), PTR_OK);
     ptr_accel_free(&accel);
     ptr_scene_free(&s);

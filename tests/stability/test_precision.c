@@ -141,7 +141,8 @@ static int leave_surfaces(const PtrIsectTable *isect, int cases, uint64_t seed, 
             continue;
         }
         tested++;
-        PtrVec3 n = ptr_hit_normal(&s.spheres, &ray, &hit);
+        PtrVec3 point, n;
+        ptr_sphere_surface(c, (float)radius, o, d, hit.t, &point, &n);
         /* Outward, down to grazing: cos from 10^-4 to 1. */
         PtrVec3 tangent = v3_normalize(v3_cross(n, random_unit(&rng)));
         float cosine = (float)log_uniform(&rng, -4, 0);
