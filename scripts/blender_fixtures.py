@@ -1,7 +1,7 @@
 """Builds ptr's Blender test scene and exports it with Blender's own exporters:
 glTF (.gltf with a separate .bin, and .glb, cameras included) and OBJ (with and
-without its PBR extensions). tests/test_blender.c checks the imports against
-the values set here.
+without its PBR extensions). tests/import/test_blender.c checks the imports
+against the values set here.
 
 Run through scripts/make-blender-fixtures.sh, or:
     blender -b --factory-startup --python scripts/blender_fixtures.py -- OUT_DIR

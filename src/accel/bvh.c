@@ -35,8 +35,9 @@
  * the positions involved by the spheres' box padding, 2^-18 of the largest
  * magnitude in the tree plus the radius (bvh_prims.c). The largest magnitude
  * bounds where rays start, because the camera sits at 0 and other rays start
- * on spheres. tests/test_bvh.c checks the answers bit for bit on adversarial
- * scenes (far from the origin, huge and tiny radii, grazing rays). */
+ * on spheres. tests/unit/test_bvh.c checks the answers bit for bit on
+ * adversarial scenes (far from the origin, huge and tiny radii, grazing
+ * rays). */
 #include "accel/bvh.h"
 
 #include <assert.h>

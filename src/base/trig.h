@@ -11,8 +11,8 @@
 #include "base/vec.h"
 
 /* sin and cos of 2 pi u for u in [0, 1), within 2e-7 absolutely (tested
- * against double precision in tests/test_trig.c). Branch-free, so loops over
- * lanes vectorise. */
+ * against double precision in tests/unit/test_trig.c). Branch-free, so loops
+ * over lanes vectorise. */
 static inline void ptr_sincos_turns(float u, float *sin_out, float *cos_out)
 {
     /* u = (k + f) / 4 with k the nearest quarter turn, f in [-1/2, 1/2]. */

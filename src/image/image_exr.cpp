@@ -1,7 +1,7 @@
 /* EXR through OpenEXR, the format's reference library, linked in: it loads in
  * a few milliseconds, where OpenImageIO's 260 libraries take a core for a
  * quarter of a second. The files are those OpenImageIO wrote for ptr before
- * (tests/test_exr.sh): zip compression, R, G, B at the depth asked and the
+ * (tests/cli/test_exr.sh): zip compression, R, G, B at the depth asked and the
  * float "samples" channel of adaptive renders, a data window for regions, the
  * capture date, and every attribute ptr gives but OpenImageIO's own (oiio:*),
  * which it never wrote to EXR. */

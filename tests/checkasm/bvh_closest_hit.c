@@ -1,11 +1,12 @@
 /* The table's bvh_closest_hit, the tree traversal: every assembly level's
  * against the C traversal (the same answer to the bit: return value, t and
  * sphere) and the C traversal against brute force over the scene in file
- * order (the same t and the same sphere, by id), on the hard sets of tests/bvh_scenes.h: duplicates,
- * concentric, collinear, one centre, a flat sheet, grounds of radius 1000 and
- * 1e5 under tiny spheres, radii from 1e-4 to 1e3, far from the origin,
- * overlapping clusters, of 1 to 3000 spheres, with rays from the origin, from
- * sphere surfaces, at spheres and grazing them, and random tmin and tmax. */
+ * order (the same t and the same sphere, by id), on the hard sets of
+ * tests/support/bvh_scenes.h: duplicates, concentric, collinear, one centre,
+ * a flat sheet, grounds of radius 1000 and 1e5 under tiny spheres, radii from
+ * 1e-4 to 1e3, far from the origin, overlapping clusters, of 1 to 3000
+ * spheres, with rays from the origin, from sphere surfaces, at spheres and
+ * grazing them, and random tmin and tmax. */
 #include <inttypes.h>
 #include <stdio.h>
 #include <string.h>

@@ -7,7 +7,7 @@
 set -u
 ptr=$1
 src=$2
-. "$src/tests/shell_test.sh"
+. "$src/tests/support/shell_test.sh"
 
 # loads NAME: how many times the log names NAME as loaded.
 loads() { grep -c "file=[^ ]*$1.* generating link map" "$dir/log"; }

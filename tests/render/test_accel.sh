@@ -1,17 +1,17 @@
 #!/bin/sh
 # --accel brute and --accel bvh (C, and the fastest kernels the CPU has) give
-# the same pixels, bit for bit, through
-# the command line: on the committed scenes and on sphere sets hard for a
-# tree (tests/hard_scenes.py). Also checks the metadata the choice leaves,
-# and that parts rendered with each merge.
+# the same pixels, bit for bit, through the command line: on the committed
+# scenes and on sphere sets hard for a tree (tests/support/hard_scenes.py).
+# Also checks the metadata the choice leaves, and that parts rendered with
+# each merge.
 # Usage: test_accel.sh PTR SOURCE_DIR
 set -u
 ptr=$1
 src=$2
-. "$src/tests/shell_test.sh"
+. "$src/tests/support/shell_test.sh"
 # Whether two images hold the same pixels, bit for bit.
 same_pixels() { idiff -q -fail 0 -failpercent 0 -warn 0 "$1" "$2" >/dev/null; }
-python3 "$src/tests/hard_scenes.py" "$dir" || exit 1
+python3 "$src/tests/support/hard_scenes.py" "$dir" || exit 1
 scenes="$src/scenes/seed.gltf $src/scenes/final.gltf"
 for json in "$dir"/*.json; do
     python3 "$src/scripts/make_scenes.py" "$json" "${json%.json}.gltf" || exit 1

@@ -15,7 +15,7 @@ if [ "$3" = 1 ]; then
     echo "skipped: address-space limits do not apply under the sanitizers"
     exit 77
 fi
-. "$src/tests/shell_test.sh"
+. "$src/tests/support/shell_test.sh"
 
 python3 - "$src/scripts" "$dir/million.glb" <<'PY'
 import random, sys

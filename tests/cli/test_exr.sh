@@ -10,7 +10,7 @@
 set -u
 ptr=$1
 src=$2
-. "$src/tests/shell_test.sh"
+. "$src/tests/support/shell_test.sh"
 fixtures=$src/tests/fixtures/exr
 
 # render_cases DIR: every EXR feature, one file each (the scene path as the

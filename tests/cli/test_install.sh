@@ -9,7 +9,7 @@ set -u
 cmake=$1
 build=$2
 src=$3
-. "$src/tests/shell_test.sh"
+. "$src/tests/support/shell_test.sh"
 
 prefix=$dir/prefix
 "$cmake" --install "$build" --prefix "$prefix" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }

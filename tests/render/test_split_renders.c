@@ -261,7 +261,7 @@ static void test_time_budget(void)
 
 int main(void)
 {
-    if (!test_dir_create("test-split"))
+    if (!test_dir_create("test-split-renders"))
         return 1;
     test_passes_are_exact();
     test_split_and_merge();
