@@ -72,13 +72,6 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
 
 void ptr_bvh_free(PtrBvh *bvh);
 
-/* Entries a traversal stack needs: each node visited pushes at most
- * PTR_BVH_WIDTH - 1 children and pops one. */
-static inline size_t ptr_bvh_stack_size(const PtrBvh *bvh)
-{
-    return (size_t)bvh->depth * (PTR_BVH_WIDTH - 1) + 1;
-}
-
 /* The closest hit among the spheres of a tree built over them (bvh.c says
  * how). Same contract as PTR_DECL_CLOSEST_HIT over all spheres->count
  * spheres, and the same answer bit for bit, except that on equal t the

@@ -31,7 +31,7 @@
 
 typedef PTR_DECL_CLOSEST_HIT((*PtrClosestHitFn));
 
-/* Bundles of paths (core/bundle.c) trace their rays together: lane k of a
+/* Bundles of paths (render/bundle.c) trace their rays together: lane k of a
  * packet is one ray, and lane k of the answer is exactly what the one-ray
  * kernel answers for it. Tests the first count spheres, with the one-ray
  * kernel's preconditions in every lane. */

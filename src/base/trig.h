@@ -1,5 +1,5 @@
 /* Sine and cosine of an angle given in turns, ptr's own: the path tracer's
- * scalar reference and its bundles of paths (core/bundle.c, compiled for
+ * scalar reference and its bundles of paths (render/bundle.c, compiled for
  * several instruction sets) must compute the same bits, which a library's
  * sinf may not promise across calls, inlining and vectorisation. Every angle
  * ptr takes is 2 pi times a uniform number in [0, 1), so the argument comes
