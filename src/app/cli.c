@@ -233,11 +233,11 @@ int ptr_cli_main(int argc, char **argv)
                           ptr_isect_has_asm() ? "has them" : "was built without them");
             code = fail(&err);
         } else if (!ptr_integrator_available(o.integrator)) {
+            int built = ptr_integrator_for_level(PTR_CPU_LEVEL_COUNT - 1) == PTR_INTEGRATOR_BUNDLES;
             ptr_error_set(&err, PTR_ERR_USAGE,
                           "--integrator %s: not at CPU level '%s' (this build %s)",
                           ptr_integrator_name(o.integrator), ptr_cpu_level_name(ptr_cpu_level()),
-                          ptr_integrator_for_level(PTR_CPU_LEVEL_COUNT - 1) == PTR_INTEGRATOR_BUNDLES
-                              ? "has them from AVX2 on" : "was built without them");
+                          built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
         } else {
             code = o.watch ? watch_scene(&o, color) : render_all(&o, color);

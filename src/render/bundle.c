@@ -202,7 +202,8 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
             set_lane_v3(v->point, l, point);
         }
         for (int l = 0; l < LANES; l++)
-            set_lane_v3(v->albedo, l, ptr_path_albedo(spheres, v->sphere[l], lane_v3(v->albedo, l)));
+            set_lane_v3(v->albedo, l,
+                        ptr_path_albedo(spheres, v->sphere[l], lane_v3(v->albedo, l)));
     }
     if (scene->huge.count)
         for (int l = 0; l < LANES; l++)
@@ -242,8 +243,9 @@ static inline __attribute__((always_inline)) void add_found(Lanes *restrict lane
 {
     for (int l = 0; l < LANES; l++) {
         PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
+        PtrVec3 sky_l = ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l));
         PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
-                                  : v3_mul(throughput, ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l)));
+                                  : v3_mul(throughput, sky_l);
         int adds = !v->hit[l] | (v3_max_comp(emission) > 0.0f);
         PtrVec3 radiance = lane_v3(lanes->radiance, l);
         set_lane_v3(lanes->radiance, l, adds ? v3_add(radiance, found) : radiance);
@@ -262,7 +264,8 @@ STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
         add_found(lanes, v, weight, (PtrSky){ .kind = PTR_SKY_GRADIENT });
         break;
     case PTR_SKY_CONSTANT:
-        add_found(lanes, v, weight, (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = sky->radiance });
+        add_found(lanes, v, weight,
+                  (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = sky->radiance });
         break;
     default:
         add_found(lanes, v, weight, *sky);

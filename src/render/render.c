@@ -37,32 +37,31 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
-        PtrMaterial material = scene->materials[spheres->material[hit.sphere]];
-        material.albedo = ptr_path_albedo(spheres, hit.sphere, material.albedo);
-        const PtrMaterial *m = &material;
+        PtrMaterial m = scene->materials[spheres->material[hit.sphere]];
+        m.albedo = ptr_path_albedo(spheres, hit.sphere, m.albedo);
         PtrVec3 normal, point;
         ptr_path_surface(job, &ray, &hit, &point, &normal);
-        if (v3_max_comp(m->emission) > 0.0f) {
+        if (v3_max_comp(m.emission) > 0.0f) {
             float weight = lit.sampled ? ptr_path_emission_weight(job, &lit, hit.sphere, dir,
                                                                   v3_length(v3_sub(point, lit.point)),
                                                                   normal)
                                        : 1.0f;
-            radiance = v3_add(radiance, v3_scale(v3_mul(throughput, m->emission), weight));
+            radiance = v3_add(radiance, v3_scale(v3_mul(throughput, m.emission), weight));
         }
 
-        lit = ptr_path_vertex(job, m->kind, depth, point, hit.sphere,
+        lit = ptr_path_vertex(job, m.kind, depth, point, hit.sphere,
                               v3_dot(dir, normal) < 0.0f);
         PtrVec3 n = ptr_facing_normal(dir, normal);
         if (lit.sampled)
             radiance = v3_add(radiance,
-                              v3_mul(throughput, ptr_path_sample_emitter(job, sampler, depth, m,
+                              v3_mul(throughput, ptr_path_sample_emitter(job, sampler, depth, &m,
                                                                          &lit, n, normal, rays)));
 
         float u[4]; /* u[3] is unused: one pair holds the third number */
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF), u);
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF_EXTRA), u + 2);
         PtrVec3 out_dir, attenuation;
-        if (!ptr_scatter(m, dir, normal, u, &out_dir, &attenuation))
+        if (!ptr_scatter(&m, dir, normal, u, &out_dir, &attenuation))
             break;
         if (lit.sampled)
             lit.scatter_pdf = ptr_diffuse_pdf(n, out_dir);
