@@ -40,6 +40,10 @@ typedef struct PtrImportOptions {
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
                            PtrScene *scene, PtrStrings *warnings, PtrError *err);
 
+/* The glTF extensions ptr reads, NULL-terminated: a file that requires any
+ * other is refused, naming it. */
+extern const char *const ptr_gltf_extensions[];
+
 /* Appends a printf-formatted line. */
 void ptr_warn(PtrStrings *lines, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));

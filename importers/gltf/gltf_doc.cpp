@@ -1,7 +1,7 @@
 #include "gltf_doc.h"
-#include "base/shim_error.h"
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -13,10 +13,16 @@
 #include <string>
 #include <vector>
 
+#include "base/shim_error.h"
+#include "gltf_meshopt.h"
+
+extern "C" const char *const ptr_gltf_extensions[]; /* importer.h */
+
 struct GltfDoc {
     tinygltf::Model model;
     int scene = -1;
     std::vector<std::string> files;
+    std::map<int, std::vector<unsigned char>> decoded; /* buffer views, decompressed */
 };
 
 namespace {
@@ -57,11 +63,11 @@ int primitive_attribute(const tinygltf::Primitive &p, const char *name)
     return it == p.attributes.end() ? -1 : it->second;
 }
 
-std::string required_extension_fault(const tinygltf::Model &m)
+std::string required_extension_fault(const std::vector<std::string> &required)
 {
-    for (const std::string &name : m.extensionsRequired) {
+    for (const std::string &name : required) {
         bool known = false;
-        for (const char *const *e = gltf_implemented_extensions; *e; e++)
+        for (const char *const *e = ptr_gltf_extensions; *e; e++)
             known = known || name == *e;
         if (!known)
             return "requires the glTF extension " + name + ", which ptr does not implement";
@@ -71,7 +77,8 @@ std::string required_extension_fault(const tinygltf::Model &m)
 
 // tinygltf leaves most cross-references unchecked; check every one ptr
 // follows, so the C side can index without looking.
-std::string check_indices(const tinygltf::Model &m)
+std::string check_indices(const tinygltf::Model &m,
+                          const std::map<int, std::vector<unsigned char>> &decoded)
 {
     const size_t nodes = m.nodes.size();
     for (size_t i = 0; i < nodes; i++) {
@@ -123,6 +130,8 @@ std::string check_indices(const tinygltf::Model &m)
         if (!in_range(v.buffer, m.buffers.size()))
             return "buffer view " + std::to_string(i) + " refers to buffer " +
                    std::to_string(v.buffer) + ", which does not exist";
+        if (decoded.count(int(i))) /* its byteLength, decoded */
+            continue;
         const size_t size = m.buffers[size_t(v.buffer)].data.size();
         if (v.byteOffset > size || v.byteLength > size - v.byteOffset)
             return "buffer view " + std::to_string(i) + " lies past the end of buffer " +
@@ -167,6 +176,104 @@ bool is_binary_gltf(const char *path, bool *readable)
     return file.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
 }
 
+std::vector<unsigned char> read_file(const char *path)
+{
+    std::ifstream file(path, std::ios::binary);
+    return std::vector<unsigned char>(std::istreambuf_iterator<char>(file), {});
+}
+
+// The JSON of a glTF file's bytes: all of a .gltf, a .glb's JSON chunk (rest:
+// where the chunks after it start). False if there is none.
+bool json_of(const std::vector<unsigned char> &bytes, bool binary, std::string *json,
+             size_t *rest)
+{
+    if (!binary) {
+        json->assign(bytes.begin(), bytes.end());
+        *rest = bytes.size();
+        return true;
+    }
+    uint32_t length = 0;
+    if (bytes.size() < 20 || std::memcmp(&bytes[16], "JSON", 4) != 0)
+        return false;
+    std::memcpy(&length, &bytes[12], 4);
+    if (length > bytes.size() - 20)
+        return false;
+    json->assign(reinterpret_cast<const char *>(&bytes[20]), length);
+    *rest = 20 + size_t(length);
+    return true;
+}
+
+// A .glb's bytes with its JSON chunk replaced by json.
+std::vector<unsigned char> with_json(const std::vector<unsigned char> &glb, size_t rest,
+                                     std::string json)
+{
+    json.resize((json.size() + 3) / 4 * 4, ' ');
+    const uint32_t version = 2, json_length = uint32_t(json.size());
+    const uint32_t total = uint32_t(20 + json.size() + (glb.size() - rest));
+    unsigned char header[20];
+    std::memcpy(&header[0], "glTF", 4);
+    std::memcpy(&header[4], &version, 4);
+    std::memcpy(&header[8], &total, 4);
+    std::memcpy(&header[12], &json_length, 4);
+    std::memcpy(&header[16], "JSON", 4);
+    std::vector<unsigned char> out(header, header + sizeof header);
+    out.reserve(total);
+    out.insert(out.end(), json.begin(), json.end());
+    out.insert(out.end(), glb.begin() + long(rest), glb.end());
+    return out;
+}
+
+const char *const draco_extension = "KHR_draco_mesh_compression";
+
+// An object's extensions[name], or null.
+const nlohmann::json *json_extension(const nlohmann::json &object, const char *name)
+{
+    if (!object.is_object() || !object.contains("extensions") ||
+        !object["extensions"].is_object() || !object["extensions"].contains(name))
+        return nullptr;
+    return &object["extensions"][name];
+}
+
+// What tinygltf refuses of compressed files, taken out of their JSON: the
+// fallback buffers of EXT_meshopt_compression (no data: for loaders that
+// cannot decode) get one byte, and primitives compressed by Draco lose their
+// indices (an accessor without data, which ptr never reads). Empty if the
+// text does not parse.
+std::string loadable_by_tinygltf(const std::string &json)
+{
+    nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object())
+        return "";
+    if (doc.contains("buffers") && doc["buffers"].is_array())
+        for (nlohmann::json &buffer : doc["buffers"]) {
+            const nlohmann::json *ext = json_extension(buffer, meshopt_extension);
+            if (ext && ext->is_object() && ext->value("fallback", false)) {
+                buffer["byteLength"] = 1;
+                buffer["uri"] = "data:application/octet-stream;base64,AA==";
+            }
+        }
+    if (doc.contains("meshes") && doc["meshes"].is_array())
+        for (nlohmann::json &mesh : doc["meshes"])
+            if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array())
+                for (nlohmann::json &primitive : mesh["primitives"])
+                    if (json_extension(primitive, draco_extension))
+                        primitive.erase("indices");
+    return doc.dump();
+}
+
+// The extensionsRequired of a glTF JSON text; none if it does not parse.
+std::vector<std::string> required_extensions(const std::string &json)
+{
+    const nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    std::vector<std::string> names;
+    if (doc.is_object() && doc.contains("extensionsRequired") &&
+        doc["extensionsRequired"].is_array())
+        for (const nlohmann::json &name : doc["extensionsRequired"])
+            if (name.is_string())
+                names.push_back(name.get<std::string>());
+    return names;
+}
+
 const tinygltf::Value *object_member(const tinygltf::Value &object, const char *key)
 {
     // Get(key) asserts on a non-object.
@@ -201,9 +308,10 @@ void copy_or(double (&dst)[N], const std::vector<double> &src, const double (&fa
 
 } // namespace
 
-extern "C" const char *const gltf_implemented_extensions[] = {
-    "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength", "KHR_materials_ior",
-    "KHR_materials_transmission", nullptr,
+extern "C" const char *const ptr_gltf_extensions[] = {
+    "EXT_mesh_gpu_instancing", "EXT_meshopt_compression", "KHR_draco_mesh_compression",
+    "KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_transmission",
+    "KHR_mesh_quantization", nullptr,
 };
 
 extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
@@ -215,30 +323,60 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
             ptr_shim_error(err, PTR_ERR_SCENE_UNREADABLE, std::string(path) + ": " + std::strerror(errno));
             return nullptr;
         }
+        // External buffers' URIs are relative to the .gltf's folder.
+        const std::string scene_path = path;
+        const size_t slash = scene_path.rfind('/');
+        const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
         auto doc = std::make_unique<GltfDoc>();
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
         std::string error, warning;
         bool ok = binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
                          : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path);
+        std::string fault;
         if (!ok) {
-            ptr_shim_error(err, PTR_ERR_SCENE_INVALID,
-                           std::string(path) + ": " + (error.empty() ? "not a valid glTF file" : error));
-            return nullptr;
+            // tinygltf stops at what it cannot load before ptr sees the
+            // extensions: say first what the file requires that ptr lacks,
+            // and load a compressed file again without what tinygltf refuses
+            // of it.
+            const std::vector<unsigned char> bytes = read_file(path);
+            std::string json;
+            size_t rest = 0;
+            if (json_of(bytes, binary, &json, &rest)) {
+                fault = required_extension_fault(required_extensions(json));
+                const std::string patched =
+                    fault.empty() && (json.find(meshopt_extension) != std::string::npos ||
+                                      json.find(draco_extension) != std::string::npos)
+                        ? loadable_by_tinygltf(json) : "";
+                if (!patched.empty()) {
+                    error.clear();
+                    doc->model = tinygltf::Model();
+                    if (binary) {
+                        const std::vector<unsigned char> glb = with_json(bytes, rest, patched);
+                        ok = loader.LoadBinaryFromMemory(&doc->model, &error, &warning, glb.data(),
+                                                         unsigned(glb.size()), dir);
+                    } else {
+                        ok = loader.LoadASCIIFromString(&doc->model, &error, &warning,
+                                                        patched.data(), unsigned(patched.size()),
+                                                        dir);
+                    }
+                }
+            }
         }
-        std::string fault = required_extension_fault(doc->model);
+        if (!ok && fault.empty())
+            fault = error.empty() ? "not a valid glTF file" : error;
         if (fault.empty())
-            fault = check_indices(doc->model);
+            fault = required_extension_fault(doc->model.extensionsRequired);
+        if (fault.empty())
+            fault = meshopt_decode(doc->model, doc->decoded);
+        if (fault.empty())
+            fault = check_indices(doc->model, doc->decoded);
         if (!fault.empty()) {
             ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": " + fault);
             return nullptr;
         }
         const tinygltf::Model &m = doc->model;
         doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
-        // External buffers' URIs are relative to the .gltf's folder.
-        const std::string scene_path = path;
-        const size_t slash = scene_path.rfind('/');
-        const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
         for (const tinygltf::Buffer &b : m.buffers)
             if (!b.uri.empty() && b.uri.compare(0, 5, "data:") != 0)
                 doc->files.push_back(b.uri[0] == '/' ? b.uri : dir + b.uri);
@@ -310,8 +448,10 @@ extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
             continue;
         }
         for (size_t k = 0; k < 3; k++) {
-            out->min[k] = std::min(out->min[k], a.minValues[k]);
-            out->max[k] = std::max(out->max[k], a.maxValues[k]);
+            out->min[k] = std::min(out->min[k], gltf_component_value(a.componentType, a.normalized,
+                                                                     a.minValues[k]));
+            out->max[k] = std::max(out->max[k], gltf_component_value(a.componentType, a.normalized,
+                                                                     a.maxValues[k]));
         }
     }
 }
@@ -322,7 +462,8 @@ extern "C" void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index
     const tinygltf::Primitive &p = doc->model.meshes[mesh].primitives[index];
     *out = GltfPrimitive{ p.mode == TINYGLTF_MODE_POINTS, p.material,
                           primitive_attribute(p, "POSITION"), primitive_attribute(p, "_RADIUS"),
-                          primitive_attribute(p, "COLOR_0") };
+                          primitive_attribute(p, "COLOR_0"),
+                          p.extensions.count(draco_extension) > 0 };
 }
 
 extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *out)
@@ -341,7 +482,10 @@ extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor
         return;
     const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
     out->stride = size_t(a.ByteStride(v));
-    out->data = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+    auto decoded = doc->decoded.find(a.bufferView);
+    out->data = decoded != doc->decoded.end()
+                    ? decoded->second.data() + a.byteOffset
+                    : m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
 }
 
 extern "C" void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *out)

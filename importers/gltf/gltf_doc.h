@@ -20,6 +20,23 @@ enum {
     GLTF_UNSIGNED_SHORT = 5123, GLTF_UNSIGNED_INT = 5125, GLTF_FLOAT = 5126,
 };
 
+/* A component as glTF reads it: a normalized integer maps to [0, 1]
+ * (unsigned) or [-1, 1] (signed, the lowest value clamped), any other number
+ * is its value. For the elements and for an accessor's min and max alike
+ * (those of a normalized accessor are stored as integers). */
+static inline double gltf_component_value(int component_type, int normalized, double raw)
+{
+    if (!normalized)
+        return raw;
+    switch (component_type) {
+    case GLTF_UNSIGNED_BYTE: return raw / 255.0;
+    case GLTF_BYTE: return raw / 127.0 < -1.0 ? -1.0 : raw / 127.0;
+    case GLTF_UNSIGNED_SHORT: return raw / 65535.0;
+    case GLTF_SHORT: return raw / 32767.0 < -1.0 ? -1.0 : raw / 32767.0;
+    default: return raw;
+    }
+}
+
 /* An accessor's elements as the file stores them. Elements lie inside the
  * buffer (checked when the file loaded); data is NULL where the accessor
  * has no buffer view (glTF's all-zero accessor) or is sparse. */
@@ -43,6 +60,7 @@ typedef struct GltfPrimitive {
     int points;   /* mode 0 (POINTS) */
     int material; /* -1 if none */
     int position, radius, color; /* POSITION, _RADIUS, COLOR_0; -1 if absent */
+    int draco;    /* compressed by KHR_draco_mesh_compression: bounds only */
 } GltfPrimitive;
 
 typedef struct GltfNode {
@@ -111,10 +129,6 @@ typedef struct GltfScene {
  * reports what it drops itself. */
 GltfDoc *gltf_doc_load(const char *path, PtrError *err);
 void gltf_doc_free(GltfDoc *doc);
-
-/* The extensions ptr implements, for messages: glTF files that require
- * another are refused when they load. */
-extern const char *const gltf_implemented_extensions[];
 
 /* Files besides the .gltf that were read: external buffers, as paths. */
 size_t gltf_doc_file_count(const GltfDoc *doc);

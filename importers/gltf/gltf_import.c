@@ -223,6 +223,8 @@ typedef enum Components {
     FLOATS,              /* float only */
     FLOATS_OR_SIGNED,    /* float, normalized byte or short */
     FLOATS_OR_UNSIGNED,  /* float, normalized unsigned byte or short */
+    QUANTIZED,           /* float, or any byte or short, normalized or not
+                          * (KHR_mesh_quantization) */
 } Components;
 
 /* Checks accessor index as attribute `what` of o's node: its type (between
@@ -235,7 +237,9 @@ static PtrResult attribute_accessor(Importer *im, const Origin *o, const char *w
 {
     gltf_doc_accessor(im->doc, (size_t)index, a);
     const int t = a->component_type;
-    int kind_ok = (t == GLTF_FLOAT && !a->normalized) ||
+    int integer = t == GLTF_BYTE || t == GLTF_UNSIGNED_BYTE || t == GLTF_SHORT ||
+                  t == GLTF_UNSIGNED_SHORT;
+    int kind_ok = (t == GLTF_FLOAT && !a->normalized) || (kinds == QUANTIZED && integer) ||
                   (kinds == FLOATS_OR_SIGNED && a->normalized && (t == GLTF_BYTE || t == GLTF_SHORT)) ||
                   (kinds == FLOATS_OR_UNSIGNED && a->normalized &&
                    (t == GLTF_UNSIGNED_BYTE || t == GLTF_UNSIGNED_SHORT));
@@ -257,23 +261,23 @@ static PtrResult attribute_accessor(Importer *im, const Origin *o, const char *w
     return PTR_OK;
 }
 
-/* Element i of an accessor checked by attribute_accessor, as glTF defines
- * normalized integers. Missing components are 0. */
+/* Element i of an accessor checked by attribute_accessor, each component
+ * as gltf_component_value reads it. Missing components are 0. */
 static void element(const GltfAccessor *a, size_t i, double out[4])
 {
     const unsigned char *p = a->data + i * a->stride;
     for (int c = 0; c < 4; c++) {
-        double v = 0;
+        double raw = 0;
         if (c < a->components) {
             switch (a->component_type) {
-            case GLTF_FLOAT: { float f; memcpy(&f, p + 4 * c, 4); v = f; break; }
-            case GLTF_UNSIGNED_BYTE: v = p[c] / 255.0; break;
-            case GLTF_BYTE: v = fmax((signed char)p[c] / 127.0, -1.0); break;
-            case GLTF_UNSIGNED_SHORT: { uint16_t u; memcpy(&u, p + 2 * c, 2); v = u / 65535.0; break; }
-            case GLTF_SHORT: { int16_t u; memcpy(&u, p + 2 * c, 2); v = fmax(u / 32767.0, -1.0); break; }
+            case GLTF_FLOAT: { float f; memcpy(&f, p + 4 * c, 4); raw = f; break; }
+            case GLTF_UNSIGNED_BYTE: raw = p[c]; break;
+            case GLTF_BYTE: raw = (signed char)p[c]; break;
+            case GLTF_UNSIGNED_SHORT: { uint16_t u; memcpy(&u, p + 2 * c, 2); raw = u; break; }
+            case GLTF_SHORT: { int16_t u; memcpy(&u, p + 2 * c, 2); raw = u; break; }
             }
         }
-        out[c] = v;
+        out[c] = gltf_component_value(a->component_type, a->normalized, raw);
     }
 }
 
@@ -291,10 +295,15 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: node %zu ('%s') has POINTS without POSITION", im->path,
                              node_origin->node_index, node_origin->node_name);
+    if (prim->draco)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS compressed by "
+                             "KHR_draco_mesh_compression, of which ptr reads only the bounds of "
+                             "meshes", im->path, node_origin->node_index, node_origin->node_name);
     size_t count = 0;
     GltfAccessor pos, rad, col;
-    PtrResult res = attribute_accessor(im, node_origin, "POSITION", prim->position, 3, 3, FLOATS,
-                                       &count, &pos);
+    PtrResult res = attribute_accessor(im, node_origin, "POSITION", prim->position, 3, 3,
+                                       QUANTIZED, &count, &pos);
     if (res == PTR_OK && prim->radius >= 0)
         res = attribute_accessor(im, node_origin, "_RADIUS", prim->radius, 1, 1, FLOATS, &count,
                                  &rad);
@@ -389,12 +398,13 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
     GltfAccessor t, r, s, c;
     PtrResult res = PTR_OK;
     if (in->translation >= 0)
-        res = attribute_accessor(im, o, "TRANSLATION", in->translation, 3, 3, FLOATS, &count, &t);
+        res = attribute_accessor(im, o, "TRANSLATION", in->translation, 3, 3, QUANTIZED, &count,
+                                 &t);
     if (res == PTR_OK && in->rotation >= 0)
         res = attribute_accessor(im, o, "ROTATION", in->rotation, 4, 4, FLOATS_OR_SIGNED, &count,
                                  &r);
     if (res == PTR_OK && in->scale >= 0)
-        res = attribute_accessor(im, o, "SCALE", in->scale, 3, 3, FLOATS, &count, &s);
+        res = attribute_accessor(im, o, "SCALE", in->scale, 3, 3, QUANTIZED, &count, &s);
     if (res == PTR_OK && in->color >= 0)
         res = attribute_accessor(im, o, "_COLOR_0", in->color, 3, 4, FLOATS_OR_UNSIGNED, &count,
                                  &c);

@@ -1,6 +1,7 @@
 #include "app/cli_help.h"
 
 #include <stdio.h>
+#include <string.h>
 
 #include "accel/accel.h"
 #include "accel/isect.h"
@@ -8,6 +9,7 @@
 #include "base/cpu.h"
 #include "base/result.h"
 #include "base/version.h"
+#include "importer.h"
 #include "render/render.h"
 
 /* A macro's value as a string: SPELLED(PTR_DEFAULT_SAMPLES) is "100". */
@@ -60,6 +62,14 @@ void ptr_print_help(void)
           "or OBJ (.obj with its .mtl: objects named *sphere*); scripts/particles_to_glb.py\n"
           "turns particle files (CSV, PLY) into .glb.\n",
           stdout);
+    /* The list the importer checks files against, filled to 80 columns. */
+    size_t column = (size_t)printf("glTF extensions read:");
+    for (const char *const *e = ptr_gltf_extensions; *e; e++) {
+        size_t width = 1 + strlen(*e) + 1; /* " NAME," */
+        if (column + width > 80)
+            column = (size_t)printf("\n ");
+        column += (size_t)printf(" %s%s", *e, e[1] ? "," : ".\n");
+    }
     for (size_t i = 0; i < sizeof help_lines / sizeof help_lines[0]; i++) {
         if (help_lines[i].heading)
             printf("\n%s\n", help_lines[i].heading);
