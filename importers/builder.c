@@ -94,8 +94,11 @@ static void use_override(PtrSceneBuilder *b)
     for (int k = 0; k < 3; k++)
         d2 += (c->lookat[k] - c->lookfrom[k]) * (c->lookat[k] - c->lookfrom[k]);
     const PtrCamera lens = {
+        .projection = c->ortho_height > 0 ? PTR_PROJECTION_ORTHOGRAPHIC
+                                          : PTR_PROJECTION_PERSPECTIVE,
         .vfov_deg = (float)c->vfov_deg, .aperture = (float)c->aperture,
         .focus_distance = (float)(c->focus_distance > 0 ? c->focus_distance : sqrt(d2)),
+        .ymag = (float)(0.5 * c->ortho_height),
     };
     place_camera(b, c->lookfrom, c->lookat, c->up, &lens);
 }

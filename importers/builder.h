@@ -27,7 +27,7 @@ typedef struct PtrSceneBuilder {
     size_t count, capacity;
     int has_camera;
     double eye[3], target[3], up[3];
-    PtrCamera lens;   /* field of view, aperture, focus distance, aspect */
+    PtrCamera lens;   /* projection, field of view, aperture, focus, aspect */
     const PtrCameraSpec *override; /* the command line's camera, if any */
 } PtrSceneBuilder;
 

@@ -20,6 +20,7 @@ typedef struct PtrStrings {
 typedef struct PtrCameraSpec {
     double lookfrom[3], lookat[3], up[3];
     double vfov_deg;
+    double ortho_height;   /* above 0: orthographic, the view this high; vfov_deg unused */
     double aperture;       /* lens diameter; 0: a pinhole */
     double focus_distance; /* 0: the distance from lookfrom to lookat */
 } PtrCameraSpec;

@@ -521,6 +521,10 @@ extern "C" void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *ou
     out->perspective = c.type == "perspective";
     out->yfov = c.perspective.yfov;
     out->aspect_ratio = c.perspective.aspectRatio;
+    out->xmag = c.orthographic.xmag;
+    out->ymag = c.orthographic.ymag;
+    out->znear = c.orthographic.znear;
+    out->zfar = c.orthographic.zfar;
     out->has_aperture = number_member(c.extras, "aperture", &out->aperture);
     out->has_focus_distance = number_member(c.extras, "focus_distance", &out->focus_distance);
 }

@@ -102,9 +102,10 @@ typedef struct GltfMaterial {
 
 typedef struct GltfCamera {
     const char *name;
-    int perspective;
-    double yfov;         /* radians */
-    double aspect_ratio; /* 0 if not given */
+    int perspective;     /* else orthographic */
+    double yfov;         /* perspective: radians */
+    double aspect_ratio; /* perspective: 0 if not given */
+    double xmag, ymag, znear, zfar; /* orthographic */
     int has_aperture, has_focus_distance; /* extras */
     double aperture, focus_distance;
 } GltfCamera;

@@ -91,6 +91,8 @@ typedef struct Importer {
     PtrError *err;
     const char *camera_name;
     int camera_found;
+    const char *ortho_name; /* the orthographic camera taken, if one was */
+    double zfar;            /* its far plane */
     uint32_t *material_index; /* glTF material -> scene material, UINT32_MAX unset */
     uint32_t default_material;
     int warned_texture;
@@ -443,6 +445,37 @@ static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNod
     return add_mesh_spheres(im, &o, node, &mesh, world, NULL, &warned);
 }
 
+/* The projection of a glTF camera, in the scene's terms; 0 if a value is out
+ * of the range glTF allows. */
+static int camera_lens(Importer *im, const GltfCamera *cam, const char *name, PtrCamera *lens)
+{
+    double focus = cam->has_focus_distance ? cam->focus_distance : 1.0;
+    double aperture = cam->has_aperture ? cam->aperture : 0.0;
+    if (!(focus > 0) || !isfinite(focus) || !(aperture >= 0) || !isfinite(aperture))
+        return 0;
+    if (cam->perspective) {
+        double yfov_deg = cam->yfov * 180.0 / 3.14159265358979323846;
+        *lens = (PtrCamera){
+            .vfov_deg = (float)yfov_deg, .aperture = (float)aperture,
+            .focus_distance = (float)focus, .aspect = (float)cam->aspect_ratio,
+        };
+        return yfov_deg > 0 && yfov_deg < 180 && cam->aspect_ratio >= 0;
+    }
+    if (aperture > 0 && !im->builder.override) /* only of the camera used */
+        ptr_warn(im->warnings, "%s: camera '%s' is orthographic, which has no depth of field: "
+                 "extras.aperture is ignored", im->path, name);
+    *lens = (PtrCamera){
+        .projection = PTR_PROJECTION_ORTHOGRAPHIC, .focus_distance = (float)focus,
+        .ymag = (float)cam->ymag, .znear = (float)cam->znear,
+        .aspect = (float)(cam->xmag / cam->ymag),
+    };
+    im->ortho_name = name;
+    im->zfar = cam->zfar;
+    return cam->xmag > 0 && cam->ymag > 0 && isfinite(cam->xmag) && isfinite(cam->ymag) &&
+           cam->znear >= 0 && cam->zfar > cam->znear && isfinite(cam->zfar) &&
+           isfinite(lens->aspect) && lens->aspect > 0;
+}
+
 static PtrResult take_camera(Importer *im, const GltfNode *node, const Mat4 *world)
 {
     if (im->camera_found)
@@ -452,37 +485,54 @@ static PtrResult take_camera(Importer *im, const GltfNode *node, const Mat4 *wor
     if (im->camera_name && strcmp(im->camera_name, node->name) &&
         strcmp(im->camera_name, cam.name))
         return PTR_OK;
-    if (!cam.perspective) {
-        ptr_warn(im->warnings, "%s: camera '%s' is not perspective and is ignored", im->path,
-                 label(cam.name, label(node->name, "unnamed")));
-        return PTR_OK;
-    }
+    const char *name = label(cam.name, label(node->name, "unnamed"));
     const double origin[3] = { 0, 0, 0 };
     double eye[3];
     mat4_point(world, origin, eye);
-    double focus = cam.has_focus_distance ? cam.focus_distance : 1.0;
-    double aperture = cam.has_aperture ? cam.aperture : 0.0;
-    double yfov_deg = cam.yfov * 180.0 / 3.14159265358979323846;
     double fwd_len = column_length(world, 2), up_len = column_length(world, 1);
-    if (!all_finite(world->m, 16) || !(fwd_len > 0) || !(up_len > 0) ||
-        !(yfov_deg > 0 && yfov_deg < 180) || !(focus > 0) || !isfinite(focus) ||
-        !(aperture >= 0) || !isfinite(aperture) || !(cam.aspect_ratio >= 0))
+    PtrCamera lens;
+    if (!camera_lens(im, &cam, name, &lens) || !all_finite(world->m, 16) || !(fwd_len > 0) ||
+        !(up_len > 0))
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: camera '%s' has a degenerate transform or a value out of range",
-                             im->path, label(cam.name, label(node->name, "unnamed")));
+                             im->path, name);
     double target[3], up[3];
     for (int k = 0; k < 3; k++) {
         /* A glTF camera looks down its local -Z with +Y up. */
-        target[k] = eye[k] - world->m[8 + k] / fwd_len * focus;
+        target[k] = eye[k] - world->m[8 + k] / fwd_len * lens.focus_distance;
         up[k] = world->m[4 + k] / up_len;
     }
-    const PtrCamera lens = {
-        .vfov_deg = (float)yfov_deg, .aperture = (float)aperture,
-        .focus_distance = (float)focus, .aspect = (float)cam.aspect_ratio,
-    };
     ptr_builder_set_camera(&im->builder, eye, target, up, &lens);
     im->camera_found = 1;
     return PTR_OK;
+}
+
+/* Rays are not cut at an orthographic camera's far plane (a path tracer's
+ * rays go on to the sky): warns, naming the camera, if a sphere reaches
+ * beyond it, and so shows where a rasteriser would clip it. */
+static void check_far_plane(Importer *im)
+{
+    const PtrSceneBuilder *b = &im->builder;
+    if (!im->ortho_name || b->override)
+        return;
+    double fwd[3], len = 0;
+    for (int k = 0; k < 3; k++) {
+        fwd[k] = b->target[k] - b->eye[k];
+        len += fwd[k] * fwd[k];
+    }
+    len = sqrt(len);
+    size_t beyond = 0;
+    for (size_t i = 0; i < b->count; i++) {
+        const double *s = &b->spheres[4 * i];
+        double depth = 0;
+        for (int k = 0; k < 3; k++)
+            depth += (s[k] - b->eye[k]) * fwd[k] / len;
+        beyond += depth + s[3] > im->zfar;
+    }
+    if (beyond)
+        ptr_warn(im->warnings, "%s: camera '%s': ptr does not clip at zfar (%g); %zu sphere%s "
+                 "beyond it %s seen", im->path, im->ortho_name, im->zfar, beyond,
+                 beyond == 1 ? "" : "s", beyond == 1 ? "is" : "are");
 }
 
 /* Depth-first, pre-order, over the default scene; glTF requires the nodes to
@@ -611,8 +661,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     }
     if (res == PTR_OK && im.camera_name && !im.camera_found && !(options && options->camera))
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                            "%s: no perspective camera named '%s' in the default scene", path,
+                            "%s: no camera named '%s' in the default scene", path,
                             im.camera_name);
+    if (res == PTR_OK)
+        check_far_plane(&im);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
     if (res == PTR_OK)

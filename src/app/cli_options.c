@@ -15,9 +15,12 @@ enum {
     MAX_THREADS = 1024,
 };
 
-/* Which of --lookfrom, --lookat and --vfov were given: a camera needs all
- * three. */
-enum { CAMERA_LOOKFROM = 1, CAMERA_LOOKAT = 2, CAMERA_VFOV = 4, CAMERA_COMPLETE = 7 };
+/* Which of --lookfrom, --lookat, --vfov and --ortho were given: a camera
+ * needs the first two and one of the others. */
+enum {
+    CAMERA_LOOKFROM = 1, CAMERA_LOOKAT = 2, CAMERA_VFOV = 4, CAMERA_ORTHO = 8,
+    CAMERA_PLACED = CAMERA_LOOKFROM | CAMERA_LOOKAT,
+};
 
 /* The table's headings are --help's alone. */
 #define HEADING(title)
@@ -234,6 +237,12 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
         o->camera.vfov_deg = x;
         o->has_camera |= CAMERA_VFOV;
         break;
+    case OPT_ortho:
+        if (!parse_number(value, &x) || !(isfinite(x) && x > 0))
+            return bad_value(id, value, "a height above 0");
+        o->camera.ortho_height = x;
+        o->has_camera |= CAMERA_ORTHO;
+        break;
     case OPT_up: return set_point(id, value, o->camera.up);
     case OPT_aperture:
         if (!parse_number(value, &x) || !(isfinite(x) && x >= 0))
@@ -326,8 +335,14 @@ static int read_options(int argc, char **argv, PtrOptions *o)
 /* What is wrong with the options taken together, or NULL. */
 static const char *usage_problem(const PtrOptions *o)
 {
-    if (o->has_camera && o->has_camera != CAMERA_COMPLETE)
-        return "a camera needs --lookfrom, --lookat and --vfov together";
+    if ((o->has_camera & CAMERA_VFOV) && (o->has_camera & CAMERA_ORTHO))
+        return "--vfov and --ortho exclude each other: a camera has one projection";
+    if (o->has_camera && ((o->has_camera & CAMERA_PLACED) != CAMERA_PLACED ||
+                          !(o->has_camera & (CAMERA_VFOV | CAMERA_ORTHO))))
+        return "a camera needs --lookfrom, --lookat and --vfov (or --ortho) together";
+    /* Parallel rays have no lens: rather than ignore a lens asked for, say so. */
+    if ((o->has_camera & CAMERA_ORTHO) && o->camera.aperture > 0)
+        return "--ortho has no depth of field: leave out --aperture";
     if (o->input_count == 0)
         return o->merge ? "no parts given" : "no scene file given";
     if (!o->output && !o->dump_scene)

@@ -83,9 +83,14 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
     write_point(out, scene, c->lookat);
     fputs(", \"up\": ", out);
     write_vec(out, c->up);
-    fprintf(out, ", \"vfov_deg\": %.9g, \"aperture\": %.9g, \"focus_distance\": %.9g, "
-                 "\"aspect\": %.9g},\n  \"sky\": ",
-            c->vfov_deg, c->aperture, c->focus_distance, c->aspect);
+    if (c->projection == PTR_PROJECTION_ORTHOGRAPHIC)
+        fprintf(out, ", \"projection\": \"orthographic\", \"ymag\": %.9g, \"znear\": %.9g",
+                c->ymag, c->znear);
+    else
+        fprintf(out, ", \"projection\": \"perspective\", \"vfov_deg\": %.9g, "
+                     "\"aperture\": %.9g, \"focus_distance\": %.9g",
+                c->vfov_deg, c->aperture, c->focus_distance);
+    fprintf(out, ", \"aspect\": %.9g},\n  \"sky\": ", c->aspect);
     write_sky(out, &scene->sky);
     if (scene->width > 0)
         fprintf(out, ",\n  \"resolution\": [%d, %d]", scene->width, scene->height);

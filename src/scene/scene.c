@@ -239,6 +239,13 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     const float lens[4] = { c->vfov_deg, c->aperture, c->focus_distance, c->aspect };
     h = hash_vec(hash_vec(hash_vec(h, c->lookfrom), c->lookat), c->up);
     h = hash_bytes(h, lens, sizeof lens);
+    /* Only an orthographic camera adds its projection: a perspective scene
+     * keeps the fingerprint it had before there were projections, so parts
+     * rendered by either build still merge. */
+    if (c->projection == PTR_PROJECTION_ORTHOGRAPHIC) {
+        const float ortho[2] = { c->ymag, c->znear };
+        h = hash_bytes(h, ortho, sizeof ortho);
+    }
     const int sky = scene->sky.kind;
     h = hash_bytes(h, &sky, sizeof sky);
     return hash_vec(h, scene->sky.radiance);

@@ -46,12 +46,24 @@ typedef struct PtrMaterial {
     PtrVec3 emission; /* emitted radiance, seen from both sides */
 } PtrMaterial;
 
+typedef enum PtrProjection {
+    PTR_PROJECTION_PERSPECTIVE, /* rays from lookfrom through a lens */
+    PTR_PROJECTION_ORTHOGRAPHIC, /* parallel rays along the view direction */
+} PtrProjection;
+
 typedef struct PtrCamera {
     PtrVec3 lookfrom, lookat, up;
-    float vfov_deg;       /* vertical field of view */
-    float aperture;       /* lens diameter; 0 is a pinhole */
-    float focus_distance; /* distance to the plane in focus */
-    float aspect;         /* width / height the scene suggests; 0 if none */
+    PtrProjection projection;
+    float vfov_deg;       /* perspective: vertical field of view */
+    float aperture;       /* perspective: lens diameter; 0 is a pinhole */
+    float focus_distance; /* perspective: distance to the plane in focus */
+    /* Orthographic: half the view's height in world units (glTF's ymag; the
+     * width follows the image's aspect ratio), and how far ahead of lookfrom
+     * the rays start (glTF's znear): nothing nearer is seen. */
+    float ymag, znear;
+    /* Width / height the scene suggests (glTF's aspectRatio, or xmag / ymag
+     * of an orthographic camera); 0 if none. */
+    float aspect;
 } PtrCamera;
 
 typedef enum PtrSkyKind {

@@ -111,6 +111,29 @@ static void test_png_and_options(void)
     ptr_image_free(img);
 }
 
+/* --ortho: tests/fixtures/orthographic.gltf's Ball (radiance 1, radius 1 at
+ * (1, 0, 0)) through a view 4 high from (1, 0, 5), a pixel 0.25 across:
+ * the centre sees it, a corner the black sky. Clipped, behind lookfrom, is
+ * not seen. */
+static void test_orthographic_option(void)
+{
+    const char *out = test_path("ortho.exr");
+    CHECK_INT(test_ptr(FIXTURE("orthographic.gltf"), "-o", out, "--lookfrom", "1,0,5", "--lookat",
+                       "1,0,0", "--ortho", "4", "--width", "16", "--height", "16", "--samples",
+                       "4", "--quiet", NULL),
+              0);
+    PtrError err;
+    PtrImage *img = ptr_image_read(out, &err);
+    CHECK(img != NULL);
+    if (!img)
+        return;
+    const float *px = ptr_image_pixels(img);
+    CHECK_FLOAT_EQ(px[3 * (8 * 16 + 8)], 1.0f);
+    CHECK_FLOAT_EQ(px[3 * (7 * 16 + 7)], 1.0f);
+    CHECK_FLOAT_EQ(px[0], 0.0f);
+    ptr_image_free(img);
+}
+
 static void test_bad_input(void)
 {
     const char *out = test_path("keep.exr");
@@ -118,7 +141,7 @@ static void test_bad_input(void)
     int ok_files;
     struct {
         PtrResult expected;
-        const char *args[8];
+        const char *args[10];
     } cases[] = {
         { PTR_ERR_SCENE_UNREADABLE, { FIXTURE("missing.gltf") } },
         { PTR_ERR_SCENE_UNREADABLE, { FIXTURE("bad") } },
@@ -135,6 +158,13 @@ static void test_bad_input(void)
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5" } }, /* needs --lookat, --vfov */
         { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0", "--lookat", "0,0,0", "--vfov", "40" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--vfov", "180" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5", "--lookat", "0,0,0", "--vfov", "40",
+                           "--ortho", "2" } }, /* two projections */
+        { PTR_ERR_USAGE,
+          { SEED_SCENE, "--lookfrom", "0,0,5", "--lookat", "0,0,0", "--ortho", "0" } },
+        { PTR_ERR_USAGE, { SEED_SCENE, "--ortho", "2" } }, /* needs --lookfrom, --lookat */
+        { PTR_ERR_USAGE, { SEED_SCENE, "--lookfrom", "0,0,5", "--lookat", "0,0,0", "--ortho", "2",
+                           "--aperture", "0.1" } }, /* no lens */
         { PTR_ERR_USAGE, { SEED_SCENE, "--sampler", "halton" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--direct-lighting", "yes" } },
         { PTR_ERR_USAGE, { SEED_SCENE, "--noise-threshold", "0" } },
@@ -145,7 +175,7 @@ static void test_bad_input(void)
     write_file(out, keep);
     ok_files = file_count();
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        char *argv[16] = { "ptr", "-o", (char *)out, "--samples", "1", "--quiet" };
+        char *argv[18] = { "ptr", "-o", (char *)out, "--samples", "1", "--quiet" };
         int argc = 6;
         for (int k = 0; cases[i].args[k]; k++)
             argv[argc++] = (char *)cases[i].args[k];
@@ -183,6 +213,7 @@ int main(void)
         return 1;
     test_render_seed_exr();
     test_png_and_options();
+    test_orthographic_option();
     test_bad_input();
     test_dir_remove();
     return test_report();

@@ -172,11 +172,48 @@ static void test_bad_input(void)
     check_bad(PTR_SOURCE_DIR "/CMakeLists.txt", PTR_ERR_SCENE_INVALID, "unknown scene format");
 }
 
+/* An orthographic camera: its half-height, near plane and aspect ratio
+ * (xmag / ymag); warnings for its aperture and for the sphere beyond zfar,
+ * which ptr does not clip. */
+static void test_orthographic_camera(void)
+{
+    PtrScene s;
+    PtrStrings w = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(FIXTURE("orthographic.gltf"), NULL, &s, &w, &err), PTR_OK);
+    CHECK_INT(s.camera.projection, PTR_PROJECTION_ORTHOGRAPHIC);
+    CHECK_FLOAT_EQ(s.camera.ymag, 2.0f);
+    CHECK_FLOAT_EQ(s.camera.znear, 1.0f);
+    CHECK_FLOAT_EQ(s.camera.aspect, 1.5f);
+    CHECK_NEAR(s.origin[0], 1.0, 1e-12);
+    CHECK_NEAR(s.origin[2], 10.0, 1e-12);
+    CHECK_NEAR(s.camera.lookat.z, -1.0, 1e-6);
+    CHECK_INT(w.count, 2);
+    CHECK_INT(has_warning(&w, "camera 'Ortho' is orthographic, which has no depth of field"), 1);
+    CHECK_INT(has_warning(&w, "camera 'Ortho': ptr does not clip at zfar (20); 1 sphere"), 1);
+    ptr_strings_free(&w);
+    ptr_scene_free(&s);
+
+    /* The command line's camera replaces it, and no warning is about the
+     * file's camera. */
+    const PtrCameraSpec spec = { .lookfrom = { 0, 0, 5 }, .lookat = { 0, 0, 0 },
+                                 .up = { 0, 1, 0 }, .ortho_height = 3 };
+    PtrImportOptions options = { .camera = &spec };
+    CHECK_INT(ptr_import_scene(FIXTURE("orthographic.gltf"), &options, &s, &w, &err), PTR_OK);
+    CHECK_INT(s.camera.projection, PTR_PROJECTION_ORTHOGRAPHIC);
+    CHECK_FLOAT_EQ(s.camera.ymag, 1.5f);
+    CHECK_FLOAT_EQ(s.camera.znear, 0.0f);
+    CHECK_INT(w.count, 0);
+    ptr_strings_free(&w);
+    ptr_scene_free(&s);
+}
+
 int main(void)
 {
     test_hierarchy();
     test_glb_matches_gltf();
     test_automatic_camera();
+    test_orthographic_camera();
     test_bad_input();
     return test_report();
 }

@@ -4,10 +4,10 @@
  * at a time with the fastest. The same sums for every pixel, bit for bit,
  * and the same number of rays, on scenes that take every branch a path can
  * take (each material, fuzz, colours, emitters with light sampling, a huge
- * sphere, the tree, no sphere at all) under every setting that changes a
- * path (sampler, light sampling, depth limit, adaptive sampling, regions,
- * sample ranges split into passes, threads). Below AVX2 there are no
- * bundles, which the test says. */
+ * sphere, the tree, no sphere at all, an orthographic camera) under every
+ * setting that changes a path (sampler, light sampling, depth limit,
+ * adaptive sampling, regions, sample ranges split into passes, threads).
+ * Below AVX2 there are no bundles, which the test says. */
 #include "test.h"
 
 #include "accel/accel.h"
@@ -18,8 +18,9 @@
 
 enum { WIDTH = 48, HEIGHT = 32 };
 
-typedef enum SceneKind { CLUSTER, HUGE_GROUND, CLOUD, EMPTY, SCENE_KINDS } SceneKind;
-static const char *const scene_names[] = { "cluster", "huge ground", "cloud", "empty" };
+typedef enum SceneKind { CLUSTER, ORTHOGRAPHIC, HUGE_GROUND, CLOUD, EMPTY, SCENE_KINDS } SceneKind;
+static const char *const scene_names[] = { "cluster", "cluster, orthographic", "huge ground",
+                                           "cloud", "empty" };
 
 static uint32_t add(PtrScene *s, PtrMaterial m)
 {
@@ -29,7 +30,8 @@ static uint32_t add(PtrScene *s, PtrMaterial m)
 }
 
 /* Spheres of every material (some coloured, some emitting, glass inside
- * glass, overlaps) over a ground, seen through a lens. */
+ * glass, overlaps) over a ground, seen through a lens, or orthographically
+ * (parallel rays from a near plane that stays clear of every sphere). */
 static PtrScene make_scene(SceneKind kind)
 {
     PtrScene s;
@@ -49,7 +51,10 @@ static PtrScene make_scene(SceneKind kind)
     PtrSceneBuilder b;
     ptr_builder_init(&b, &s, NULL);
     PtrRng rng = ptr_rng_for_sample(kind, 7, 0);
-    int n = kind == CLUSTER ? 60 : kind == CLOUD ? 3000 : kind == HUGE_GROUND ? 12 : 0;
+    int n = kind == CLUSTER || kind == ORTHOGRAPHIC ? 60
+            : kind == CLOUD                        ? 3000
+            : kind == HUGE_GROUND                  ? 12
+                                                   : 0;
     for (int i = 0; i < n; i++) {
         double spread = kind == CLOUD ? 12.0 : 4.0;
         double c[3] = { spread * (ptr_rng_float(&rng) - 0.5), 1.5 * ptr_rng_float(&rng),
@@ -69,7 +74,11 @@ static PtrScene make_scene(SceneKind kind)
         CHECK_INT(ptr_builder_add_sphere(&b, ground, radius, materials[0]), PTR_OK);
     }
     const double eye[3] = { 0, 2, 7 }, target[3] = { 0, 0.5, 0 }, up[3] = { 0, 1, 0 };
-    const PtrCamera lens = { .vfov_deg = 50.0f, .aperture = 0.1f, .focus_distance = 7.0f };
+    const PtrCamera lens = kind == ORTHOGRAPHIC
+                               ? (PtrCamera){ .projection = PTR_PROJECTION_ORTHOGRAPHIC,
+                                              .ymag = 1.5f, .znear = 1.0f }
+                               : (PtrCamera){ .vfov_deg = 50.0f, .aperture = 0.1f,
+                                              .focus_distance = 7.0f };
     ptr_builder_set_camera(&b, eye, target, up, &lens);
     CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT), PTR_OK);
     s.sky = kind == HUGE_GROUND ? (PtrSky){ PTR_SKY_CONSTANT, v3(0.3f, 0.4f, 0.5f) }
@@ -167,7 +176,7 @@ int main(void)
     variants[6].settings.threads = 1;
     for (int k = 0; k < SCENE_KINDS; k++) {
         /* A scene of its own for each side: the tree reorders the spheres,
-         * and the cluster goes to the tree with the C kernels (68 spheres,
+         * and each cluster goes to the tree with the C kernels (68 spheres,
          * above their crossover) and to brute force with assembly, so the
          * two sides also see the spheres in different orders. */
         PtrScene scene = make_scene((SceneKind)k), other = make_scene((SceneKind)k);

@@ -95,10 +95,67 @@ static void test_camera(void)
     CHECK(!ptr_view_init(&view, &bad, 10, 10));
 }
 
+/* Parallel rays: every one runs along the view direction from the near
+ * plane, the view is 2 ymag high and as wide as the image's aspect ratio
+ * makes it, and lens samples change nothing. */
+static void test_orthographic_camera(void)
+{
+    PtrCamera cam = { .lookfrom = v3(0, 0, 10), .lookat = v3(0, 0, 0), .up = v3(0, 1, 0),
+                      .projection = PTR_PROJECTION_ORTHOGRAPHIC, .ymag = 2.0f, .znear = 1.5f,
+                      .aperture = 3.0f };
+    PtrView view;
+    CHECK(ptr_view_init(&view, &cam, 200, 100)); /* 0.04 world units a pixel */
+
+    /* Pixel (112, 35)'s corner lies 12 pixels right of the centre and 15
+     * up: its ray starts at (0.48, 0.6) on the near plane z = 8.5 and meets
+     * the unit sphere at the origin where z = sqrt(1 - 0.48^2 - 0.6^2), at
+     * (0.48, 0.6, 0.64). */
+    PtrVec3 o, d;
+    ptr_view_ray(&view, 112, 35, 0.0f, 0.0f, 0.7f, -0.3f, &o, &d);
+    CHECK_NEAR(o.x, 0.48, 1e-6);
+    CHECK_NEAR(o.y, 0.6, 1e-6);
+    CHECK_FLOAT_EQ(o.z, 8.5f);
+    CHECK_FLOAT_EQ(d.x, 0.0f);
+    CHECK_FLOAT_EQ(d.y, 0.0f);
+    CHECK_FLOAT_EQ(d.z, -1.0f);
+    double b = (double)o.x * d.x + (double)o.y * d.y + (double)o.z * d.z;
+    double c = (double)o.x * o.x + (double)o.y * o.y + (double)o.z * o.z - 1.0;
+    double t = -b - sqrt(b * b - c);
+    CHECK_NEAR(o.z + t * d.z, 0.64, 1e-5);
+
+    /* The lens sample moved nothing: the same ray without it. */
+    PtrVec3 o0, d0;
+    ptr_view_ray(&view, 112, 35, 0.0f, 0.0f, 0.0f, 0.0f, &o0, &d0);
+    CHECK(!memcmp(&o, &o0, sizeof o) && !memcmp(&d, &d0, sizeof d));
+
+    /* The image's edges: 2 ymag = 4 high, 4 * 200 / 100 = 8 wide. */
+    ptr_view_ray(&view, 0, 0, 0.0f, 0.0f, 0.0f, 0.0f, &o, &d);
+    CHECK_NEAR(o.x, -4.0, 1e-6);
+    CHECK_NEAR(o.y, 2.0, 1e-6);
+
+    /* Turned and moved, the rays still share the view direction. */
+    cam.lookfrom = v3(3, 4, 5);
+    cam.lookat = v3(4, 2, 3);
+    CHECK(ptr_view_init(&view, &cam, 7, 5));
+    PtrVec3 forward = v3_normalize(v3_sub(cam.lookat, cam.lookfrom));
+    ptr_view_ray(&view, 6, 0, 0.9f, 0.1f, 0.0f, 0.0f, &o, &d);
+    CHECK_NEAR(v3_dot(d, forward), 1.0, 1e-6);
+    CHECK_NEAR(v3_dot(v3_sub(o, cam.lookfrom), forward), 1.5, 1e-5); /* on the near plane */
+
+    /* A view of no height, or a near plane behind the camera, is refused. */
+    PtrCamera bad = cam;
+    bad.ymag = 0.0f;
+    CHECK(!ptr_view_init(&view, &bad, 10, 10));
+    bad = cam;
+    bad.znear = -1.0f;
+    CHECK(!ptr_view_init(&view, &bad, 10, 10));
+}
+
 int main(void)
 {
     test_vectors();
     test_rng();
     test_camera();
+    test_orthographic_camera();
     return test_report();
 }
