@@ -55,9 +55,10 @@ for file in "$src"/tests/fixtures/bad/*.gltf "$src"/tests/fixtures/bad/*.glb \
     "$src"/tests/fixtures/bad/*.obj "$src"/tests/fixtures/hostile/*.gltf \
     "$src"/tests/fixtures/hostile/*.glb "$src"/tests/fixtures/hostile/*.obj; do
     case $(basename "$file") in
-    # Valid: re-centring on the camera makes a sphere 1e300 away renderable, and
-    # tinygltf reads the JSON of a GLB whose header says version 1.
-    translation_huge.gltf | glb_version_1.glb) run "$file" ok ;;
+    # Valid: re-centring on the camera makes a sphere 1e300 away renderable,
+    # tinygltf reads the JSON of a GLB whose header says version 1, and ptr
+    # reads Draco meshes by their bounds alone, never the stream they spoil.
+    translation_huge.gltf | glb_version_1.glb | draco_*.glb) run "$file" ok ;;
     *) run "$file" error ;;
     esac
 done
