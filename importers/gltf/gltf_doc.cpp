@@ -176,6 +176,31 @@ bool is_binary_gltf(const char *path, bool *readable)
     return file.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
 }
 
+// What is wrong with a .glb's container, "" if nothing. tinygltf 2.7 lets a
+// BIN chunk end up to 8 bytes past the data it is given (it leaves the
+// chunk's own header out of its bound): such a file is refused before it
+// gets there, and so is one shorter than its header says.
+std::string glb_chunk_fault(const char *path)
+{
+    std::ifstream file(path, std::ios::binary | std::ios::ate);
+    const unsigned long long size = (unsigned long long)file.tellg();
+    uint32_t header[5] = { 0, 0, 0, 0, 0 }; /* magic, version, length, JSON length, type */
+    uint32_t bin = 0;
+    file.seekg(0);
+    if (!file.read(reinterpret_cast<char *>(header), sizeof header))
+        return "";
+    const unsigned long long length = header[2], bin_at = 20ull + header[3];
+    if (length > size)
+        return "the file is shorter (" + std::to_string(size) + " bytes) than its header says (" +
+               std::to_string(length) + ")";
+    if (bin_at + 8 > length)
+        return ""; /* no BIN chunk, or tinygltf says what is wrong */
+    file.seekg(std::streamoff(bin_at));
+    if (file.read(reinterpret_cast<char *>(&bin), 4) && bin_at + 8 + bin > length)
+        return "the BIN chunk runs past the end of the file";
+    return "";
+}
+
 std::vector<unsigned char> read_file(const char *path)
 {
     std::ifstream file(path, std::ios::binary);
@@ -331,10 +356,11 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
         std::string error, warning;
-        bool ok = binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
-                         : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path);
-        std::string fault;
-        if (!ok) {
+        std::string fault = binary ? glb_chunk_fault(path) : "";
+        bool ok = fault.empty() &&
+                  (binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
+                          : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path));
+        if (!ok && fault.empty()) {
             // tinygltf stops at what it cannot load before ptr sees the
             // extensions: say first what the file requires that ptr lacks,
             // and load a compressed file again without what tinygltf refuses

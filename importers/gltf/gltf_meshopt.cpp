@@ -33,9 +33,10 @@ bool read_stream(const tinygltf::Value &ext, Stream *s)
         return true;
     };
     size_t buffer = 0;
-    if (!ext.IsObject() || !number("buffer", &buffer, true) || !number("byteOffset", &s->offset, false) ||
-        !number("byteLength", &s->length, true) || !number("byteStride", &s->stride, true) ||
-        !number("count", &s->count, true) || !ext.Has("mode") || !ext.Get("mode").IsString())
+    if (!ext.IsObject() || !number("buffer", &buffer, true) ||
+        !number("byteOffset", &s->offset, false) || !number("byteLength", &s->length, true) ||
+        !number("byteStride", &s->stride, true) || !number("count", &s->count, true) ||
+        !ext.Has("mode") || !ext.Get("mode").IsString())
         return false;
     s->buffer = int(buffer);
     s->mode = ext.Get("mode").Get<std::string>();
@@ -84,7 +85,8 @@ void unfilter(const Stream &s, unsigned char *data)
 
 } // namespace
 
-std::string meshopt_decode(const tinygltf::Model &m, std::map<int, std::vector<unsigned char>> &views)
+std::string meshopt_decode(const tinygltf::Model &m,
+                           std::map<int, std::vector<unsigned char>> &views)
 {
     for (size_t i = 0; i < m.bufferViews.size(); i++) {
         const tinygltf::BufferView &view = m.bufferViews[i];
@@ -105,19 +107,26 @@ std::string meshopt_decode(const tinygltf::Model &m, std::map<int, std::vector<u
             return view_error(i, "has a compressed stream past the end of buffer " +
                                      std::to_string(s.buffer));
         // In 64 bits, so that no count can wrap the product.
-        if ((unsigned long long)s.count * s.stride != view.byteLength)
-            return view_error(i, "decodes to " + std::to_string((unsigned long long)s.count * s.stride) +
+        const unsigned long long decoded = (unsigned long long)s.count * s.stride;
+        if (decoded != view.byteLength)
+            return view_error(i, "decodes to " + std::to_string(decoded) +
                                      " bytes, not its byteLength of " +
                                      std::to_string(view.byteLength));
+        // No stream holds more than 64 times its size (a vertex block's
+        // header spends 2 bits on 16 bytes; an index takes a byte or more):
+        // a larger claim is a file that would have ptr allocate for nothing.
+        if (decoded > 128 * (unsigned long long)s.length + 256)
+            return view_error(i, "claims " + std::to_string(decoded) + " bytes from a stream of " +
+                                     std::to_string(s.length) + ", more than the codec holds");
         std::vector<unsigned char> &out = views[int(i)];
         out.resize(view.byteLength);
         const unsigned char *stream = source.data() + s.offset;
+        unsigned char *to = out.data();
         int failed = s.mode == "ATTRIBUTES"
-                         ? meshopt_decodeVertexBuffer(out.data(), s.count, s.stride, stream, s.length)
+                         ? meshopt_decodeVertexBuffer(to, s.count, s.stride, stream, s.length)
                      : s.mode == "TRIANGLES"
-                         ? meshopt_decodeIndexBuffer(out.data(), s.count, s.stride, stream, s.length)
-                         : meshopt_decodeIndexSequence(out.data(), s.count, s.stride, stream,
-                                                       s.length);
+                         ? meshopt_decodeIndexBuffer(to, s.count, s.stride, stream, s.length)
+                         : meshopt_decodeIndexSequence(to, s.count, s.stride, stream, s.length);
         if (failed)
             return view_error(i, "has a compressed stream that does not decode (truncated or "
                                  "corrupt)");

@@ -170,6 +170,14 @@ static void test_bad_input(void)
     check_bad(FIXTURE("bad/no_bounds.gltf"), PTR_ERR_SCENE_INVALID, "bounds");
     check_bad(FIXTURE("bad/bad_sky.gltf"), PTR_ERR_SCENE_INVALID, "sky");
     check_bad(PTR_SOURCE_DIR "/CMakeLists.txt", PTR_ERR_SCENE_INVALID, "unknown scene format");
+    /* Compressed files: what is wrong, naming the extension; one that requires
+     * an extension ptr lacks says so first, though tinygltf cannot load it. */
+    check_bad(FIXTURE("hostile/meshopt_requires_unknown.glb"), PTR_ERR_SCENE_INVALID,
+              "requires the glTF extension KHR_texture_basisu");
+    check_bad(FIXTURE("hostile/meshopt_stream_truncated.glb"), PTR_ERR_SCENE_INVALID,
+              "EXT_meshopt_compression: buffer view 2 has a compressed stream");
+    check_bad(FIXTURE("hostile/meshopt_decoded_too_large.glb"), PTR_ERR_SCENE_INVALID,
+              "EXT_meshopt_compression: buffer view 2 decodes to 15424 bytes");
 }
 
 /* An orthographic camera: its half-height, near plane and aspect ratio
