@@ -19,9 +19,12 @@ python3 "$src/scripts/make_scenes.py" --instanced "$json" "$dir/scene.glb"
 # Each run: ptr, then each Embree mode, with their build + render seconds and
 # the whole process's wall time (/usr/bin/time: loading, import, writing).
 for run in $(seq "$runs"); do
-    ptr_s=$(/usr/bin/time -f "%e" -o "$dir/wall" "$ptr" "$dir/scene.glb" -o "$dir/out.exr" \
-        --samples "$spp" --quiet --json "$@" |
-        python3 -c 'import json,sys; r=json.load(sys.stdin); print("%.3f" % (r["build_seconds"] + r["render_seconds"]))')
+    # The JSON goes to a file, read after: a reader starting beside the render
+    # would take a core from it.
+    /usr/bin/time -f "%e" -o "$dir/wall" "$ptr" "$dir/scene.glb" -o "$dir/out.exr" \
+        --samples "$spp" --quiet --json "$@" >"$dir/ptr.json"
+    ptr_s=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1]))
+print("%.3f" % (r["build_seconds"] + r["render_seconds"]))' "$dir/ptr.json")
     ptr_wall=$(cat "$dir/wall")
     times=
     walls=
