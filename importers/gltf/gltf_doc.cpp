@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -167,44 +168,56 @@ std::string check_indices(const tinygltf::Model &m,
     return "";
 }
 
-bool is_binary_gltf(const char *path, bool *readable)
+// The whole file; false, with errno saying why, if it cannot be read.
+bool read_file(const char *path, std::vector<unsigned char> *bytes)
 {
-    std::ifstream file(path, std::ios::binary);
-    *readable = bool(file);
-    char magic[4] = { 0, 0, 0, 0 };
-    file.read(magic, 4);
-    return file.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+    std::ifstream file(path, std::ios::binary | std::ios::ate);
+    const std::streamoff size = file ? std::streamoff(file.tellg()) : -1;
+    if (size < 0)
+        return false;
+    bytes->resize(size_t(size));
+    file.seekg(0);
+    return bool(file.read(reinterpret_cast<char *>(bytes->data()), std::streamsize(bytes->size())));
+}
+
+bool is_glb(const std::vector<unsigned char> &bytes)
+{
+    return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
 }
 
 // What is wrong with a .glb's container, "" if nothing. tinygltf 2.7 lets a
 // BIN chunk end up to 8 bytes past the data it is given (it leaves the
 // chunk's own header out of its bound): such a file is refused before it
 // gets there, and so is one shorter than its header says.
-std::string glb_chunk_fault(const char *path)
+std::string glb_chunk_fault(const std::vector<unsigned char> &bytes)
 {
-    std::ifstream file(path, std::ios::binary | std::ios::ate);
-    const unsigned long long size = (unsigned long long)file.tellg();
-    uint32_t header[5] = { 0, 0, 0, 0, 0 }; /* magic, version, length, JSON length, type */
-    uint32_t bin = 0;
-    file.seekg(0);
-    if (!file.read(reinterpret_cast<char *>(header), sizeof header))
-        return "";
+    uint32_t header[5]; /* magic, version, length, JSON length, type */
+    if (bytes.size() < sizeof header)
+        return ""; /* tinygltf says what is wrong */
+    std::memcpy(header, bytes.data(), sizeof header);
     const unsigned long long length = header[2], bin_at = 20ull + header[3];
-    if (length > size)
-        return "the file is shorter (" + std::to_string(size) + " bytes) than its header says (" +
-               std::to_string(length) + ")";
+    if (length > bytes.size())
+        return "the file is shorter (" + std::to_string(bytes.size()) +
+               " bytes) than its header says (" + std::to_string(length) + ")";
     if (bin_at + 8 > length)
         return ""; /* no BIN chunk, or tinygltf says what is wrong */
-    file.seekg(std::streamoff(bin_at));
-    if (file.read(reinterpret_cast<char *>(&bin), 4) && bin_at + 8 + bin > length)
-        return "the BIN chunk runs past the end of the file";
-    return "";
+    uint32_t bin;
+    std::memcpy(&bin, &bytes[size_t(bin_at)], 4);
+    return bin_at + 8 + bin > length ? "the BIN chunk runs past the end of the file" : "";
 }
 
-std::vector<unsigned char> read_file(const char *path)
+// Loads a .glb's bytes, or a .gltf's text, into model; false with *error set
+// if tinygltf cannot.
+bool load(tinygltf::TinyGLTF &loader, const unsigned char *data, size_t size, bool binary,
+          const std::string &dir, tinygltf::Model *model, std::string *error)
 {
-    std::ifstream file(path, std::ios::binary);
-    return std::vector<unsigned char>(std::istreambuf_iterator<char>(file), {});
+    std::string warning;
+    *model = tinygltf::Model();
+    error->clear();
+    return binary ? loader.LoadBinaryFromMemory(model, error, &warning, data, unsigned(size), dir)
+                  : loader.LoadASCIIFromString(model, error, &warning,
+                                               reinterpret_cast<const char *>(data),
+                                               unsigned(size), dir);
 }
 
 // The JSON of a glTF file's bytes: all of a .gltf, a .glb's JSON chunk (rest:
@@ -342,12 +355,13 @@ extern "C" const char *const ptr_gltf_extensions[] = {
 extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
 {
     try {
-        bool readable = false;
-        bool binary = is_binary_gltf(path, &readable);
-        if (!readable) {
-            ptr_shim_error(err, PTR_ERR_SCENE_UNREADABLE, std::string(path) + ": " + std::strerror(errno));
+        std::vector<unsigned char> bytes;
+        if (!read_file(path, &bytes)) {
+            ptr_shim_error(err, PTR_ERR_SCENE_UNREADABLE,
+                           std::string(path) + ": " + std::strerror(errno));
             return nullptr;
         }
+        const bool binary = is_glb(bytes);
         // External buffers' URIs are relative to the .gltf's folder.
         const std::string scene_path = path;
         const size_t slash = scene_path.rfind('/');
@@ -355,38 +369,30 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         auto doc = std::make_unique<GltfDoc>();
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
-        std::string error, warning;
-        std::string fault = binary ? glb_chunk_fault(path) : "";
+        std::string error;
+        std::string fault = bytes.size() > UINT32_MAX ? "larger than 4 GiB, the most glTF holds"
+                            : binary                  ? glb_chunk_fault(bytes)
+                                                      : "";
         bool ok = fault.empty() &&
-                  (binary ? loader.LoadBinaryFromFile(&doc->model, &error, &warning, path)
-                          : loader.LoadASCIIFromFile(&doc->model, &error, &warning, path));
-        if (!ok && fault.empty()) {
+                  load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
+        std::string json;
+        size_t rest = 0;
+        if (!ok && fault.empty() && json_of(bytes, binary, &json, &rest)) {
             // tinygltf stops at what it cannot load before ptr sees the
             // extensions: say first what the file requires that ptr lacks,
             // and load a compressed file again without what tinygltf refuses
             // of it.
-            const std::vector<unsigned char> bytes = read_file(path);
-            std::string json;
-            size_t rest = 0;
-            if (json_of(bytes, binary, &json, &rest)) {
-                fault = required_extension_fault(required_extensions(json));
-                const std::string patched =
-                    fault.empty() && (json.find(meshopt_extension) != std::string::npos ||
-                                      json.find(draco_extension) != std::string::npos)
-                        ? loadable_by_tinygltf(json) : "";
-                if (!patched.empty()) {
-                    error.clear();
-                    doc->model = tinygltf::Model();
-                    if (binary) {
-                        const std::vector<unsigned char> glb = with_json(bytes, rest, patched);
-                        ok = loader.LoadBinaryFromMemory(&doc->model, &error, &warning, glb.data(),
-                                                         unsigned(glb.size()), dir);
-                    } else {
-                        ok = loader.LoadASCIIFromString(&doc->model, &error, &warning,
-                                                        patched.data(), unsigned(patched.size()),
-                                                        dir);
-                    }
-                }
+            fault = required_extension_fault(required_extensions(json));
+            const std::string patched =
+                fault.empty() && (json.find(meshopt_extension) != std::string::npos ||
+                                  json.find(draco_extension) != std::string::npos)
+                    ? loadable_by_tinygltf(json) : "";
+            if (!patched.empty() && binary) {
+                const std::vector<unsigned char> glb = with_json(bytes, rest, patched);
+                ok = load(loader, glb.data(), glb.size(), binary, dir, &doc->model, &error);
+            } else if (!patched.empty()) {
+                ok = load(loader, reinterpret_cast<const unsigned char *>(patched.data()),
+                          patched.size(), binary, dir, &doc->model, &error);
             }
         }
         if (!ok && fault.empty())

@@ -130,8 +130,7 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     PtrIsectTable isect;
     ptr_isect_init(&isect, o->kernel, scene->spheres.count);
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
-    const PtrRenderSettings asked = { .integrator = o->integrator };
-    PtrIntegrator integrator = ptr_render_integrator(&asked);
+    PtrIntegrator integrator = ptr_integrator_resolve(o->integrator);
     snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
     /* Before the tree reorders the spheres: the hash does not depend on
      * their order, but there is no need to find the file order again. */

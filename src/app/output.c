@@ -171,9 +171,7 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    const char *dot = strrchr(path, '.');
-    const float *counts = dot && !strcasecmp(dot, ".exr") ? info->sample_counts : NULL;
-    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, counts,
+    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, info->sample_counts,
                                     pixel_formats[depth], attrs, sizeof attrs / sizeof attrs[0], err);
     free(viewed);
     return res;

@@ -17,15 +17,10 @@ enum { PATH_SIZE = 4096 };
 static char partial_path[PATH_SIZE];
 static volatile sig_atomic_t partial_active;
 
-static int is_exr(const char *path)
+int ptr_image_is_exr(const char *path)
 {
     const char *dot = strrchr(path, '.');
     return dot && !strcasecmp(dot, ".exr");
-}
-
-int ptr_image_needs_module(const char *path)
-{
-    return !is_exr(path);
 }
 
 PtrResult ptr_image_set_threads(int threads, PtrError *err)
@@ -46,7 +41,7 @@ PtrResult ptr_image_ready(PtrError *err)
 int ptr_image_can_write(const char *path)
 {
     const PtrImageModule *m;
-    return is_exr(path) || ((m = ptr_oiio_module(NULL)) && m->can_write(path));
+    return ptr_image_is_exr(path) || ((m = ptr_oiio_module(NULL)) && m->can_write(path));
 }
 
 /* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
@@ -67,19 +62,18 @@ PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const 
                           const float *sample_counts, PtrPixelFormat format,
                           const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
-    PtrImageWriteFn write = ptr_exr_write;
-    if (!is_exr(path)) {
-        const PtrImageModule *m = ptr_oiio_module(err);
-        if (!m)
-            return err->code;
-        write = m->write;
-    }
+    const int exr = ptr_image_is_exr(path);
+    const PtrImageModule *m = exr ? NULL : ptr_oiio_module(err);
+    if (!exr && !m)
+        return err->code;
     char tmp[PATH_SIZE];
     if (!temporary_name(path, tmp, sizeof tmp))
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
     memcpy(partial_path, tmp, sizeof tmp);
     partial_active = 1;
-    PtrResult res = write(tmp, path, layout, rgb, sample_counts, format, attrs, attr_count, err);
+    PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, sample_counts, format, attrs,
+                                        attr_count, err)
+                        : m->write(tmp, path, layout, rgb, format, attrs, attr_count, err);
     if (res == PTR_OK && rename(tmp, path) != 0)
         res = ptr_error_set(err, PTR_ERR_OUTPUT, "%s: cannot replace file: %s", path,
                             strerror(errno));
@@ -97,7 +91,7 @@ void ptr_image_discard_partial(void)
 
 PtrImage *ptr_image_read(const char *path, PtrError *err)
 {
-    if (is_exr(path))
+    if (ptr_image_is_exr(path))
         return ptr_exr_read(path, err);
     const PtrImageModule *m = ptr_oiio_module(err);
     return m ? m->read(path, err) : NULL;

@@ -46,9 +46,9 @@ typedef struct PtrImageLayout {
  * PTR_ERR_NOMEM if they cannot be started. */
 PtrResult ptr_image_set_threads(int threads, PtrError *err);
 
-/* Whether a file of this name is written and read through the OpenImageIO
- * module (any format but EXR). */
-int ptr_image_needs_module(const char *path);
+/* Whether a file of this name is EXR, written and read through OpenEXR; every
+ * other format goes through the OpenImageIO module. */
+int ptr_image_is_exr(const char *path);
 
 /* If writing output needs the module, starts loading it on a thread of its
  * own and returns at once: PTR_OK, or PTR_ERR_INSTALL with one line in err if
@@ -66,8 +66,8 @@ PtrResult ptr_image_ready(PtrError *err);
 int ptr_image_can_write(const char *path);
 
 /* Writes RGB float pixels (rows top to bottom), stored in the file as format,
- * and if sample_counts is not NULL (a format with named channels only), a
- * fourth float channel "samples" from it.
+ * and for EXR, whose channels have names, a fourth float channel "samples"
+ * from sample_counts if it is not NULL (other formats ignore it).
  * The file is created under a temporary name in the same directory and
  * renamed over path only once complete, so an existing file is replaced by a
  * whole new one or not at all. Returns PTR_OK; otherwise fills err with one

@@ -70,15 +70,9 @@ static inline int ptr_image_set_attr(PtrImage *image, size_t i, const char *name
     return image->attr_names[i] && image->attr_values[i];
 }
 
-/* Writes file, whose format is that of name's extension. */
-typedef PtrResult (*PtrImageWriteFn)(const char *file, const char *name,
-                                     const PtrImageLayout *layout, const float *rgb,
-                                     const float *sample_counts, PtrPixelFormat format,
-                                     const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
-typedef PtrImage *(*PtrImageReadFn)(const char *path, PtrError *err);
-
-/* OpenEXR (image_exr.cpp): errors are PTR_ERR_OUTPUT when writing,
- * PTR_ERR_USAGE when reading, PTR_ERR_NOMEM either way. */
+/* The writers write file, whose format is that of name's extension (the
+ * name messages give). OpenEXR (image_exr.cpp): errors are PTR_ERR_OUTPUT
+ * when writing, PTR_ERR_USAGE when reading, PTR_ERR_NOMEM either way. */
 PtrResult ptr_exr_write(const char *file, const char *name, const PtrImageLayout *layout,
                         const float *rgb, const float *sample_counts, PtrPixelFormat format,
                         const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
@@ -95,8 +89,10 @@ typedef struct PtrImageModule {
     const char *version;
 
     int (*can_write)(const char *path);
-    PtrImageWriteFn write;
-    PtrImageReadFn read;
+    PtrResult (*write)(const char *file, const char *name, const PtrImageLayout *layout,
+                       const float *rgb, PtrPixelFormat format, const PtrImageAttr *attrs,
+                       size_t attr_count, PtrError *err);
+    PtrImage *(*read)(const char *path, PtrError *err);
 } PtrImageModule;
 
 /* The module, loaded now if oiio_loader.c's thread has not (see

@@ -6,7 +6,6 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include <cstring>
 #include <new>
 #include <string>
 #include <vector>
@@ -34,30 +33,15 @@ int can_write(const char *path)
 }
 
 PtrResult write_image(const char *file, const char *name, const PtrImageLayout *layout,
-                      const float *rgb, const float *sample_counts, PtrPixelFormat format,
-                      const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
+                      const float *rgb, PtrPixelFormat format, const PtrImageAttr *attrs,
+                      size_t attr_count, PtrError *err)
 {
     try {
         auto out = OIIO::ImageOutput::create(name);
         if (!out)
             return ptr_shim_error(err, PTR_ERR_OUTPUT,
                                   std::string(name) + ": no image format for this extension");
-        int channels = sample_counts ? 4 : 3;
-        OIIO::ImageSpec spec(layout->width, layout->height, channels, pixel_type(format));
-        std::vector<float> interleaved;
-        if (sample_counts) {
-            // Counts stay whole numbers whatever the colour channels' depth.
-            spec.channelnames = { "R", "G", "B", "samples" };
-            spec.channelformats = { pixel_type(format), pixel_type(format), pixel_type(format),
-                                    OIIO::TypeDesc::FLOAT };
-            spec.alpha_channel = -1;
-            size_t pixels = (size_t)layout->width * (size_t)layout->height;
-            interleaved.resize(pixels * 4);
-            for (size_t p = 0; p < pixels; p++) {
-                std::memcpy(&interleaved[4 * p], &rgb[3 * p], 3 * sizeof(float));
-                interleaved[4 * p + 3] = sample_counts[p];
-            }
-        }
+        OIIO::ImageSpec spec(layout->width, layout->height, 3, pixel_type(format));
         spec.x = layout->x;
         spec.y = layout->y;
         spec.full_x = 0;
@@ -73,7 +57,7 @@ PtrResult write_image(const char *file, const char *name, const PtrImageLayout *
             }
         }
         bool ok = out->open(file, spec) &&
-                  out->write_image(OIIO::TypeDesc::FLOAT, sample_counts ? interleaved.data() : rgb);
+                  out->write_image(OIIO::TypeDesc::FLOAT, rgb);
         ok = out->close() && ok;
         if (!ok)
             return ptr_shim_error(err, PTR_ERR_OUTPUT, std::string(name) + ": " + out->geterror());

@@ -119,7 +119,7 @@ static void join_loader(void)
 
 PtrResult ptr_image_preload(const char *output, PtrError *err)
 {
-    if (!ptr_image_needs_module(output))
+    if (ptr_image_is_exr(output))
         return PTR_OK;
     char path[PATH_SIZE];
     if (module_path(path, sizeof path, err) != PTR_OK)

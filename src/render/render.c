@@ -145,12 +145,15 @@ int ptr_integrator_available(PtrIntegrator integrator)
            ptr_integrator_for_level(ptr_cpu_level()) == PTR_INTEGRATOR_BUNDLES;
 }
 
+PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator)
+{
+    return integrator == PTR_INTEGRATOR_AUTO ? ptr_integrator_for_level(ptr_cpu_level())
+                                             : integrator;
+}
+
 PtrIntegrator ptr_render_integrator(const PtrRenderSettings *s)
 {
-    if (s->fixed_tmin > 0.0f)
-        return PTR_INTEGRATOR_PATHS;
-    return s->integrator == PTR_INTEGRATOR_AUTO ? ptr_integrator_for_level(ptr_cpu_level())
-                                                : s->integrator;
+    return s->fixed_tmin > 0.0f ? PTR_INTEGRATOR_PATHS : ptr_integrator_resolve(s->integrator);
 }
 
 static PtrRenderTileFn render_tile_for(PtrIntegrator integrator)
@@ -207,17 +210,18 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
                              double *sums, PtrTickFn tick, void *user, PtrRenderStats *stats,
                              PtrError *err)
 {
+    const PtrIntegrator integrator = ptr_render_integrator(settings);
     RenderJob job = {
         .paths = { .scene = scene, .accel = accel, .settings = settings, .first = first,
                    .count = count, .sums = sums, .region = ptr_render_region(settings) },
-        .render_tile = render_tile_for(ptr_render_integrator(settings)),
+        .render_tile = render_tile_for(integrator),
     };
     if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "max depth and fixed t_min must not be negative, samples must fit 32 bits");
-    if (!ptr_integrator_available(ptr_render_integrator(settings)))
+    if (!ptr_integrator_available(integrator))
         return ptr_error_set(err, PTR_ERR_USAGE, "the %s integrator cannot run at CPU level %s",
-                             ptr_integrator_name(ptr_render_integrator(settings)),
+                             ptr_integrator_name(integrator),
                              ptr_cpu_level_name(ptr_cpu_level()));
     if (job.paths.region.x1 == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",

@@ -73,9 +73,12 @@ PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level);
 /* Whether the integrator can run at the CPU level in force. */
 int ptr_integrator_available(PtrIntegrator integrator);
 
-/* The integrator a render with these settings uses: theirs, or for
- * PTR_INTEGRATOR_AUTO the ladder's at the CPU level in force; always paths
- * with a fixed t_min, which the bundles do not take. */
+/* The integrator asked for, or for PTR_INTEGRATOR_AUTO the ladder's at the
+ * CPU level in force. */
+PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator);
+
+/* The integrator a render with these settings uses: theirs resolved, but
+ * always paths with a fixed t_min, which the bundles do not take. */
 PtrIntegrator ptr_render_integrator(const PtrRenderSettings *settings);
 
 /* "paths" or "bundles", and back ("auto" too); parse returns 0 for neither. */
