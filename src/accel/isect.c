@@ -26,6 +26,7 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_sse41);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx2);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx512);
 PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_avx2);
+PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_avx512);
 PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_avx2);
 #endif
 
@@ -67,8 +68,6 @@ PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c)
     }
 }
 
-/* The tree traversal has an AVX2 version, which the AVX-512 level keeps:
- * no AVX-512 machine was at hand to check one (docs/intersectors.md). */
 void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
 {
     table->closest_hit = ptr_closest_hit_c;
@@ -90,6 +89,7 @@ void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
     if (level < PTR_CPU_AVX512)
         return;
     table->closest_hit = ptr_closest_hit_avx512;
+    table->bvh_closest_hit = ptr_bvh_closest_hit_avx512;
     table->name = "avx512";
 #else
     (void)level;
