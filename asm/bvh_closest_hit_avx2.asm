@@ -223,8 +223,12 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmovmskps   edx, ymm13
     test        edx, edx
     jz          .pop
+    ; One child entered: enter it. Several: push them all, swap the nearest
+    ; (its lowest lane on a tie) onto the top, and pop it at once.
+    lea         ecx, [rdx - 1]
+    test        edx, ecx
+    jz          .one
     vmovaps     [rbp + ENTRY], ymm10
-    ; Push every child entered; then swap the nearest onto the top.
     vmovss      xmm15, [infinity]
     mov         rbx, r14
 .push:
@@ -248,6 +252,14 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmovups     xmm9, [r14 - 16]
     vmovups     [rbx], xmm9
     vmovups     [r14 - 16], xmm8
+    jmp         .pop
+.one:
+    bsf         ecx, edx
+    mov         eax, [rsi + NODE_CHILD + rcx*4]
+    mov         ecx, [rsi + NODE_LEAF_COUNT + rcx*4]
+    test        ecx, ecx
+    jz          .node
+    call        test_leaf
     jmp         .pop
 
 .finish:
