@@ -1,8 +1,10 @@
 /* The closest-hit query alone, ptr against Embree 3 on identical rays: the
  * rays a render of the scene asks (camera, scattered and shadow rays, in the
  * order the integrator asks them), recorded, then answered again by every
- * traversal ptr's dispatch ladder has on this CPU and by Embree's
- * rtcIntersect1 and rtcIntersect16 over the same spheres. One thread each, so
+ * one-ray traversal ptr's dispatch ladder has on this CPU, by this CPU's
+ * table as the renderer asked it ("as asked": packets of eight where it
+ * asked for packets), and by Embree's rtcIntersect1 and rtcIntersect16 over
+ * the same spheres. One thread each, so
  * the figures are per core; runs alternate, and the best of them is printed.
  *
  *   query SCENE SPP [RUNS]
@@ -37,16 +39,33 @@ typedef struct RTCRayHit16 RTCRayHit16;
 enum { RAYS_MAX = 1 << 24, PACKET = 16 };
 
 /* The rays a render asks, in order: the recording wraps the table's tree
- * traversal, which every query of a scene without huge spheres reaches. */
+ * traversals, which every query of a scene without huge spheres reaches,
+ * and marks the first ray of each packet of eight the renderer asked
+ * together (a pixel's camera rays). */
 static PtrRay *recorded;
+static uint8_t *packet_start;
 static size_t recorded_count;
-static PtrBvhClosestHitFn recorded_traversal;
+static PtrIsectTable recorded_table;
 
 static PTR_DECL_BVH_CLOSEST_HIT(record_ray)
 {
-    if (recorded_count < RAYS_MAX)
+    if (recorded_count < RAYS_MAX) {
+        packet_start[recorded_count] = 0;
         recorded[recorded_count++] = *ray;
-    return recorded_traversal(ray, bvh, spheres, hit);
+    }
+    return recorded_table.bvh_closest_hit(ray, bvh, spheres, hit);
+}
+
+static PTR_DECL_BVH_CLOSEST_HIT_PACKET(record_packet)
+{
+    for (int k = 0; k < PTR_PACKET_LANES && recorded_count < RAYS_MAX; k++) {
+        packet_start[recorded_count] = k == 0;
+        recorded[recorded_count++] = (PtrRay){ { rays->org[0][k], rays->org[1][k], rays->org[2][k] },
+                                               rays->tmin[k],
+                                               { rays->dir[0][k], rays->dir[1][k], rays->dir[2][k] },
+                                               rays->tmax[k] };
+    }
+    recorded_table.bvh_closest_hit_packet(rays, bvh, spheres, hits);
 }
 
 typedef struct Method {
@@ -73,6 +92,40 @@ static void time_ptr(Method *m, const PtrAccel *accel, PtrBvhClosestHitFn traver
         PtrHit hit;
         if (traversal(&recorded[i], &accel->bvh, accel->spheres, &hit))
             sum += hit.t;
+    }
+    keep_best(m, ptr_now_seconds() - t0, (double)(__rdtsc() - c0), sum);
+}
+
+/* The rays as the renderer asked them of the table: packets of eight where
+ * it asked for packets, else one by one. */
+static void time_ptr_as_asked(Method *m, const PtrAccel *accel, const PtrIsectTable *table)
+{
+    double sum = 0;
+    const double t0 = ptr_now_seconds();
+    const uint64_t c0 = __rdtsc();
+    for (size_t i = 0; i < recorded_count;) {
+        if (packet_start[i] && i + PTR_PACKET_LANES <= recorded_count) {
+            PtrRayPacket rays;
+            for (int k = 0; k < PTR_PACKET_LANES; k++) {
+                const PtrRay *r = &recorded[i + (size_t)k];
+                for (int a = 0; a < 3; a++) {
+                    rays.org[a][k] = r->org[a];
+                    rays.dir[a][k] = r->dir[a];
+                }
+                rays.tmin[k] = r->tmin;
+                rays.tmax[k] = r->tmax;
+            }
+            PtrHitPacket hits;
+            table->bvh_closest_hit_packet(&rays, &accel->bvh, accel->spheres, &hits);
+            for (int k = 0; k < PTR_PACKET_LANES; k++)
+                sum += hits.sphere[k] != PTR_NO_HIT ? hits.t[k] : 0.0f;
+            i += PTR_PACKET_LANES;
+        } else {
+            PtrHit hit;
+            if (table->bvh_closest_hit(&recorded[i], &accel->bvh, accel->spheres, &hit))
+                sum += hit.t;
+            i++;
+        }
     }
     keep_best(m, ptr_now_seconds() - t0, (double)(__rdtsc() - c0), sum);
 }
@@ -223,17 +276,17 @@ int main(int argc, char **argv)
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     PtrAccel accel;
     recorded = malloc(RAYS_MAX * sizeof *recorded);
-    if (!recorded || ptr_accel_init(&accel, PTR_ACCEL_BVH, &c, 0, &scene, 0) != PTR_OK) {
+    packet_start = malloc(RAYS_MAX);
+    if (!recorded || !packet_start || ptr_accel_init(&accel, PTR_ACCEL_BVH, &c, 0, &scene, 0) != PTR_OK) {
         fprintf(stderr, "query: out of memory\n");
         return 6;
     }
 
     /* Record with the table of this CPU, as a render would trace. */
-    PtrIsectTable fastest;
-    ptr_isect_init(&fastest, PTR_KERNEL_AUTO, SIZE_MAX);
-    accel.isect = fastest;
-    recorded_traversal = fastest.bvh_closest_hit;
+    ptr_isect_init(&recorded_table, PTR_KERNEL_AUTO, SIZE_MAX);
+    accel.isect = recorded_table;
     accel.isect.bvh_closest_hit = record_ray;
+    accel.isect.bvh_closest_hit_packet = record_packet;
     PtrRenderSettings settings = { .width = scene.width ? scene.width : 400,
                                    .height = scene.height ? scene.height : 225,
                                    .samples = spp, .seed = 1, .max_depth = 50, .threads = 1 };
@@ -252,7 +305,7 @@ int main(int argc, char **argv)
     RTCScene user = embree_scene(device, accel.spheres, accel.spheres->count, 1);
 
     PtrIsectTable levels[PTR_CPU_LEVEL_COUNT];
-    Method methods[PTR_CPU_LEVEL_COUNT + 4];
+    Method methods[PTR_CPU_LEVEL_COUNT + 5];
     int n = 0;
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
         ptr_isect_init_level(&levels[n], (PtrCpuLevel)level);
@@ -261,6 +314,7 @@ int main(int argc, char **argv)
         methods[n] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level) };
         n++;
     }
+    methods[n++] = (Method){ .name = "as asked" };
     const int ptr_methods = n;
     methods[n++] = (Method){ .name = "embree point 1" };
     methods[n++] = (Method){ .name = "embree point 16" };
@@ -269,8 +323,9 @@ int main(int argc, char **argv)
 
     float *embree_t = malloc(recorded_count * sizeof *embree_t);
     for (int run = 0; run < runs; run++) {
-        for (int k = 0; k < ptr_methods; k++)
+        for (int k = 0; k < ptr_methods - 1; k++)
             time_ptr(&methods[k], &accel, levels[k].bvh_closest_hit);
+        time_ptr_as_asked(&methods[ptr_methods - 1], &accel, &recorded_table);
         time_embree1(&methods[ptr_methods], points, NULL);
         time_embree16(&methods[ptr_methods + 1], points);
         time_embree1(&methods[ptr_methods + 2], user, run == 0 ? embree_t : NULL);
@@ -304,6 +359,7 @@ int main(int argc, char **argv)
     free(embree_t);
     free(rgb);
     free(recorded);
+    free(packet_start);
     ptr_accel_free(&accel);
     ptr_scene_free(&scene);
     ptr_strings_free(&warnings);
