@@ -7,13 +7,16 @@
  * the same spheres. One thread each, so
  * the figures are per core; runs alternate, and the best of them is printed.
  *
- *   query SCENE SPP [RUNS]
+ *   query SCENE SPP [RUNS [METHOD]]
  *
  * Prints, per method: Mrays/s, nanoseconds and cycles per ray (of the time
  * stamp counter), all of the thread's CPU time, and the ratio to Embree's
  * best. Embree's answers are checked against ptr's (hit or
  * miss, and the same t to 1e-4 relative): its arithmetic is not ptr's, so a
  * few grazing rays may disagree, and their count is printed.
+ *
+ * METHOD (a name of the table, "avx512", "embree user 16"...) times that one
+ * alone, for a profile (bench/stages.sh).
  *
  * Embree's geometries: its own spheres (RTC_GEOMETRY_TYPE_SPHERE_POINT, what
  * ../shared/peers/embree_pt.c traces with -m 1), and user geometry whose
@@ -70,8 +73,16 @@ static PTR_DECL_BVH_CLOSEST_HIT_PACKET(record_packet)
     recorded_table.bvh_closest_hit_packet(rays, bvh, spheres, hits);
 }
 
+typedef enum MethodKind {
+    PTR_ONE_RAY,  /* one ray at a time through a traversal of the ladder */
+    PTR_AS_ASKED, /* the table as the renderer asked it */
+    EMBREE_POINT_1, EMBREE_POINT_16, EMBREE_USER_1, EMBREE_USER_16,
+} MethodKind;
+
 typedef struct Method {
     const char *name;
+    MethodKind kind;
+    PtrBvhClosestHitFn traversal; /* PTR_ONE_RAY's */
     double seconds;  /* the best run's, over all rays */
     double checksum; /* sum of the hits' t, to keep every query alive */
 } Method;
@@ -271,11 +282,12 @@ static RTCScene embree_scene(RTCDevice device, const PtrSpheres *s, size_t count
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: query SCENE SPP [RUNS]\n");
+        fprintf(stderr, "usage: query SCENE SPP [RUNS [METHOD]]\n");
         return 2;
     }
     const uint32_t spp = (uint32_t)atoi(argv[2]);
     const int runs = argc > 3 ? atoi(argv[3]) : 3;
+    const char *only = argc > 4 ? argv[4] : NULL;
     PtrScene scene;
     PtrStrings warnings = { 0 };
     PtrError err = { 0 };
@@ -320,36 +332,43 @@ int main(int argc, char **argv)
     RTCScene points = embree_scene(device, accel.spheres, accel.spheres->count, 0);
     RTCScene user = embree_scene(device, accel.spheres, accel.spheres->count, 1);
 
-    PtrIsectTable levels[PTR_CPU_LEVEL_COUNT];
+    /* Every one-ray traversal of the ladder (a level that keeps the level
+     * below's is left out), the table as asked, and Embree's four ways. */
     Method methods[PTR_CPU_LEVEL_COUNT + 5];
     int n = 0;
+    PtrBvhClosestHitFn last = NULL;
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
-        ptr_isect_init_level(&levels[n], (PtrCpuLevel)level);
-        if (n > 0 && levels[n].bvh_closest_hit == levels[n - 1].bvh_closest_hit)
-            continue; /* this level keeps the level below's traversal */
-        methods[n] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level) };
-        n++;
+        PtrIsectTable table;
+        ptr_isect_init_level(&table, (PtrCpuLevel)level);
+        if (table.bvh_closest_hit != last)
+            methods[n++] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level),
+                                     .kind = PTR_ONE_RAY, .traversal = last = table.bvh_closest_hit };
     }
-    methods[n++] = (Method){ .name = "as asked" };
-    const int ptr_methods = n;
-    methods[n++] = (Method){ .name = "embree point 1" };
-    methods[n++] = (Method){ .name = "embree point 16" };
-    methods[n++] = (Method){ .name = "embree user 1" };
-    methods[n++] = (Method){ .name = "embree user 16" };
+    methods[n++] = (Method){ .name = "as asked", .kind = PTR_AS_ASKED };
+    methods[n++] = (Method){ .name = "embree point 1", .kind = EMBREE_POINT_1 };
+    methods[n++] = (Method){ .name = "embree point 16", .kind = EMBREE_POINT_16 };
+    methods[n++] = (Method){ .name = "embree user 1", .kind = EMBREE_USER_1 };
+    methods[n++] = (Method){ .name = "embree user 16", .kind = EMBREE_USER_16 };
 
     float *embree_t = malloc(recorded_count * sizeof *embree_t);
     for (int run = 0; run < runs; run++) {
-        for (int k = 0; k < ptr_methods - 1; k++)
-            time_ptr(&methods[k], &accel, levels[k].bvh_closest_hit);
-        time_ptr_as_asked(&methods[ptr_methods - 1], &accel, &recorded_table);
-        time_embree1(&methods[ptr_methods], points, NULL);
-        time_embree16(&methods[ptr_methods + 1], points);
-        time_embree1(&methods[ptr_methods + 2], user, run == 0 ? embree_t : NULL);
-        time_embree16(&methods[ptr_methods + 3], user);
+        for (int k = 0; k < n; k++) {
+            Method *m = &methods[k];
+            if (only && strcmp(only, m->name))
+                continue;
+            switch (m->kind) {
+            case PTR_ONE_RAY: time_ptr(m, &accel, m->traversal); break;
+            case PTR_AS_ASKED: time_ptr_as_asked(m, &accel, &recorded_table); break;
+            case EMBREE_POINT_1: time_embree1(m, points, NULL); break;
+            case EMBREE_POINT_16: time_embree16(m, points); break;
+            case EMBREE_USER_1: time_embree1(m, user, run == 0 ? embree_t : NULL); break;
+            case EMBREE_USER_16: time_embree16(m, user); break;
+            }
+        }
     }
 
     size_t disagree = 0;
-    for (size_t i = 0; embree_t && i < recorded_count; i++) {
+    for (size_t i = 0; !only && i < recorded_count; i++) {
         PtrHit hit;
         const int found = c.bvh_closest_hit(&recorded[i], &accel.bvh, accel.spheres, &hit);
         if (found != !isnan(embree_t[i]) ||
@@ -358,18 +377,22 @@ int main(int argc, char **argv)
     }
     const double hz = tsc_hz();
     double embree_best = INFINITY;
-    for (int k = ptr_methods; k < n; k++)
-        embree_best = fmin(embree_best, methods[k].seconds);
+    for (int k = 0; k < n; k++)
+        if (methods[k].kind >= EMBREE_POINT_1 && methods[k].seconds > 0)
+            embree_best = fmin(embree_best, methods[k].seconds);
     printf("%-16s %9s %9s %11s %13s\n", "method", "Mrays/s", "ns/ray", "cycles/ray",
            "Embree best /");
     for (int k = 0; k < n; k++) {
         const Method *m = &methods[k];
-        printf("%-16s %9.2f %9.1f %11.0f %12.2fx\n", m->name,
-               (double)recorded_count / m->seconds * 1e-6, m->seconds / (double)recorded_count * 1e9,
-               m->seconds * hz / (double)recorded_count, embree_best / m->seconds);
+        if (m->seconds > 0)
+            printf("%-16s %9.2f %9.1f %11.0f %12.2fx\n", m->name,
+                   (double)recorded_count / m->seconds * 1e-6,
+                   m->seconds / (double)recorded_count * 1e9,
+                   m->seconds * hz / (double)recorded_count, embree_best / m->seconds);
     }
-    printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t to 1e-4)\n",
-           disagree, recorded_count);
+    if (!only)
+        printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t "
+               "to 1e-4)\n", disagree, recorded_count);
     rtcReleaseScene(points);
     rtcReleaseScene(user);
     rtcReleaseDevice(device);
