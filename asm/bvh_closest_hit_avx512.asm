@@ -2,10 +2,13 @@
 ; on 8-lane ymm registers: a node has eight children). What it adds to the
 ; AVX2 traversal is in the bookkeeping, not the arithmetic: comparisons into
 ; mask registers, the ray's constants kept in ymm16-25 instead of the frame,
-; and a node's children entered in one step: the nearest is entered at once,
+; a node's children entered in one step: the nearest is entered at once,
 ; without a round trip through the stack, and the others are compressed
 ; (vcompressps, vpcompressd) onto three stacks, of entry distances, children
-; and leaf counts, with one store each instead of a loop over the lanes.
+; and leaf counts, with one store each instead of a loop over the lanes; and
+; the spheres kept out of the tree tested last, so that the first node test
+; does not wait on their square roots (on the recorded rays of a 10^5-sphere
+; cloud, 1.1x as fast; bench/query).
 ;
 ; Returns exactly what ptr_bvh_closest_hit_c returns: the box test and the
 ; sphere arithmetic are the same operations in the same order as there (no
@@ -88,7 +91,7 @@ test_leaf:
 ; rdi ray, rsi bvh (then the node being tested), rdx spheres (then scratch),
 ; rcx hit (pushed; then scratch)
 ; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 entries on the stacks
-; r15d best sphere (PTR_NO_HIT)   rbx spheres out of the tree   rbp the frame
+; r15d best sphere (PTR_NO_HIT)   rbx spheres kept out of the tree   rbp the frame
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm5 best id   ymm6 lane
 ; indices   ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
 ; ymm19-21 1 / d clamped   ymm22 slack   ymm23 +inf   ymm24 best * slack
@@ -131,23 +134,9 @@ FUNCTION ptr_bvh_closest_hit_avx512
     vpxord      ymm25, ymm25, ymm25
     mov         r15d, -1                        ; PTR_NO_HIT
 
-    ; The spheres kept out of the tree, eight at a time.
-    xor         eax, eax
-.unbounded:
-    mov         rcx, rbx
-    sub         rcx, rax
-    jbe         .tree
-    cmp         rcx, 8
-    jbe         .last
-    mov         ecx, 8
-.last:
-    call        test_leaf
-    add         rax, 8
-    jmp         .unbounded
-
 .tree:
     test        r13, r13
-    jz          .finish
+    jz          .kept_out
     ; Per ray: 1 / dir clamped to +-FLT_MAX (finite or zero products, never
     ; NaN), and which axes' near planes are the upper ones.
     vbroadcastss ymm8, [one]
@@ -229,7 +218,7 @@ FUNCTION ptr_bvh_closest_hit_avx512
 
 .pop:
     test        r14, r14
-    jz          .finish
+    jz          .kept_out
     dec         r14
     vmovss      xmm8, [rbp + STACK_ENTRY + r14*4]
     vucomiss    xmm8, xmm24
@@ -240,6 +229,22 @@ FUNCTION ptr_bvh_closest_hit_avx512
     jz          .node
     call        test_leaf
     jmp         .pop
+
+    ; The spheres kept out of the tree, eight at a time, once the tree has
+    ; found its best: the tree's first node test need not wait for them.
+.kept_out:
+    xor         eax, eax
+.unbounded:
+    mov         rcx, rbx
+    sub         rcx, rax
+    jbe         .finish
+    cmp         rcx, 8
+    jbe         .last
+    mov         ecx, 8
+.last:
+    call        test_leaf
+    add         rax, 8
+    jmp         .unbounded
 
 .finish:
     mov         rsp, [rbp + SAVED_RSP]

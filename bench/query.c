@@ -388,7 +388,8 @@ int main(int argc, char **argv)
             printf("%-16s %9.2f %9.1f %11.0f %12.2fx\n", m->name,
                    (double)recorded_count / m->seconds * 1e-6,
                    m->seconds / (double)recorded_count * 1e9,
-                   m->seconds * hz / (double)recorded_count, embree_best / m->seconds);
+                   m->seconds * hz / (double)recorded_count,
+                   isinf(embree_best) ? NAN : embree_best / m->seconds);
     }
     if (!only)
         printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t "
