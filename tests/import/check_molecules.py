@@ -9,7 +9,8 @@ of Alvarez 2013 times --radius-scale, colours Jmol's decoded from sRGB (to
 ptr's 1/65535), and each atom's B-factor, occupancy or property as the value
 --color-by reads. Broken files are refused naming their line; --color-by an
 attribute the file lacks, and bad --colormap and --color-range values, are
-one-line errors with the README's exit codes.
+one-line errors with the README's exit codes. The examples
+scenes/1tii.glb and scenes/droplet.glb are what their sources make.
 Usage: check_molecules.py PTR SOURCE_DIR"""
 import json
 import os
@@ -176,6 +177,22 @@ for options, code, words in ((["--color-by", "charge"], 4, "'charge'"),
     ok = not isinstance(run, list) and run.returncode == code and words in run.stderr and \
         len(run.stderr.strip().splitlines()) == 1
     expect(f"{options}: {run if isinstance(run, list) else (run.returncode, run.stderr)}", ok)
+
+# ptr itself points at the converter.
+run = subprocess.run([ptr, pdb, "-o", os.path.join(tmp, "x.png")], capture_output=True, text=True)
+expect(f"ptr {pdb}: {run.returncode}, {run.stderr!r}",
+       run.returncode == 4 and "scripts/molecule_to_glb.py" in run.stderr)
+
+# The examples in scenes/ are what their sources and scripts make.
+frame = os.path.join(tmp, "droplet.extxyz")
+subprocess.run([sys.executable, os.path.join(src, "scripts", "make_particle_frame.py"), frame],
+               check=True, capture_output=True)
+convert(os.path.join(src, "scenes", "1tii.pdb"), "1tii.glb")
+convert(frame, "droplet.glb")
+for name in ("droplet.extxyz", "1tii.glb", "droplet.glb"):
+    with open(os.path.join(tmp, name), "rb") as made, \
+            open(os.path.join(src, "scenes", name), "rb") as committed:
+        expect(f"scenes/{name} differs from what its script makes", made.read() == committed.read())
 
 for f in failures:
     print(f)
