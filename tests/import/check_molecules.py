@@ -18,7 +18,7 @@ import subprocess
 import sys
 import tempfile
 
-ptr, src = sys.argv[1], sys.argv[2]
+ptr, src = sys.argv[1], os.path.abspath(sys.argv[2])
 script = os.path.join(src, "scripts", "molecule_to_glb.py")
 tmp = tempfile.mkdtemp()
 failures, checks = [], 0
@@ -177,6 +177,57 @@ for options, code, words in ((["--color-by", "charge"], 4, "'charge'"),
     ok = not isinstance(run, list) and run.returncode == code and words in run.stderr and \
         len(run.stderr.strip().splitlines()) == 1
     expect(f"{options}: {run if isinstance(run, list) else (run.returncode, run.stderr)}", ok)
+
+# POINTS and instances alike: --color-by COLOR_0 finds COLOR_0 and _COLOR_0,
+# a VEC3 whose length is the value.
+fixtures = os.path.join(src, "tests", "fixtures", "instancing")
+for form in ("instances", "points"):
+    path = os.path.join(fixtures, form + ".gltf")
+    plain, valued = dump(path), dump(path, "--color-by", "color_0")
+    expect(f"{form}: {valued if not isinstance(valued, list) else len(valued)} valued spheres",
+           isinstance(valued, list) and len(valued) == len(plain))
+    for i, (p, v) in enumerate(zip(plain, valued if isinstance(valued, list) else [])):
+        length = sum(c * c for c in p["color"]) ** 0.5
+        expect(f"{form} sphere {i}: value {v.get('value')}, not {length}",
+               abs(v.get("value", 1e30) - length) <= 2e-4)
+
+# Broken attributes: one line naming the node, exit code 4.
+sys.path.insert(0, os.path.join(src, "scripts"))
+import make_scenes  # noqa: E402
+import particles_to_glb  # noqa: E402
+
+
+def broken(name, values, patch=None):
+    doc, blob = particles_to_glb.convert([[i, 0, 0, 0.5] for i in range(3)],
+                                         {"material": "lambertian"}, {"_T": values})
+    if patch:
+        patch(doc["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"], doc)
+    path = os.path.join(tmp, name)
+    make_scenes.write(doc, blob, path)
+    return path
+
+
+def point_elsewhere(attributes, doc):
+    attributes["_T"] = 99
+
+
+def short_count(attributes, doc):
+    doc["accessors"][attributes["_T"]]["count"] = 2
+
+
+def as_unsigned_int(attributes, doc):
+    doc["accessors"][attributes["_T"]]["componentType"] = 5125
+
+
+for path, words in ((broken("nan.gltf", [1.0, float("nan"), 2.0]), "instance 1"),
+                    (broken("missing.gltf", [1.0, 2.0, 3.0], point_elsewhere), "does not exist"),
+                    (broken("count.gltf", [1.0, 2.0, 3.0], short_count), "count"),
+                    (broken("uint.gltf", [1.0, 2.0, 3.0], as_unsigned_int), "component type")):
+    run = dump(path, "--color-by", "t")
+    ok = not isinstance(run, list) and run.returncode == 4 and words in run.stderr and \
+        len(run.stderr.strip().splitlines()) == 1 and run.stderr.startswith(f"ptr: {path}:")
+    expect(f"{path}: {run if isinstance(run, list) else (run.returncode, run.stderr)}", ok)
+    expect(f"{path} without --color-by: refused", isinstance(dump(path), list))
 
 # ptr itself points at the converter.
 run = subprocess.run([ptr, pdb, "-o", os.path.join(tmp, "x.png")], capture_output=True, text=True)
