@@ -153,7 +153,8 @@ def xyz_properties(path, number, comment):
     fields = spec.split(":")
     if len(fields) % 3 or not all(f.isdigit() and int(f) > 0 for f in fields[2::3]):
         fail(path, number, f"Properties={spec}: not NAME:TYPE:COUNT triples")
-    return [(fields[i], fields[i + 1].upper(), int(fields[i + 2])) for i in range(0, len(fields), 3)]
+    return [(fields[i], fields[i + 1].upper(), int(fields[i + 2]))
+            for i in range(0, len(fields), 3)]
 
 
 def xyz_value(path, number, kind, text):

@@ -10,11 +10,12 @@
 enum { BAR_WIDTH = 512, BAR_HEIGHT = 32 }; /* two columns an entry of 256 */
 
 /* The map from lo (left) to hi (right), each column the colour its centre's
- * value gets, written as a render is: the same view, depth and format rules. */
+ * value gets, written as a render is, through the same view, at its
+ * format's default depth (a key needs no more). */
 static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const char *scene_path,
                            const PtrColor *color, PtrError *err)
 {
-    if (ptr_output_check(o->color_bar, o->depth, err) != PTR_OK)
+    if (ptr_output_check(o->color_bar, PTR_DEPTH_DEFAULT, err) != PTR_OK)
         return err->code;
     float *rgb = malloc((size_t)BAR_WIDTH * BAR_HEIGHT * 3 * sizeof *rgb);
     if (!rgb)
@@ -30,7 +31,7 @@ static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const ch
     }
     const PtrImageLayout layout = { BAR_WIDTH, BAR_HEIGHT, 0, 0, BAR_WIDTH, BAR_HEIGHT };
     const PtrOutputInfo info = {
-        .scene_path = scene_path, .kernel = "", .accel = "", .sampler = "", .depth = o->depth,
+        .scene_path = scene_path, .kernel = "", .accel = "", .sampler = "",
         .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
         .dither = o->dither,
     };

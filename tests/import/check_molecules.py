@@ -14,9 +14,11 @@ scenes/1tii.glb and scenes/droplet.glb are what their sources make.
 Usage: check_molecules.py PTR SOURCE_DIR"""
 import json
 import os
+import struct
 import subprocess
 import sys
 import tempfile
+import zlib
 
 ptr, src = sys.argv[1], os.path.abspath(sys.argv[2])
 script = os.path.join(src, "scripts", "molecule_to_glb.py")
@@ -158,6 +160,57 @@ for i, end in ((0, 1), (1, 0), (3, 1)):
     want = decoded(viridis_ends[end])
     expect(f"--color-range 0,1: sphere {i} {spheres[i]['color']}, not {want}",
            max(abs(a - b) for a, b in zip(spheres[i]["color"], want)) <= 1.01 / 65535)
+
+# A render prints the data's range; its colour bar shows viridis, entry x / 2
+# in column x, through the sRGB view (8-bit PNG, within a step of rounding).
+def png_rgb(path):
+    """The rows of an 8-bit RGB or RGBA PNG, as lists of (r, g, b)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    at, idat, width, height, channels = 8, b"", 0, 0, 3
+    while at < len(data):
+        length, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
+            assert depth == 8 and colour in (2, 6), (depth, colour)
+            channels = 3 if colour == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        at += 12 + length
+    raw, stride, rows = zlib.decompress(idat), width * channels, []
+    previous = bytearray(stride)
+    for y in range(height):
+        start = y * (stride + 1)
+        kind, line = raw[start], bytearray(raw[start + 1:start + 1 + stride])
+        for i in range(stride):
+            left = line[i - channels] if i >= channels else 0
+            up, corner = previous[i], previous[i - channels] if i >= channels else 0
+            p = left + up - corner
+            nearest = min((abs(p - left), 0, left), (abs(p - up), 1, up),
+                          (abs(p - corner), 2, corner))[2]
+            line[i] = (line[i] + (0, left, up, (left + up) // 2, nearest)[kind]) & 255
+        rows.append([tuple(line[x * channels:x * channels + 3]) for x in range(width)])
+        previous = line
+    return rows
+
+
+bar = os.path.join(tmp, "bar.png")
+run = subprocess.run([ptr, os.path.join(tmp, "gas_0001.glb"), "-o", os.path.join(tmp, "gas.exr"),
+                      "--width", "8", "--height", "8", "--samples", "1", "--color-by", "energy",
+                      "--color-bar", bar], capture_output=True, text=True)
+expect(f"the range printed: {run.stderr!r}", run.returncode == 0 and
+       "values -1.5 to 7, mapped from -1.5 to 7 through viridis" in run.stderr)
+rows = png_rgb(bar) if os.path.exists(bar) else [[]]
+expect(f"bar: {len(rows[0])}x{len(rows)}", len(rows) == 32 and len(rows[0]) == 512)
+viridis_128 = [0.127568, 0.566949, 0.550556]
+for x, entry in ((0, viridis_ends[0]), (256, viridis_128), (257, viridis_128),
+                 (511, viridis_ends[1])):
+    want = [round(255 * c) for c in entry]
+    for y in (0, 31):
+        got = rows[y][x] if len(rows) == 32 else None
+        expect(f"bar pixel ({x}, {y}): {got}, not {want}",
+               got is not None and max(abs(a - b) for a, b in zip(got, want)) <= 1)
 
 # Broken inputs: one line naming the file and line; nothing written.
 bad_pdb = write("bad.pdb", "".join(model1[:2]) + model1[2][:33] + "x.yyy" + model1[2][38:])
