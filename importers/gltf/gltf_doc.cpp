@@ -531,6 +531,28 @@ extern "C" int gltf_doc_primitive_attribute(const GltfDoc *doc, size_t mesh, siz
     return -1;
 }
 
+extern "C" void gltf_doc_custom_attributes(const GltfDoc *doc, char *out, size_t size)
+{
+    std::vector<std::string> names;
+    auto note = [&names](const std::string &name) {
+        if (name[0] == '_' && std::find(names.begin(), names.end(), name) == names.end())
+            names.push_back(name);
+    };
+    for (const tinygltf::Node &n : doc->model.nodes)
+        if (const tinygltf::Value *a = instancing_attributes(n))
+            if (a->IsObject())
+                for (const std::string &key : a->Keys())
+                    note(key);
+    for (const tinygltf::Mesh &mesh : doc->model.meshes)
+        for (const tinygltf::Primitive &p : mesh.primitives)
+            for (const auto &attr : p.attributes)
+                note(attr.first);
+    std::string list;
+    for (const std::string &name : names)
+        list += (list.empty() ? "" : ", ") + name;
+    snprintf(out, size, "%s", list.c_str());
+}
+
 extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *out)
 {
     const tinygltf::Model &m = doc->model;

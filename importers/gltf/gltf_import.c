@@ -721,6 +721,14 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: no camera named '%s' in the default scene", path,
                             im.camera_name);
+    if (res == PTR_OK && im.value_name && !im.builder.values) {
+        char names[256];
+        gltf_doc_custom_attributes(doc, names, sizeof names);
+        res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                            "%s: no instance or point attribute '%s' (--color-by); %s%s", path,
+                            im.value_name, *names ? "the file has " : "the file has none",
+                            names);
+    }
     if (res == PTR_OK)
         check_far_plane(&im);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)

@@ -222,7 +222,8 @@ for path, line in ((bad_pdb, 3), (bad_xyz, 3)):
            not os.path.exists(os.path.join(tmp, "bad.glb")))
 
 # The command line: an attribute the file lacks is exit 4; bad values exit 2.
-for options, code, words in ((["--color-by", "charge"], 4, "'charge'"),
+lacking = "'charge' (--color-by); the file has _COLOR_0, _ENERGY, _VEL"
+for options, code, words in ((["--color-by", "charge"], 4, lacking),
                              (["--color-by", "energy", "--colormap", "jet"], 2, "--colormap"),
                              (["--color-by", "energy", "--color-range", "5,1"], 2, "--color-range"),
                              (["--colormap", "magma"], 2, "--color-by")):
