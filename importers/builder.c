@@ -28,13 +28,14 @@ void ptr_builder_free(PtrSceneBuilder *builder)
 
 /* The optional per-sphere arrays (width floats a sphere, and the value of a
  * sphere that has none): they exist from the first sphere that has one. */
+enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
 static const struct {
     size_t offset;
     int width;
     float none;
 } optional_arrays[] = {
-    { offsetof(PtrSceneBuilder, colors), 3, 1.0f }, /* white */
-    { offsetof(PtrSceneBuilder, values), 1, NAN },
+    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 3, 1.0f }, /* white */
+    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, NAN },
 };
 
 static float **optional_array(PtrSceneBuilder *b, size_t k)
@@ -105,7 +106,7 @@ static float *last_entry(PtrSceneBuilder *b, size_t k)
 
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
 {
-    float *entry = last_entry(b, 0);
+    float *entry = last_entry(b, OPTIONAL_COLORS);
     if (!entry)
         return PTR_ERR_NOMEM;
     for (int k = 0; k < 3; k++)
@@ -115,7 +116,7 @@ PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
 
 PtrResult ptr_builder_set_value(PtrSceneBuilder *b, double value)
 {
-    float *entry = last_entry(b, 1);
+    float *entry = last_entry(b, OPTIONAL_VALUES);
     if (!entry)
         return PTR_ERR_NOMEM;
     *entry = (float)value;
