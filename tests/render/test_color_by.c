@@ -6,6 +6,7 @@
  * times map(value). */
 #include <math.h>
 
+#include "importer.h"
 #include "render/render.h"
 #include "scene/colormap.h"
 #include "test.h"
@@ -184,8 +185,27 @@ static void test_materials(void)
     ptr_scene_free(&s);
 }
 
+/* The values take memory only when asked for: a file with instance
+ * attributes imports without a value array unless --color-by names one. */
+static void test_values_only_when_asked(void)
+{
+    const char *path = PTR_SOURCE_DIR "/tests/fixtures/instancing/instances.gltf";
+    for (int asked = 0; asked < 2; asked++) {
+        PtrImportOptions options = { .value_attribute = asked ? "color_0" : NULL };
+        PtrScene s;
+        PtrStrings warnings = { 0 };
+        PtrError err = { 0 };
+        CHECK_INT(ptr_import_scene(path, &options, &s, &warnings, &err), PTR_OK);
+        CHECK(s.spheres.count > 0);
+        CHECK(asked ? s.spheres.value != NULL : s.spheres.value == NULL);
+        ptr_strings_free(&warnings);
+        ptr_scene_free(&s);
+    }
+}
+
 int main(void)
 {
+    test_values_only_when_asked();
     test_published_entries();
     test_bins_and_clamping();
     test_furnace_shows_the_map();
