@@ -110,9 +110,10 @@ def read_pdb(path):
             elif record.rstrip() == "END":
                 break
             elif record in ("ATOM  ", "HETATM"):
-                if len(line.rstrip("\n")) < 54:
+                line = line.rstrip("\r\n")
+                if len(line) < 54:
                     fail(path, number, "an atom record shorter than its coordinates (54 columns)")
-                line = line.rstrip("\n").ljust(80)
+                line = line.ljust(80)
                 if atoms is None:  # atoms outside MODEL records: one frame
                     atoms, first_of = Atoms(), {}
                     frames.append(atoms)
@@ -274,7 +275,10 @@ def main():
         raise SystemExit(f"{PROGRAM}: --radius-scale {radius_scale}: not above 0")
     source, output = args
     pdb = source.lower().endswith((".pdb", ".ent"))
-    frames = read_pdb(source) if pdb else read_xyz(source)
+    try:
+        frames = read_pdb(source) if pdb else read_xyz(source)
+    except OSError as e:
+        raise SystemExit(f"{PROGRAM}: {source}: {e.strerror}") from None
     frames = [f for f in frames if f.positions]
     if not frames:
         raise SystemExit(f"{PROGRAM}: {source}: no atoms")

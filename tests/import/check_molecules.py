@@ -122,6 +122,11 @@ check_spheres("mol_0002.glb", [(7.0, 8.0, 9.0, "N", 5.0)], value_option="_bfacto
 expect("two models: mol.glb written", not os.path.exists(os.path.join(tmp, "mol.glb")))
 run = convert(pdb, "half.glb", "--radius-scale", "0.5", "--frame", "1")
 check_spheres("half.glb", model1_atoms, scale=0.5)
+crlf = os.path.join(tmp, "crlf.pdb")
+with open(crlf, "w", newline="\r\n") as f:
+    f.write("".join(model1))
+convert(crlf, "crlf.glb")
+check_spheres("crlf.glb", model1_atoms, value_option="bfactor")
 
 # Plain XYZ: element symbols in any case, a fifth column kept.
 xyz = write("water.xyz", "3\nwater\nO 0 0 0 -0.8\nH 0.96 0 0 0.4\nh -0.24 0.93 0 0.4\n")
