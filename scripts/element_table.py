@@ -1,7 +1,7 @@
 """Element data for scripts/molecule_to_glb.py, written by
 scripts/make_element_table.py (see there for the sources): symbol ->
-(atomic number, van der Waals radius in angstrom (Alvarez 2013),
-Jmol CPK colour as 8-bit sRGB)."""
+(atomic number, van der Waals radius in angstrom (Alvarez 2013; None where
+it gives none), Jmol CPK colour as 8-bit sRGB)."""
 
 ELEMENTS = {
     'H': (1, 1.2, (255, 255, 255)),
@@ -64,6 +64,7 @@ ELEMENTS = {
     'Ce': (58, 2.88, (255, 255, 199)),
     'Pr': (59, 2.92, (217, 255, 199)),
     'Nd': (60, 2.95, (199, 255, 199)),
+    'Pm': (61, None, (163, 255, 199)),
     'Sm': (62, 2.9, (143, 255, 199)),
     'Eu': (63, 2.87, (97, 255, 199)),
     'Gd': (64, 2.83, (69, 255, 199)),
@@ -86,6 +87,11 @@ ELEMENTS = {
     'Tl': (81, 2.47, (166, 84, 77)),
     'Pb': (82, 2.6, (87, 89, 97)),
     'Bi': (83, 2.54, (158, 79, 181)),
+    'Po': (84, None, (171, 92, 0)),
+    'At': (85, None, (117, 79, 69)),
+    'Rn': (86, None, (66, 130, 150)),
+    'Fr': (87, None, (66, 0, 102)),
+    'Ra': (88, None, (0, 125, 0)),
     'Ac': (89, 2.8, (112, 171, 250)),
     'Th': (90, 2.93, (0, 186, 255)),
     'Pa': (91, 2.88, (0, 161, 255)),
@@ -97,4 +103,14 @@ ELEMENTS = {
     'Bk': (97, 3.4, (138, 79, 227)),
     'Cf': (98, 3.05, (161, 54, 212)),
     'Es': (99, 2.7, (179, 31, 212)),
+    'Fm': (100, None, (179, 31, 186)),
+    'Md': (101, None, (179, 13, 166)),
+    'No': (102, None, (189, 13, 135)),
+    'Lr': (103, None, (199, 0, 102)),
+    'Rf': (104, None, (204, 0, 89)),
+    'Db': (105, None, (209, 0, 79)),
+    'Sg': (106, None, (217, 0, 69)),
+    'Bh': (107, None, (224, 0, 56)),
+    'Hs': (108, None, (230, 0, 46)),
+    'Mt': (109, None, (235, 0, 38)),
 }

@@ -4,7 +4,7 @@ from the tables the Atomic Simulation Environment ships (Debian: python3-ase):
 
 - van der Waals radii (angstrom): S. Alvarez, "A cartography of the van der Waals
   territories", Dalton Trans. 42 (2013) 8617-8636, doi:10.1039/C3DT50599E
-  (ase/data/vdw_alvarez.py); elements the paper gives no radius are left out;
+  (ase/data/vdw_alvarez.py); None for the elements the paper gives no radius;
 - colours: Jmol's CPK colours (jmol.sourceforge.net/jscolors, ase/data/colors.py,
   whose three decimals are Jmol's 8-bit values over 255, kept as those bytes).
 
@@ -24,15 +24,17 @@ def main():
         raise SystemExit(__doc__)
     rows = []
     for number, symbol in enumerate(chemical_symbols):
-        if number == 0 or number >= len(vdw_radii) or math.isnan(vdw_radii[number]):
+        if number == 0 or number >= len(jmol_colors):
             continue
+        radius = float(vdw_radii[number]) if number < len(vdw_radii) else math.nan
         rgb = tuple(int(round(float(c) * 255)) for c in jmol_colors[number])
-        rows.append(f"    {symbol!r}: ({number}, {float(vdw_radii[number])!r}, {rgb!r}),")
+        rows.append(f"    {symbol!r}: ({number}, {None if math.isnan(radius) else radius!r}, "
+                    f"{rgb!r}),")
     with open(sys.argv[1], "w") as f:
         f.write('"""Element data for scripts/molecule_to_glb.py, written by\n'
                 "scripts/make_element_table.py (see there for the sources): symbol ->\n"
-                "(atomic number, van der Waals radius in angstrom (Alvarez 2013),\n"
-                'Jmol CPK colour as 8-bit sRGB)."""\n\nELEMENTS = {\n')
+                "(atomic number, van der Waals radius in angstrom (Alvarez 2013; None where\n"
+                'it gives none), Jmol CPK colour as 8-bit sRGB)."""\n\nELEMENTS = {\n')
         f.write("\n".join(rows) + "\n}\n")
 
 

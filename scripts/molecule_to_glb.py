@@ -248,12 +248,15 @@ def read_xyz(path):
     return frames
 
 
-def frame_scene(atoms, radius_scale, radius, material):
+def frame_scene(source, atoms, radius_scale, radius, material):
     particles = []
     for position, species, own_radius in zip(atoms.positions, atoms.species, atoms.radii):
         if isinstance(species, str):
             _, table_radius, srgb = ELEMENTS[species]
-            r = table_radius * radius_scale
+            if table_radius is None and radius is None and own_radius is None:
+                raise SystemExit(f"{PROGRAM}: {source}: {species} has no van der Waals radius in "
+                                 "Alvarez (2013): give --radius")
+            r = table_radius * radius_scale if table_radius is not None else None
         else:
             srgb = TYPE_COLOURS[species % len(TYPE_COLOURS)]
             r = TYPE_RADIUS
@@ -287,7 +290,7 @@ def main():
             raise SystemExit(f"{PROGRAM}: --frame {frame}: {source} has {len(frames)} frames")
         frames = [frames[frame - 1]]
     # Every frame converted before any file is written.
-    scenes = [frame_scene(f, radius_scale or 1.0, radius, material) for f in frames]
+    scenes = [frame_scene(source, f, radius_scale or 1.0, radius, material) for f in frames]
     stem = output[:-len(".glb")]
     for i, (scene, atoms) in enumerate(zip(scenes, frames)):
         path = output if len(scenes) == 1 else f"{stem}_{i + 1:04d}.glb"

@@ -226,6 +226,14 @@ for path, line in ((bad_pdb, 3), (bad_xyz, 3)):
            run.returncode != 0 and f"{path}:{line}:" in run.stderr and
            not os.path.exists(os.path.join(tmp, "bad.glb")))
 
+# An element without a radius in the table (polonium) needs --radius.
+polonium = write("po.xyz", "2\n\nPo 0 0 0\nC 2 0 0\n")
+run = convert(polonium, "po.glb")
+expect(f"po.xyz: {run.returncode}, {run.stderr!r}",
+       run.returncode != 0 and "Po has no van der Waals radius" in run.stderr)
+convert(polonium, "po.glb", "--radius", "1.25")
+check_spheres("po.glb", [(0, 0, 0, (1.25, "AB5C00")), (2, 0, 0, (1.25, JMOL["C"]))])
+
 # The command line: an attribute the file lacks is exit 4; bad values exit 2.
 lacking = "'charge' (--color-by); the file has _COLOR_0, _ENERGY, _VEL"
 for options, code, words in ((["--color-by", "charge"], 4, lacking),
