@@ -2,6 +2,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,15 +18,43 @@ void ptr_builder_free(PtrSceneBuilder *builder)
     free(builder->spheres);
     free(builder->materials);
     free(builder->colors);
+    free(builder->values);
     builder->spheres = NULL;
     builder->materials = NULL;
     builder->colors = NULL;
+    builder->values = NULL;
     builder->count = builder->capacity = 0;
+}
+
+/* The optional per-sphere arrays (width floats a sphere, and the value of a
+ * sphere that has none): they exist from the first sphere that has one. */
+enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
+static const struct {
+    size_t offset;
+    int width;
+    float none;
+} optional_arrays[] = {
+    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 3, 1.0f }, /* white */
+    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, NAN },
+};
+
+static float **optional_array(PtrSceneBuilder *b, size_t k)
+{
+    return (float **)((char *)b + optional_arrays[k].offset);
+}
+
+/* Entries from .. to - 1 of optional array k get its value for none. */
+static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
+{
+    const int width = optional_arrays[k].width;
+    for (size_t i = from * (size_t)width; i < to * (size_t)width; i++)
+        (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material)
 {
+    const size_t optionals = sizeof optional_arrays / sizeof optional_arrays[0];
     if (b->count == b->capacity) {
         size_t capacity = b->capacity ? 2 * b->capacity : 64;
         double *spheres = realloc(b->spheres, capacity * 4 * sizeof *spheres);
@@ -36,17 +65,21 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
         if (!materials)
             return PTR_ERR_NOMEM;
         b->materials = materials;
-        if (b->colors) {
-            float *colors = realloc(b->colors, capacity * 3 * sizeof *colors);
-            if (!colors)
+        for (size_t k = 0; k < optionals; k++) {
+            float **array = optional_array(b, k);
+            if (!*array)
+                continue;
+            float *grown = realloc(*array, capacity * (size_t)optional_arrays[k].width *
+                                               sizeof *grown);
+            if (!grown)
                 return PTR_ERR_NOMEM;
-            b->colors = colors;
+            *array = grown;
         }
         b->capacity = capacity;
     }
-    if (b->colors)
-        for (int k = 0; k < 3; k++)
-            b->colors[3 * b->count + k] = 1.0f;
+    for (size_t k = 0; k < optionals; k++)
+        if (*optional_array(b, k))
+            fill_none(b, k, b->count, b->count + 1);
     double *s = &b->spheres[4 * b->count];
     s[0] = centre[0];
     s[1] = centre[1];
@@ -56,17 +89,37 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     return PTR_OK;
 }
 
+/* Optional array k's entry for the sphere added last, the array created if
+ * it is the first. NULL if memory runs out. */
+static float *last_entry(PtrSceneBuilder *b, size_t k)
+{
+    float **array = optional_array(b, k);
+    const int width = optional_arrays[k].width;
+    if (!*array) {
+        *array = malloc(b->capacity * (size_t)width * sizeof **array);
+        if (!*array)
+            return NULL;
+        fill_none(b, k, 0, b->capacity);
+    }
+    return &(*array)[(b->count - 1) * (size_t)width];
+}
+
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
 {
-    if (!b->colors) {
-        b->colors = malloc(b->capacity * 3 * sizeof *b->colors);
-        if (!b->colors)
-            return PTR_ERR_NOMEM;
-        for (size_t i = 0; i < 3 * b->capacity; i++)
-            b->colors[i] = 1.0f;
-    }
+    float *entry = last_entry(b, OPTIONAL_COLORS);
+    if (!entry)
+        return PTR_ERR_NOMEM;
     for (int k = 0; k < 3; k++)
-        b->colors[3 * (b->count - 1) + k] = (float)rgb[k];
+        entry[k] = (float)rgb[k];
+    return PTR_OK;
+}
+
+PtrResult ptr_builder_set_value(PtrSceneBuilder *b, double value)
+{
+    float *entry = last_entry(b, OPTIONAL_VALUES);
+    if (!entry)
+        return PTR_ERR_NOMEM;
+    *entry = (float)value;
     return PTR_OK;
 }
 
@@ -204,6 +257,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i)
         const float *rgb = &b->colors[3 * i];
         res = ptr_scene_set_sphere_color(scene, added, v3(rgb[0], rgb[1], rgb[2]));
     }
+    if (res == PTR_OK && b->values)
+        res = ptr_scene_set_sphere_value(scene, added, b->values[i]);
     return res;
 }
 

@@ -24,6 +24,7 @@ typedef struct PtrSceneBuilder {
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
     float *colors;    /* r, g, b of each sphere; NULL while none has its own */
+    float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
     size_t count, capacity;
     int has_camera;
     double eye[3], target[3], up[3];
@@ -40,6 +41,9 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 
 /* Gives the sphere added last its own colour (see PtrSpheres.color). */
 PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
+
+/* Gives the sphere added last its value (see PtrSpheres.value). */
+PtrResult ptr_builder_set_value(PtrSceneBuilder *builder, double value);
 
 /* lens gives everything but the position and orientation. Ignored when the
  * builder has an override. */

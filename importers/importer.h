@@ -29,6 +29,10 @@ typedef struct PtrImportOptions {
     const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
     const PtrCameraSpec *camera; /* if set, the camera, whatever the file says */
     int fit_all_objects;     /* OBJ: fit every object, not only those named *sphere* */
+    /* glTF: read each sphere's value of this instance or point attribute
+     * (--color-by) into PtrSpheres.value; NULL: none. A scene where no
+     * sphere has it is refused. */
+    const char *value_attribute;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

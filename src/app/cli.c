@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include "app/cli_options.h"
+#include "app/color_by.h"
 #include "app/job.h"
 #include "app/merge.h"
 #include "app/report.h"
@@ -79,6 +80,9 @@ static int dump_scenes(const PtrOptions *o)
         if (res == PTR_OK) {
             if (o->has_sky)
                 scene.sky = o->sky;
+            res = ptr_color_by_apply(o, o->inputs[i], &scene, NULL, &err);
+        }
+        if (res == PTR_OK) {
             res = ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings);
             if (res != PTR_OK)
                 ptr_error_set(&err, res, "%s: %s", o->inputs[i], ptr_result_description(res));

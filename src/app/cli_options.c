@@ -255,6 +255,26 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
         o->camera.focus_distance = x;
         break;
     case OPT_fit_all_objects: o->fit_all_objects = 1; break;
+    case OPT_color_by:
+        if (!*value)
+            return bad_value(id, value, "an attribute name");
+        o->color_by = value;
+        break;
+    case OPT_colormap:
+        o->colormap = ptr_colormap_find(value);
+        if (!o->colormap)
+            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm");
+        break;
+    case OPT_color_range: {
+        char tail;
+        double *r = o->color_range;
+        if (sscanf(value, "%lf,%lf%c", &r[0], &r[1], &tail) != 2 || !isfinite(r[0]) ||
+            !isfinite(r[1]) || !(r[0] < r[1]))
+            return bad_value(id, value, "MIN,MAX (finite numbers, MIN below MAX)");
+        o->has_color_range = 1;
+        break;
+    }
+    case OPT_color_bar: o->color_bar = value; break;
     case OPT_accel:
         if (!ptr_accel_parse(value, &o->accel))
             return bad_value(id, value, "auto, brute or bvh");
@@ -343,6 +363,8 @@ static const char *usage_problem(const PtrOptions *o)
     /* Parallel rays have no lens: rather than ignore a lens asked for, say so. */
     if ((o->has_camera & CAMERA_ORTHO) && o->camera.aperture > 0)
         return "--ortho has no depth of field: leave out --aperture";
+    if (!o->color_by && (o->colormap || o->has_color_range || o->color_bar))
+        return "--colormap, --color-range and --color-bar need --color-by";
     if (o->input_count == 0)
         return o->merge ? "no parts given" : "no scene file given";
     if (!o->output && !o->dump_scene)
@@ -392,6 +414,7 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .camera_name = o->camera_name,
         .camera = o->has_camera ? &o->camera : NULL,
         .fit_all_objects = o->fit_all_objects,
+        .value_attribute = o->color_by,
         .dependencies = dependencies,
     };
 }

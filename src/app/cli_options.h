@@ -9,6 +9,7 @@
 #include "app/output.h"
 #include "importer.h"
 #include "render/render.h"
+#include "scene/colormap.h"
 #include "scene/scene.h"
 
 /* Defaults, as macros: the --help text spells them out. */
@@ -28,6 +29,11 @@ typedef struct PtrOptions {
     PtrCameraSpec camera;   /* --lookfrom ... */
     int has_camera;
     int fit_all_objects;
+    const char *color_by;   /* --color-by: the attribute; NULL: none */
+    const PtrColormap *colormap;
+    int has_color_range;
+    double color_range[2];  /* --color-range MIN,MAX */
+    const char *color_bar;  /* --color-bar FILE */
     uint32_t samples;
     uint32_t sample_first;  /* --sample-range START:END sets both */
     uint64_t seed;

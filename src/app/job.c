@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/color_by.h"
 #include "app/output.h"
 #include "app/signals.h"
 #include "base/cpu.h"
@@ -168,6 +169,9 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
     if (res == PTR_OK) {
         if (o->has_sky)
             scene.sky = o->sky;
+        res = ptr_color_by_apply(o, scene_path, &scene, color, &err);
+    }
+    if (res == PTR_OK) {
         res = render_and_write(o, &scene, color, report, &err);
     }
     ptr_scene_free(&scene);
