@@ -117,7 +117,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
     /* Every output is settled before anything renders. */
     for (int i = 0; i < o->input_count; i++) {
         if (output_for(o, o->inputs[i], outputs[i], &err) == PTR_OK)
-            ptr_output_check(outputs[i], o->depth, &err);
+            ptr_output_check(outputs[i], o->depth, o->transparent, &err);
         for (int j = 0; err.code == PTR_OK && j < i; j++)
             if (!strcmp(outputs[i], outputs[j]))
                 ptr_error_set(&err, PTR_ERR_USAGE, "%s and %s would both be written to %s",
@@ -155,7 +155,7 @@ static int watch_scene(const PtrOptions *o, const PtrColor *color)
     char output[PATH_SIZE];
     PtrError err = { 0 };
     if (output_for(o, o->inputs[0], output, &err) != PTR_OK ||
-        ptr_output_check(output, o->depth, &err) != PTR_OK)
+        ptr_output_check(output, o->depth, o->transparent, &err) != PTR_OK)
         return fail(&err);
     PtrWatch watch = { 0 };
     int code = 0;

@@ -194,6 +194,7 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
         break;
     case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width);
     case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height);
+    case OPT_transparent: o->transparent = 1; break;
     case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))

@@ -32,6 +32,7 @@ typedef struct PtrOptions {
     uint32_t sample_first;  /* --sample-range START:END sets both */
     uint64_t seed;
     int width, height;      /* 0: from the scene */
+    int transparent;        /* alpha 0 where camera rays meet no sphere */
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;
