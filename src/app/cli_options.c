@@ -176,6 +176,21 @@ static int set_region(OptionId id, const char *value, PtrOptions *o)
     return GO_ON;
 }
 
+static int set_frames(OptionId id, const char *value, PtrOptions *o)
+{
+    long a, b, step = 1;
+    char tail;
+    int n = sscanf(value, "%ld:%ld:%ld%c", &a, &b, &step, &tail);
+    if ((n != 2 && n != 3) || value[0] < '0' || value[0] > '9' || a < 0 || b < a ||
+        b > 1000000000L || step < 1)
+        return bad_value(id, value, "A:B or A:B:STEP with 0 <= A <= B <= 10^9, STEP >= 1");
+    o->has_frames = 1;
+    o->frame_first = a;
+    o->frame_last = b;
+    o->frame_step = step;
+    return GO_ON;
+}
+
 /* Takes one option (and its value, if it has one) into o. Returns GO_ON,
  * else the exit code: 0 after printing what replaces the render, a usage
  * error after reporting it. The cases follow the table; the switch has no
@@ -255,6 +270,12 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
             return bad_value(id, value, "a distance above 0");
         o->camera.focus_distance = x;
         break;
+    case OPT_auto_camera:
+        if (strcmp(value, "perspective") && strcmp(value, "orthographic"))
+            return bad_value(id, value, "perspective or orthographic");
+        o->auto_camera = strcmp(value, "perspective") ? PTR_PROJECTION_ORTHOGRAPHIC
+                                                      : PTR_PROJECTION_PERSPECTIVE;
+        break;
     case OPT_fit_all_objects: o->fit_all_objects = 1; break;
     case OPT_accel:
         if (!ptr_accel_parse(value, &o->accel))
@@ -299,6 +320,9 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_sample_range: return set_sample_range(id, value, o);
     case OPT_region: return set_region(id, value, o);
     case OPT_watch: o->watch = 1; break;
+    case OPT_frames: return set_frames(id, value, o);
+    case OPT_turntable: return set_int(id, value, 1, 1000000, &o->turntable);
+    case OPT_skip_existing: o->skip_existing = 1; break;
     case OPT_json: o->json = 1; break;
     case OPT_quiet: o->quiet = 1; break;
     case OPT_dump_scene: o->dump_scene = 1; break;
@@ -350,6 +374,10 @@ static const char *usage_problem(const PtrOptions *o)
         return "no output given (-o)";
     if (o->watch && o->input_count > 1)
         return "--watch takes one scene";
+    if (o->watch && (o->turntable || o->has_frames || o->skip_existing ||
+                     strchr(o->inputs[0], '#')))
+        return "--watch takes one scene, not a sequence (# patterns, --frames, --turntable, "
+               "--skip-existing)";
     if (o->merge && o->dump_scene)
         return "--dump-scene is not for merge";
     /* Stopping decisions need every sample of a pixel from the first on; a
@@ -393,6 +421,9 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .camera_name = o->camera_name,
         .camera = o->has_camera ? &o->camera : NULL,
         .fit_all_objects = o->fit_all_objects,
+        .auto_projection = o->auto_camera,
+        .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
+        .orbit_degrees = o->orbit_degrees,
         .dependencies = dependencies,
     };
 }

@@ -27,6 +27,7 @@ typedef struct PtrOptions {
     const char *camera_name;
     PtrCameraSpec camera;   /* --lookfrom ... */
     int has_camera;
+    PtrProjection auto_camera; /* the projection of a scene without a camera */
     int fit_all_objects;
     uint32_t samples;
     uint32_t sample_first;  /* --sample-range START:END sets both */
@@ -53,6 +54,11 @@ typedef struct PtrOptions {
     double time_budget;     /* seconds; 0: none */
     int preview;
     int watch;
+    int has_frames;         /* --frames A:B:STEP */
+    long frame_first, frame_last, frame_step;
+    int turntable;          /* frames in a full turn; 0: none */
+    int skip_existing;
+    double orbit_degrees;   /* the camera's turn in the frame being rendered */
     int json;
     int quiet;
     int dump_scene;

@@ -113,12 +113,20 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
             .dither = o->dither,
         };
-        res = ptr_output_write(report->output, &layout, rgb, &info, err);
+        /* A frame of a sequence that --skip-existing resumes is written
+         * whole or not at all: an output that exists is never rendered again. */
+        if (!(done.stopped && o->skip_existing))
+            res = ptr_output_write(report->output, &layout, rgb, &info, err);
     }
     free(rgb);
     free(counts);
     free(alpha);
-    if (res == PTR_OK && done.stopped)
+    if (res == PTR_OK && done.stopped && o->skip_existing)
+        res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
+                            "%s: interrupted after %u of %u samples; not written, so that "
+                            "--skip-existing renders it again", report->output,
+                            done.samples_done, report->samples_requested);
+    else if (res == PTR_OK && done.stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted; wrote the %u samples done of %u",
                             report->output, done.samples_done, report->samples_requested);
