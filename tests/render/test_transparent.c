@@ -212,6 +212,40 @@ static void test_adaptive(void)
     ptr_scene_free(&scene);
 }
 
+/* The automatic camera, seen in the alpha of a camera-less scene at 160x90:
+ * its spheres span 18 units across and 7 up, so the width binds and they
+ * cover 95% of it, 152 columns, centred (4 empty on each side); a pixel
+ * the silhouette crosses counts, so the span may reach a column further on
+ * each side. The height holds them with rows to spare. */
+static void test_framing(const char *projection)
+{
+    const char *out = test_path("framed.exr");
+    CHECK_INT(test_ptr(PTR_SOURCE_DIR "/tests/fixtures/no_camera.gltf", "-o", out, "--width",
+                       "160", "--height", "90", "--samples", "16", "--transparent",
+                       "--auto-camera", projection, "--quiet", NULL),
+              0);
+    PtrError err;
+    PtrImage *image = ptr_image_read(out, &err);
+    const float *alpha = image ? ptr_image_alpha(image) : NULL;
+    CHECK(alpha != NULL);
+    if (!alpha)
+        return;
+    int left = 160, right = -1, top = 90, bottom = -1;
+    for (int y = 0; y < 90; y++)
+        for (int x = 0; x < 160; x++)
+            if (alpha[y * 160 + x] > 0.0f) {
+                left = x < left ? x : left;
+                right = x > right ? x : right;
+                top = y < top ? y : top;
+                bottom = y > bottom ? y : bottom;
+            }
+    printf("%s framing: columns %d to %d, rows %d to %d\n", projection, left, right, top, bottom);
+    CHECK(right - left + 1 >= 152 && right - left + 1 <= 154);
+    CHECK(left >= 3 && left <= 4 && right >= 155 && right <= 156);
+    CHECK(top > 0 && bottom < 89);
+    ptr_image_free(image);
+}
+
 int main(void)
 {
     if (!test_dir_create("transparent"))
@@ -220,6 +254,8 @@ int main(void)
     test_regions_merge();
     test_png();
     test_adaptive();
+    test_framing("perspective");
+    test_framing("orthographic");
     test_same_bytes(); /* last: it caps the CPU level */
     test_dir_remove();
     return test_report();
