@@ -8,16 +8,6 @@ ptr=$1
 src=$2
 . "$src/tests/support/shell_test.sh"
 
-# Waits (up to 60 s) until the command in $1 succeeds.
-wait_until() {
-    i=0
-    while ! eval "$1"; do
-        i=$((i + 1))
-        [ $i -gt 600 ] && return 1
-        sleep 0.1
-    done
-}
-
 samples_of() { iinfo -v "$1" 2>/dev/null | sed -n 's/.*ptr:samples: //p'; }
 # Inode and modification time to the nanosecond: a file left alone keeps both.
 identity() { stat -c '%i %y' "$1"; }
