@@ -112,6 +112,12 @@ static PtrResult find_frames(const char *pattern, long **frames, int *count, Ptr
                              "%s: no file matches (# stands for one digit of the frame number)",
                              pattern);
     }
+    if (found.gl_pathc > PTR_MAX_FRAMES) {
+        ptr_error_set(err, PTR_ERR_USAGE, "%s: %zu frames; at most %d", pattern,
+                      (size_t)found.gl_pathc, PTR_MAX_FRAMES);
+        globfree(&found);
+        return PTR_ERR_USAGE;
+    }
     *frames = malloc(found.gl_pathc * sizeof **frames);
     if (!*frames) {
         globfree(&found);
@@ -129,12 +135,27 @@ static PtrResult find_frames(const char *pattern, long **frames, int *count, Ptr
 static PtrResult listed_frames(const PtrOptions *o, long **frames, int *count, PtrError *err)
 {
     long n = (o->frame_last - o->frame_first) / o->frame_step + 1;
+    if (n > PTR_MAX_FRAMES)
+        return ptr_error_set(err, PTR_ERR_USAGE, "--frames: %ld frames; at most %d", n,
+                             PTR_MAX_FRAMES);
     *frames = malloc((size_t)n * sizeof **frames);
     if (!*frames)
         return ptr_error_set(err, PTR_ERR_NOMEM, "--frames: out of memory");
     for (long i = 0; i < n; i++)
         (*frames)[i] = o->frame_first + i * o->frame_step;
     *count = (int)n;
+    return PTR_OK;
+}
+
+/* Gives item copies of its scene and output: PTR_ERR_NOMEM if memory runs
+ * out. */
+static PtrResult set_item(PtrBatchItem *item, const char *scene, const char *output,
+                          PtrError *err)
+{
+    item->scene = strdup(scene);
+    item->output = strdup(output);
+    if (!item->scene || !item->output)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", scene);
     return PTR_OK;
 }
 
@@ -157,30 +178,29 @@ static PtrResult plan_frames(const PtrOptions *o, PtrBatchItem **items, int *cou
         free(frames);
         return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %d frames", n);
     }
+    *count = n;
+    char frame_scene[PTR_PATH_SIZE], output[PTR_PATH_SIZE];
     for (int i = 0; res == PTR_OK && i < n; i++) {
         long frame = frames ? frames[i] : i;
-        PtrBatchItem *item = &(*items)[i];
         if (o->turntable && frame >= o->turntable) {
             res = ptr_error_set(err, PTR_ERR_USAGE,
                                 "--frames: frame %ld is beyond --turntable %d (frames 0 to %d)",
                                 frame, o->turntable, o->turntable - 1);
             break;
         }
-        res = o->turntable ? (snprintf(item->scene, PTR_PATH_SIZE, "%s", scene) < PTR_PATH_SIZE
-                                  ? PTR_OK
-                                  : ptr_error_set(err, PTR_ERR_USAGE, "%s: the path is too long",
-                                                  scene))
-                           : substitute(scene, frame, item->scene, err);
+        if (!o->turntable)
+            res = substitute(scene, frame, frame_scene, err);
+        const char *this_scene = o->turntable ? scene : frame_scene;
         if (res == PTR_OK)
-            res = ptr_batch_is_pattern(o->output) ? substitute(o->output, frame, item->output, err)
-                                                  : ptr_batch_output(o, item->scene, item->output,
-                                                                     err);
+            res = ptr_batch_is_pattern(o->output) ? substitute(o->output, frame, output, err)
+                                                  : ptr_batch_output(o, this_scene, output, err);
+        if (res == PTR_OK)
+            res = set_item(&(*items)[i], this_scene, output, err);
         /* Frame k of N turns the camera k/N of a full turn: frame 0 is the
          * scene's own view. */
-        item->orbit_degrees = o->turntable ? 360.0 * (double)frame / o->turntable : 0.0;
+        (*items)[i].orbit_degrees = o->turntable ? 360.0 * (double)frame / o->turntable : 0.0;
     }
     free(frames);
-    *count = n;
     return res;
 }
 
@@ -215,9 +235,11 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
         if (!*items)
             return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory");
         *count = o->input_count;
+        char output[PTR_PATH_SIZE];
         for (int i = 0; res == PTR_OK && i < o->input_count; i++) {
-            snprintf((*items)[i].scene, PTR_PATH_SIZE, "%s", o->inputs[i]);
-            res = ptr_batch_output(o, o->inputs[i], (*items)[i].output, err);
+            res = ptr_batch_output(o, o->inputs[i], output, err);
+            if (res == PTR_OK)
+                res = set_item(&(*items)[i], o->inputs[i], output, err);
         }
     }
     /* Every output is settled before anything renders. Outputs numbered by
@@ -231,9 +253,18 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
                                     (*items)[j].scene, (*items)[i].scene, (*items)[i].output);
     }
     if (res != PTR_OK) {
-        free(*items);
+        ptr_batch_free(*items, *count);
         *items = NULL;
         *count = 0;
     }
     return res;
+}
+
+void ptr_batch_free(PtrBatchItem *items, int count)
+{
+    for (int i = 0; items && i < count; i++) {
+        free(items[i].scene);
+        free(items[i].output);
+    }
+    free(items);
 }

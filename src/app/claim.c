@@ -169,6 +169,8 @@ static void *keep_claims(void *unused)
 
 int ptr_claim_keeper_start(void)
 {
+    if (held.running)
+        return 1;
     /* The keeper takes no signals: the render's stop stays the main thread's. */
     sigset_t all, old;
     sigfillset(&all);

@@ -95,7 +95,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         return fail(&err);
     PtrJobReport *reports = calloc((size_t)count, sizeof *reports);
     if (!reports) {
-        free(items);
+        ptr_batch_free(items, count);
         ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
         return fail(&err);
     }
@@ -125,7 +125,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
     for (int i = 0; i < done; i++)
         ptr_job_report_free(&reports[i]);
     free(reports);
-    free(items);
+    ptr_batch_free(items, count);
     return code;
 }
 

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/batch.h"
 #include "app/cli_help.h"
 #include "base/cpu.h"
 
@@ -321,7 +322,7 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_region: return set_region(id, value, o);
     case OPT_watch: o->watch = 1; break;
     case OPT_frames: return set_frames(id, value, o);
-    case OPT_turntable: return set_int(id, value, 1, 1000000, &o->turntable);
+    case OPT_turntable: return set_int(id, value, 1, PTR_MAX_FRAMES, &o->turntable);
     case OPT_skip_existing: o->skip_existing = 1; break;
     case OPT_json: o->json = 1; break;
     case OPT_quiet: o->quiet = 1; break;
