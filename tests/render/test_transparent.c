@@ -124,7 +124,7 @@ static void test_regions_merge(void)
     if (whole && merged)
         CHECK(same_pixels(whole, merged));
     /* A transparent part and an opaque one are not parts of one render. */
-    render("opaque_bottom.exr", "--region", "0,20,48,48", NULL);
+    ptr_image_free(render("opaque_bottom.exr", "--region", "0,20,48,48", NULL));
     CHECK_INT(test_ptr("merge", test_path("top.exr"), test_path("opaque_bottom.exr"), "-o",
                        test_path("mixed.exr"), "--quiet", NULL),
               2);
@@ -228,8 +228,10 @@ static void test_framing(const char *projection)
     PtrImage *image = ptr_image_read(out, &err);
     const float *alpha = image ? ptr_image_alpha(image) : NULL;
     CHECK(alpha != NULL);
-    if (!alpha)
+    if (!alpha) {
+        ptr_image_free(image);
         return;
+    }
     int left = 160, right = -1, top = 90, bottom = -1;
     for (int y = 0; y < 90; y++)
         for (int x = 0; x < 160; x++)
