@@ -201,14 +201,16 @@ static void frame_spheres(PtrSceneBuilder *b)
         eye[1] = centre[1];
         eye[2] = hi[2] + half_height;
     } else {
-        const double vfov_deg = 40.0;
-        double tan_v = tan(0.5 * vfov_deg * DEG_TO_RAD);
-        double z_v, z_h;
-        fit_axis(b, 1, atan(FRAME_FILL * tan_v), &eye[1], &z_v);
-        fit_axis(b, 0, atan(FRAME_FILL * tan_v * aspect), &eye[0], &z_h);
-        eye[2] = b->count ? fmax(z_v, z_h) : centre[2] + 1.0 / sin(0.5 * vfov_deg * DEG_TO_RAD);
-        if (!b->count)
+        const double vfov_deg = 40.0, tan_v = tan(0.5 * vfov_deg * DEG_TO_RAD);
+        if (b->count) {
+            double z_v, z_h;
+            fit_axis(b, 1, atan(FRAME_FILL * tan_v), &eye[1], &z_v);
+            fit_axis(b, 0, atan(FRAME_FILL * tan_v * aspect), &eye[0], &z_h);
+            eye[2] = fmax(z_v, z_h);
+        } else { /* nothing to frame: the unit sphere at the origin */
             eye[0] = eye[1] = 0;
+            eye[2] = 1.0 / sin(0.5 * vfov_deg * DEG_TO_RAD);
+        }
         lens.vfov_deg = (float)vfov_deg;
         lens.focus_distance = (float)(eye[2] - centre[2]);
     }

@@ -180,9 +180,12 @@ static int set_region(OptionId id, const char *value, PtrOptions *o)
 static int set_frames(OptionId id, const char *value, PtrOptions *o)
 {
     long a, b, step = 1;
-    char tail;
-    int n = sscanf(value, "%ld:%ld:%ld%c", &a, &b, &step, &tail);
-    if ((n != 2 && n != 3) || value[0] < '0' || value[0] > '9' || a < 0 || b < a ||
+    int end = 0, with_step = 0;
+    /* %n after each form: the whole text must be A:B or A:B:STEP. */
+    int n = sscanf(value, "%ld:%ld%n:%ld%n", &a, &b, &end, &step, &with_step);
+    if (n == 3)
+        end = with_step;
+    if (n < 2 || value[end] || value[0] < '0' || value[0] > '9' || a < 0 || b < a ||
         b > 1000000000L || step < 1)
         return bad_value(id, value, "A:B or A:B:STEP with 0 <= A <= B <= 10^9, STEP >= 1");
     o->has_frames = 1;

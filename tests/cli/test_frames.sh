@@ -106,10 +106,15 @@ idiff -q -a -fail 0 -failpercent 0 "$dir/plain.exr" "$dir/turn_000.exr" >/dev/nu
 idiff -q -a "$dir/plain.exr" "$dir/turn_002.exr" >/dev/null 2>&1 &&
     fail "turntable frame 2 looks from the other side"
 
-# Usage: a turntable needs # in -o; a pattern must find files.
+# Usage: a turntable needs # in -o; a pattern must find files; --frames is
+# A:B or A:B:STEP and nothing more.
 "$ptr" "$src/scenes/seed.gltf" -o "$dir/x.png" --turntable 4 2>/dev/null
 [ $? -eq 2 ] || fail "--turntable without # in -o is a usage error"
 "$ptr" "$dir/in/none_####.gltf" -o "$dir/y_####.png" 2>/dev/null
 [ $? -eq 3 ] || fail "a pattern that finds no file cannot be read"
+for range in 1:10: 5:3 1:10:0 x; do
+    "$ptr" "$dir/in/f_####.gltf" -o "$dir/z_####.png" --frames "$range" 2>/dev/null
+    [ $? -eq 2 ] || fail "--frames $range is a usage error"
+done
 
 finish "sequences: resumed after an interruption, shared by two processes, claims, --frames, --turntable"
