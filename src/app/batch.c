@@ -43,15 +43,21 @@ static PtrResult substitute(const char *pattern, long frame, char *out, PtrError
     return PTR_OK;
 }
 
+/* Whether -o names a folder: one that exists, or written with a trailing /. */
+static int is_folder(const char *output)
+{
+    struct stat st;
+    size_t len = strlen(output);
+    return (len > 0 && output[len - 1] == '/') || (stat(output, &st) == 0 && S_ISDIR(st.st_mode));
+}
+
 PtrResult ptr_batch_output(const PtrOptions *o, const char *scene, char *out, PtrError *err)
 {
     const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
     const char *dot = strrchr(base, '.');
     int name_len = (int)(dot && dot != base ? (size_t)(dot - base) : strlen(base));
-    struct stat st;
     size_t len = strlen(o->output);
-    int folder = (len > 0 && o->output[len - 1] == '/') ||
-                 (stat(o->output, &st) == 0 && S_ISDIR(st.st_mode));
+    int folder = is_folder(o->output);
     int n;
     if (strstr(o->output, "{name}")) {
         const char *at = o->output, *hit;
@@ -214,6 +220,10 @@ static const char *sequence_problem(const PtrOptions *o)
         return "--turntable turns one scene: give a scene, not a pattern with #";
     if (o->turntable && !ptr_batch_is_pattern(o->output))
         return "--turntable needs # in -o for the frame number, e.g. -o out/turn_####.png";
+    if (pattern && !ptr_batch_is_pattern(o->output) && !strstr(o->output, "{name}") &&
+        !is_folder(o->output))
+        return "a sequence needs # (the frame number), {name} or a folder in -o, "
+               "e.g. -o out/f_####.png";
     if (o->has_frames && !pattern && !o->turntable)
         return "--frames needs a scene pattern with # or --turntable";
     return NULL;
@@ -242,12 +252,12 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
                 res = set_item(&(*items)[i], o->inputs[i], output, err);
         }
     }
-    /* Every output is settled before anything renders. Outputs numbered by
-     * a pattern differ; any others may not. */
-    int numbered = sequence && ptr_batch_is_pattern(o->output);
+    /* Every output is settled before anything renders. A sequence's differ
+     * (by their numbers, or the names of its numbered scenes); a list of
+     * scenes' may not. */
     for (int i = 0; res == PTR_OK && i < *count; i++) {
         res = ptr_output_check((*items)[i].output, o->depth, o->transparent, err);
-        for (int j = 0; res == PTR_OK && !numbered && j < i; j++)
+        for (int j = 0; res == PTR_OK && !sequence && j < i; j++)
             if (!strcmp((*items)[i].output, (*items)[j].output))
                 res = ptr_error_set(err, PTR_ERR_USAGE, "%s and %s would both be written to %s",
                                     (*items)[j].scene, (*items)[i].scene, (*items)[i].output);

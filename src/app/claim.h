@@ -9,7 +9,8 @@
  * written, so that the next run renders it whole).
  *
  * A claim is stale, and taken over, when the process that made it is gone:
- * on the same host, when no process has its PID; from another host, when
+ * on the same host, when no process has its PID; from another host (or a
+ * claim that names none, its maker having died before writing it), when
  * its file has not been touched for PTR_CLAIM_STALE_SECONDS (a live holder
  * touches it every PTR_CLAIM_REFRESH_SECONDS). Two processes taking over one
  * stale claim at the same instant may both render that frame: the images

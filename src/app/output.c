@@ -77,7 +77,8 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError
     int known = format != NULL;
     if (alpha && !(format && format->alpha))
         return ptr_error_set(err, PTR_ERR_USAGE,
-                             "%s: --transparent needs a format with alpha: .exr, .png or .tif",
+                             "%s: a transparent image (--transparent) needs a format with "
+                             "alpha: .exr, .png or .tif",
                              path);
     if (!known && ptr_image_ready(err) != PTR_OK)
         return err->code;

@@ -112,6 +112,8 @@ idiff -q -a "$dir/plain.exr" "$dir/turn_002.exr" >/dev/null 2>&1 &&
 [ $? -eq 2 ] || fail "--turntable without # in -o is a usage error"
 "$ptr" "$dir/in/none_####.gltf" -o "$dir/y_####.png" 2>/dev/null
 [ $? -eq 3 ] || fail "a pattern that finds no file cannot be read"
+"$ptr" "$dir/in/f_####.gltf" -o "$dir/one.png" 2>/dev/null
+[ $? -eq 2 ] || fail "a sequence into one file name is a usage error"
 for range in 1:10: 5:3 1:10:0 x; do
     "$ptr" "$dir/in/f_####.gltf" -o "$dir/z_####.png" --frames "$range" 2>/dev/null
     [ $? -eq 2 ] || fail "--frames $range is a usage error"
