@@ -33,6 +33,14 @@ typedef struct PtrImportOptions {
      * (--color-by) into PtrSpheres.value; NULL: none. A scene where no
      * sphere has it is refused. */
     const char *value_attribute;
+    /* The automatic camera of a scene that has none: its projection, and the
+     * width / height of the image it frames the spheres in (0: the scene's
+     * resolution, else 16:9). */
+    PtrProjection auto_projection;
+    double auto_aspect;
+    /* Degrees the camera, whichever it is, turns about the vertical axis
+     * (+Y) through the spheres' centre: a frame of a turntable. */
+    double orbit_degrees;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

@@ -701,7 +701,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .default_material = UINT32_MAX,
         .value_name = options ? options->value_attribute : NULL,
     };
-    ptr_builder_init(&im.builder, scene, options ? options->camera : NULL);
+    ptr_builder_init(&im.builder, scene, options);
     size_t materials = gltf_doc_material_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     PtrResult res = PTR_OK;

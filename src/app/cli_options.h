@@ -28,6 +28,7 @@ typedef struct PtrOptions {
     const char *camera_name;
     PtrCameraSpec camera;   /* --lookfrom ... */
     int has_camera;
+    PtrProjection auto_camera; /* the projection of a scene without a camera */
     int fit_all_objects;
     const char *color_by;   /* --color-by: the attribute; NULL: none */
     const PtrColormap *colormap;
@@ -38,6 +39,7 @@ typedef struct PtrOptions {
     uint32_t sample_first;  /* --sample-range START:END sets both */
     uint64_t seed;
     int width, height;      /* 0: from the scene */
+    int transparent;        /* alpha 0 where camera rays meet no sphere */
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;
@@ -58,6 +60,11 @@ typedef struct PtrOptions {
     double time_budget;     /* seconds; 0: none */
     int preview;
     int watch;
+    int has_frames;         /* --frames A:B:STEP */
+    long frame_first, frame_last, frame_step;
+    int turntable;          /* frames in a full turn; 0: none */
+    int skip_existing;
+    double orbit_degrees;   /* the camera's turn in the frame being rendered */
     int json;
     int quiet;
     int dump_scene;

@@ -15,7 +15,7 @@ enum { BAR_WIDTH = 512, BAR_HEIGHT = 32 }; /* two columns an entry of 256 */
 static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const char *scene_path,
                            const PtrColor *color, PtrError *err)
 {
-    if (ptr_output_check(o->color_bar, PTR_DEPTH_DEFAULT, err) != PTR_OK)
+    if (ptr_output_check(o->color_bar, PTR_DEPTH_DEFAULT, 0, err) != PTR_OK)
         return err->code;
     float *rgb = malloc((size_t)BAR_WIDTH * BAR_HEIGHT * 3 * sizeof *rgb);
     if (!rgb)

@@ -384,9 +384,10 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
 }
 
 /* The next ray of every path that goes on; the result of every path that
- * ends, which frees its lane. */
+ * ends, which frees its lane: its radiance, and whether its camera ray hit
+ * a sphere (a path past its first ray did). */
 STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
-                            PtrVec3 *results)
+                            PtrVec3 *results, unsigned char *covered)
 {
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
@@ -418,6 +419,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
             continue;
         if (!go_on[l]) {
             results[lanes->slot[l]] = lane_v3(lanes->radiance, l);
+            covered[lanes->slot[l]] = lanes->depth[l] > 0 || v->hit[l];
             lanes->slot[l] = FREE;
             continue;
         }
@@ -429,7 +431,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
 }
 
 static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *results,
-                         uint64_t *rays)
+                         unsigned char *covered, uint64_t *rays)
 {
     Lanes lanes;
     Vertex vertex;
@@ -459,7 +461,7 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
         if (job->sample_lights)
             sample_emitters(job, &lanes, &vertex, rays);
         scatter(job, &lanes, &vertex);
-        continue_or_end(job, &lanes, &vertex, results);
+        continue_or_end(job, &lanes, &vertex, results, covered);
     }
 }
 
@@ -468,6 +470,7 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
     const PtrRenderSettings *s = job->settings;
     Round round;
     PtrVec3 results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    unsigned char covered[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
     uint64_t end = (uint64_t)job->first + job->count;
     /* Rounds end where adaptive sampling may stop a pixel, so a round's
      * samples are all ones the path tracer would take too. */
@@ -489,14 +492,17 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
             }
         round.items = (uint32_t)round.pixels * round.span;
         if (s->max_depth > 0)
-            render_round(job, &round, results, rays);
+            render_round(job, &round, results, covered, rays);
         else
-            for (uint32_t i = 0; i < round.items; i++)
+            for (uint32_t i = 0; i < round.items; i++) {
                 results[i] = v3_splat(0.0f);
+                covered[i] = 0;
+            }
         for (int p = 0; p < round.pixels; p++)
             for (uint32_t i = 0; i < round.span; i++)
                 ptr_path_accumulate(s, round.sums[p], round.first + i,
-                                    results[(uint32_t)p * round.span + i]);
+                                    results[(uint32_t)p * round.span + i],
+                                    covered[(uint32_t)p * round.span + i]);
         a = b;
     }
 }
