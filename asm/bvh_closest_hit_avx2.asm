@@ -11,6 +11,7 @@
 %include "ptr.inc"
 %include "layout.inc"
 %include "sphere_math.inc"
+%include "bvh.inc"
 
 section .rodata
 align 32
@@ -25,10 +26,9 @@ section .text
 ; The frame, at rbp aligned to 32: the ray's origin and clamped
 ; reciprocal direction broadcast to 8 lanes, the children's entry distances,
 ; best * PTR_BVH_SLACK broadcast, then the traversal stack of 16-byte
-; entries (child, leaf count, entry distance, unused); also the hit pointer,
-; the rsp to return with and the count of the spheres kept out of the tree,
-; which are tested last: the tree's first node test need not wait on their
-; square roots.
+; entries (child, leaf count, entry distance, unused); also the count of the
+; spheres kept out of the tree, which are tested last (the tree's first node
+; test need not wait on their square roots), and the rsp to return with.
 ORG_X   equ 0
 ORG_Y   equ 32
 ORG_Z   equ 64
@@ -37,11 +37,9 @@ INV_Y   equ 128
 INV_Z   equ 160
 ENTRY   equ 192
 BEST_UP equ 224
-HIT_PTR equ 256
-SAVED_RSP equ 264
-KEPT_OUT equ 272
+KEPT_OUT equ 256
 STACK   equ 288
-FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32
+FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32    ; the rsp in the last 8
 
 ; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
 ; every lane whose t beats the best, (t, id) lexicographically; the smallest
@@ -98,33 +96,15 @@ test_leaf:
 ;                              const PtrSpheres *spheres, PtrHit *hit);
 ;
 ; rdi ray, rsi bvh (then the node being tested), rdx spheres (then scratch),
-; rcx hit (kept in the frame; then scratch)
+; rcx hit (pushed; then scratch)
 ; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 stack top
 ; r15d best sphere (PTR_NO_HIT)   rbx where the nearest child was pushed
 ; rbp the frame
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm5 best id   ymm6 lane
 ; indices   ymm7 sign mask   ymm8-15 scratch
 FUNCTION ptr_bvh_closest_hit_avx2
-    push        rbx
-    push        rbp
-    push        r12
-    push        r13
-    push        r14
-    push        r15
-    mov         rax, rsp
-    sub         rsp, FRAME
-    and         rsp, -32
-    mov         rbp, rsp
-    mov         [rbp + SAVED_RSP], rax
-    mov         [rbp + HIT_PTR], rcx
-    mov         r8,  [rdx + SPHERES_CX]
-    mov         r9,  [rdx + SPHERES_CY]
-    mov         r10, [rdx + SPHERES_CZ]
-    mov         r11, [rdx + SPHERES_RADIUS]
-    mov         r12, [rdx + SPHERES_ID]
-    mov         r13, [rsi + BVH_NODES]
-    mov         rax, [rsi + BVH_UNBOUNDED_COUNT]
-    mov         [rbp + KEPT_OUT], rax
+    TREE_ENTRY  FRAME, 32
+    mov         [rbp + KEPT_OUT], rbx
     vbroadcastss ymm0, [rdi + RAY_DIR_X]
     vbroadcastss ymm1, [rdi + RAY_DIR_Y]
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
@@ -255,34 +235,9 @@ FUNCTION ptr_bvh_closest_hit_avx2
     ; The spheres kept out of the tree, eight at a time, once the tree has
     ; found its best: the tree's first node test need not wait for them.
 .kept_out:
-    xor         eax, eax
-.unbounded:
-    mov         rcx, [rbp + KEPT_OUT]
-    sub         rcx, rax
-    jbe         .finish
-    cmp         rcx, 8
-    jbe         .last
-    mov         ecx, 8
-.last:
-    call        test_leaf
-    add         rax, 8
-    jmp         .unbounded
-
+    TEST_KEPT_OUT [rbp + KEPT_OUT]
 .finish:
-    mov         rcx, [rbp + HIT_PTR]
-    vmovss      [rcx + HIT_T], xmm4
-    mov         [rcx + HIT_SPHERE], r15d
-    xor         eax, eax
-    cmp         r15d, -1
-    setne       al
-    mov         rsp, [rbp + SAVED_RSP]
-    pop         r15
-    pop         r14
-    pop         r13
-    pop         r12
-    pop         rbp
-    pop         rbx
-    vzeroupper
-    ret
+    TREE_LEAVE_FRAME FRAME
+    TREE_RETURN_HIT
 
 section .note.GNU-stack noalloc noexec nowrite progbits

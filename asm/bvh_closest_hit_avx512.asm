@@ -20,6 +20,7 @@
 %include "ptr.inc"
 %include "layout.inc"
 %include "sphere_math.inc"
+%include "bvh.inc"
 
 section .rodata
 align 32
@@ -39,8 +40,7 @@ STACK_SIZE  equ 4 * (PTR_BVH_MAX_DEPTH * 7 + 8)
 STACK_ENTRY equ 0
 STACK_CHILD equ STACK_SIZE
 STACK_COUNT equ 2 * STACK_SIZE
-SAVED_RSP   equ 3 * STACK_SIZE
-FRAME       equ SAVED_RSP + 8
+FRAME       equ 3 * STACK_SIZE + 8
 
 ; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
 ; every lane whose t beats the best, (t, id) lexicographically; the smallest
@@ -98,25 +98,7 @@ test_leaf:
 ; ymm25 zero   k5-k7 the lanes of each axis whose 1 / d is negative (all or
 ; none)
 FUNCTION ptr_bvh_closest_hit_avx512
-    push        rbx
-    push        rbp
-    push        r12
-    push        r13
-    push        r14
-    push        r15
-    push        rcx
-    mov         rax, rsp
-    sub         rsp, FRAME
-    and         rsp, -64
-    mov         rbp, rsp
-    mov         [rbp + SAVED_RSP], rax
-    mov         r8,  [rdx + SPHERES_CX]
-    mov         r9,  [rdx + SPHERES_CY]
-    mov         r10, [rdx + SPHERES_CZ]
-    mov         r11, [rdx + SPHERES_RADIUS]
-    mov         r12, [rdx + SPHERES_ID]
-    mov         r13, [rsi + BVH_NODES]
-    mov         rbx, [rsi + BVH_UNBOUNDED_COUNT]
+    TREE_ENTRY  FRAME, 64
     vbroadcastss ymm0, [rdi + RAY_DIR_X]
     vbroadcastss ymm1, [rdi + RAY_DIR_Y]
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
@@ -156,27 +138,7 @@ FUNCTION ptr_bvh_closest_hit_avx512
 .node:
     shl         rax, 8                          ; 256-byte nodes
     lea         rsi, [r13 + rax]
-    ; tn and tf per axis: the near plane is lower where 1 / dir has its
-    ; sign bit clear, else upper.
-%assign axis 0
-%rep 3
-    vmovaps     ymm8, [rsi + NODE_LOWER_X + 64 * axis]
-    vsubps      ymm8, ymm8, ymm %+ %eval(16 + axis)
-    vmulps      ymm8, ymm8, ymm %+ %eval(19 + axis)     ; (lower - org) * inv
-    vmovaps     ymm9, [rsi + NODE_UPPER_X + 64 * axis]
-    vsubps      ymm9, ymm9, ymm %+ %eval(16 + axis)
-    vmulps      ymm9, ymm9, ymm %+ %eval(19 + axis)     ; (upper - org) * inv
-    vblendmps   ymm %+ %eval(10 + axis) {k %+ %eval(5 + axis)}, ymm8, ymm9   ; tn
-    vblendmps   ymm %+ %eval(13 + axis) {k %+ %eval(5 + axis)}, ymm9, ymm8   ; tf
-%assign axis axis + 1
-%endrep
-    vmaxps      ymm10, ymm10, ymm11
-    vmaxps      ymm10, ymm10, ymm12
-    vmaxps      ymm10, ymm10, ymm3              ; entry = max(tn x, y, z, tmin)
-    vminps      ymm13, ymm13, ymm14
-    vminps      ymm13, ymm13, ymm15
-    vmulps      ymm13, ymm13, ymm22
-    vminps      ymm13, ymm13, ymm24             ; exit = min(min(tf) * slack, best_up)
+    BOX_ENTRY_EXIT_AVX512 vmovaps, , 10, 13     ; the eight children's
     vcmpps      k1, ymm10, ymm13, CMP_LE_OQ
     kmovw       eax, k1
     test        eax, eax
@@ -233,34 +195,9 @@ FUNCTION ptr_bvh_closest_hit_avx512
     ; The spheres kept out of the tree, eight at a time, once the tree has
     ; found its best: the tree's first node test need not wait for them.
 .kept_out:
-    xor         eax, eax
-.unbounded:
-    mov         rcx, rbx
-    sub         rcx, rax
-    jbe         .finish
-    cmp         rcx, 8
-    jbe         .last
-    mov         ecx, 8
-.last:
-    call        test_leaf
-    add         rax, 8
-    jmp         .unbounded
-
+    TEST_KEPT_OUT rbx
 .finish:
-    mov         rsp, [rbp + SAVED_RSP]
-    pop         rcx
-    vmovss      [rcx + HIT_T], xmm4
-    mov         [rcx + HIT_SPHERE], r15d
-    xor         eax, eax
-    cmp         r15d, -1
-    setne       al
-    pop         r15
-    pop         r14
-    pop         r13
-    pop         r12
-    pop         rbp
-    pop         rbx
-    vzeroupper
-    ret
+    TREE_LEAVE_FRAME FRAME
+    TREE_RETURN_HIT
 
 section .note.GNU-stack noalloc noexec nowrite progbits

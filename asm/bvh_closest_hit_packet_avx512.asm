@@ -15,6 +15,7 @@
 %include "ptr.inc"
 %include "layout.inc"
 %include "sphere_math.inc"
+%include "bvh.inc"
 
 section .rodata
 align 4
@@ -36,8 +37,7 @@ ENTRY_SIZE  equ 64
 E_CHILD     equ 32
 E_COUNT     equ 36
 STACK       equ 0
-SAVED_RSP   equ ENTRY_SIZE * (PTR_BVH_MAX_DEPTH * 7 + 8)
-FRAME       equ SAVED_RSP + 8
+FRAME       equ ENTRY_SIZE * (PTR_BVH_MAX_DEPTH * 7 + 8) + 8
 
 ; Tests spheres eax .. eax + ecx - 1 (ecx >= 1) against the rays of mask k1:
 ; a ray takes a sphere whose (t, id) is below its best, lexicographically.
@@ -88,25 +88,7 @@ test_leaf:
 ; quiet NaN in a node
 ; k1 the rays at work   k5-k7 the rays whose 1 / d is negative, per axis
 FUNCTION ptr_bvh_closest_hit_packet_avx512
-    push        rbx
-    push        rbp
-    push        r12
-    push        r13
-    push        r14
-    push        r15
-    push        rcx
-    mov         rax, rsp
-    sub         rsp, FRAME
-    and         rsp, -64
-    mov         rbp, rsp
-    mov         [rbp + SAVED_RSP], rax
-    mov         r8,  [rdx + SPHERES_CX]
-    mov         r9,  [rdx + SPHERES_CY]
-    mov         r10, [rdx + SPHERES_CZ]
-    mov         r11, [rdx + SPHERES_RADIUS]
-    mov         r12, [rdx + SPHERES_ID]
-    mov         r13, [rsi + BVH_NODES]
-    mov         rbx, [rsi + BVH_UNBOUNDED_COUNT]
+    TREE_ENTRY  FRAME, 64
     vmovaps     ymm0, [rdi + PACKET_DIR_X]
     vmovaps     ymm1, [rdi + PACKET_DIR_Y]
     vmovaps     ymm2, [rdi + PACKET_DIR_Z]
@@ -184,25 +166,7 @@ FUNCTION ptr_bvh_closest_hit_packet_avx512
     btr         r15d, ecx
     ; Each ray's entry and exit of the child's box, as C computes them for
     ; it: the near plane is lower where its 1 / dir has the sign bit clear.
-%assign axis 0
-%rep 3
-    vbroadcastss ymm8, [rsi + NODE_LOWER_X + 64 * axis + rcx*4]
-    vsubps      ymm8, ymm8, ymm %+ %eval(16 + axis)
-    vmulps      ymm8, ymm8, ymm %+ %eval(19 + axis)     ; (lower - org) * inv
-    vbroadcastss ymm9, [rsi + NODE_UPPER_X + 64 * axis + rcx*4]
-    vsubps      ymm9, ymm9, ymm %+ %eval(16 + axis)
-    vmulps      ymm9, ymm9, ymm %+ %eval(19 + axis)     ; (upper - org) * inv
-    vblendmps   ymm %+ %eval(26 + axis) {k %+ %eval(5 + axis)}, ymm8, ymm9   ; tn
-    vblendmps   ymm %+ %eval(29 + axis) {k %+ %eval(5 + axis)}, ymm9, ymm8   ; tf
-%assign axis axis + 1
-%endrep
-    vmaxps      ymm26, ymm26, ymm27
-    vmaxps      ymm26, ymm26, ymm28
-    vmaxps      ymm26, ymm26, ymm3              ; entry = max(tn x, y, z, tmin)
-    vminps      ymm29, ymm29, ymm30
-    vminps      ymm29, ymm29, ymm31
-    vmulps      ymm29, ymm29, ymm22
-    vminps      ymm29, ymm29, ymm24             ; exit = min(min(tf) * slack, best_up)
+    BOX_ENTRY_EXIT_AVX512 vbroadcastss, + rcx*4, 26, 29
     vcmpps      k2{k1}, ymm26, ymm29, CMP_LE_OQ
     kortestw    k2, k2
     jz          .next_child
@@ -240,17 +204,9 @@ FUNCTION ptr_bvh_closest_hit_packet_avx512
     jmp         .pop
 
 .finish:
-    mov         rsp, [rbp + SAVED_RSP]
-    pop         rcx
+    TREE_LEAVE_FRAME FRAME
     vmovaps     [rcx + HITS_T], ymm4
     vmovdqa     [rcx + HITS_SPHERE], ymm6
-    pop         r15
-    pop         r14
-    pop         r13
-    pop         r12
-    pop         rbp
-    pop         rbx
-    vzeroupper
-    ret
+    TREE_RETURN
 
 section .note.GNU-stack noalloc noexec nowrite progbits
