@@ -119,19 +119,7 @@ FUNCTION ptr_bvh_closest_hit_avx512
 .tree:
     test        r13, r13
     jz          .kept_out
-    ; Per ray: 1 / dir clamped to +-FLT_MAX (finite or zero products, never
-    ; NaN), and which axes' near planes are the upper ones.
-    vbroadcastss ymm8, [one]
-    vbroadcastss ymm9, [flt_max]
-    vxorps      ymm10, ymm9, ymm7               ; -FLT_MAX
-%assign axis 0
-%rep 3
-    vdivps      ymm %+ %eval(19 + axis), ymm8, %cond(axis == 0, ymm0, %cond(axis == 1, ymm1, ymm2))
-    vmaxps      ymm %+ %eval(19 + axis), ymm %+ %eval(19 + axis), ymm10
-    vminps      ymm %+ %eval(19 + axis), ymm %+ %eval(19 + axis), ymm9
-    vptestmd    k %+ %eval(5 + axis), ymm %+ %eval(19 + axis), ymm7
-%assign axis axis + 1
-%endrep
+    RECIPROCALS_AVX512
     xor         r14d, r14d
     xor         eax, eax                        ; the root
 

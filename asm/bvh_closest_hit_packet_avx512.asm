@@ -117,19 +117,7 @@ FUNCTION ptr_bvh_closest_hit_packet_avx512
 .tree:
     test        r13, r13
     jz          .finish
-    ; Per ray: 1 / dir clamped to +-FLT_MAX (finite or zero products, never
-    ; NaN), and which rays meet each axis's upper plane first.
-    vbroadcastss ymm8, [one]
-    vbroadcastss ymm9, [flt_max]
-    vxorps      ymm10, ymm9, ymm7               ; -FLT_MAX
-%assign axis 0
-%rep 3
-    vdivps      ymm %+ %eval(19 + axis), ymm8, %cond(axis == 0, ymm0, %cond(axis == 1, ymm1, ymm2))
-    vmaxps      ymm %+ %eval(19 + axis), ymm %+ %eval(19 + axis), ymm10
-    vminps      ymm %+ %eval(19 + axis), ymm %+ %eval(19 + axis), ymm9
-    vptestmd    k %+ %eval(5 + axis), ymm %+ %eval(19 + axis), ymm7
-%assign axis axis + 1
-%endrep
+    RECIPROCALS_AVX512
     ; The root, entered by every ray.
     lea         r14, [rbp + STACK]
     vbroadcastss ymm8, [minus_infinity]
