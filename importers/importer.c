@@ -1,6 +1,7 @@
 #include "importer.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +9,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "base/memory.h"
 #include "importer_internal.h"
 
 typedef PtrResult (*ImportFn)(const char *, const PtrImportOptions *, PtrScene *,
@@ -70,6 +72,17 @@ PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError
     default:
         return ptr_error_set(err, res, "%s: %s", path, ptr_result_description(res));
     }
+}
+
+PtrResult ptr_import_check_memory(const char *path, uint64_t spheres, PtrError *err)
+{
+    const uint64_t available = ptr_memory_available();
+    if (spheres <= available / PTR_SPHERE_PEAK_BYTES)
+        return PTR_OK;
+    return ptr_error_set(err, PTR_ERR_NOMEM,
+                         "%s: out of memory: %" PRIu64 " spheres need about %.1f GB, and %.1f GB "
+                         "is available", path, spheres,
+                         (double)spheres * PTR_SPHERE_PEAK_BYTES * 1e-9, (double)available * 1e-9);
 }
 
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,

@@ -592,6 +592,75 @@ static void check_far_plane(Importer *im)
                  beyond == 1 ? "" : "s", beyond == 1 ? "is" : "are");
 }
 
+static uint64_t add_saturating(uint64_t a, uint64_t b)
+{
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+static uint64_t mul_saturating(uint64_t a, uint64_t b)
+{
+    return b && a > UINT64_MAX / b ? UINT64_MAX : a * b;
+}
+
+/* The spheres of a node: its surface's and its points', once per instance,
+ * from the accessors' counts alone. */
+static uint64_t node_sphere_count(const Importer *im, const GltfNode *node)
+{
+    GltfMesh mesh;
+    gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
+    uint64_t spheres = mesh.has_surface ? 1 : 0;
+    for (size_t p = 0; p < mesh.primitive_count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        if (prim.points && prim.position >= 0) {
+            GltfAccessor a;
+            gltf_doc_accessor(im->doc, (size_t)prim.position, &a);
+            spheres = add_saturating(spheres, a.count);
+        }
+    }
+    const GltfInstancing *in = &node->instances;
+    const int per_instance = in->translation >= 0 ? in->translation
+                           : in->rotation >= 0    ? in->rotation
+                                                  : in->scale;
+    if (!node->instanced || per_instance < 0)
+        return spheres;
+    GltfAccessor a;
+    gltf_doc_accessor(im->doc, (size_t)per_instance, &a);
+    return mul_saturating(spheres, a.count);
+}
+
+/* The spheres the default scene will hold, counted before anything is read
+ * or allocated for them: instances can multiply a small file's accessors
+ * into more spheres than the machine holds. Nodes met twice are counted once
+ * (walk_nodes refuses them). Returns UINT64_MAX if out of memory. */
+static uint64_t scene_sphere_count(const Importer *im, const GltfScene *gs)
+{
+    size_t n = gltf_doc_node_count(im->doc);
+    int *stack = malloc((n ? n : 1) * sizeof *stack);
+    unsigned char *seen = calloc(n ? n : 1, 1);
+    uint64_t spheres = stack && seen ? 0 : UINT64_MAX;
+    for (size_t r = 0; r < gs->root_count && stack && seen; r++) {
+        size_t top = 0;
+        stack[top++] = gs->roots[r];
+        while (top > 0) {
+            int index = stack[--top];
+            if (seen[index])
+                continue;
+            seen[index] = 1;
+            GltfNode node;
+            gltf_doc_node(im->doc, (size_t)index, &node);
+            if (node.mesh >= 0)
+                spheres = add_saturating(spheres, node_sphere_count(im, &node));
+            for (size_t c = 0; c < node.child_count && top < n; c++)
+                if (!seen[node.children[c]])
+                    stack[top++] = node.children[c];
+        }
+    }
+    free(stack);
+    free(seen);
+    return spheres;
+}
+
 /* Depth-first, pre-order, over the default scene; glTF requires the nodes to
  * form trees, so a node met twice is an error (a cycle or a shared child). */
 static PtrResult walk_nodes(Importer *im, const GltfScene *gs)
@@ -714,6 +783,8 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         for (size_t i = 0; i < materials; i++)
             im.material_index[i] = UINT32_MAX;
         res = read_scene_extras(&im, &gs);
+        if (res == PTR_OK)
+            res = ptr_import_check_memory(path, scene_sphere_count(&im, &gs), err);
         if (res == PTR_OK)
             res = walk_nodes(&im, &gs);
     }
