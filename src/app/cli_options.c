@@ -298,6 +298,8 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_sample_range: return set_sample_range(id, value, o);
     case OPT_region: return set_region(id, value, o);
     case OPT_watch: o->watch = 1; break;
+    case OPT_live: o->live = value; break;
+    case OPT_tev: o->tev = value; break;
     case OPT_json: o->json = 1; break;
     case OPT_quiet: o->quiet = 1; break;
     case OPT_dump_scene: o->dump_scene = 1; break;

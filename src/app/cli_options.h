@@ -52,6 +52,7 @@ typedef struct PtrOptions {
     double time_budget;     /* seconds; 0: none */
     int preview;
     int watch;
+    const char *live, *tev; /* [HOST:]PORT of the live view, of tev */
     int json;
     int quiet;
     int dump_scene;

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/live_view.h"
 #include "app/output.h"
 #include "app/signals.h"
 #include "base/cpu.h"
@@ -75,6 +76,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
+    ptr_live_view_begin(report->scene, report->output, layout.width, layout.height, &passes);
     size_t pixels = (size_t)layout.width * (size_t)layout.height;
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
@@ -115,6 +117,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
     }
     free(rgb);
     free(counts);
+    ptr_live_view_end(res == PTR_OK && !done.stopped);
     if (res == PTR_OK && done.stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted; wrote the %u samples done of %u",
