@@ -192,7 +192,7 @@ static enum MHD_Result set_exposure(PtrLiveSession *s, struct MHD_Connection *co
     const char *text = MHD_lookup_connection_value(connection, MHD_GET_ARGUMENT_KIND, "stops");
     char *end;
     double stops = text ? strtod(text, &end) : NAN;
-    if (!text || *end || !(fabs(stops) <= 16))
+    if (!text || end == text || *end || !(fabs(stops) <= 16))
         return send_text(connection, MHD_HTTP_BAD_REQUEST, "stops: a number from -16 to 16\n");
     pthread_mutex_lock(&s->lock);
     if ((float)stops != s->stops) {
