@@ -33,8 +33,16 @@ enum {
 typedef struct Stream {
     PtrLiveSession *session;
     uint64_t event; /* the last one sent */
-    double last_sent;
+    struct Stream *next; /* in session->streams */
 } Stream;
+
+int ptr_live_http_pages_behind(const PtrLiveSession *s)
+{
+    for (const Stream *stream = s->streams; stream; stream = stream->next)
+        if (stream->event != s->event)
+            return 1;
+    return 0;
+}
 
 static void json_string(char *out, size_t size, const char *text)
 {
@@ -82,18 +90,19 @@ static ssize_t read_events(void *cls, uint64_t pos, char *buf, size_t max)
     if (stream->event == s->event && !s->stopping)
         ptr_live_wait(s, KEEPALIVE_SECONDS);
     ssize_t n;
-    if (s->stopping) {
-        n = MHD_CONTENT_READER_END_OF_STREAM;
-    } else if (stream->event != s->event) {
+    if (stream->event != s->event) { /* even when stopping: the last state too */
         char event[EVENT_SIZE];
         int len = format_event(s, event, sizeof event);
         if (len > 0 && (size_t)len < sizeof event && (size_t)len <= max) {
             memcpy(buf, event, (size_t)len);
             stream->event = s->event;
             n = len;
+            pthread_cond_broadcast(&s->changed); /* stop() waits for the last one */
         } else {
             n = 0; /* no room now: again at the next call */
         }
+    } else if (s->stopping) {
+        n = MHD_CONTENT_READER_END_OF_STREAM;
     } else {
         static const char keepalive[] = ": keepalive\n\n";
         n = max >= sizeof keepalive - 1 ? (ssize_t)(sizeof keepalive - 1) : 0;
@@ -109,6 +118,12 @@ static void close_events(void *cls)
     PtrLiveSession *s = stream->session;
     pthread_mutex_lock(&s->lock);
     s->pages--;
+    for (Stream **at = (Stream **)&s->streams; *at; at = &(*at)->next)
+        if (*at == stream) {
+            *at = stream->next;
+            break;
+        }
+    pthread_cond_broadcast(&s->changed);
     pthread_mutex_unlock(&s->lock);
     free(stream);
 }
@@ -162,6 +177,8 @@ static enum MHD_Result serve_events(PtrLiveSession *s, struct MHD_Connection *co
     }
     pthread_mutex_lock(&s->lock);
     s->pages++;
+    stream->next = s->streams;
+    s->streams = stream;
     pthread_cond_broadcast(&s->changed); /* the encoder has a page to encode for */
     pthread_mutex_unlock(&s->lock);
     return send_response(connection, MHD_HTTP_OK, r, "text/event-stream");

@@ -174,10 +174,12 @@ static void session_stop(PtrLiveSession *s)
     if (!s)
         return;
     pthread_mutex_lock(&s->lock);
-    /* An open page gets the chance to fetch the last image. */
+    /* An open page gets the chance to hear the last state and fetch the
+     * last image. */
     double deadline = ptr_live_now() + linger_seconds;
-    while (s->pages > 0 && s->frame_version > 0 && s->served_frame != s->frame_version &&
-           ptr_live_now() < deadline)
+    while (s->pages > 0 && ptr_live_now() < deadline &&
+           ((s->frame_version > 0 && s->served_frame != s->frame_version) ||
+            ptr_live_http_pages_behind(s)))
         ptr_live_wait(s, deadline - ptr_live_now());
     s->stopping = 1;
     pthread_cond_broadcast(&s->changed);

@@ -32,6 +32,7 @@ struct PtrLiveSession {
 
     /* The page: open event streams, its exposure, and the PNG of the view. */
     int pages;
+    void *streams;          /* live_http.c's list of them */
     float stops;
     uint64_t stops_version;
     unsigned char *png;
@@ -68,6 +69,8 @@ void ptr_live_wait(PtrLiveSession *s, double seconds);
 /* The server (live_http.c): binds options->http and starts serving. */
 PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err);
 void ptr_live_http_stop(PtrLiveSession *s);
+/* Whether an open page has yet to hear of the latest change (the lock held). */
+int ptr_live_http_pages_behind(const PtrLiveSession *s);
 
 /* tev's sender (live_tev.c): a thread that connects to options->tev,
  * reconnecting when the connection fails, and sends changed tiles. */

@@ -4,7 +4,7 @@ warning for any other, a port in use is one line and exit 2), images
 byte-identical with and without a page open, and a flood of malformed and
 slow requests during a render that neither crashes ptr nor stalls it.
 
-Usage: test_live.py PTR SOURCE_DIR"""
+Usage: test_live.py PTR SOURCE_DIR [SANITIZED]"""
 import os
 import random
 import socket
@@ -14,7 +14,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from live_client import Ptr, Page, get, same_image_bytes, wait_for  # noqa: E402
+from live_client import Ptr, Page, get, same_image_bytes, samples, wait_for  # noqa: E402
 
 ptr, src = sys.argv[1], sys.argv[2]
 scene = os.path.join(src, "scenes", "seed.gltf")
@@ -28,9 +28,9 @@ def check(ok, message):
     return ok
 
 
-def render(out, extra=(), samples=300, size=160):
+def render(out, extra=(), n=300, size=160):
     return [ptr, scene, "-o", out, "--width", str(size), "--height", str(size), "--samples",
-            str(samples), "--threads", "2", *extra]
+            str(samples(n)), "--threads", "2", *extra]
 
 
 def plain(out, **kw):
@@ -78,7 +78,7 @@ def identical_with_page(d):
         check(page.error is None, "page: %s" % page.error)
         check(len(page.frames) >= 2, "the page saw %d frames, not 2 or more" % len(page.frames))
         check(len(page.states) and page.states[-1]["state"] == "done" and
-              page.states[-1]["samples"] == 300,
+              page.states[-1]["samples"] == samples(300),
               "the page's last state: %s" % (page.states[-1:] or None))
         check(same_image_bytes(a, b), "%s and %s differ" % (a, b))
         if ext == "png" and page.frames:
@@ -110,11 +110,11 @@ def addresses(d):
     p = Ptr(render(out, ["--live", "no-such-host.invalid:0"]))
     check(p.wait() == 2, "--live on an unknown host: not exit 2: %s" % p.stderr)
     # Another address than the loopback: served, with a warning.
-    p = Ptr(render(out, ["--live", "0.0.0.0:0"], samples=4))
+    p = Ptr(render(out, ["--live", "0.0.0.0:0"], n=4))
     code = p.wait()
     check(code == 0 and "warning" in p.stderr and "loopback" in p.stderr,
           "--live 0.0.0.0:0: exit %d, stderr %r" % (code, p.stderr))
-    p = Ptr(render(out, ["--live", "[::1]:0"], samples=4))
+    p = Ptr(render(out, ["--live", "[::1]:0"], n=4))
     code = p.wait()
     check(code == 0 and "http://[::1]:" in p.stderr and "warning" not in p.stderr,
           "--live [::1]:0: exit %d, stderr %r" % (code, p.stderr))
@@ -204,10 +204,10 @@ class Flood:
 def flood(d):
     a, b = os.path.join(d, "plain_flood.exr"), os.path.join(d, "flood.exr")
     start = time.time()
-    plain(a, samples=1500)
+    plain(a, n=1500)
     alone = time.time() - start
     start = time.time()
-    p = Ptr(render(b, ["--live", "0"], samples=1500))
+    p = Ptr(render(b, ["--live", "0"], n=1500))
     url = p.url()
     if not check(url, "no address: %s" % p.stderr):
         p.process.kill()

@@ -10,6 +10,13 @@ import time
 import urllib.parse
 
 
+def samples(n):
+    """n samples, or an eighth under the sanitizers (a third argument of 1,
+    after PTR and SOURCE_DIR)."""
+    import sys
+    return max(8, n // 8) if len(sys.argv) > 3 and sys.argv[3] == "1" else n
+
+
 class Ptr:
     """A ptr process whose stderr is read on a thread; url is the live
     view's address once ptr printed it."""
