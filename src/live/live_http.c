@@ -17,17 +17,148 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 enum {
     CONNECTIONS = 32,          /* in all */
     CONNECTIONS_PER_IP = 16,
     TIMEOUT_SECONDS = 10,      /* idle connections close */
+    REQUEST_SECONDS = 10,      /* from a connection or a response to the next request's end */
     MEMORY_PER_CONNECTION = 16 * 1024, /* a request's headers and more */
     THREAD_STACK = 256 * 1024,
     KEEPALIVE_SECONDS = 2,
     EVENT_SIZE = 1024,
 };
+
+/* One connection, from its start to its close. */
+typedef struct Connection {
+    int fd;
+    double deadline; /* for the request under way to be read; 0: answering one */
+    struct Connection *next;
+} Connection;
+
+/* The connections, for the watchdog. */
+typedef struct Http {
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    Connection *connections;
+    pthread_t watchdog;
+    int stop;
+} Http;
+
+static void notify_connection(void *cls, struct MHD_Connection *connection,
+                              void **socket_context, enum MHD_ConnectionNotificationCode code)
+{
+    Http *http = ((PtrLiveSession *)cls)->http;
+    if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+        const union MHD_ConnectionInfo *info =
+            MHD_get_connection_info(connection, MHD_CONNECTION_INFO_CONNECTION_FD);
+        Connection *c = info ? calloc(1, sizeof *c) : NULL;
+        if (!c)
+            return; /* unwatched: the idle timeout still holds */
+        c->fd = info->connect_fd;
+        c->deadline = ptr_live_now() + REQUEST_SECONDS;
+        pthread_mutex_lock(&http->lock);
+        c->next = http->connections;
+        http->connections = c;
+        pthread_mutex_unlock(&http->lock);
+        *socket_context = c;
+    } else if (*socket_context) {
+        /* Before libmicrohttpd closes the socket: once off the list, the
+         * watchdog never touches its descriptor. */
+        pthread_mutex_lock(&http->lock);
+        for (Connection **at = &http->connections; *at; at = &(*at)->next)
+            if (*at == *socket_context) {
+                *at = (*at)->next;
+                break;
+            }
+        pthread_mutex_unlock(&http->lock);
+        free(*socket_context);
+        *socket_context = NULL;
+    }
+}
+
+/* A request was read (answering): 0; a response was sent: the next
+ * request has REQUEST_SECONDS. */
+static void set_deadline(PtrLiveSession *s, struct MHD_Connection *connection, double deadline)
+{
+    Http *http = s->http;
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(connection, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    Connection *c = info ? info->socket_context : NULL;
+    if (!c)
+        return;
+    pthread_mutex_lock(&http->lock);
+    c->deadline = deadline;
+    pthread_mutex_unlock(&http->lock);
+}
+
+static void request_completed(void *cls, struct MHD_Connection *connection, void **request,
+                              enum MHD_RequestTerminationCode code)
+{
+    (void)request;
+    (void)code;
+    set_deadline(cls, connection, ptr_live_now() + REQUEST_SECONDS);
+}
+
+static void *watch_requests(void *arg)
+{
+    Http *http = arg;
+    pthread_mutex_lock(&http->lock);
+    while (!http->stop) {
+        struct timespec t;
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        t.tv_nsec += 500000000L;
+        if (t.tv_nsec >= 1000000000L) {
+            t.tv_sec++;
+            t.tv_nsec -= 1000000000L;
+        }
+        pthread_cond_timedwait(&http->wake, &http->lock, &t);
+        double now = ptr_live_now();
+        for (Connection *c = http->connections; c; c = c->next)
+            if (c->deadline > 0 && now > c->deadline) {
+                shutdown(c->fd, SHUT_RDWR); /* the connection's thread sees it and closes */
+                c->deadline = now + REQUEST_SECONDS;
+            }
+    }
+    pthread_mutex_unlock(&http->lock);
+    return NULL;
+}
+
+static Http *http_new(void)
+{
+    Http *http = calloc(1, sizeof *http);
+    if (!http)
+        return NULL;
+    pthread_mutex_init(&http->lock, NULL);
+    pthread_condattr_t attr;
+    pthread_condattr_init(&attr);
+    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
+    pthread_cond_init(&http->wake, &attr);
+    pthread_condattr_destroy(&attr);
+    if (pthread_create(&http->watchdog, NULL, watch_requests, http)) {
+        pthread_cond_destroy(&http->wake);
+        pthread_mutex_destroy(&http->lock);
+        free(http);
+        return NULL;
+    }
+    return http;
+}
+
+static void http_free(Http *http)
+{
+    if (!http)
+        return;
+    pthread_mutex_lock(&http->lock);
+    http->stop = 1;
+    pthread_cond_broadcast(&http->wake);
+    pthread_mutex_unlock(&http->lock);
+    pthread_join(http->watchdog, NULL);
+    pthread_cond_destroy(&http->wake);
+    pthread_mutex_destroy(&http->lock);
+    free(http);
+}
 
 /* One /events stream. */
 typedef struct Stream {
@@ -231,10 +362,13 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *connection, cons
     (void)upload_data;
     static int seen;
     PtrLiveSession *s = cls;
-    if (strcmp(method, MHD_HTTP_METHOD_GET) && strcmp(method, MHD_HTTP_METHOD_HEAD))
+    if (strcmp(method, MHD_HTTP_METHOD_GET) && strcmp(method, MHD_HTTP_METHOD_HEAD)) {
+        set_deadline(s, connection, 0);
         return send_text(connection, MHD_HTTP_METHOD_NOT_ALLOWED, "GET only\n");
+    }
     if (!*request) { /* the headers: answer once any body has arrived */
         *request = &seen;
+        set_deadline(s, connection, 0);
         return MHD_YES;
     }
     if (*upload_data_size)
@@ -321,6 +455,12 @@ PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err)
     s->listen_fd = bind_socket("--live", host, port, &family, s->url, sizeof s->url, err);
     if (s->listen_fd < 0)
         return err->code;
+    s->http = http_new();
+    if (!s->http) {
+        close(s->listen_fd);
+        s->listen_fd = -1;
+        return ptr_live_error(err, PTR_ERR_NOMEM, "--live: out of memory");
+    }
     unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD;
     if (family == AF_INET6)
         flags |= MHD_USE_IPv6;
@@ -332,8 +472,12 @@ PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err)
         MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)TIMEOUT_SECONDS,
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)MEMORY_PER_CONNECTION,
         MHD_OPTION_THREAD_STACK_SIZE, (size_t)THREAD_STACK,
+        MHD_OPTION_NOTIFY_CONNECTION, notify_connection, s,
+        MHD_OPTION_NOTIFY_COMPLETED, request_completed, s,
         MHD_OPTION_END);
     if (!s->daemon) {
+        http_free(s->http);
+        s->http = NULL;
         close(s->listen_fd);
         s->listen_fd = -1;
         return ptr_live_error(err, PTR_ERR_INTERNAL, "--live %s: cannot start the server", s->url);
@@ -347,6 +491,8 @@ void ptr_live_http_stop(PtrLiveSession *s)
     if (s->daemon)
         MHD_stop_daemon(s->daemon);
     s->daemon = NULL;
+    http_free(s->http);
+    s->http = NULL;
     if (s->listen_fd >= 0)
         close(s->listen_fd);
     s->listen_fd = -1;

@@ -45,6 +45,7 @@ struct PtrLiveSession {
 
     /* The server. */
     void *daemon;
+    void *http;             /* live_http.c's connections and their deadlines */
     int listen_fd;
     char url[128];
 

@@ -239,10 +239,48 @@ def flood(d):
           % (f.sent, alone, took))
 
 
+def request_deadline(d):
+    """A client that sends a header line a second is never idle, yet its
+    request is cut off 10 s after it connected; a page's event stream stays.
+    With --watch, ptr serves after the render until Ctrl-C."""
+    p = Ptr(render(os.path.join(d, "watch.exr"), ["--live", "0", "--watch"], n=4, size=16))
+    url = p.url()
+    if not check(url, "--watch --live: no address: %s" % p.stderr):
+        p.process.kill()
+        return
+    host, port = url.split("/")[2].rsplit(":", 1)
+    page = Page(url)
+    slow = socket.create_connection((host, int(port)), timeout=5)
+    slow.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n")
+    start, cut = time.time(), None
+    while time.time() - start < 20:
+        try:
+            slow.sendall(b"X-a: b\r\n")
+            slow.settimeout(1)
+            if slow.recv(100) == b"":
+                cut = time.time() - start
+                break
+        except socket.timeout:
+            continue
+        except OSError:
+            cut = time.time() - start
+            break
+    slow.close()
+    check(cut is not None and 8 <= cut <= 13,
+          "a request trickling a header a second was cut after %s s, not about 10" % cut)
+    check(page.error is None and page.states, "the page's stream: %s, %d states"
+          % (page.error, len(page.states)))
+    p.process.send_signal(2)
+    code = p.wait(30)
+    page.close()
+    check(code == 0, "--watch stopped by SIGINT: exit %d: %s" % (code, p.stderr))
+
+
 def main():
     with tempfile.TemporaryDirectory() as d:
         identical_with_page(d)
         addresses(d)
+        request_deadline(d)
         flood(d)
     if failures:
         return 1
