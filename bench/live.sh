@@ -1,8 +1,13 @@
 #!/bin/sh
 # What a live view costs the render: rays per second of renders without
 # --live and of renders with --live and a page open, alternating run by run
-# so that both see the same machine, then the median of each and their
-# ratio. The page is a script that does what the page does (follows the
+# so that both see the same machine; the ratio of each pair (with a page
+# over without) and their median, and the same for the CPU time the process
+# took (user + system: the encoder's work shows there even on a machine
+# whose load from elsewhere makes wall times vary), and the share of that
+# CPU time the live view's own threads took (the encoder, the server's:
+# read from /proc while ptr runs), the cost that does not depend on the
+# machine's other load. The page is a script that does what the page does (follows the
 # event stream and fetches every new frame: tests/support/live_client.py),
 # or with --browser, the page itself in headless Chromium on the same
 # machine (its drawing competes with the render too).
@@ -23,8 +28,11 @@ while [ $# -gt 0 ]; do
     shift
 done
 [ $# -gt 0 ] || set -- scenes/seed.gltf --width 500 --height 500 --samples 400
-exec python3 - "$ptr" "$runs" "$browser" "$@" <<'PY'
-import json, os, statistics, sys, tempfile
+python=python3
+# Debian's python3-selenium is for Debian's python3.
+[ $browser = 0 ] || [ ! -x /usr/bin/python3 ] || python=/usr/bin/python3
+exec $python - "$ptr" "$runs" "$browser" "$@" <<'PY'
+import glob, json, os, resource, statistics, sys, tempfile, threading, time
 sys.path.insert(0, "tests/support")
 from live_client import Ptr, Page
 
@@ -39,10 +47,37 @@ if browser:
     web = test_browser.start_browser(b, d)
 
 
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def thread_cpu(pid, seen):
+    """Polls the CPU time (ticks) of each of pid's threads until it ends:
+    seen[tid] = (name, ticks)."""
+    while True:
+        tasks = glob.glob("/proc/%d/task/*" % pid)
+        if not tasks:
+            return
+        for task in tasks:
+            try:
+                stat = open(task + "/stat").read()
+                name = stat[stat.index("(") + 1:stat.rindex(")")]
+                fields = stat[stat.rindex(")") + 2:].split()
+                seen[task] = (name, int(fields[11]) + int(fields[12]))
+            except (OSError, ValueError):
+                pass
+        time.sleep(0.05)
+
+
 def run(live, out):
+    before = cpu()
     p = Ptr([ptr, *args, "-o", out, "--json", "--quiet"] + (["--live", "0"] if live else []))
     page = None
     frames = 0
+    seen = {}
+    poller = threading.Thread(target=thread_cpu, args=(p.process.pid, seen), daemon=True)
+    poller.start()
     if live:
         url = p.url()
         if web:
@@ -51,26 +86,35 @@ def run(live, out):
             page = Page(url)
     if p.wait() != 0:
         sys.exit("ptr failed: " + p.stderr)
+    seconds = cpu() - before
+    poller.join(5)
+    total = sum(t for _, t in seen.values())
+    mine = sum(t for name, t in seen.values() if name.startswith(("ptr-live", "MHD")))
+    share = mine / total if total else 0
     if page:
         page.close()
         frames = len(page.frames)
     if web:
         frames = int(web.execute_script("return document.getElementById('image').dataset.frame"))
-    return json.loads(p.stdout.splitlines()[-1])["rays_per_second"], frames
+    return json.loads(p.stdout.splitlines()[-1])["rays_per_second"], frames, seconds, share
 
 
 with tempfile.TemporaryDirectory() as d:
-    plain, live, frames = [], [], []
+    speed, cpu_ratio, shares = [], [], []
     for i in range(runs):
-        plain.append(run(False, os.path.join(d, "plain.exr"))[0])
-        r, f = run(True, os.path.join(d, "live.exr"))
-        live.append(r)
-        frames.append(f)
-        print("run %d: %.2f Mrays/s without --live, %.2f with a page open (%d frames)"
-              % (i + 1, plain[-1] / 1e6, live[-1] / 1e6, f), flush=True)
+        r0, _, c0, _ = run(False, os.path.join(d, "plain.exr"))
+        r1, f, c1, share = run(True, os.path.join(d, "live.exr"))
+        speed.append(r1 / r0)
+        cpu_ratio.append(c0 / c1)
+        shares.append(share)
+        print("run %d: %.2f Mrays/s and %.2f CPU s without --live, %.2f Mrays/s and %.2f CPU s "
+              "with a page open (%d frames, %.1f%% of the CPU time in the live view's threads): "
+              "ratios %.3f, %.3f" % (i + 1, r0 / 1e6, c0, r1 / 1e6, c1, f, 100 * share,
+                                     speed[-1], cpu_ratio[-1]), flush=True)
 if web:
     web.quit()
-a, b = statistics.median(plain), statistics.median(live)
-print("median: %.2f Mrays/s without --live, %.2f with a page open%s: ratio %.3f"
-      % (a / 1e6, b / 1e6, " in Chromium" if browser else "", b / a))
+print("median of %d pairs, with a page open%s over without --live: rays per second %.3f, "
+      "CPU time (inverse) %.3f; the live view's threads took %.1f%% of ptr's CPU time"
+      % (runs, " in Chromium" if browser else "", statistics.median(speed),
+         statistics.median(cpu_ratio), 100 * statistics.median(shares)))
 PY

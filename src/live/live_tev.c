@@ -8,6 +8,7 @@
  * the next frame reconnects (at most once a second), creating the image
  * again, so a tev that restarts gets the whole image. The render never
  * waits for any of it. */
+#define _GNU_SOURCE /* pthread_setname_np */
 #include "live/live_module.h"
 
 #include <errno.h>
@@ -238,6 +239,7 @@ static int take_frame(PtrLiveSession *s, LiveTev *t)
 static void *send_loop(void *arg)
 {
     PtrLiveSession *s = arg;
+    pthread_setname_np(pthread_self(), "ptr-live-tev");
     LiveTev *t = s->tev;
     double last_send = -1e9, last_attempt = -1e9;
     pthread_mutex_lock(&s->lock);
