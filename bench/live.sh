@@ -10,7 +10,8 @@
 # machine's other load. The page is a script that does what the page does (follows the
 # event stream and fetches every new frame: tests/support/live_client.py),
 # or with --browser, the page itself in headless Chromium on the same
-# machine (its drawing competes with the render too).
+# machine (its drawing competes with the render too; Chromium stays open on
+# an empty page during the renders without --live: it costs a core 5% idle).
 # Usage: bench/live.sh PTR [RUNS] [--browser] [-- RENDER OPTIONS]
 #   (from the source folder; default RUNS 7 and options
 #    scenes/seed.gltf --width 500 --height 500 --samples 400)
@@ -71,6 +72,8 @@ def thread_cpu(pid, seen):
 
 
 def run(live, out):
+    if web and not live:
+        web.get("about:blank")  # the browser runs in both: what the page costs, not Chromium
     before = cpu()
     p = Ptr([ptr, *args, "-o", out, "--json", "--quiet"] + (["--live", "0"] if live else []))
     page = None
@@ -95,7 +98,8 @@ def run(live, out):
         page.close()
         frames = len(page.frames)
     if web:
-        frames = int(web.execute_script("return document.getElementById('image').dataset.frame"))
+        frames = web.execute_script("const e = document.getElementById('image');"
+                                    "return e ? Number(e.dataset.frame) : 0")
     return json.loads(p.stdout.splitlines()[-1])["rays_per_second"], frames, seconds, share
 
 

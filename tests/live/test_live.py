@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """--live: the server's routes, the address rules (loopback by default, a
 warning for any other, a port in use is one line and exit 2), images
-byte-identical with and without a page open, and a flood of malformed and
-slow requests during a render that neither crashes ptr nor stalls it.
+byte-identical with and without a page open, the page following a batch and
+--watch, a slow request cut off, and a flood of malformed and slow requests
+during a render that neither crashes ptr nor stalls it.
 
 Usage: test_live.py PTR SOURCE_DIR [SANITIZED]"""
 import os
 import random
+import shutil
 import socket
 import sys
 import tempfile
@@ -239,6 +241,37 @@ def flood(d):
           % (f.sent, alone, took))
 
 
+def follows(d):
+    """In a batch the page follows the scene being rendered; with --watch,
+    each re-render after a save."""
+    folder = os.path.join(d, "batch")
+    os.mkdir(folder)
+    second = os.path.join(d, "second.gltf")
+    shutil.copy(scene, second)
+    p = Ptr([ptr, scene, second, "-o", folder + "/", "--width", "128", "--height", "128",
+             "--samples", str(samples(200)), "--threads", "2", "--live", "0"])
+    page = Page(p.url())
+    code = p.wait()
+    page.close()
+    done = {s["render"]: s["scene"] for s in page.states if s["state"] == "done"}
+    check(code == 0 and done == {1: scene, 2: second},
+          "a batch: exit %d, the page saw %s done" % (code, done))
+
+    p = Ptr([ptr, second, "-o", os.path.join(d, "watched.exr"), "--width", "32", "--height",
+             "32", "--samples", "4", "--threads", "2", "--live", "0", "--watch"])
+    page = Page(p.url())
+    wait_for(lambda: any(s["state"] == "done" for s in page.states), 30)
+    with open(second, "a") as f:
+        f.write("\n")  # saved again
+    renders = lambda: {s["render"] for s in page.states if s["state"] == "done"}  # noqa: E731
+    wait_for(lambda: renders() == {1, 2}, 30)
+    p.process.send_signal(2)
+    code = p.wait(30)
+    page.close()
+    check(code == 0 and renders() == {1, 2},
+          "--watch: exit %d, the page saw renders %s done, not 1 and 2" % (code, renders()))
+
+
 def request_deadline(d):
     """A client that sends a header line a second is never idle, yet its
     request is cut off 10 s after it connected; a page's event stream stays.
@@ -280,6 +313,7 @@ def main():
     with tempfile.TemporaryDirectory() as d:
         identical_with_page(d)
         addresses(d)
+        follows(d)
         request_deadline(d)
         flood(d)
     if failures:
