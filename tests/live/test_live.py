@@ -206,10 +206,10 @@ class Flood:
 def flood(d):
     a, b = os.path.join(d, "plain_flood.exr"), os.path.join(d, "flood.exr")
     start = time.time()
-    plain(a, n=1500)
+    plain(a, n=3000)
     alone = time.time() - start
     start = time.time()
-    p = Ptr(render(b, ["--live", "0"], n=1500))
+    p = Ptr(render(b, ["--live", "0"], n=3000))
     url = p.url()
     if not check(url, "no address: %s" % p.stderr):
         p.process.kill()
@@ -248,8 +248,9 @@ def follows(d):
     os.mkdir(folder)
     second = os.path.join(d, "second.gltf")
     shutil.copy(scene, second)
+    # The first render lasts a second or more: the page connects during it.
     p = Ptr([ptr, scene, second, "-o", folder + "/", "--width", "128", "--height", "128",
-             "--samples", str(samples(200)), "--threads", "2", "--live", "0"])
+             "--samples", str(samples(1500)), "--threads", "2", "--live", "0"])
     page = Page(p.url())
     code = p.wait()
     page.close()
