@@ -18,7 +18,9 @@
 #include "base/version.h"
 
 enum { FRAMES_PER_SECOND = 4, VIEW_PIXELS = 4096, ENCODER_NICE = 10 };
-static const double linger_seconds = 1.0; /* for a page to fetch the last image */
+/* At the end, for a page to hear the last state and fetch the last image,
+ * then for its event stream to end: each wait at most this long. */
+static const double linger_seconds = 1.0;
 
 PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
 {
@@ -199,6 +201,11 @@ static void session_stop(PtrLiveSession *s)
         ptr_live_wait(s, deadline - ptr_live_now());
     s->stopping = 1;
     pthread_cond_broadcast(&s->changed);
+    /* The event streams send what they have not sent yet, then end: let them
+     * end before the server closes their connections. */
+    deadline = ptr_live_now() + linger_seconds;
+    while (s->pages > 0 && ptr_live_now() < deadline)
+        ptr_live_wait(s, deadline - ptr_live_now());
     pthread_mutex_unlock(&s->lock);
     if (s->encoder_started)
         pthread_join(s->encoder, NULL);
