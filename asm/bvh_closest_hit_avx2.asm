@@ -25,8 +25,10 @@ section .text
 ; The frame, at rbp aligned to 32: the ray's origin and clamped
 ; reciprocal direction broadcast to 8 lanes, the children's entry distances,
 ; best * PTR_BVH_SLACK broadcast, then the traversal stack of 16-byte
-; entries (child, leaf count, entry distance, unused); also the hit pointer
-; and the rsp to return with.
+; entries (child, leaf count, entry distance, unused); also the hit pointer,
+; the rsp to return with and the count of the spheres kept out of the tree,
+; which are tested last: the tree's first node test need not wait on their
+; square roots.
 ORG_X   equ 0
 ORG_Y   equ 32
 ORG_Z   equ 64
@@ -37,6 +39,7 @@ ENTRY   equ 192
 BEST_UP equ 224
 HIT_PTR equ 256
 SAVED_RSP equ 264
+KEPT_OUT equ 272
 STACK   equ 288
 FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32
 
@@ -120,7 +123,8 @@ FUNCTION ptr_bvh_closest_hit_avx2
     mov         r11, [rdx + SPHERES_RADIUS]
     mov         r12, [rdx + SPHERES_ID]
     mov         r13, [rsi + BVH_NODES]
-    mov         rbx, [rsi + BVH_UNBOUNDED_COUNT]
+    mov         rax, [rsi + BVH_UNBOUNDED_COUNT]
+    mov         [rbp + KEPT_OUT], rax
     vbroadcastss ymm0, [rdi + RAY_DIR_X]
     vbroadcastss ymm1, [rdi + RAY_DIR_Y]
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
@@ -133,23 +137,9 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmulps      ymm8, ymm4, [slack]
     vmovaps     [rbp + BEST_UP], ymm8
 
-    ; The spheres kept out of the tree, eight at a time.
-    xor         eax, eax
-.unbounded:
-    mov         rcx, rbx
-    sub         rcx, rax
-    jbe         .tree
-    cmp         rcx, 8
-    jbe         .last
-    mov         ecx, 8
-.last:
-    call        test_leaf
-    add         rax, 8
-    jmp         .unbounded
-
 .tree:
     test        r13, r13
-    jz          .finish
+    jz          .kept_out
     ; Per ray: origin, and 1 / dir clamped to +-FLT_MAX (finite or zero
     ; products, never NaN), each in 8 lanes.
     vbroadcastss ymm8, [rdi + RAY_ORG_X]
@@ -182,7 +172,7 @@ FUNCTION ptr_bvh_closest_hit_avx2
 .pop:
     lea         rax, [rbp + STACK]
     cmp         r14, rax
-    je          .finish
+    je          .kept_out
     sub         r14, 16
     vmovss      xmm8, [r14 + 8]
     vucomiss    xmm8, [rbp + BEST_UP]
@@ -223,8 +213,12 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmovmskps   edx, ymm13
     test        edx, edx
     jz          .pop
+    ; One child entered: enter it. Several: push them all, swap the nearest
+    ; (its lowest lane on a tie) onto the top, and pop it at once.
+    lea         ecx, [rdx - 1]
+    test        edx, ecx
+    jz          .one
     vmovaps     [rbp + ENTRY], ymm10
-    ; Push every child entered; then swap the nearest onto the top.
     vmovss      xmm15, [infinity]
     mov         rbx, r14
 .push:
@@ -249,6 +243,30 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmovups     [rbx], xmm9
     vmovups     [r14 - 16], xmm8
     jmp         .pop
+.one:
+    bsf         ecx, edx
+    mov         eax, [rsi + NODE_CHILD + rcx*4]
+    mov         ecx, [rsi + NODE_LEAF_COUNT + rcx*4]
+    test        ecx, ecx
+    jz          .node
+    call        test_leaf
+    jmp         .pop
+
+    ; The spheres kept out of the tree, eight at a time, once the tree has
+    ; found its best: the tree's first node test need not wait for them.
+.kept_out:
+    xor         eax, eax
+.unbounded:
+    mov         rcx, [rbp + KEPT_OUT]
+    sub         rcx, rax
+    jbe         .finish
+    cmp         rcx, 8
+    jbe         .last
+    mov         ecx, 8
+.last:
+    call        test_leaf
+    add         rax, 8
+    jmp         .unbounded
 
 .finish:
     mov         rcx, [rbp + HIT_PTR]

@@ -2,14 +2,20 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
-void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrCameraSpec *override)
+void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImportOptions *options)
 {
     memset(builder, 0, sizeof *builder);
     builder->scene = scene;
-    builder->override = override;
+    if (options) {
+        builder->override = options->camera;
+        builder->auto_projection = options->auto_projection;
+        builder->auto_aspect = options->auto_aspect;
+        builder->orbit_degrees = options->orbit_degrees;
+    }
 }
 
 void ptr_builder_free(PtrSceneBuilder *builder)
@@ -17,15 +23,43 @@ void ptr_builder_free(PtrSceneBuilder *builder)
     free(builder->spheres);
     free(builder->materials);
     free(builder->colors);
+    free(builder->values);
     builder->spheres = NULL;
     builder->materials = NULL;
     builder->colors = NULL;
+    builder->values = NULL;
     builder->count = builder->capacity = 0;
+}
+
+/* The optional per-sphere arrays (width floats a sphere, and the value of a
+ * sphere that has none): they exist from the first sphere that has one. */
+enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
+static const struct {
+    size_t offset;
+    int width;
+    float none;
+} optional_arrays[] = {
+    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 3, 1.0f }, /* white */
+    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, NAN },
+};
+
+static float **optional_array(PtrSceneBuilder *b, size_t k)
+{
+    return (float **)((char *)b + optional_arrays[k].offset);
+}
+
+/* Entries from .. to - 1 of optional array k get its value for none. */
+static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
+{
+    const int width = optional_arrays[k].width;
+    for (size_t i = from * (size_t)width; i < to * (size_t)width; i++)
+        (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material)
 {
+    const size_t optionals = sizeof optional_arrays / sizeof optional_arrays[0];
     if (b->count == b->capacity) {
         size_t capacity = b->capacity ? 2 * b->capacity : 64;
         double *spheres = realloc(b->spheres, capacity * 4 * sizeof *spheres);
@@ -36,17 +70,21 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
         if (!materials)
             return PTR_ERR_NOMEM;
         b->materials = materials;
-        if (b->colors) {
-            float *colors = realloc(b->colors, capacity * 3 * sizeof *colors);
-            if (!colors)
+        for (size_t k = 0; k < optionals; k++) {
+            float **array = optional_array(b, k);
+            if (!*array)
+                continue;
+            float *grown = realloc(*array, capacity * (size_t)optional_arrays[k].width *
+                                               sizeof *grown);
+            if (!grown)
                 return PTR_ERR_NOMEM;
-            b->colors = colors;
+            *array = grown;
         }
         b->capacity = capacity;
     }
-    if (b->colors)
-        for (int k = 0; k < 3; k++)
-            b->colors[3 * b->count + k] = 1.0f;
+    for (size_t k = 0; k < optionals; k++)
+        if (*optional_array(b, k))
+            fill_none(b, k, b->count, b->count + 1);
     double *s = &b->spheres[4 * b->count];
     s[0] = centre[0];
     s[1] = centre[1];
@@ -56,17 +94,37 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     return PTR_OK;
 }
 
+/* Optional array k's entry for the sphere added last, the array created if
+ * it is the first. NULL if memory runs out. */
+static float *last_entry(PtrSceneBuilder *b, size_t k)
+{
+    float **array = optional_array(b, k);
+    const int width = optional_arrays[k].width;
+    if (!*array) {
+        *array = malloc(b->capacity * (size_t)width * sizeof **array);
+        if (!*array)
+            return NULL;
+        fill_none(b, k, 0, b->capacity);
+    }
+    return &(*array)[(b->count - 1) * (size_t)width];
+}
+
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
 {
-    if (!b->colors) {
-        b->colors = malloc(b->capacity * 3 * sizeof *b->colors);
-        if (!b->colors)
-            return PTR_ERR_NOMEM;
-        for (size_t i = 0; i < 3 * b->capacity; i++)
-            b->colors[i] = 1.0f;
-    }
+    float *entry = last_entry(b, OPTIONAL_COLORS);
+    if (!entry)
+        return PTR_ERR_NOMEM;
     for (int k = 0; k < 3; k++)
-        b->colors[3 * (b->count - 1) + k] = (float)rgb[k];
+        entry[k] = (float)rgb[k];
+    return PTR_OK;
+}
+
+PtrResult ptr_builder_set_value(PtrSceneBuilder *b, double value)
+{
+    float *entry = last_entry(b, OPTIONAL_VALUES);
+    if (!entry)
+        return PTR_ERR_NOMEM;
+    *entry = (float)value;
     return PTR_OK;
 }
 
@@ -103,30 +161,138 @@ static void use_override(PtrSceneBuilder *b)
     place_camera(b, c->lookfrom, c->lookat, c->up, &lens);
 }
 
-/* Far enough back along +Z that the bounding sphere of all spheres' box fits
- * a 40 degree vertical field of view (and so the wider horizontal one). */
-static void frame_spheres(PtrSceneBuilder *b)
+/* Share of the image's height or width (whichever binds) the automatic
+ * camera gives the spheres: a little margin, as molecular viewers leave. */
+#define FRAME_FILL 0.95
+#define DEG_TO_RAD (3.14159265358979323846 / 180.0)
+
+/* Which spheres the framing, the turntable's axis and the choice of huge
+ * spheres (below) consider: those whose radius is within SMALL_RATIO of the
+ * smallest. A ground of radius 1000 under spheres of 0.5 is not what a
+ * camera should frame. */
+#define SMALL_RATIO 16.0
+
+static double smallest_radius(const PtrSceneBuilder *b)
 {
-    double lo[3] = { 0, 0, 0 }, hi[3] = { 0, 0, 0 };
+    double smallest = INFINITY;
+    for (size_t i = 0; i < b->count; i++)
+        smallest = fmin(smallest, b->spheres[4 * i + 3]);
+    return smallest;
+}
+
+static int is_framed(const PtrSceneBuilder *b, size_t i, double smallest)
+{
+    return !(b->spheres[4 * i + 3] > SMALL_RATIO * smallest);
+}
+
+/* The box around the spheres the framing considers; 0 if there are none. */
+static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
+{
+    double smallest = smallest_radius(b);
+    int any = 0;
     for (size_t i = 0; i < b->count; i++) {
         const double *s = &b->spheres[4 * i];
+        if (!is_framed(b, i, smallest))
+            continue;
         for (int k = 0; k < 3; k++) {
-            lo[k] = i ? fmin(lo[k], s[k] - s[3]) : s[k] - s[3];
-            hi[k] = i ? fmax(hi[k], s[k] + s[3]) : s[k] + s[3];
+            lo[k] = any ? fmin(lo[k], s[k] - s[3]) : s[k] - s[3];
+            hi[k] = any ? fmax(hi[k], s[k] + s[3]) : s[k] + s[3];
         }
+        any = 1;
     }
-    const double vfov_deg = 40.0;
-    double centre[3], diagonal2 = 0;
-    for (int k = 0; k < 3; k++) {
+    return any;
+}
+
+/* How a perspective camera looking down -Z with half-angle half_angle (in
+ * the plane of axis and Z) sees the spheres: the least eye z at which all of
+ * them lie inside the two planes bounding the view along that axis, and the
+ * eye's coordinate on the axis that centres them. A sphere (c, r) is inside
+ * the plane through the eye E with outward normal (cos a, sin a) iff
+ * (c_axis - E_axis) cos a + (c_z - E_z) sin a + r <= 0; the two planes give
+ * E_z sin a >= hi - E_axis cos a and E_z sin a >= lo + E_axis cos a, least
+ * when both hold with equality. */
+static void fit_axis(const PtrSceneBuilder *b, int axis, double half_angle, double *eye_axis,
+                     double *eye_z)
+{
+    double smallest = smallest_radius(b), hi = -INFINITY, lo = -INFINITY;
+    double ca = cos(half_angle), sa = sin(half_angle);
+    for (size_t i = 0; i < b->count; i++) {
+        const double *s = &b->spheres[4 * i];
+        if (!is_framed(b, i, smallest))
+            continue;
+        hi = fmax(hi, s[axis] * ca + s[2] * sa + s[3]);
+        lo = fmax(lo, -s[axis] * ca + s[2] * sa + s[3]);
+    }
+    *eye_axis = 0.5 * (hi - lo) / ca;
+    *eye_z = 0.5 * (hi + lo) / sa;
+}
+
+/* The automatic camera: looking down -Z, +Y up, placed so that the spheres'
+ * projection fills FRAME_FILL of the image along the axis that binds and is
+ * centred along both. Perspective has a 40 degree vertical field of view;
+ * orthographic views parallel rays from in front of every sphere. The
+ * image's aspect is the command line's, else the scene's resolution's,
+ * else 16:9, and the camera keeps it, so the image size follows. */
+static void frame_spheres(PtrSceneBuilder *b)
+{
+    const PtrScene *scene = b->scene;
+    double aspect = b->auto_aspect > 0   ? b->auto_aspect
+                    : scene->width > 0 ? (double)scene->width / scene->height
+                                       : 16.0 / 9.0;
+    double lo[3] = { -1, -1, -1 }, hi[3] = { 1, 1, 1 };
+    framed_box(b, lo, hi);
+    double centre[3];
+    for (int k = 0; k < 3; k++)
         centre[k] = 0.5 * (lo[k] + hi[k]);
-        diagonal2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    }
-    double bound = diagonal2 > 0 ? 0.5 * sqrt(diagonal2) : 1.0;
-    double distance = bound / sin(0.5 * vfov_deg * 3.14159265358979323846 / 180.0);
-    const double eye[3] = { centre[0], centre[1], centre[2] + distance };
     const double up[3] = { 0, 1, 0 };
-    const PtrCamera lens = { .vfov_deg = (float)vfov_deg, .focus_distance = (float)distance };
-    place_camera(b, eye, centre, up, &lens);
+    PtrCamera lens = { .projection = b->auto_projection, .aspect = (float)aspect };
+    double eye[3];
+    if (b->auto_projection == PTR_PROJECTION_ORTHOGRAPHIC) {
+        double half_height = fmax(hi[1] - lo[1], (hi[0] - lo[0]) / aspect) / (2 * FRAME_FILL);
+        lens.ymag = (float)half_height;
+        eye[0] = centre[0];
+        eye[1] = centre[1];
+        eye[2] = hi[2] + half_height;
+    } else {
+        const double vfov_deg = 40.0, tan_v = tan(0.5 * vfov_deg * DEG_TO_RAD);
+        if (b->count) {
+            double z_v, z_h;
+            fit_axis(b, 1, atan(FRAME_FILL * tan_v), &eye[1], &z_v);
+            fit_axis(b, 0, atan(FRAME_FILL * tan_v * aspect), &eye[0], &z_h);
+            eye[2] = fmax(z_v, z_h);
+        } else { /* nothing to frame: the unit sphere at the origin */
+            eye[0] = eye[1] = 0;
+            eye[2] = 1.0 / sin(0.5 * vfov_deg * DEG_TO_RAD);
+        }
+        lens.vfov_deg = (float)vfov_deg;
+        lens.focus_distance = (float)(eye[2] - centre[2]);
+    }
+    const double target[3] = { eye[0], eye[1], centre[2] };
+    place_camera(b, eye, target, up, &lens);
+}
+
+/* Turns p by the orbit about the vertical line through axis (x, z). */
+static void orbit_point(double p[3], double cos_t, double sin_t, const double axis[2])
+{
+    double x = p[0] - axis[0], z = p[2] - axis[1];
+    p[0] = axis[0] + cos_t * x + sin_t * z;
+    p[2] = axis[1] - sin_t * x + cos_t * z;
+}
+
+/* Turns the camera about the vertical axis (+Y) through the centre of the
+ * framed spheres' box, counter-clockwise seen from above. */
+static void orbit_camera(PtrSceneBuilder *b)
+{
+    if (b->orbit_degrees == 0)
+        return;
+    double lo[3] = { 0, 0, 0 }, hi[3] = { 0, 0, 0 };
+    framed_box(b, lo, hi);
+    const double axis[2] = { 0.5 * (lo[0] + hi[0]), 0.5 * (lo[2] + hi[2]) };
+    double t = b->orbit_degrees * DEG_TO_RAD, c = cos(t), s = sin(t);
+    const double through_origin[2] = { 0, 0 };
+    orbit_point(b->eye, c, s, axis);
+    orbit_point(b->target, c, s, axis);
+    orbit_point(b->up, c, s, through_origin); /* a direction */
 }
 
 static PtrVec3 relative(const double p[3], const double origin[3])
@@ -147,25 +313,18 @@ static PtrVec3 relative(const double p[3], const double origin[3])
  * (every ray tests them all). Marks them in huge[] (all zero on entry) and
  * returns how many. */
 #define HUGE_RATIO 256.0
-#define SMALL_RATIO 16.0
 
 static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigned char *huge)
 {
-    double smallest = INFINITY;
-    for (size_t i = 0; i < b->count; i++)
-        smallest = fmin(smallest, b->spheres[4 * i + 3]);
     double lo[3], hi[3];
     memcpy(lo, eye, sizeof lo);
     memcpy(hi, eye, sizeof hi);
-    for (size_t i = 0; i < b->count; i++) {
-        const double *s = &b->spheres[4 * i];
-        if (s[3] > SMALL_RATIO * smallest)
-            continue;
+    double around[2][3];
+    if (framed_box(b, around[0], around[1]))
         for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], s[k] - s[3]);
-            hi[k] = fmax(hi[k], s[k] + s[3]);
+            lo[k] = fmin(lo[k], around[0][k]);
+            hi[k] = fmax(hi[k], around[1][k]);
         }
-    }
     double extent = 0;
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
@@ -204,6 +363,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i)
         const float *rgb = &b->colors[3 * i];
         res = ptr_scene_set_sphere_color(scene, added, v3(rgb[0], rgb[1], rgb[2]));
     }
+    if (res == PTR_OK && b->values)
+        res = ptr_scene_set_sphere_value(scene, added, b->values[i]);
     return res;
 }
 
@@ -249,6 +410,7 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags)
         use_override(b);
     else if (!b->has_camera)
         frame_spheres(b);
+    orbit_camera(b);
     const double zero[3] = { 0, 0, 0 };
     const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : zero;
     memcpy(scene->origin, origin, sizeof scene->origin);

@@ -24,15 +24,20 @@ typedef struct PtrSceneBuilder {
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
     float *colors;    /* r, g, b of each sphere; NULL while none has its own */
+    float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
     size_t count, capacity;
     int has_camera;
     double eye[3], target[3], up[3];
     PtrCamera lens;   /* projection, field of view, aperture, focus, aspect */
     const PtrCameraSpec *override; /* the command line's camera, if any */
+    PtrProjection auto_projection;  /* see PtrImportOptions */
+    double auto_aspect, orbit_degrees;
 } PtrSceneBuilder;
 
-/* override (may be NULL): a camera that replaces any the file gives. */
-void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrCameraSpec *override);
+/* options (may be NULL) give the command line's camera, which replaces any
+ * the file gives, the automatic camera's projection and aspect, and the
+ * turntable's orbit. */
+void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImportOptions *options);
 void ptr_builder_free(PtrSceneBuilder *builder);
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
@@ -40,6 +45,9 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 
 /* Gives the sphere added last its own colour (see PtrSpheres.color). */
 PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
+
+/* Gives the sphere added last its value (see PtrSpheres.value). */
+PtrResult ptr_builder_set_value(PtrSceneBuilder *builder, double value);
 
 /* lens gives everything but the position and orientation. Ignored when the
  * builder has an override. */
@@ -57,7 +65,8 @@ typedef enum PtrBuildFlags {
 } PtrBuildFlags;
 
 /* Fills the scene's spheres and camera: the camera given, or one that frames
- * every sphere from +Z, looking down -Z. Frees the builder's memory. Returns
+ * the spheres from +Z, looking down -Z (see frame_spheres), then turned by
+ * the orbit. Frees the builder's memory. Returns
  * PTR_ERR_SCENE_INVALID if a sphere is too far from the camera for single
  * precision, PTR_ERR_NOMEM if memory runs out. */
 PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags);

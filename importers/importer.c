@@ -22,6 +22,15 @@ static const struct {
     { ".obj", ptr_import_obj },
 };
 
+/* Formats that a script turns into an instanced .glb (docs/scenes.md). */
+static const struct {
+    const char *extension, *script;
+} converters[] = {
+    { ".pdb", "molecule_to_glb.py" }, { ".ent", "molecule_to_glb.py" },
+    { ".xyz", "molecule_to_glb.py" }, { ".extxyz", "molecule_to_glb.py" },
+    { ".csv", "particles_to_glb.py" }, { ".ply", "particles_to_glb.py" },
+};
+
 void ptr_warn(PtrStrings *warnings, const char *fmt, ...)
 {
     char line[512];
@@ -83,11 +92,21 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
             if (S_ISREG(st.st_mode) && st.st_size == 0)
                 return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
             PtrResult r = importers[i].import(path, options, scene, warnings, err);
+            if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value)
+                r = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                                  "%s: no instance or point attribute '%s' (--color-by)", path,
+                                  options->value_attribute);
             if (r != PTR_OK)
                 ptr_scene_free(scene);
             return r;
         }
     }
+    for (size_t i = 0; dot && i < sizeof converters / sizeof converters[0]; i++)
+        if (!strcasecmp(dot, converters[i].extension))
+            return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                                 "%s: unknown scene format (expected .gltf, .glb or .obj); "
+                                 "scripts/%s converts this one to .glb", path,
+                                 converters[i].script);
     return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                          "%s: unknown scene format (expected .gltf, .glb or .obj)", path);
 }

@@ -11,8 +11,9 @@ emitted radiance. The camera node looks from `lookfrom` towards
 
 With --instanced, the spheres of one material are instead one node with
 EXT_mesh_gpu_instancing (TRANSLATION = centre, SCALE = radius, _COLOR_0 =
-albedo over a white base colour): the compact form for large sets, a few
-dozen bytes a sphere. Without a "camera" the file has none (ptr then frames
+albedo over a white base colour, and a float attribute for each of the
+sphere's "attributes", e.g. "_TEMPERATURE"): the compact form for large sets,
+a few dozen bytes a sphere. Without a "camera" the file has none (ptr then frames
 every sphere); "image" and "sky" are optional too.
 
 Usage: make_scenes.py [--instanced] INPUT.json OUTPUT.gltf|OUTPUT.glb
@@ -145,6 +146,14 @@ def add_instances(buffer, spheres, name):
         "_COLOR_0": buffer.add(b"".join(pack(*s.get("albedo", [1.0, 1.0, 1.0])) for s in spheres),
                                5126, n, "VEC3"),
     }
+    # Per-sphere quantities ("attributes": {"_NAME": number or [2 to 4 numbers]}),
+    # as Blender writes custom point attributes: float SCALAR or VECn.
+    for name, first in spheres[0].get("attributes", {}).items():
+        width = len(first) if isinstance(first, list) else 1
+        values = [s["attributes"][name] for s in spheres]
+        flat = [x for v in values for x in (v if width > 1 else [v])]
+        attributes[name] = buffer.add(struct.pack(f"<{len(flat)}f", *flat), 5126, n,
+                                      "SCALAR" if width == 1 else f"VEC{width}")
     return {"name": name, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attributes}}}
 
 

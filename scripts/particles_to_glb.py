@@ -24,10 +24,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import make_scenes  # noqa: E402  (the glTF writer)
 
 GREY = [0.8, 0.8, 0.8]
+PROGRAM = os.path.splitext(os.path.basename(sys.argv[0]))[0]  # for messages
 
 
 def fail(path, line, message):
-    raise SystemExit(f"particles_to_glb: {path}:{line}: {message}")
+    raise SystemExit(f"{PROGRAM}: {path}:{line}: {message}")
 
 
 def read_columns(path):
@@ -112,24 +113,50 @@ def read_ply(path):
     return particles
 
 
-def convert(particles, material):
+def convert(particles, material, attributes=None):
+    """The scene of particles [x, y, z, radius, (r, g, b)], each an instance of
+    material; attributes: {"_NAME": [a value (number, or 2 to 4 numbers) per
+    particle]}, written as per-instance attributes."""
     spheres = []
     for i, p in enumerate(particles):
         if not p[3] > 0:
-            raise SystemExit(f"particles_to_glb: particle {i}: radius {p[3]} is not positive")
-        spheres.append(dict(material, center=p[:3], radius=p[3], albedo=p[4:7] or GREY))
+            raise SystemExit(f"{PROGRAM}: particle {i}: radius {p[3]} is not positive")
+        extra = {name: values[i] for name, values in (attributes or {}).items()}
+        spheres.append(dict(material, center=p[:3], radius=p[3], albedo=p[4:7] or GREY,
+                            attributes=extra))
     return make_scenes.build({"name": "particles", "spheres": spheres,
                               "sky": {"type": "gradient"}}, instanced=True)
 
 
-def main():
-    args = sys.argv[1:]
+def take_option(args, flag, convert_value=float):
+    """The value after flag in args (both removed), or None without it."""
+    if flag not in args:
+        return None
+    i = args.index(flag)
+    if i + 1 >= len(args):
+        raise SystemExit(f"{PROGRAM}: {flag} needs a value")
+    try:
+        value = convert_value(args[i + 1])
+    except ValueError:
+        raise SystemExit(f"{PROGRAM}: {flag} {args[i + 1]}: not a number") from None
+    del args[i:i + 2]
+    return value
+
+
+def take_material(args):
+    """The material --metal FUZZ or --glass IOR asks for (removed from args),
+    else diffuse."""
     material = {"material": "lambertian"}
     for flag, kind, key in (("--metal", "metal", "fuzz"), ("--glass", "dielectric", "ior")):
-        if flag in args:
-            i = args.index(flag)
-            material = {"material": kind, key: float(args[i + 1])}
-            del args[i:i + 2]
+        value = take_option(args, flag)
+        if value is not None:
+            material = {"material": kind, key: value}
+    return material
+
+
+def main():
+    args = sys.argv[1:]
+    material = take_material(args)
     if len(args) != 2 or not args[1].endswith(".glb"):
         raise SystemExit(__doc__)
     source, output = args

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <strings.h>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -62,6 +63,16 @@ int primitive_attribute(const tinygltf::Primitive &p, const char *name)
 {
     auto it = p.attributes.find(name);
     return it == p.attributes.end() ? -1 : it->second;
+}
+
+// Whether an attribute's name is the one asked for (docs/scenes.md): the same
+// letters in any case, the leading underscore optional.
+bool attribute_named(const std::string &key, const char *name)
+{
+    const char *k = key.c_str();
+    if (*k == '_' && *name != '_')
+        k++;
+    return strcasecmp(k, name) == 0;
 }
 
 std::string required_extension_fault(const std::vector<std::string> &required)
@@ -496,6 +507,50 @@ extern "C" void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index
                           primitive_attribute(p, "POSITION"), primitive_attribute(p, "_RADIUS"),
                           primitive_attribute(p, "COLOR_0"),
                           p.extensions.count(draco_extension) > 0 };
+}
+
+extern "C" int gltf_doc_instance_attribute(const GltfDoc *doc, size_t node, const char *name)
+{
+    const tinygltf::Value *a = instancing_attributes(doc->model.nodes[node]);
+    if (!a || !a->IsObject())
+        return -1;
+    for (const std::string &key : a->Keys())
+        if (attribute_named(key, name)) {
+            int index = attribute(*a, key.c_str());
+            return in_range(index, doc->model.accessors.size()) ? index : -2;
+        }
+    return -1;
+}
+
+extern "C" int gltf_doc_primitive_attribute(const GltfDoc *doc, size_t mesh, size_t index,
+                                            const char *name)
+{
+    for (const auto &attr : doc->model.meshes[mesh].primitives[index].attributes)
+        if (attribute_named(attr.first, name))
+            return attr.second; /* every primitive attribute was checked at load */
+    return -1;
+}
+
+extern "C" void gltf_doc_custom_attributes(const GltfDoc *doc, char *out, size_t size)
+{
+    std::vector<std::string> names;
+    auto note = [&names](const std::string &name) {
+        if (name[0] == '_' && std::find(names.begin(), names.end(), name) == names.end())
+            names.push_back(name);
+    };
+    for (const tinygltf::Node &n : doc->model.nodes)
+        if (const tinygltf::Value *a = instancing_attributes(n))
+            if (a->IsObject())
+                for (const std::string &key : a->Keys())
+                    note(key);
+    for (const tinygltf::Mesh &mesh : doc->model.meshes)
+        for (const tinygltf::Primitive &p : mesh.primitives)
+            for (const auto &attr : p.attributes)
+                note(attr.first);
+    std::string list;
+    for (const std::string &name : names)
+        list += (list.empty() ? "" : ", ") + name;
+    snprintf(out, size, "%s", list.c_str());
 }
 
 extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *out)

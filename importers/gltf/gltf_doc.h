@@ -146,6 +146,16 @@ void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *material)
 void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *camera);
 void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index, GltfPrimitive *primitive);
 void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *accessor);
+/* The accessor of a node's EXT_mesh_gpu_instancing attribute, or of a
+ * primitive's attribute, named `name` in any case, its leading underscore
+ * optional (docs/scenes.md, --color-by): -1 if there is none, -2 if the
+ * node's names no accessor. */
+int gltf_doc_instance_attribute(const GltfDoc *doc, size_t node, const char *name);
+int gltf_doc_primitive_attribute(const GltfDoc *doc, size_t mesh, size_t index,
+                                 const char *name);
+/* The names of the file's instance and primitive attributes that start with
+ * '_', comma-separated, in out (cut to size); "" if there are none. */
+void gltf_doc_custom_attributes(const GltfDoc *doc, char *out, size_t size);
 /* Returns 0 if the file has no scene at all. */
 int gltf_doc_scene(const GltfDoc *doc, GltfScene *scene);
 

@@ -96,6 +96,7 @@ typedef struct Importer {
     uint32_t *material_index; /* glTF material -> scene material, UINT32_MAX unset */
     uint32_t default_material;
     int warned_texture;
+    const char *value_name; /* the attribute --color-by asks for, or NULL */
 } Importer;
 
 static const char *label(const char *name, const char *fallback)
@@ -176,7 +177,7 @@ static double largest_scale(const Mat4 *world, Importer *im, const Origin *o, in
 }
 
 static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3], double radius,
-                            uint32_t material, const double *color)
+                            uint32_t material, const double *color, const double *value)
 {
     float r = (float)radius;
     if (!(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3)) {
@@ -187,7 +188,8 @@ static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3
                              "is not positive and finite", im->path, where);
     }
     if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK ||
-        (color && ptr_builder_set_color(&im->builder, color) != PTR_OK))
+        (color && ptr_builder_set_color(&im->builder, color) != PTR_OK) ||
+        (value && ptr_builder_set_value(&im->builder, *value) != PTR_OK))
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return PTR_OK;
 }
@@ -195,7 +197,7 @@ static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3
 /* The sphere of a node's mesh surface under world. */
 static PtrResult add_surface_sphere(Importer *im, const Origin *o, const GltfNode *node,
                                     const GltfMesh *mesh, const Mat4 *world, const double *color,
-                                    int *warned)
+                                    const double *value, int *warned)
 {
     double centre[3], radius;
     if (node->has_radius) {
@@ -217,7 +219,7 @@ static PtrResult add_surface_sphere(Importer *im, const Origin *o, const GltfNod
     }
     uint32_t material = 0;
     PtrResult res = map_material(im, mesh->material, &material);
-    return res != PTR_OK ? res : add_sphere(im, o, centre, radius, material, color);
+    return res != PTR_OK ? res : add_sphere(im, o, centre, radius, material, color, value);
 }
 
 /* What kinds of stored numbers an attribute accepts. */
@@ -283,10 +285,45 @@ static void element(const GltfAccessor *a, size_t i, double out[4])
     }
 }
 
-/* The spheres of a POINTS primitive under world (times color, if any). */
+/* Checks the accessor of the attribute --color-by names (index from
+ * gltf_doc_*_attribute: -2 if it names no accessor) as o's `what`. */
+static PtrResult value_accessor(Importer *im, const Origin *o, const char *what, int index,
+                                size_t *count, GltfAccessor *a)
+{
+    if (index == -2) {
+        char where[160];
+        origin_text(o, where, sizeof where);
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: %s: %s attribute '%s' refers to an accessor that does not "
+                             "exist", im->path, where, what, im->value_name);
+    }
+    return attribute_accessor(im, o, im->value_name, index, 1, 4, QUANTIZED, count, a);
+}
+
+/* Element i of a value accessor: the number, or the length of a vector
+ * (docs/scenes.md); refused unless finite. o names element i. */
+static PtrResult read_value(Importer *im, const Origin *o, const GltfAccessor *a, size_t i,
+                            double *value)
+{
+    double v[4], sum = 0;
+    element(a, i, v);
+    for (int c = 0; c < a->components; c++)
+        sum += v[c] * v[c];
+    *value = a->components == 1 ? v[0] : sqrt(sum);
+    if (isfinite(*value))
+        return PTR_OK;
+    char where[160];
+    origin_text(o, where, sizeof where);
+    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: %s: attribute '%s' is not finite",
+                         im->path, where, im->value_name);
+}
+
+/* The spheres of a POINTS primitive under world (times color, if any), each
+ * with its own value of the attribute value_index (-1: none) names, else
+ * value (if any). */
 static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfNode *node,
-                            const GltfPrimitive *prim, const Mat4 *world, const double *color,
-                            int *warned)
+                            const GltfPrimitive *prim, int value_index, const Mat4 *world,
+                            const double *color, const double *value, int *warned)
 {
     if (prim->radius < 0 && !node->has_radius)
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
@@ -312,6 +349,9 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
     if (res == PTR_OK && prim->color >= 0)
         res = attribute_accessor(im, node_origin, "COLOR_0", prim->color, 3, 4,
                                  FLOATS_OR_UNSIGNED, &count, &col);
+    GltfAccessor val;
+    if (res == PTR_OK && value_index != -1)
+        res = value_accessor(im, node_origin, "point", value_index, &count, &val);
     uint32_t material = 0;
     if (res == PTR_OK)
         res = map_material(im, prim->material, &material);
@@ -321,7 +361,7 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
     Origin o = *node_origin;
     o.part = "point";
     for (size_t i = 0; i < count && res == PTR_OK; i++) {
-        double p[4], r[4], c[4], centre[3], rgb[3];
+        double p[4], r[4], c[4], centre[3], rgb[3], own_value;
         element(&pos, i, p);
         mat4_point(world, p, centre);
         if (prim->radius >= 0)
@@ -334,8 +374,12 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
                 rgb[k] = c[k] * (color ? color[k] : 1.0);
         }
         o.part_index = i;
-        res = add_sphere(im, &o, centre, r[0] * scale, material,
-                         prim->color >= 0 ? rgb : color);
+        if (value_index != -1)
+            res = read_value(im, &o, &val, i, &own_value);
+        if (res == PTR_OK)
+            res = add_sphere(im, &o, centre, r[0] * scale, material,
+                             prim->color >= 0 ? rgb : color,
+                             value_index != -1 ? &own_value : value);
     }
     return res;
 }
@@ -343,16 +387,19 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
 /* A node's spheres under world: its surface's and its points'. */
 static PtrResult add_mesh_spheres(Importer *im, const Origin *o, const GltfNode *node,
                                   const GltfMesh *mesh, const Mat4 *world, const double *color,
-                                  int *warned)
+                                  const double *value, int *warned)
 {
     PtrResult res = PTR_OK;
     if (mesh->has_surface)
-        res = add_surface_sphere(im, o, node, mesh, world, color, warned);
+        res = add_surface_sphere(im, o, node, mesh, world, color, value, warned);
     for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        int value_index = im->value_name ? gltf_doc_primitive_attribute(
+                                               im->doc, (size_t)node->mesh, p, im->value_name)
+                                         : -1;
         if (prim.points)
-            res = add_points(im, o, node, &prim, world, color, warned);
+            res = add_points(im, o, node, &prim, value_index, world, color, value, warned);
     }
     return res;
 }
@@ -410,6 +457,12 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
     if (res == PTR_OK && in->color >= 0)
         res = attribute_accessor(im, o, "_COLOR_0", in->color, 3, 4, FLOATS_OR_UNSIGNED, &count,
                                  &c);
+    int value_index = im->value_name
+                          ? gltf_doc_instance_attribute(im->doc, o->node_index, im->value_name)
+                          : -1;
+    GltfAccessor v;
+    if (res == PTR_OK && value_index != -1)
+        res = value_accessor(im, o, "instance", value_index, &count, &v);
     Origin instance = *o;
     instance.part = "instance";
     for (size_t i = 0; i < count && res == PTR_OK; i++) {
@@ -424,11 +477,15 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
                                  "scale that is not positive", im->path, where);
         }
         instance_world = mat4_mul(world, &local);
-        double color[4];
+        double color[4], value;
         if (in->color >= 0)
             element(&c, i, color);
-        res = add_mesh_spheres(im, &instance, node, mesh, &instance_world,
-                               in->color >= 0 ? color : NULL, warned);
+        if (value_index != -1)
+            res = read_value(im, &instance, &v, i, &value);
+        if (res == PTR_OK)
+            res = add_mesh_spheres(im, &instance, node, mesh, &instance_world,
+                                   in->color >= 0 ? color : NULL,
+                                   value_index != -1 ? &value : NULL, warned);
     }
     return res;
 }
@@ -442,7 +499,7 @@ static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNod
     int warned = 0;
     if (node->instanced)
         return add_instances(im, &o, node, &mesh, world, &warned);
-    return add_mesh_spheres(im, &o, node, &mesh, world, NULL, &warned);
+    return add_mesh_spheres(im, &o, node, &mesh, world, NULL, NULL, &warned);
 }
 
 /* The projection of a glTF camera, in the scene's terms; 0 if a value is out
@@ -642,8 +699,9 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .path = path, .doc = doc, .scene = scene, .warnings = warnings, .err = err,
         .camera_name = options ? options->camera_name : NULL,
         .default_material = UINT32_MAX,
+        .value_name = options ? options->value_attribute : NULL,
     };
-    ptr_builder_init(&im.builder, scene, options ? options->camera : NULL);
+    ptr_builder_init(&im.builder, scene, options);
     size_t materials = gltf_doc_material_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     PtrResult res = PTR_OK;
@@ -663,6 +721,14 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                             "%s: no camera named '%s' in the default scene", path,
                             im.camera_name);
+    if (res == PTR_OK && im.value_name && !im.builder.values) {
+        char names[256];
+        gltf_doc_custom_attributes(doc, names, sizeof names);
+        res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                            "%s: no instance or point attribute '%s' (--color-by); %s%s", path,
+                            im.value_name, *names ? "the file has " : "the file has none",
+                            names);
+    }
     if (res == PTR_OK)
         check_far_plane(&im);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)

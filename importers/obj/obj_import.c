@@ -398,7 +398,7 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
     const Parts *parts = r->objects.named || !r->groups.named ? &r->objects : &r->groups;
     const char *base = strrchr(r->path, '/') ? strrchr(r->path, '/') + 1 : r->path;
     PtrSceneBuilder builder;
-    ptr_builder_init(&builder, scene, options ? options->camera : NULL);
+    ptr_builder_init(&builder, scene, options);
     uint32_t grey = UINT32_MAX;
     size_t fitted = 0;
     PtrResult res = PTR_OK;

@@ -26,7 +26,10 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_sse41);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx2);
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_avx512);
 PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_avx2);
+PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_avx512);
 PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_avx2);
+PTR_DECL_BVH_CLOSEST_HIT_PACKET(ptr_bvh_closest_hit_packet_avx2);
+PTR_DECL_BVH_CLOSEST_HIT_PACKET(ptr_bvh_closest_hit_packet_avx512);
 #endif
 
 /* The arithmetic is ptr_sphere_hit's (sphere_hit.h), which says what the
@@ -53,13 +56,18 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c)
     return best_index != PTR_NO_HIT;
 }
 
-/* Lane by lane, the one-ray reference: the definition the packet kernels
+static PtrRay packet_lane(const PtrRayPacket *rays, int k)
+{
+    return (PtrRay){ { rays->org[0][k], rays->org[1][k], rays->org[2][k] }, rays->tmin[k],
+                     { rays->dir[0][k], rays->dir[1][k], rays->dir[2][k] }, rays->tmax[k] };
+}
+
+/* Lane by lane, the one-ray references: the definitions the packet kernels
  * must match. */
 PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c)
 {
     for (int k = 0; k < PTR_PACKET_LANES; k++) {
-        PtrRay ray = { { rays->org[0][k], rays->org[1][k], rays->org[2][k] }, rays->tmin[k],
-                       { rays->dir[0][k], rays->dir[1][k], rays->dir[2][k] }, rays->tmax[k] };
+        const PtrRay ray = packet_lane(rays, k);
         PtrHit hit;
         ptr_closest_hit_c(&ray, spheres, count, &hit);
         hits->t[k] = hit.t;
@@ -67,13 +75,23 @@ PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c)
     }
 }
 
-/* The tree traversal has an AVX2 version, which the AVX-512 level keeps:
- * no AVX-512 machine was at hand to check one (docs/intersectors.md). */
+PTR_DECL_BVH_CLOSEST_HIT_PACKET(ptr_bvh_closest_hit_packet_c)
+{
+    for (int k = 0; k < PTR_PACKET_LANES; k++) {
+        const PtrRay ray = packet_lane(rays, k);
+        PtrHit hit;
+        ptr_bvh_closest_hit_c(&ray, bvh, spheres, &hit);
+        hits->t[k] = hit.t;
+        hits->sphere[k] = hit.sphere;
+    }
+}
+
 void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
 {
     table->closest_hit = ptr_closest_hit_c;
     table->bvh_closest_hit = ptr_bvh_closest_hit_c;
     table->closest_hit_packet = ptr_closest_hit_packet_c;
+    table->bvh_closest_hit_packet = ptr_bvh_closest_hit_packet_c;
     table->name = "c";
     table->level = level;
 #if PTR_HAVE_ASM
@@ -86,10 +104,13 @@ void ptr_isect_init_level(PtrIsectTable *table, PtrCpuLevel level)
     table->closest_hit = ptr_closest_hit_avx2;
     table->bvh_closest_hit = ptr_bvh_closest_hit_avx2;
     table->closest_hit_packet = ptr_closest_hit_packet_avx2;
+    table->bvh_closest_hit_packet = ptr_bvh_closest_hit_packet_avx2;
     table->name = "avx2";
     if (level < PTR_CPU_AVX512)
         return;
     table->closest_hit = ptr_closest_hit_avx512;
+    table->bvh_closest_hit = ptr_bvh_closest_hit_avx512;
+    table->bvh_closest_hit_packet = ptr_bvh_closest_hit_packet_avx512;
     table->name = "avx512";
 #else
     (void)level;

@@ -55,6 +55,14 @@ typedef struct PtrHitPacket {
 
 typedef PTR_DECL_CLOSEST_HIT_PACKET((*PtrClosestHitPacketFn));
 
+/* The same for the tree: lane k of the answer is exactly what
+ * PTR_DECL_BVH_CLOSEST_HIT answers for lane k's ray. */
+#define PTR_DECL_BVH_CLOSEST_HIT_PACKET(name)                                 \
+    void name(const PtrRayPacket *rays, const PtrBvh *bvh,                    \
+              const PtrSpheres *spheres, PtrHitPacket *hits)
+
+typedef PTR_DECL_BVH_CLOSEST_HIT_PACKET((*PtrBvhClosestHitPacketFn));
+
 typedef enum PtrKernel {
     PTR_KERNEL_AUTO, /* the fastest at the CPU level in force */
     PTR_KERNEL_C,    /* the portable reference */
@@ -65,6 +73,7 @@ typedef struct PtrIsectTable {
     PtrClosestHitFn closest_hit;
     PtrBvhClosestHitFn bvh_closest_hit;
     PtrClosestHitPacketFn closest_hit_packet;
+    PtrBvhClosestHitPacketFn bvh_closest_hit_packet;
     const char *name;  /* which implementation closest_hit is: "c", "avx2", ... */
     PtrCpuLevel level; /* the CPU level the table is for (closest_hit may be
                         * narrower: see ptr_isect_init) */
@@ -86,5 +95,6 @@ int ptr_isect_has_asm(void);
 /* The reference implementations. */
 PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c);
 PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c);
+PTR_DECL_BVH_CLOSEST_HIT_PACKET(ptr_bvh_closest_hit_packet_c);
 
 #endif /* PTR_ISECT_H */

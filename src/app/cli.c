@@ -2,10 +2,11 @@
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
-#include <sys/stat.h>
 
+#include "app/batch.h"
+#include "app/claim.h"
 #include "app/cli_options.h"
+#include "app/color_by.h"
 #include "app/job.h"
 #include "app/live_view.h"
 #include "app/merge.h"
@@ -19,51 +20,10 @@
 #include "image/image.h"
 #include "importer.h"
 
-enum { PATH_SIZE = 4096 };
-
 static int fail(const PtrError *err)
 {
     fprintf(stderr, "ptr: %s\n", err->message);
     return ptr_result_exit_code(err->code);
-}
-
-/* The output for one scene: -o with {name} replaced by the scene's name; a
- * folder (existing, or written with a trailing /) gets NAME.exr; a plain
- * file name serves one scene only. */
-static PtrResult output_for(const PtrOptions *o, const char *scene, char *out, PtrError *err)
-{
-    const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
-    const char *dot = strrchr(base, '.');
-    int name_len = (int)(dot && dot != base ? (size_t)(dot - base) : strlen(base));
-    struct stat st;
-    size_t len = strlen(o->output);
-    int folder = (len > 0 && o->output[len - 1] == '/') ||
-                 (stat(o->output, &st) == 0 && S_ISDIR(st.st_mode));
-    int n;
-    if (strstr(o->output, "{name}")) {
-        const char *at = o->output, *hit;
-        out[0] = '\0';
-        n = 0;
-        while ((hit = strstr(at, "{name}")) && n < PATH_SIZE) {
-            n += snprintf(out + n, (size_t)(PATH_SIZE - n), "%.*s%.*s", (int)(hit - at), at,
-                          name_len, base);
-            at = hit + 6;
-        }
-        if (n < PATH_SIZE)
-            n += snprintf(out + n, (size_t)(PATH_SIZE - n), "%s", at);
-    } else if (folder) {
-        n = snprintf(out, PATH_SIZE, "%s%s%.*s.exr", o->output,
-                     o->output[len - 1] == '/' ? "" : "/", name_len, base);
-    } else if (o->input_count > 1) {
-        return ptr_error_set(err, PTR_ERR_USAGE,
-                             "-o %s: with several scenes, -o must be a folder or a pattern with {name}",
-                             o->output);
-    } else {
-        n = snprintf(out, PATH_SIZE, "%s", o->output);
-    }
-    if (n >= PATH_SIZE)
-        return ptr_error_set(err, PTR_ERR_USAGE, "-o %s: the output path is too long", o->output);
-    return PTR_OK;
 }
 
 static int dump_scenes(const PtrOptions *o)
@@ -80,6 +40,9 @@ static int dump_scenes(const PtrOptions *o)
         if (res == PTR_OK) {
             if (o->has_sky)
                 scene.sky = o->sky;
+            res = ptr_color_by_apply(o, o->inputs[i], &scene, NULL, &err);
+        }
+        if (res == PTR_OK) {
             res = ptr_scene_write_json(stdout, o->inputs[i], &scene, &warnings);
             if (res != PTR_OK)
                 ptr_error_set(&err, res, "%s: %s", o->inputs[i], ptr_result_description(res));
@@ -104,48 +67,68 @@ static int finish_job(const PtrOptions *o, PtrJobReport *report)
     return ptr_result_exit_code(report->result);
 }
 
+/* With --skip-existing: whether to render item, having claimed it. */
+static int claim_item(const PtrOptions *o, const PtrBatchItem *item, int *code)
+{
+    char holder[300];
+    PtrError err = { 0 };
+    switch (ptr_claim_take(item->output, holder, sizeof holder, &err)) {
+    case PTR_CLAIM_TAKEN: return 1;
+    case PTR_CLAIM_EXISTS:
+        if (!o->quiet)
+            fprintf(stderr, "ptr: %s exists: skipped\n", item->output);
+        return 0;
+    case PTR_CLAIM_BUSY:
+        if (!o->quiet)
+            fprintf(stderr, "ptr: %s is being rendered by %s: skipped\n", item->output,
+                    holder[0] ? holder : "another process");
+        return 0;
+    case PTR_CLAIM_FAILED: break;
+    }
+    *code = fail(&err);
+    return 0;
+}
+
 static int render_all(const PtrOptions *o, const PtrColor *color)
 {
     PtrError err = { 0 };
-    char (*outputs)[PATH_SIZE] = calloc((size_t)o->input_count, PATH_SIZE);
-    PtrJobReport *reports = calloc((size_t)o->input_count, sizeof *reports);
-    int code = 0, done = 0;
-    if (!outputs || !reports) {
+    PtrBatchItem *items;
+    int count;
+    if (ptr_batch_plan(o, &items, &count, &err) != PTR_OK)
+        return fail(&err);
+    PtrJobReport *reports = calloc((size_t)count, sizeof *reports);
+    if (!reports) {
+        ptr_batch_free(items, count);
         ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
-        code = fail(&err);
-        goto end;
+        return fail(&err);
     }
-    /* Every output is settled before anything renders. */
-    for (int i = 0; i < o->input_count; i++) {
-        if (output_for(o, o->inputs[i], outputs[i], &err) == PTR_OK)
-            ptr_output_check(outputs[i], o->depth, &err);
-        for (int j = 0; err.code == PTR_OK && j < i; j++)
-            if (!strcmp(outputs[i], outputs[j]))
-                ptr_error_set(&err, PTR_ERR_USAGE, "%s and %s would both be written to %s",
-                              o->inputs[j], o->inputs[i], outputs[i]);
-        if (err.code != PTR_OK) {
-            code = fail(&err);
-            goto end;
+    int code = 0, done = 0, failed = 0;
+    for (int i = 0; i < count && !ptr_stop_requested; i++) {
+        int claim_code = 0;
+        if (o->skip_existing && !claim_item(o, &items[i], &claim_code)) {
+            failed += claim_code != 0;
+            code = claim_code ? claim_code : code;
+            continue;
         }
-    }
-    int failed = 0;
-    for (; done < o->input_count && !ptr_stop_requested; done++) {
-        ptr_job_render(o, o->inputs[done], outputs[done], color, NULL, &reports[done]);
+        PtrOptions frame = *o;
+        frame.orbit_degrees = items[i].orbit_degrees;
+        ptr_job_render(&frame, items[i].scene, items[i].output, color, NULL, &reports[done]);
+        if (o->skip_existing)
+            ptr_claim_release(items[i].output);
         code = finish_job(o, &reports[done]);
-        failed += reports[done].result != PTR_OK;
+        failed += reports[done++].result != PTR_OK;
     }
-    if (o->input_count > 1) {
-        if (!o->quiet)
+    if (count > 1) {
+        if (!o->quiet && done > 0)
             ptr_report_summary(stderr, reports, done);
         code = ptr_stop_requested ? ptr_result_exit_code(PTR_ERR_INTERRUPTED)
                : failed           ? ptr_result_exit_code(PTR_ERR_BATCH)
                                   : 0;
     }
-end:
-    for (int i = 0; reports && i < done; i++)
+    for (int i = 0; i < done; i++)
         ptr_job_report_free(&reports[i]);
     free(reports);
-    free(outputs);
+    ptr_batch_free(items, count);
     return code;
 }
 
@@ -153,10 +136,10 @@ end:
  * broken save is reported and the last good image kept. */
 static int watch_scene(const PtrOptions *o, const PtrColor *color)
 {
-    char output[PATH_SIZE];
+    char output[PTR_PATH_SIZE];
     PtrError err = { 0 };
-    if (output_for(o, o->inputs[0], output, &err) != PTR_OK ||
-        ptr_output_check(output, o->depth, &err) != PTR_OK)
+    if (ptr_batch_output(o, o->inputs[0], output, &err) != PTR_OK ||
+        ptr_output_check(output, o->depth, o->transparent, &err) != PTR_OK)
         return fail(&err);
     PtrWatch watch = { 0 };
     int code = 0;
@@ -199,14 +182,18 @@ int ptr_cli_main(int argc, char **argv)
      * loads on a thread of its own while the colour config, the scenes and
      * the render proceed. The tree's and the render's threads start first:
      * no thread can start while the load runs. */
-    char first_output[PATH_SIZE];
+    char first_output[PTR_PATH_SIZE];
     if (!o.list_views) {
         int threads = o.threads > 0 ? o.threads : ptr_online_cpus();
         ptr_threads_keep(threads);
+        if (o.skip_existing && !ptr_claim_keeper_start()) {
+            ptr_error_set(&err, PTR_ERR_NOMEM, "cannot start the thread that keeps claims fresh");
+            return fail(&err);
+        }
         if (ptr_image_set_threads(threads, &err) != PTR_OK)
             return fail(&err);
         const char *output = o.merge ? o.output
-                             : output_for(&o, o.inputs[0], first_output, &err) == PTR_OK
+                             : ptr_batch_output(&o, o.inputs[0], first_output, &err) == PTR_OK
                                  ? first_output
                                  : NULL;
         if (output && ptr_image_preload(output, &err) != PTR_OK)
@@ -248,5 +235,6 @@ int ptr_cli_main(int argc, char **argv)
         ptr_live_view_close();
     }
     ptr_color_close(color);
+    ptr_claim_keeper_stop();
     return code;
 }

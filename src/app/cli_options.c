@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/batch.h"
 #include "app/cli_help.h"
 #include "base/cpu.h"
 
@@ -176,6 +177,24 @@ static int set_region(OptionId id, const char *value, PtrOptions *o)
     return GO_ON;
 }
 
+static int set_frames(OptionId id, const char *value, PtrOptions *o)
+{
+    long a, b, step = 1;
+    int end = 0, with_step = 0;
+    /* %n after each form: the whole text must be A:B or A:B:STEP. */
+    int n = sscanf(value, "%ld:%ld%n:%ld%n", &a, &b, &end, &step, &with_step);
+    if (n == 3)
+        end = with_step;
+    if (n < 2 || value[end] || value[0] < '0' || value[0] > '9' || a < 0 || b < a ||
+        b > 1000000000L || step < 1)
+        return bad_value(id, value, "A:B or A:B:STEP with 0 <= A <= B <= 10^9, STEP >= 1");
+    o->has_frames = 1;
+    o->frame_first = a;
+    o->frame_last = b;
+    o->frame_step = step;
+    return GO_ON;
+}
+
 /* Takes one option (and its value, if it has one) into o. Returns GO_ON,
  * else the exit code: 0 after printing what replaces the render, a usage
  * error after reporting it. The cases follow the table; the switch has no
@@ -194,6 +213,7 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
         break;
     case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width);
     case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height);
+    case OPT_transparent: o->transparent = 1; break;
     case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))
@@ -254,7 +274,33 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
             return bad_value(id, value, "a distance above 0");
         o->camera.focus_distance = x;
         break;
+    case OPT_auto_camera:
+        if (strcmp(value, "perspective") && strcmp(value, "orthographic"))
+            return bad_value(id, value, "perspective or orthographic");
+        o->auto_camera = strcmp(value, "perspective") ? PTR_PROJECTION_ORTHOGRAPHIC
+                                                      : PTR_PROJECTION_PERSPECTIVE;
+        break;
     case OPT_fit_all_objects: o->fit_all_objects = 1; break;
+    case OPT_color_by:
+        if (!*value)
+            return bad_value(id, value, "an attribute name");
+        o->color_by = value;
+        break;
+    case OPT_colormap:
+        o->colormap = ptr_colormap_find(value);
+        if (!o->colormap)
+            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm");
+        break;
+    case OPT_color_range: {
+        char tail;
+        double *r = o->color_range;
+        if (sscanf(value, "%lf,%lf%c", &r[0], &r[1], &tail) != 2 || !isfinite(r[0]) ||
+            !isfinite(r[1]) || !(r[0] < r[1]))
+            return bad_value(id, value, "MIN,MAX (finite numbers, MIN below MAX)");
+        o->has_color_range = 1;
+        break;
+    }
+    case OPT_color_bar: o->color_bar = value; break;
     case OPT_accel:
         if (!ptr_accel_parse(value, &o->accel))
             return bad_value(id, value, "auto, brute or bvh");
@@ -300,6 +346,9 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_watch: o->watch = 1; break;
     case OPT_live: o->live = value; break;
     case OPT_tev: o->tev = value; break;
+    case OPT_frames: return set_frames(id, value, o);
+    case OPT_turntable: return set_int(id, value, 1, PTR_MAX_FRAMES, &o->turntable);
+    case OPT_skip_existing: o->skip_existing = 1; break;
     case OPT_json: o->json = 1; break;
     case OPT_quiet: o->quiet = 1; break;
     case OPT_dump_scene: o->dump_scene = 1; break;
@@ -345,12 +394,18 @@ static const char *usage_problem(const PtrOptions *o)
     /* Parallel rays have no lens: rather than ignore a lens asked for, say so. */
     if ((o->has_camera & CAMERA_ORTHO) && o->camera.aperture > 0)
         return "--ortho has no depth of field: leave out --aperture";
+    if (!o->color_by && (o->colormap || o->has_color_range || o->color_bar))
+        return "--colormap, --color-range and --color-bar need --color-by";
     if (o->input_count == 0)
         return o->merge ? "no parts given" : "no scene file given";
     if (!o->output && !o->dump_scene)
         return "no output given (-o)";
     if (o->watch && o->input_count > 1)
         return "--watch takes one scene";
+    if (o->watch && (o->turntable || o->has_frames || o->skip_existing ||
+                     strchr(o->inputs[0], '#')))
+        return "--watch takes one scene, not a sequence (# patterns, --frames, --turntable, "
+               "--skip-existing)";
     if (o->merge && o->dump_scene)
         return "--dump-scene is not for merge";
     /* Stopping decisions need every sample of a pixel from the first on; a
@@ -394,6 +449,10 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .camera_name = o->camera_name,
         .camera = o->has_camera ? &o->camera : NULL,
         .fit_all_objects = o->fit_all_objects,
+        .value_attribute = o->color_by,
+        .auto_projection = o->auto_camera,
+        .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
+        .orbit_degrees = o->orbit_degrees,
         .dependencies = dependencies,
     };
 }

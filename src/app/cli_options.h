@@ -9,6 +9,7 @@
 #include "app/output.h"
 #include "importer.h"
 #include "render/render.h"
+#include "scene/colormap.h"
 #include "scene/scene.h"
 
 /* Defaults, as macros: the --help text spells them out. */
@@ -27,11 +28,18 @@ typedef struct PtrOptions {
     const char *camera_name;
     PtrCameraSpec camera;   /* --lookfrom ... */
     int has_camera;
+    PtrProjection auto_camera; /* the projection of a scene without a camera */
     int fit_all_objects;
+    const char *color_by;   /* --color-by: the attribute; NULL: none */
+    const PtrColormap *colormap;
+    int has_color_range;
+    double color_range[2];  /* --color-range MIN,MAX */
+    const char *color_bar;  /* --color-bar FILE */
     uint32_t samples;
     uint32_t sample_first;  /* --sample-range START:END sets both */
     uint64_t seed;
     int width, height;      /* 0: from the scene */
+    int transparent;        /* alpha 0 where camera rays meet no sphere */
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;
@@ -53,6 +61,11 @@ typedef struct PtrOptions {
     int preview;
     int watch;
     const char *live, *tev; /* [HOST:]PORT of the live view, of tev */
+    int has_frames;         /* --frames A:B:STEP */
+    long frame_first, frame_last, frame_step;
+    int turntable;          /* frames in a full turn; 0: none */
+    int skip_existing;
+    double orbit_degrees;   /* the camera's turn in the frame being rendered */
     int json;
     int quiet;
     int dump_scene;

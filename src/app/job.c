@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/color_by.h"
 #include "app/live_view.h"
 #include "app/output.h"
 #include "app/signals.h"
@@ -56,7 +57,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = o->integrator,
+        .integrator = o->integrator, .transparent = o->transparent,
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -80,15 +81,17 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
     size_t pixels = (size_t)layout.width * (size_t)layout.height;
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
-    if (!rgb || (o->noise_threshold > 0 && !counts)) {
+    float *alpha = o->transparent ? malloc(pixels * sizeof *alpha) : NULL;
+    if (!rgb || (o->noise_threshold > 0 && !counts) || (o->transparent && !alpha)) {
         free(rgb);
         free(counts);
+        free(alpha);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
                              report->output, layout.width, layout.height);
     }
     PtrProgressiveResult done;
-    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, counts, &done,
-                                           err);
+    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, alpha, counts,
+                                           &done, err);
     ptr_progress_done(&printer);
     if (res == PTR_ERR_SCENE_INVALID) {
         /* The renderer does not know where the scene came from. */
@@ -109,16 +112,25 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
             .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
             .direct_lighting = o->direct_lighting == PTR_ON,
             .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-            .sample_counts = counts, .render_seconds = done.stats.seconds, .depth = o->depth,
+            .sample_counts = counts, .alpha = alpha, .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
             .dither = o->dither,
         };
-        res = ptr_output_write(report->output, &layout, rgb, &info, err);
+        /* A frame of a sequence that --skip-existing resumes is written
+         * whole or not at all: an output that exists is never rendered again. */
+        if (!(done.stopped && o->skip_existing))
+            res = ptr_output_write(report->output, &layout, rgb, &info, err);
     }
     free(rgb);
     free(counts);
+    free(alpha);
     ptr_live_view_end(res == PTR_OK && !done.stopped);
-    if (res == PTR_OK && done.stopped)
+    if (res == PTR_OK && done.stopped && o->skip_existing)
+        res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
+                            "%s: interrupted after %u of %u samples; not written, so that "
+                            "--skip-existing renders it again", report->output,
+                            done.samples_done, report->samples_requested);
+    else if (res == PTR_OK && done.stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted; wrote the %u samples done of %u",
                             report->output, done.samples_done, report->samples_requested);
@@ -171,6 +183,9 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
     if (res == PTR_OK) {
         if (o->has_sky)
             scene.sky = o->sky;
+        res = ptr_color_by_apply(o, scene_path, &scene, color, &err);
+    }
+    if (res == PTR_OK) {
         res = render_and_write(o, &scene, color, report, &err);
     }
     ptr_scene_free(&scene);

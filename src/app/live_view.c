@@ -62,7 +62,7 @@ static void pass_done(void *user, const double *film, size_t pixels, const PtrPr
     (void)user;
     if (pixels != scratch_pixels)
         return;
-    ptr_accum_resolve(film, pixels, scratch, NULL);
+    ptr_accum_resolve(film, pixels, scratch, NULL, NULL);
     double per_sample = p->samples_done ? p->elapsed / p->samples_done : 0;
     last = (PtrLiveStatus){
         .samples_done = p->samples_done, .samples_total = p->samples_total,

@@ -91,6 +91,8 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
                                    a->layout.full_height != b->layout.full_height
                                ? "image size"
                                : NULL;
+        if (!what && !ptr_image_alpha(a->image) != !ptr_image_alpha(b->image))
+            what = "background (--transparent or not)";
         if (what)
             return ptr_error_set(err, PTR_ERR_USAGE, "%s: another %s than %s: not parts of one render",
                                  b->path, what, a->path);
@@ -120,18 +122,21 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
 {
     const int w = parts[0].layout.full_width, h = parts[0].layout.full_height;
     size_t pixels = (size_t)w * (size_t)h;
-    double *sum = calloc(pixels * 3, sizeof *sum);
+    /* Premultiplied colour and alpha alike are means over samples. */
+    const int channels = ptr_image_alpha(parts[0].image) ? 4 : 3;
+    double *sum = calloc(pixels * 4, sizeof *sum);
     long *n = calloc(pixels, sizeof *n);
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
+    float *alpha = channels == 4 ? malloc(pixels * sizeof *alpha) : NULL;
     PtrResult res = PTR_OK;
-    if (!sum || !n || !rgb) {
+    if (!sum || !n || !rgb || (channels == 4 && !alpha)) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", output);
         goto done;
     }
     long first = parts[0].first;
     for (int i = 0; i < count; i++) {
         const Part *p = &parts[i];
-        const float *px = ptr_image_pixels(p->image);
+        const float *px = ptr_image_pixels(p->image), *pa = ptr_image_alpha(p->image);
         first = p->first < first ? p->first : first;
         for (int y = 0; y < p->layout.height; y++)
             for (int x = 0; x < p->layout.width; x++) {
@@ -139,8 +144,9 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
                 if (fx < 0 || fy < 0 || fx >= w || fy >= h)
                     continue;
                 size_t at = (size_t)fy * (size_t)w + (size_t)fx;
-                for (int c = 0; c < 3; c++)
-                    sum[3 * at + c] += (double)px[3 * ((size_t)y * p->layout.width + x) + c] * p->samples;
+                size_t from = (size_t)y * p->layout.width + x;
+                for (int c = 0; c < channels; c++)
+                    sum[4 * at + c] += (double)(c < 3 ? px[3 * from + c] : pa[from]) * p->samples;
                 n[at] += p->samples;
             }
     }
@@ -154,7 +160,9 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         fewest = n[at] < fewest ? n[at] : fewest;
         most = n[at] > most ? n[at] : most;
         for (int c = 0; c < 3; c++)
-            rgb[3 * at + c] = (float)(sum[3 * at + c] / (double)n[at]);
+            rgb[3 * at + c] = (float)(sum[4 * at + c] / (double)n[at]);
+        if (alpha)
+            alpha[at] = (float)(sum[4 * at + 3] / (double)n[at]);
     }
     if (fewest != most)
         fprintf(stderr, "ptr: warning: %s: pixels hold %ld to %ld samples\n", output, fewest, most);
@@ -180,13 +188,15 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .min_samples = ptr_image_attr(parts[0].image, "ptr:min_samples")
                            ? (uint32_t)atol(ptr_image_attr(parts[0].image, "ptr:min_samples"))
                            : 0,
-        .color = color, .exposure = o->exposure, .bake_view = o->bake_view, .dither = o->dither,
+        .alpha = alpha, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
+        .dither = o->dither,
     };
     res = ptr_output_write(output, &full, rgb, &info, err);
 done:
     free(sum);
     free(n);
     free(rgb);
+    free(alpha);
     return res;
 }
 
@@ -203,7 +213,7 @@ PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOption
         res = read_part(&parts[i], &err);
     }
     if (res == PTR_OK)
-        res = ptr_output_check(output, o->depth, &err);
+        res = ptr_output_check(output, o->depth, ptr_image_alpha(parts[0].image) != NULL, &err);
     if (res == PTR_OK)
         res = check_parts(parts, count, &err);
     if (res == PTR_OK)

@@ -20,16 +20,17 @@
 typedef struct Format {
     const char *extension;
     PtrDepth depths[4];
+    int alpha; /* can store an alpha channel */
 } Format;
 
 static const Format formats[] = {
-    { ".exr", { PTR_DEPTH_FLOAT, PTR_DEPTH_HALF } },
-    { ".hdr", { PTR_DEPTH_FLOAT } },
-    { ".png", { PTR_DEPTH_8, PTR_DEPTH_16 } },
-    { ".jpg", { PTR_DEPTH_8 } },
-    { ".jpeg", { PTR_DEPTH_8 } },
-    { ".tif", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
-    { ".tiff", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT } },
+    { ".exr", { PTR_DEPTH_FLOAT, PTR_DEPTH_HALF }, 1 },
+    { ".hdr", { PTR_DEPTH_FLOAT }, 0 },
+    { ".png", { PTR_DEPTH_8, PTR_DEPTH_16 }, 1 },
+    { ".jpg", { PTR_DEPTH_8 }, 0 },
+    { ".jpeg", { PTR_DEPTH_8 }, 0 },
+    { ".tif", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT }, 1 },
+    { ".tiff", { PTR_DEPTH_8, PTR_DEPTH_16, PTR_DEPTH_HALF, PTR_DEPTH_FLOAT }, 1 },
 };
 
 /* The entry for path's extension, or NULL. */
@@ -70,9 +71,15 @@ static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
     return wanted == PTR_DEPTH_DEFAULT || wanted == PTR_DEPTH_8 ? PTR_DEPTH_8 : PTR_DEPTH_DEFAULT;
 }
 
-PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
+PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError *err)
 {
-    int known = find_format(path) != NULL;
+    const Format *format = find_format(path);
+    int known = format != NULL;
+    if (alpha && !(format && format->alpha))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "%s: a transparent image (--transparent) needs a format with "
+                             "alpha: .exr, .png or .tif",
+                             path);
     if (!known && ptr_image_ready(err) != PTR_OK)
         return err->code;
     if (!known && !ptr_image_can_write(path))
@@ -103,6 +110,15 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err)
     return PTR_OK;
 }
 
+/* Premultiplies rgb by alpha, or divides it by alpha (where alpha is 0,
+ * premultiplied colour is 0 and stays so); nothing if alpha is NULL. */
+static void scale_by_alpha(float *rgb, const float *alpha, size_t pixels, int premultiply)
+{
+    for (size_t p = 0; alpha && p < pixels; p++)
+        for (int c = 0; c < 3 && alpha[p] > 0.0f; c++)
+            rgb[3 * p + c] = premultiply ? rgb[3 * p + c] * alpha[p] : rgb[3 * p + c] / alpha[p];
+}
+
 PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err)
 {
@@ -111,17 +127,22 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
     int display_referred = !is_float || info->bake_view;
     size_t pixels = (size_t)layout->width * (size_t)layout->height;
 
+    const float *alpha = info->alpha;
+    int straight = alpha && !ptr_image_is_exr(path);
     float *viewed = NULL;
-    if (display_referred) {
+    if (display_referred || straight) {
         viewed = malloc(pixels * 3 * sizeof *viewed);
         if (!viewed)
             return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
         memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
+        scale_by_alpha(viewed, alpha, pixels, 0);
         PtrError color_err;
-        if (ptr_color_apply(info->color, viewed, pixels, &color_err) != PTR_OK) {
+        if (display_referred && ptr_color_apply(info->color, viewed, pixels, &color_err) != PTR_OK) {
             free(viewed);
             return ptr_error_set(err, color_err.code, "%s: %s", path, color_err.message);
         }
+        if (!straight)
+            scale_by_alpha(viewed, alpha, pixels, 1);
     }
 
     char seed[24], exposure[32], hash[24], spheres[24], threshold[32];
@@ -171,7 +192,7 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, info->sample_counts,
+    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, alpha, info->sample_counts,
                                     pixel_formats[depth], attrs, sizeof attrs / sizeof attrs[0], err);
     free(viewed);
     return res;

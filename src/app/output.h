@@ -36,6 +36,9 @@ typedef struct PtrOutputInfo {
     float noise_threshold; /* adaptive sampling; 0: off */
     uint32_t min_samples;
     const float *sample_counts; /* per pixel, written as an EXR channel (may be NULL) */
+    /* Per pixel, the share of its samples that were covered (may be NULL):
+     * the image's alpha, the RGB given then premultiplied by it. */
+    const float *alpha;
     double render_seconds;
     PtrDepth depth;
     const PtrColor *color; /* the display, view, look and exposure in force */
@@ -48,12 +51,16 @@ typedef struct PtrOutputInfo {
 int ptr_depth_parse(const char *text, PtrDepth *depth);
 
 /* Fails early, before any rendering, if no writer exists for the output's
- * extension or it cannot store that depth (PTR_ERR_USAGE), or its folder
- * cannot take the file (PTR_ERR_OUTPUT). */
-PtrResult ptr_output_check(const char *path, PtrDepth depth, PtrError *err);
+ * extension or it cannot store that depth, or an alpha channel if alpha is
+ * set (PTR_ERR_USAGE), or its folder cannot take the file (PTR_ERR_OUTPUT). */
+PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError *err);
 
 /* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
- * full image as layout says) as info says. The file is replaced atomically. */
+ * full image as layout says) as info says. The file is replaced atomically.
+ * With an alpha channel, EXR stores the colour premultiplied, as OpenEXR
+ * defines it, and every other format straight (divided by alpha); the view
+ * of an integer format is taken of the straight colour, as OpenColorIO's
+ * transforms expect. */
 PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
                            const PtrOutputInfo *info, PtrError *err);
 

@@ -1,5 +1,6 @@
 #include "app/scene_json.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "app/report.h"
@@ -59,6 +60,8 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
             fputs(", \"color\": ", out);
             write_vec(out, ptr_sphere_color(s, i));
         }
+        if (s->value && !isnan(s->value[i]))
+            fprintf(out, ", \"value\": %.9g", s->value[i]);
         fputc('}', out);
     }
     free(by_id);

@@ -28,8 +28,9 @@ static PtrCpuLevel detect(void)
     __cpuid_count(7, 0, a, b, c, d);
     if (!(b & bit_AVX2))
         return PTR_CPU_SSE41;
-    /* AVX-512 F, and XCR0 opmask (5), ZMM0-15 upper (6), ZMM16-31 (7) saved. */
-    if (!(b & bit_AVX512F) || (xgetbv_low() & 0xe6) != 0xe6)
+    /* AVX-512 F and VL (the tree's traversal runs it on ymm registers), and
+     * XCR0 opmask (5), ZMM0-15 upper (6), ZMM16-31 (7) saved. */
+    if (!(b & bit_AVX512F) || !(b & bit_AVX512VL) || (xgetbv_low() & 0xe6) != 0xe6)
         return PTR_CPU_AVX2;
     return PTR_CPU_AVX512;
 }

@@ -59,7 +59,7 @@ static int temporary_name(const char *path, char *tmp, size_t size)
 }
 
 PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                          const float *sample_counts, PtrPixelFormat format,
+                          const float *alpha, const float *sample_counts, PtrPixelFormat format,
                           const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
     const int exr = ptr_image_is_exr(path);
@@ -71,9 +71,9 @@ PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const 
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
     memcpy(partial_path, tmp, sizeof tmp);
     partial_active = 1;
-    PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, sample_counts, format, attrs,
-                                        attr_count, err)
-                        : m->write(tmp, path, layout, rgb, format, attrs, attr_count, err);
+    PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, alpha, sample_counts, format,
+                                        attrs, attr_count, err)
+                        : m->write(tmp, path, layout, rgb, alpha, format, attrs, attr_count, err);
     if (res == PTR_OK && rename(tmp, path) != 0)
         res = ptr_error_set(err, PTR_ERR_OUTPUT, "%s: cannot replace file: %s", path,
                             strerror(errno));
@@ -106,6 +106,7 @@ int ptr_image_width(const PtrImage *image) { return image->layout.width; }
 int ptr_image_height(const PtrImage *image) { return image->layout.height; }
 PtrImageLayout ptr_image_layout(const PtrImage *image) { return image->layout; }
 const float *ptr_image_pixels(const PtrImage *image) { return image->rgb; }
+const float *ptr_image_alpha(const PtrImage *image) { return image->alpha; }
 
 const char *ptr_image_attr(const PtrImage *image, const char *name)
 {

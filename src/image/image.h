@@ -66,22 +66,25 @@ PtrResult ptr_image_ready(PtrError *err);
 int ptr_image_can_write(const char *path);
 
 /* Writes RGB float pixels (rows top to bottom), stored in the file as format,
- * and for EXR, whose channels have names, a fourth float channel "samples"
- * from sample_counts if it is not NULL (other formats ignore it).
+ * with an alpha channel (A) from alpha if it is not NULL, and for EXR, whose
+ * channels have names, a float channel "samples" from sample_counts if it
+ * is not NULL (other formats ignore it). The pixels are written as given:
+ * the caller premultiplies them or not, as the format expects.
  * The file is created under a temporary name in the same directory and
  * renamed over path only once complete, so an existing file is replaced by a
  * whole new one or not at all. Returns PTR_OK; otherwise fills err with one
  * line and returns its code: PTR_ERR_OUTPUT, PTR_ERR_NOMEM, or what
  * ptr_image_ready says. */
 PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                          const float *sample_counts, PtrPixelFormat format,
+                          const float *alpha, const float *sample_counts, PtrPixelFormat format,
                           const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
 
 /* Removes the temporary file of a write under way, if any. Safe to call from
  * a signal handler: for a process that is about to _exit mid-write. */
 void ptr_image_discard_partial(void);
 
-/* An image read back as float RGB (extra channels dropped, grey replicated). */
+/* An image read back as float RGB (grey replicated) and its alpha channel,
+ * if it has one; other channels are dropped. */
 typedef struct PtrImage PtrImage;
 
 /* NULL on failure, with err filled: PTR_ERR_USAGE for a file that is not an
@@ -93,6 +96,8 @@ int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);
 PtrImageLayout ptr_image_layout(const PtrImage *image);
 const float *ptr_image_pixels(const PtrImage *image);
+/* One float a pixel, as stored; NULL if the image has no alpha channel. */
+const float *ptr_image_alpha(const PtrImage *image);
 
 /* A header attribute as text (numbers formatted), or NULL if absent. The
  * string lives as long as the image. */

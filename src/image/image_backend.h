@@ -20,6 +20,7 @@ extern "C" {
 struct PtrImage {
     PtrImageLayout layout;
     float *rgb;          /* layout.width x layout.height RGB, rows top to bottom */
+    float *alpha;        /* one float a pixel, or NULL: no alpha channel */
     size_t attr_count;
     char **attr_names;   /* as the file names them */
     char **attr_values;  /* as text: numbers formatted */
@@ -37,6 +38,7 @@ static inline void ptr_image_release(PtrImage *image)
     free(image->attr_names);
     free(image->attr_values);
     free(image->rgb);
+    free(image->alpha);
     free(image);
 }
 
@@ -61,6 +63,14 @@ static inline PtrImage *ptr_image_alloc(size_t pixels, size_t attr_count)
     return image;
 }
 
+/* Gives the image an alpha channel (uninitialised): 0 if memory runs out. */
+static inline int ptr_image_alloc_alpha(PtrImage *image)
+{
+    size_t pixels = (size_t)image->layout.width * (size_t)image->layout.height;
+    image->alpha = (float *)malloc((pixels ? pixels : 1) * sizeof(float));
+    return image->alpha != NULL;
+}
+
 /* Sets attribute slot i to copies of name and value: 0 if memory runs out. */
 static inline int ptr_image_set_attr(PtrImage *image, size_t i, const char *name,
                                      const char *value)
@@ -74,7 +84,8 @@ static inline int ptr_image_set_attr(PtrImage *image, size_t i, const char *name
  * name messages give). OpenEXR (image_exr.cpp): errors are PTR_ERR_OUTPUT
  * when writing, PTR_ERR_USAGE when reading, PTR_ERR_NOMEM either way. */
 PtrResult ptr_exr_write(const char *file, const char *name, const PtrImageLayout *layout,
-                        const float *rgb, const float *sample_counts, PtrPixelFormat format,
+                        const float *rgb, const float *alpha, const float *sample_counts,
+                        PtrPixelFormat format,
                         const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
 PtrImage *ptr_exr_read(const char *path, PtrError *err);
 PtrResult ptr_exr_set_threads(int threads, PtrError *err);
@@ -90,8 +101,8 @@ typedef struct PtrImageModule {
 
     int (*can_write)(const char *path);
     PtrResult (*write)(const char *file, const char *name, const PtrImageLayout *layout,
-                       const float *rgb, PtrPixelFormat format, const PtrImageAttr *attrs,
-                       size_t attr_count, PtrError *err);
+                       const float *rgb, const float *alpha, PtrPixelFormat format,
+                       const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
     PtrImage *(*read)(const char *path, PtrError *err);
 } PtrImageModule;
 

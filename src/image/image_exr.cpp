@@ -69,7 +69,8 @@ extern "C" PtrResult ptr_exr_set_threads(int threads, PtrError *err)
 
 extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
                                    const PtrImageLayout *layout, const float *rgb,
-                                   const float *sample_counts, PtrPixelFormat format,
+                                   const float *alpha, const float *sample_counts,
+                                   PtrPixelFormat format,
                                    const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
     try {
@@ -83,6 +84,8 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
         const bool is_half = format == PTR_PIXEL_HALF;
         for (const char *channel : rgb_names)
             header.channels().insert(channel, Imf::Channel(is_half ? Imf::HALF : Imf::FLOAT));
+        if (alpha)
+            header.channels().insert("A", Imf::Channel(is_half ? Imf::HALF : Imf::FLOAT));
         if (sample_counts)
             header.channels().insert("samples", Imf::Channel(Imf::FLOAT));
         for (size_t i = 0; i < attr_count; i++) {
@@ -104,6 +107,9 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
         const size_t pixels = size_t(layout->width) * size_t(layout->height);
         std::vector<Imath::half> halves(is_half ? pixels * 3 : 0);
         std::copy(rgb, rgb + halves.size(), halves.begin());
+        std::vector<Imath::half> alpha_halves(is_half && alpha ? pixels : 0);
+        if (alpha)
+            std::copy(alpha, alpha + alpha_halves.size(), alpha_halves.begin());
         const Imf::PixelType type = is_half ? Imf::HALF : Imf::FLOAT;
         const size_t size = is_half ? sizeof(Imath::half) : sizeof(float);
         const char *first = is_half ? reinterpret_cast<const char *>(halves.data())
@@ -112,6 +118,11 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
         for (size_t c = 0; c < 3; c++)
             frame.insert(rgb_names[c], slice(type, first + c * size, 3 * size,
                                              size_t(layout->width) * 3 * size, *layout));
+        if (alpha)
+            frame.insert("A", slice(type,
+                                    is_half ? reinterpret_cast<const char *>(alpha_halves.data())
+                                            : reinterpret_cast<const char *>(alpha),
+                                    size, size_t(layout->width) * size, *layout));
         if (sample_counts)
             frame.insert("samples", slice(Imf::FLOAT, reinterpret_cast<const char *>(sample_counts),
                                           sizeof(float), size_t(layout->width) * sizeof(float),
@@ -164,7 +175,8 @@ extern "C" PtrImage *ptr_exr_read(const char *path, PtrError *err)
             if (!ptr_image_set_attr(image, i, attrs[i].first.c_str(), attrs[i].second.c_str()))
                 throw std::bad_alloc();
 
-        // R, G and B; a grey image (Y alone) in all three; the rest dropped.
+        // R, G and B; a grey image (Y alone) in all three; A if there is
+        // one; the rest dropped.
         const Imf::ChannelList &channels = header.channels();
         char *first = reinterpret_cast<char *>(image->rgb);
         const size_t row = size_t(layout.width) * 3 * sizeof(float);
@@ -174,6 +186,12 @@ extern "C" PtrImage *ptr_exr_read(const char *path, PtrError *err)
             frame.insert(grey ? "Y" : rgb_names[c],
                          slice(Imf::FLOAT, first + c * sizeof(float), 3 * sizeof(float), row,
                                layout));
+        if (channels.findChannel("A")) {
+            if (!ptr_image_alloc_alpha(image))
+                throw std::bad_alloc();
+            frame.insert("A", slice(Imf::FLOAT, reinterpret_cast<char *>(image->alpha),
+                                    sizeof(float), size_t(layout.width) * sizeof(float), layout));
+        }
         in.setFrameBuffer(frame);
         in.readPixels(data.min.y, data.max.y);
         for (size_t p = 0; grey && p < size_t(layout.width) * size_t(layout.height); p++)

@@ -33,21 +33,32 @@ int can_write(const char *path)
 }
 
 PtrResult write_image(const char *file, const char *name, const PtrImageLayout *layout,
-                      const float *rgb, PtrPixelFormat format, const PtrImageAttr *attrs,
-                      size_t attr_count, PtrError *err)
+                      const float *rgb, const float *alpha, PtrPixelFormat format,
+                      const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
     try {
         auto out = OIIO::ImageOutput::create(name);
         if (!out)
             return ptr_shim_error(err, PTR_ERR_OUTPUT,
                                   std::string(name) + ": no image format for this extension");
-        OIIO::ImageSpec spec(layout->width, layout->height, 3, pixel_type(format));
+        const size_t pixels = size_t(layout->width) * size_t(layout->height);
+        std::vector<float> rgba(alpha ? pixels * 4 : 0);
+        for (size_t p = 0; p < rgba.size() / 4; p++) {
+            std::copy(rgb + 3 * p, rgb + 3 * p + 3, &rgba[4 * p]);
+            rgba[4 * p + 3] = alpha[p];
+        }
+        OIIO::ImageSpec spec(layout->width, layout->height, alpha ? 4 : 3, pixel_type(format));
         spec.x = layout->x;
         spec.y = layout->y;
         spec.full_x = 0;
         spec.full_y = 0;
         spec.full_width = layout->full_width;
         spec.full_height = layout->full_height;
+        // Every format here takes straight alpha, as ptr gives it: without
+        // this, OpenImageIO would take the colour as premultiplied and divide
+        // it by alpha once more.
+        if (alpha)
+            spec.attribute("oiio:UnassociatedAlpha", 1);
         for (size_t i = 0; i < attr_count; i++) {
             const PtrImageAttr &a = attrs[i];
             switch (a.type) {
@@ -57,7 +68,7 @@ PtrResult write_image(const char *file, const char *name, const PtrImageLayout *
             }
         }
         bool ok = out->open(file, spec) &&
-                  out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+                  out->write_image(OIIO::TypeDesc::FLOAT, alpha ? rgba.data() : rgb);
         ok = out->close() && ok;
         if (!ok)
             return ptr_shim_error(err, PTR_ERR_OUTPUT, std::string(name) + ": " + out->geterror());
@@ -71,7 +82,10 @@ PtrImage *read_image(const char *path, PtrError *err)
 {
     PtrImage *image = nullptr;
     try {
-        auto in = OIIO::ImageInput::open(path);
+        // Colour as stored, not premultiplied by alpha on the way in.
+        OIIO::ImageSpec config;
+        config.attribute("oiio:UnassociatedAlpha", 1);
+        auto in = OIIO::ImageInput::open(path, &config);
         if (!in) {
             ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + OIIO::geterror());
             return nullptr;
@@ -87,10 +101,16 @@ PtrImage *read_image(const char *path, PtrError *err)
         if (!image)
             throw std::bad_alloc();
         image->layout = { spec.width, spec.height, spec.x, spec.y, spec.full_width, spec.full_height };
-        for (size_t p = 0; p < pixels; p++)
+        const int alpha = spec.alpha_channel;
+        if (alpha >= 0 && !ptr_image_alloc_alpha(image))
+            throw std::bad_alloc();
+        for (size_t p = 0; p < pixels; p++) {
             for (int c = 0; c < 3; c++)
                 image->rgb[3 * p + size_t(c)] =
-                    all[p * size_t(spec.nchannels) + size_t(c < spec.nchannels ? c : 0)];
+                    all[p * size_t(spec.nchannels) + size_t(c < spec.nchannels && c != alpha ? c : 0)];
+            if (alpha >= 0)
+                image->alpha[p] = all[p * size_t(spec.nchannels) + size_t(alpha)];
+        }
         size_t i = 0;
         for (const OIIO::ParamValue &param : spec.extra_attribs)
             if (!ptr_image_set_attr(image, i++, param.name().c_str(), param.get_string().c_str()))

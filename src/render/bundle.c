@@ -38,6 +38,7 @@ typedef struct Lanes {
     uint32_t index[LANES]; /* the sample index */
     int depth[LANES];
     int slot[LANES];       /* the result the path fills, or FREE */
+    int traced[LANES];     /* the lane's hit is found already (a camera ray's) */
     PtrLitVertex lit[LANES];
 } Lanes;
 
@@ -61,13 +62,16 @@ typedef struct Round {
     uint32_t first, span, items; /* item k: pixel k / span, sample first + k % span */
 } Round;
 
-/* Camera rays for items [first, first + LANES), made together. */
+/* Camera rays for items [first, first + LANES), made together, and with
+ * the tree traced together (traced). */
 typedef struct CameraBatch {
     uint32_t first;
     int x[LANES], y[LANES];
     uint64_t key[LANES];
     uint32_t index[LANES];
-    float org[3][LANES], dir[3][LANES];
+    PtrRayPacket ray;
+    PtrHitPacket hit;
+    int traced;
 } CameraBatch;
 
 static inline PtrVec3 lane_v3(const float a[3][LANES], int l)
@@ -103,9 +107,23 @@ STAGE void camera_rays(const PtrPathJob *job, CameraBatch *batch)
     for (int l = 0; l < LANES; l++) {
         PtrVec3 o, d;
         ptr_path_camera_ray(job, batch->key[l], batch->index[l], batch->x[l], batch->y[l], &o, &d);
-        set_lane_v3(batch->org, l, o);
-        set_lane_v3(batch->dir, l, d);
+        set_lane_v3(batch->ray.org, l, o);
+        set_lane_v3(batch->ray.dir, l, d);
+        batch->ray.tmin[l] = 0.0f;
+        batch->ray.tmax[l] = INFINITY;
     }
+}
+
+/* A batch's camera rays through the tree as one packet: they leave one
+ * pixel (items are a pixel's samples), so they go down the tree together.
+ * Brute force traces all lanes together anyway, and huge spheres need
+ * ptr_trace. */
+STAGE void trace_camera_rays(const PtrPathJob *job, CameraBatch *batch)
+{
+    const PtrAccel *accel = job->accel;
+    batch->traced = accel->kind == PTR_ACCEL_BVH && !job->scene->huge.count;
+    if (batch->traced)
+        accel->isect.bvh_closest_hit_packet(&batch->ray, &accel->bvh, accel->spheres, &batch->hit);
 }
 
 STAGE void make_camera_batch(const PtrPathJob *job, const Round *round, uint32_t first,
@@ -121,6 +139,7 @@ STAGE void make_camera_batch(const PtrPathJob *job, const Round *round, uint32_t
         batch->index[l] = round->first + item % round->span;
     }
     camera_rays(job, batch);
+    trace_camera_rays(job, batch);
 }
 
 /* Gives free lanes the round's next items; returns the lanes in flight. */
@@ -133,10 +152,15 @@ STAGE int refill(const PtrPathJob *job, const Round *round, Lanes *lanes, Camera
             if (*next - batch->first >= LANES)
                 make_camera_batch(job, round, *next, batch);
             int b = (int)(*next - batch->first);
+            const PtrRayPacket *r = &batch->ray;
             set_lane_ray(lanes, l,
-                         (PtrRay){ { batch->org[0][b], batch->org[1][b], batch->org[2][b] }, 0.0f,
-                                   { batch->dir[0][b], batch->dir[1][b], batch->dir[2][b] },
-                                   INFINITY });
+                         (PtrRay){ { r->org[0][b], r->org[1][b], r->org[2][b] }, r->tmin[b],
+                                   { r->dir[0][b], r->dir[1][b], r->dir[2][b] }, r->tmax[b] });
+            lanes->traced[l] = batch->traced;
+            if (batch->traced) {
+                lanes->hit.t[l] = batch->hit.t[b];
+                lanes->hit.sphere[l] = batch->hit.sphere[b];
+            }
             lanes->key[l] = batch->key[b];
             lanes->index[l] = batch->index[b];
             lanes->depth[l] = 0;
@@ -151,7 +175,8 @@ STAGE int refill(const PtrPathJob *job, const Round *round, Lanes *lanes, Camera
 }
 
 /* Closest hits of the lanes in flight: the packet kernel for brute force,
- * else ptr_trace lane by lane (the tree, huge spheres). */
+ * else ptr_trace lane by lane (the tree, huge spheres) for the lanes whose
+ * camera ray was not traced with its batch. */
 STAGE void trace(const PtrPathJob *job, Lanes *lanes)
 {
     const PtrAccel *accel = job->accel;
@@ -159,14 +184,16 @@ STAGE void trace(const PtrPathJob *job, Lanes *lanes)
         accel->isect.closest_hit_packet(&lanes->ray, accel->spheres, accel->searched, &lanes->hit);
         return;
     }
-    for (int l = 0; l < LANES; l++)
-        if (lanes->slot[l] != FREE) {
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] != FREE && !lanes->traced[l]) {
             PtrRay ray = lane_ray(lanes, l);
             PtrHit hit;
             ptr_trace(accel, &ray, &hit);
             lanes->hit.t[l] = hit.t;
             lanes->hit.sphere[l] = hit.sphere;
         }
+        lanes->traced[l] = 0;
+    }
 }
 
 /* Each lane's hit: its sphere's material (tinted by the sphere's colour),
@@ -357,9 +384,10 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
 }
 
 /* The next ray of every path that goes on; the result of every path that
- * ends, which frees its lane. */
+ * ends, which frees its lane: its radiance, and whether its camera ray hit
+ * a sphere (a path past its first ray did). */
 STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
-                            PtrVec3 *results)
+                            PtrVec3 *results, unsigned char *covered)
 {
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
@@ -391,6 +419,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
             continue;
         if (!go_on[l]) {
             results[lanes->slot[l]] = lane_v3(lanes->radiance, l);
+            covered[lanes->slot[l]] = lanes->depth[l] > 0 || v->hit[l];
             lanes->slot[l] = FREE;
             continue;
         }
@@ -402,7 +431,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
 }
 
 static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *results,
-                         uint64_t *rays)
+                         unsigned char *covered, uint64_t *rays)
 {
     Lanes lanes;
     Vertex vertex;
@@ -413,6 +442,7 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
      * and a miss. */
     for (int l = 0; l < LANES; l++) {
         lanes.slot[l] = FREE;
+        lanes.traced[l] = 0;
         set_lane_ray(&lanes, l, (PtrRay){ { 0, 0, 0 }, 0.0f, { 0, 0, 1 }, INFINITY });
         lanes.hit.t[l] = INFINITY;
         lanes.hit.sphere[l] = PTR_NO_HIT;
@@ -431,7 +461,7 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
         if (job->sample_lights)
             sample_emitters(job, &lanes, &vertex, rays);
         scatter(job, &lanes, &vertex);
-        continue_or_end(job, &lanes, &vertex, results);
+        continue_or_end(job, &lanes, &vertex, results, covered);
     }
 }
 
@@ -440,6 +470,7 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
     const PtrRenderSettings *s = job->settings;
     Round round;
     PtrVec3 results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    unsigned char covered[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
     uint64_t end = (uint64_t)job->first + job->count;
     /* Rounds end where adaptive sampling may stop a pixel, so a round's
      * samples are all ones the path tracer would take too. */
@@ -461,14 +492,17 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
             }
         round.items = (uint32_t)round.pixels * round.span;
         if (s->max_depth > 0)
-            render_round(job, &round, results, rays);
+            render_round(job, &round, results, covered, rays);
         else
-            for (uint32_t i = 0; i < round.items; i++)
+            for (uint32_t i = 0; i < round.items; i++) {
                 results[i] = v3_splat(0.0f);
+                covered[i] = 0;
+            }
         for (int p = 0; p < round.pixels; p++)
             for (uint32_t i = 0; i < round.span; i++)
                 ptr_path_accumulate(s, round.sums[p], round.first + i,
-                                    results[(uint32_t)p * round.span + i]);
+                                    results[(uint32_t)p * round.span + i],
+                                    covered[(uint32_t)p * round.span + i]);
         a = b;
     }
 }

@@ -40,12 +40,15 @@ void ptr_accum_free(double *acc, size_t pixels)
         munmap(acc, accum_bytes(pixels));
 }
 
-void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts)
+void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *alpha,
+                       float *sample_counts)
 {
     for (size_t p = 0; p < pixels; p++, acc += PTR_ACCUM_STRIDE) {
         double n = acc[PTR_ACCUM_COUNT];
         for (int c = 0; c < 3; c++)
             rgb[3 * p + c] = n > 0 ? (float)(acc[PTR_ACCUM_SUM + c] / n) : 0.0f;
+        if (alpha)
+            alpha[p] = n > 0 ? (float)(acc[PTR_ACCUM_COVERED] / n) : 0.0f;
         if (sample_counts)
             sample_counts[p] = (float)n;
     }

@@ -7,11 +7,14 @@
 
 /* What ptr_render_samples (render.h) keeps of each pixel, in doubles: the sum of its
  * samples' radiance, the sum over its odd-numbered samples (adaptive
- * sampling's second half-buffer), how many samples it took, and whether
- * adaptive sampling stopped it (1) or not (0). */
+ * sampling's second half-buffer), how many samples it took, whether
+ * adaptive sampling stopped it (1) or not (0), and how many of its samples
+ * were covered (their camera ray hit a sphere), in all and among the odd
+ * ones: the alpha of a transparent render. */
 enum {
     PTR_ACCUM_SUM = 0, PTR_ACCUM_ODD = 3, PTR_ACCUM_COUNT = 6, PTR_ACCUM_STOPPED = 7,
-    PTR_ACCUM_STRIDE = 8,
+    PTR_ACCUM_COVERED = 8, PTR_ACCUM_COVERED_ODD = 9,
+    PTR_ACCUM_STRIDE = 10,
 };
 
 /* A zeroed accumulation buffer of pixels pixels, or NULL if memory runs out;
@@ -20,7 +23,9 @@ double *ptr_accum_alloc(size_t pixels);
 void ptr_accum_free(double *acc, size_t pixels);
 
 /* The mean radiance of each of pixels accumulated pixels into rgb (3 floats
- * a pixel), and if sample_counts is not NULL, how many samples each took. */
-void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *sample_counts);
+ * a pixel); if alpha is not NULL, the share of its samples covered; if
+ * sample_counts is not NULL, how many samples each took. */
+void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *alpha,
+                       float *sample_counts);
 
 #endif /* PTR_FILM_H */

@@ -110,7 +110,7 @@ float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, 
  * of Cycles: the mean of all its samples against the mean of its odd ones,
  * summed over channels, relative to the square root of the brightness (the
  * eye forgives noise in bright pixels in about that proportion). */
-static double pixel_error(const double *acc)
+static double pixel_error(const double *acc, int transparent)
 {
     double n = acc[PTR_ACCUM_COUNT], half = floor(n / 2), difference = 0, brightness = 0;
     for (int c = 0; c < 3; c++) {
@@ -118,11 +118,24 @@ static double pixel_error(const double *acc)
         difference += fabs(all - acc[PTR_ACCUM_ODD + c] / half);
         brightness += all;
     }
+    /* With a transparent background, alpha is a fourth channel: an edge
+     * against it is noisy in coverage even where its colour is black. */
+    if (transparent) {
+        double all = acc[PTR_ACCUM_COVERED] / n;
+        difference += fabs(all - acc[PTR_ACCUM_COVERED_ODD] / half);
+        brightness += all;
+    }
     return difference / (1e-4 + sqrt(brightness));
 }
 
-void ptr_path_accumulate(const PtrRenderSettings *s, double *acc, uint32_t index, PtrVec3 l)
+void ptr_path_accumulate(const PtrRenderSettings *s, double *acc, uint32_t index, PtrVec3 l,
+                         int covered)
 {
+    if (s->transparent && !covered)
+        l = v3_splat(0.0f);
+    acc[PTR_ACCUM_COVERED] += covered;
+    if (index & 1)
+        acc[PTR_ACCUM_COVERED_ODD] += covered;
     acc[PTR_ACCUM_SUM + 0] += l.x;
     acc[PTR_ACCUM_SUM + 1] += l.y;
     acc[PTR_ACCUM_SUM + 2] += l.z;
@@ -134,6 +147,6 @@ void ptr_path_accumulate(const PtrRenderSettings *s, double *acc, uint32_t index
     acc[PTR_ACCUM_COUNT] += 1;
     uint32_t taken = index + 1;
     if (s->noise_threshold > 0 && taken >= s->min_samples && taken % PTR_ADAPTIVE_STEP == 0 &&
-        pixel_error(acc) < s->noise_threshold)
+        pixel_error(acc, s->transparent) < s->noise_threshold)
         acc[PTR_ACCUM_STOPPED] = 1;
 }

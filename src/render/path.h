@@ -119,10 +119,11 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
 float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
                                PtrVec3 dir, float t, PtrVec3 normal);
 
-/* Adds radiance as sample index of the pixel whose sums acc are, and
- * decides whether adaptive sampling stops the pixel there. */
+/* Adds radiance as sample index of the pixel whose sums acc are, covered
+ * or not (whether its camera ray hit a sphere), and decides whether
+ * adaptive sampling stops the pixel there. */
 void ptr_path_accumulate(const PtrRenderSettings *settings, double *acc, uint32_t index,
-                         PtrVec3 radiance);
+                         PtrVec3 radiance, int covered);
 
 /* Renders the job's samples of the pixels of [x0, x1) x [y0, y1), counting
  * rays: a path at a time (render.c) or in bundles (bundle.c, built for AVX2

@@ -23,7 +23,7 @@ static void on_tick(void *user, double pass_fraction)
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
-                                 float *sample_counts, PtrProgressiveResult *result, PtrError *err)
+                                 float *alpha, float *sample_counts, PtrProgressiveResult *result, PtrError *err)
 {
     PtrRegion r = ptr_render_region(settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
@@ -81,7 +81,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     result->samples_done = done;
     result->stats.seconds = ptr_now_seconds() - watch.start;
     if (res == PTR_OK)
-        ptr_accum_resolve(acc, pixels, rgb, sample_counts);
+        ptr_accum_resolve(acc, pixels, rgb, alpha, sample_counts);
     ptr_accum_free(acc, pixels);
     return res;
 }

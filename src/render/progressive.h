@@ -41,11 +41,12 @@ typedef struct PtrProgressiveResult {
 /* Renders the settings' region in passes: the first of one sample, then
  * passes sized to take about a second each. Writes the means of the samples
  * done into rgb (3 floats a pixel of the region), the same bits as one pass
- * of that many samples would give, and if sample_counts is not NULL, how
+ * of that many samples would give; if alpha is not NULL, the share of each
+ * pixel's samples that were covered; and if sample_counts is not NULL, how
  * many samples each pixel took (fewer where adaptive sampling stopped it). */
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
-                                 const PtrProgressiveOptions *options, float *rgb,
+                                 const PtrProgressiveOptions *options, float *rgb, float *alpha,
                                  float *sample_counts, PtrProgressiveResult *result,
                                  PtrError *err);
 

@@ -18,9 +18,9 @@
  * reference the bundles (bundle.c) match bit for bit. A path has at most
  * max_depth rays from the camera or a scattering; shadow rays do not count,
  * since they estimate what the next ray would find and so only where it may
- * exist. */
+ * exist. *covered says whether the camera ray hit a sphere. */
 static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrRay ray,
-                          uint64_t *rays)
+                          uint64_t *rays, int *covered)
 {
     const PtrScene *scene = job->scene;
     const PtrRenderSettings *settings = job->settings;
@@ -28,6 +28,7 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
     PtrVec3 radiance = v3_splat(0.0f);
     PtrVec3 throughput = v3_splat(1.0f);
     PtrLitVertex lit = { 0 };
+    *covered = 0;
 
     for (int depth = 0; depth < settings->max_depth; depth++) {
         PtrHit hit;
@@ -37,6 +38,7 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
             radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
             break;
         }
+        *covered = 1;
         PtrMaterial m = scene->materials[spheres->material[hit.sphere]];
         m.albedo = ptr_path_albedo(spheres, hit.sphere, m.albedo);
         PtrVec3 normal, point;
@@ -87,7 +89,9 @@ static PTR_DECL_RENDER_TILE(render_tile_by_path)
                 PtrVec3 o, d;
                 ptr_path_camera_ray(job, key, i, x, y, &o, &d);
                 PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
-                ptr_path_accumulate(s, acc, i, trace_path(job, &sampler, ray, rays));
+                int covered;
+                PtrVec3 radiance = trace_path(job, &sampler, ray, rays, &covered);
+                ptr_path_accumulate(s, acc, i, radiance, covered);
             }
         }
 }
@@ -322,7 +326,7 @@ PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
     PtrResult res = ptr_render_samples(scene, accel, settings, 0, settings->samples, acc, NULL,
                                        NULL, stats, err);
     if (res == PTR_OK)
-        ptr_accum_resolve(acc, pixels, rgb, NULL);
+        ptr_accum_resolve(acc, pixels, rgb, NULL, NULL);
     ptr_accum_free(acc, pixels);
     return res;
 }

@@ -50,6 +50,10 @@ typedef struct PtrRenderSettings {
     float noise_threshold;
     uint32_t min_samples;
     PtrIntegrator integrator;
+    /* A transparent background: a sample whose camera ray meets no sphere
+     * adds no radiance (the sky it sees is left out), and adaptive sampling
+     * weighs the noise of coverage too. Coverage is counted either way. */
+    int transparent;
 } PtrRenderSettings;
 
 typedef struct PtrRenderStats {

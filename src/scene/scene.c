@@ -40,6 +40,7 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->material, sizeof *s->material, 0, 0 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0 },
         { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1 }, /* white */
+        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1 },      /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -154,6 +155,20 @@ PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
     const float channels[3] = { color.x, color.y, color.z };
     for (int c = 0; c < 3; c++)
         s->color[4 * i + c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
+    return PTR_OK;
+}
+
+PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)
+{
+    PtrSpheres *s = &scene->spheres;
+    if (!s->value) {
+        s->value = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * sizeof *s->value);
+        if (!s->value)
+            return PTR_ERR_NOMEM;
+        for (size_t k = 0; k < s->capacity; k++)
+            s->value[k] = NAN;
+    }
+    s->value[i] = value;
     return PTR_OK;
 }
 

@@ -28,6 +28,9 @@ typedef struct PtrSpheres {
      * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
      * a million colours are a million of these, never a million materials. */
     uint16_t *color;
+    /* Each sphere's value of the quantity --color-by names (NaN: none), 4
+     * bytes a sphere, NULL unless asked for (see scene/colormap.h). */
+    float *value;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
 } PtrSpheres;
@@ -120,6 +123,10 @@ PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order);
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
+
+/* Gives sphere i a value (see PtrSpheres.value); the first call creates the
+ * array, NaN for every other sphere. */
+PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
 
 static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 {

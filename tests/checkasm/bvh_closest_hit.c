@@ -44,9 +44,11 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
     CheckedCallStatus status[PTR_CPU_LEVEL_COUNT] = { { 0 } };
     uint64_t mismatches[PTR_CPU_LEVEL_COUNT] = { 0 }, rays = 0, hits = 0, brute_mismatches = 0;
     PtrCpuLevel top = ptr_cpu_level();
+    Tally packet_tally = { 0 };
+    uint64_t packets = 0;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
         ptr_isect_init_level(&tables[l], (PtrCpuLevel)l);
-        status[l].check_xinuse = xinuse_supported();
+        status[l].check_xinuse = packet_tally.status[l].check_xinuse = xinuse_supported();
     }
     for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++) {
         for (size_t z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
@@ -105,6 +107,8 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                     }
                 }
             }
+            packets += check_bvh_closest_hit_packet(tables, top, &bvh, t, checked_ray, &rng,
+                                                    &packet_tally);
             ptr_bvh_free(&bvh);
             ptr_scene_free(&tree_scene);
             ptr_scene_free(&file_scene);
@@ -125,6 +129,7 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                status[l].failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "");
         ok ? ++*passed : ++failed;
     }
+    report_bvh_closest_hit_packet(tables, top, packets, &packet_tally, passed, &failed);
     return failed;
 }
 

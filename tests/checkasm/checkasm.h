@@ -1,7 +1,7 @@
 /* What the checker's parts share. checkasm.c is the harness: the generated
  * cases, the run and the report. Each field of the kernel table
  * (accel/isect.h) is checked in the file named after it: closest_hit.c,
- * closest_hit_packet.c, bvh_closest_hit.c. */
+ * closest_hit_packet.c, bvh_closest_hit.c, bvh_closest_hit_packet.c. */
 #ifndef PTR_CHECKASM_H
 #define PTR_CHECKASM_H
 
@@ -20,7 +20,7 @@ typedef struct CheckedCallStatus {
 } CheckedCallStatus;
 
 /* Calls fn with every callee-saved register holding a sentinel and reports
- * in status what did not survive. One routine, three signatures of 4
+ * in status what did not survive. One routine, four signatures of 4
  * arguments. */
 int ptr_checked_call(PtrClosestHitFn fn, const PtrRay *ray, const PtrSpheres *spheres,
                      size_t count, PtrHit *hit, CheckedCallStatus *status);
@@ -30,6 +30,9 @@ int ptr_checked_call_bvh(PtrBvhClosestHitFn fn, const PtrRay *ray, const PtrBvh 
 void ptr_checked_call_packet(PtrClosestHitPacketFn fn, const PtrRayPacket *rays,
                              const PtrSpheres *spheres, size_t count, PtrHitPacket *hits,
                              CheckedCallStatus *status);
+void ptr_checked_call_bvh_packet(PtrBvhClosestHitPacketFn fn, const PtrRayPacket *rays,
+                                 const PtrBvh *bvh, const PtrSpheres *spheres,
+                                 PtrHitPacket *hits, CheckedCallStatus *status);
 
 /* Whether XGETBV(1) can tell a dirty upper YMM state. */
 uint32_t xinuse_supported(void);
@@ -75,6 +78,18 @@ void check_closest_hit_packet(const PtrIsectTable *tables, PtrCpuLevel top, cons
  * traversal and against brute force; returns the number of levels that
  * failed. Then nanoseconds per ray of each level's traversal on clouds. */
 int check_bvh_closest_hit(uint64_t seed, int *passed);
+
+/* bvh_closest_hit_packet.c: every level's bvh_closest_hit_packet against
+ * ptr_bvh_closest_hit_packet_c on one scene's tree, with packets of eight
+ * rays drawn by draw (bvh_closest_hit.c's), unrelated and coherent ones;
+ * returns the packets checked. */
+typedef PtrRay (*DrawRayFn)(const PtrSpheres *s, PtrRng *rng);
+uint64_t check_bvh_closest_hit_packet(const PtrIsectTable *tables, PtrCpuLevel top,
+                                      const PtrBvh *bvh, const PtrSpheres *s, DrawRayFn draw,
+                                      PtrRng *rng, Tally *tally);
+void report_bvh_closest_hit_packet(const PtrIsectTable *tables, PtrCpuLevel top,
+                                   uint64_t packets, const Tally *tally, int *passed,
+                                   int *failed);
 void bench_bvh_closest_hit(void);
 
 #endif

@@ -38,12 +38,18 @@ section .text
 ; void ptr_checked_call_packet(PtrClosestHitPacketFn fn,
 ;                              const PtrRayPacket *rays, const PtrSpheres *spheres,
 ;                              size_t count, PtrHitPacket *hits, CheckedCallStatus *status);
+; void ptr_checked_call_bvh_packet(PtrBvhClosestHitPacketFn fn,
+;                                  const PtrRayPacket *rays, const PtrBvh *bvh,
+;                                  const PtrSpheres *spheres, PtrHitPacket *hits,
+;                                  CheckedCallStatus *status);
 ; the same routine: it only forwards four arguments.
     global ptr_checked_call_bvh:function hidden
     global ptr_checked_call_packet:function hidden
+    global ptr_checked_call_bvh_packet:function hidden
 FUNCTION ptr_checked_call
 ptr_checked_call_bvh:
 ptr_checked_call_packet:
+ptr_checked_call_bvh_packet:
     push        rbp
     push        rbx
     push        r12

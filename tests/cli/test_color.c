@@ -50,7 +50,7 @@ static void oracle(const char *config, const char *display, const char *view)
     char cmd[1024];
     const char *in = test_path("in.exr"), *ours = test_path("ours.png"), *theirs = test_path("theirs.png");
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
-    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, PTR_PIXEL_FLOAT, NULL, 0, &err), 0);
+    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, NULL, PTR_PIXEL_FLOAT, NULL, 0, &err), 0);
 
     PtrColor *color = ptr_color_open(config, &err);
     CHECK(color != NULL);
@@ -224,9 +224,9 @@ static void test_output_path(void)
     ptr_image_free(img);
 
     /* Formats refuse depths they cannot hold. */
-    CHECK_INT(ptr_output_check(test_path("x.jpg"), PTR_DEPTH_16, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(test_path("x.exr"), PTR_DEPTH_8, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(test_path("x.tif"), PTR_DEPTH_FLOAT, &perr), PTR_OK);
+    CHECK_INT(ptr_output_check(test_path("x.jpg"), PTR_DEPTH_16, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(test_path("x.exr"), PTR_DEPTH_8, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(test_path("x.tif"), PTR_DEPTH_FLOAT, 0, &perr), PTR_OK);
     ptr_color_close(c);
 }
 

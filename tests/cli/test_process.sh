@@ -4,10 +4,8 @@
 set -u
 ptr=$1
 src=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$src/tests/support/shell_test.sh"
 passed=0
-failed=0
 
 check() {
     if eval "$2"; then
@@ -16,16 +14,6 @@ check() {
         failed=$((failed + 1))
         echo "FAIL: $1" >&2
     fi
-}
-
-# Waits (up to 60 s) until the command in $1 succeeds.
-wait_until() {
-    i=0
-    while ! eval "$1"; do
-        i=$((i + 1))
-        [ $i -gt 600 ] && return 1
-        sleep 0.1
-    done
 }
 
 meta() { iinfo -v "$1" 2>/dev/null; }

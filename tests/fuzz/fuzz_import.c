@@ -50,7 +50,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     PtrScene scene;
     PtrStrings warnings = { 0 }, dependencies = { 0 };
     PtrError err = { 0 };
-    PtrImportOptions options = { .dependencies = &dependencies, .fit_all_objects = size & 1 };
+    /* Half the inputs also read a value per sphere (--color-by): COLOR_0
+     * names both the points' COLOR_0 and the instances' _COLOR_0, which the
+     * seed files have. */
+    PtrImportOptions options = { .dependencies = &dependencies, .fit_all_objects = size & 1,
+                                 .value_attribute = size & 2 ? "color_0" : NULL };
     PtrResult r = ptr_import_scene(path, &options, &scene, &warnings, &err);
     /* A refusal is one line that names the file. */
     if (r != PTR_OK && (strchr(err.message, '\n') || strncmp(err.message, path, strlen(dir))))

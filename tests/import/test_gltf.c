@@ -115,8 +115,20 @@ static void test_glb_matches_gltf(void)
     ptr_scene_free(&b);
 }
 
-/* No camera in the file: one that frames every sphere, looking down -Z,
- * from where the bounding sphere of their box fills a 40 degree view. */
+/* The tangents of the angles at which a sphere's silhouette leaves the
+ * view along one image axis, seen from eye looking down -Z: the planes
+ * through the eye that touch the sphere and hold the other axis. */
+static void silhouette_tangents(double offset, double depth, double r, double *lo, double *hi)
+{
+    double centre = atan2(offset, depth), spread = asin(r / hypot(offset, depth));
+    *lo = tan(centre - spread);
+    *hi = tan(centre + spread);
+}
+
+/* No camera in the file: one that looks down -Z and fits the spheres'
+ * projection to 95% of the image along the axis that binds. The fixture's
+ * spheres: radius 1 at (-3, 0, 0) and radius 2 at (3, 2, 1); no resolution,
+ * so the image is 16:9. */
 static void test_automatic_camera(void)
 {
     PtrScene s;
@@ -124,18 +136,77 @@ static void test_automatic_camera(void)
     PtrError err = { 0 };
     CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), NULL, &s, &w, &err), PTR_OK);
     ptr_strings_free(&w);
-    /* The box is [-4, 5] x [-1, 4] x [-1, 3]: centre (0.5, 1.5, 1), half
-     * diagonal sqrt(81 + 25 + 16) / 2. */
-    double distance = 0.5 * sqrt(122.0) / sin(20.0 * 3.14159265358979 / 180.0);
-    CHECK_NEAR(s.origin[0], 0.5, 1e-12);
-    CHECK_NEAR(s.origin[1], 1.5, 1e-12);
-    CHECK_NEAR(s.origin[2], 1.0 + distance, 1e-9);
+    const double spheres[2][4] = { { -3, 0, 0, 1 }, { 3, 2, 1, 2 } };
+    double tan_v = tan(20.0 * 3.14159265358979 / 180.0), aspect = 16.0 / 9.0;
+    double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+    for (int i = 0; i < 2; i++) {
+        const double *c = spheres[i];
+        double depth = s.origin[2] - c[2], lo, hi;
+        silhouette_tangents(c[0] - s.origin[0], depth, c[3], &lo, &hi);
+        x_lo = fmin(x_lo, lo), x_hi = fmax(x_hi, hi);
+        silhouette_tangents(c[1] - s.origin[1], depth, c[3], &lo, &hi);
+        y_lo = fmin(y_lo, lo), y_hi = fmax(y_hi, hi);
+    }
+    /* The spheres span 18 units across and 7 up: the width binds, the
+     * silhouettes touching 95% of the half-width on both sides; the height
+     * holds them inside. */
+    CHECK_NEAR(x_hi, 0.95 * tan_v * aspect, 1e-9);
+    CHECK_NEAR(x_lo, -0.95 * tan_v * aspect, 1e-9);
+    CHECK(y_hi <= 0.95 * tan_v && y_lo >= -0.95 * tan_v);
     CHECK_FLOAT_EQ(s.camera.lookfrom.x, 0.0f); /* coordinates are camera-relative */
-    CHECK_NEAR(s.camera.lookat.z, -distance, 1e-5);
+    CHECK_FLOAT_EQ(s.camera.lookat.x, 0.0f);
+    CHECK_FLOAT_EQ(s.camera.lookat.y, 0.0f);
+    CHECK(s.camera.lookat.z < 0.0f);
     CHECK_FLOAT_EQ(s.camera.vfov_deg, 40.0f);
+    CHECK_FLOAT_EQ(s.camera.aspect, (float)aspect);
     CHECK_NEAR(s.spheres.cx[0] + s.origin[0], -3.0, 1e-6);
     CHECK_NEAR(s.spheres.cz[1] + s.origin[2], 1.0, 1e-5);
     ptr_scene_free(&s);
+
+    /* Orthographic: the box [-4, 5] x [-1, 4] x [-1, 3], centred; 9 units
+     * wide at 16:9 need a view 5.0625 high, more than the box's 5, so again
+     * the width binds: half-height 5.0625 / 2 / 0.95. */
+    PtrImportOptions ortho = { .auto_projection = PTR_PROJECTION_ORTHOGRAPHIC };
+    CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), &ortho, &s, &w, &err), PTR_OK);
+    ptr_strings_free(&w);
+    CHECK_INT(s.camera.projection, PTR_PROJECTION_ORTHOGRAPHIC);
+    CHECK_NEAR(s.camera.ymag, 5.0625 / 2 / 0.95, 1e-6);
+    CHECK_NEAR(s.origin[0], 0.5, 1e-12);
+    CHECK_NEAR(s.origin[1], 1.5, 1e-12);
+    CHECK(s.origin[2] > 3.0); /* in front of every sphere */
+    ptr_scene_free(&s);
+
+    /* An aspect from the command line (both --width and --height): 1:2 makes
+     * the width bind harder, the half-height 9 * 2 / 2 / 0.95. */
+    ortho.auto_aspect = 0.5;
+    CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), &ortho, &s, &w, &err), PTR_OK);
+    ptr_strings_free(&w);
+    CHECK_NEAR(s.camera.ymag, 9.0 / 0.95, 1e-5);
+    ptr_scene_free(&s);
+}
+
+/* --turntable: the camera turned about the vertical axis through the centre
+ * of the spheres' box, (0.5, 1), counter-clockwise seen from above. */
+static void test_orbit(void)
+{
+    PtrScene plain, turned;
+    PtrStrings w = { 0 };
+    PtrError err = { 0 };
+    PtrImportOptions quarter = { .orbit_degrees = 90 };
+    CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), NULL, &plain, &w, &err), PTR_OK);
+    CHECK_INT(ptr_import_scene(FIXTURE("no_camera.gltf"), &quarter, &turned, &w, &err), PTR_OK);
+    ptr_strings_free(&w);
+    /* A quarter turn about +Y takes an eye at (0.5 + dx, y, 1 + dz) to
+     * (0.5 + dz, y, 1 - dx). */
+    double dx = plain.origin[0] - 0.5, dz = plain.origin[2] - 1.0;
+    CHECK_NEAR(turned.origin[0], 0.5 + dz, 1e-9);
+    CHECK_NEAR(turned.origin[1], plain.origin[1], 1e-12);
+    CHECK_NEAR(turned.origin[2], 1.0 - dx, 1e-9);
+    /* Looking down -Z, it now looks down -X. */
+    CHECK_NEAR(turned.camera.lookat.x, plain.camera.lookat.z, 1e-5);
+    CHECK_NEAR(turned.camera.lookat.z, 0.0, 1e-5);
+    ptr_scene_free(&plain);
+    ptr_scene_free(&turned);
 }
 
 static void check_bad(const char *path, PtrResult expected, const char *needle)
@@ -221,6 +292,7 @@ int main(void)
     test_hierarchy();
     test_glb_matches_gltf();
     test_automatic_camera();
+    test_orbit();
     test_orthographic_camera();
     test_bad_input();
     return test_report();

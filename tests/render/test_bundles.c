@@ -164,6 +164,8 @@ int main(void)
         { "depth 3", base, 0, 5, 5 },
         { "adaptive", base, 0, 48, 48 },
         { "region, samples 7..26 in passes of 5, one thread", base, 7, 19, 5 },
+        { "transparent, in passes of 4", base, 0, 12, 4 },
+        { "transparent, adaptive", base, 0, 48, 48 },
     };
     variants[1].settings.sampler = PTR_SAMPLER_INDEPENDENT;
     variants[1].settings.direct_lighting = PTR_OFF;
@@ -174,6 +176,10 @@ int main(void)
     variants[5].settings.min_samples = 16;
     variants[6].settings.region = (PtrRegion){ 5, 3, 37, 29 };
     variants[6].settings.threads = 1;
+    variants[7].settings.transparent = 1;
+    variants[8].settings.transparent = 1;
+    variants[8].settings.noise_threshold = 0.05f;
+    variants[8].settings.min_samples = 16;
     for (int k = 0; k < SCENE_KINDS; k++) {
         /* A scene of its own for each side: the tree reorders the spheres,
          * and each cluster goes to the tree with the C kernels (68 spheres,

@@ -1,0 +1,68 @@
+#include "app/color_by.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "app/output.h"
+#include "scene/colormap.h"
+
+enum { BAR_WIDTH = 512, BAR_HEIGHT = 32 }; /* two columns an entry of 256 */
+
+/* The map from lo (left) to hi (right), each column the colour its centre's
+ * value gets, written as a render is, through the same view, at its
+ * format's default depth (a key needs no more). */
+static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const char *scene_path,
+                           const PtrColor *color, PtrError *err)
+{
+    if (ptr_output_check(o->color_bar, PTR_DEPTH_DEFAULT, 0, err) != PTR_OK)
+        return err->code;
+    float *rgb = malloc((size_t)BAR_WIDTH * BAR_HEIGHT * 3 * sizeof *rgb);
+    if (!rgb)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", o->color_bar);
+    for (int x = 0; x < BAR_WIDTH; x++) {
+        PtrVec3 c = ptr_colormap_linear(map, (x + 0.5) / BAR_WIDTH, 0.0, 1.0);
+        for (int y = 0; y < BAR_HEIGHT; y++) {
+            float *p = &rgb[3 * ((size_t)y * BAR_WIDTH + (size_t)x)];
+            p[0] = c.x;
+            p[1] = c.y;
+            p[2] = c.z;
+        }
+    }
+    const PtrImageLayout layout = { BAR_WIDTH, BAR_HEIGHT, 0, 0, BAR_WIDTH, BAR_HEIGHT };
+    const PtrOutputInfo info = {
+        .scene_path = scene_path, .kernel = "", .accel = "", .sampler = "",
+        .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
+        .dither = o->dither,
+    };
+    PtrResult res = ptr_output_write(o->color_bar, &layout, rgb, &info, err);
+    free(rgb);
+    return res;
+}
+
+PtrResult ptr_color_by_apply(const PtrOptions *o, const char *scene_path, PtrScene *scene,
+                             const PtrColor *color, PtrError *err)
+{
+    if (!o->color_by)
+        return PTR_OK;
+    const PtrSpheres *s = &scene->spheres;
+    const PtrColormap *map = o->colormap ? o->colormap : &ptr_colormaps[0];
+    double lo = INFINITY, hi = -INFINITY;
+    size_t valued = 0;
+    for (size_t i = 0; i < s->count; i++) {
+        if (isnan(s->value[i]))
+            continue;
+        lo = fmin(lo, s->value[i]);
+        hi = fmax(hi, s->value[i]);
+        valued++;
+    }
+    const double from = o->has_color_range ? o->color_range[0] : lo;
+    const double to = o->has_color_range ? o->color_range[1] : hi;
+    if (!o->quiet)
+        fprintf(stderr, "ptr: %s: --color-by %s: %zu spheres, values %.9g to %.9g, mapped from "
+                        "%.9g to %.9g through %s\n", scene_path, o->color_by, valued, lo, hi,
+                from, to, map->name);
+    if (ptr_scene_color_by_value(scene, map, from, to) != PTR_OK)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", scene_path);
+    return o->color_bar && color ? write_bar(o, map, scene_path, color, err) : PTR_OK;
+}

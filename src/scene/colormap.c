@@ -1,0 +1,67 @@
+#include "scene/colormap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const PtrColormap *ptr_colormap_find(const char *name)
+{
+    for (const PtrColormap *map = ptr_colormaps; map->name; map++)
+        if (!strcmp(map->name, name))
+            return map;
+    return NULL;
+}
+
+PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, double hi)
+{
+    double t = hi > lo ? (value - lo) / (hi - lo) : 0.0;
+    t = t > 0.0 ? t : 0.0; /* NaN too */
+    int index = t >= 1.0 ? 255 : (int)(t * 256.0);
+    const float *c = map->srgb[index];
+    return v3(c[0], c[1], c[2]);
+}
+
+/* IEC 61966-2-1's sRGB decoding. */
+static float srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, double hi)
+{
+    PtrVec3 c = ptr_colormap_srgb(map, value, lo, hi);
+    return v3(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z));
+}
+
+PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,
+                                   double hi)
+{
+    PtrSpheres *s = &scene->spheres;
+    const size_t materials = scene->material_count;
+    if (!s->value)
+        return PTR_OK;
+    /* The white copy of each material, made when a sphere first needs it. */
+    uint32_t *white = malloc((materials ? materials : 1) * sizeof *white);
+    if (!white)
+        return PTR_ERR_NOMEM;
+    for (size_t m = 0; m < materials; m++)
+        white[m] = UINT32_MAX;
+    PtrResult res = PTR_OK;
+    for (size_t i = 0; i < s->count && res == PTR_OK; i++) {
+        if (isnan(s->value[i]))
+            continue;
+        uint32_t m = s->material[i];
+        if (white[m] == UINT32_MAX) {
+            PtrMaterial copy = scene->materials[m];
+            copy.albedo = v3_splat(1.0f);
+            res = ptr_scene_add_material(scene, &copy, &white[m]);
+        }
+        if (res == PTR_OK) {
+            s->material[i] = white[m];
+            res = ptr_scene_set_sphere_color(scene, i,
+                                             ptr_colormap_linear(map, s->value[i], lo, hi));
+        }
+    }
+    free(white);
+    return res;
+}

@@ -1,0 +1,40 @@
+/* Colour by a quantity: a per-sphere value through a range onto a colormap's
+ * colour, which replaces the sphere's base colour (docs/scenes.md). */
+#ifndef PTR_COLORMAP_H
+#define PTR_COLORMAP_H
+
+#include "base/result.h"
+#include "base/vec.h"
+#include "scene/scene.h"
+
+typedef struct PtrColormap {
+    const char *name;
+    const float (*srgb)[3]; /* 256 entries, sRGB-encoded, low values first */
+} PtrColormap;
+
+/* viridis, magma, inferno, plasma, cividis, coolwarm (colormap_tables.c, from
+ * scripts/make_colormaps.py); ends with a NULL name. */
+extern const PtrColormap ptr_colormaps[];
+
+/* The map of that name, or NULL. */
+const PtrColormap *ptr_colormap_find(const char *name);
+
+/* The entry for value between lo and hi, as matplotlib picks it: the range
+ * cut into 256 equal bins (hi itself in the last), values beyond it clamped
+ * to the ends, every value the first entry when lo == hi. */
+PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, double hi);
+
+/* That entry decoded from sRGB to linear light: the albedo of a diffuse
+ * sphere that, lit by white light of radiance 1, shows the entry through an
+ * sRGB view. */
+PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, double hi);
+
+/* Every sphere with a value (PtrSpheres.value not NaN) gets the colour of its
+ * value as its own colour, and a copy of its material whose base colour is
+ * white, so the mapped colour replaces the base colour instead of
+ * multiplying it; emission, fuzz and ior are kept. Other spheres are left as
+ * they are. Returns PTR_ERR_NOMEM if memory runs out. */
+PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,
+                                   double hi);
+
+#endif /* PTR_COLORMAP_H */
