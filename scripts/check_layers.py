@@ -20,8 +20,9 @@ LAYERS = {
     "importers": ("importers", ["base", "scene"]),
     "image": ("src/image", ["base"]),
     "color": ("src/color", ["base"]),
+    "live": ("src/live", ["base"]),
     "app": ("src/app", ["base", "scene", "sampling", "accel", "render", "importers", "image",
-                        "color"]),
+                        "color", "live"]),
 }
 # Where a quoted include is looked for, after the including file's folder.
 INCLUDE_DIRS = ["src", "importers", "importers/gltf"]

@@ -8,6 +8,7 @@
 #include "app/cli_options.h"
 #include "app/color_by.h"
 #include "app/job.h"
+#include "app/live_view.h"
 #include "app/merge.h"
 #include "app/report.h"
 #include "app/scene_json.h"
@@ -226,9 +227,12 @@ int ptr_cli_main(int argc, char **argv)
                           ptr_integrator_name(o.integrator), ptr_cpu_level_name(ptr_cpu_level()),
                           built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
+        } else if (ptr_live_view_open(&o, color, &err) != PTR_OK) {
+            code = fail(&err);
         } else {
             code = o.watch ? watch_scene(&o, color) : render_all(&o, color);
         }
+        ptr_live_view_close();
     }
     ptr_color_close(color);
     ptr_claim_keeper_stop();

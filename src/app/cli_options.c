@@ -344,6 +344,8 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_sample_range: return set_sample_range(id, value, o);
     case OPT_region: return set_region(id, value, o);
     case OPT_watch: o->watch = 1; break;
+    case OPT_live: o->live = value; break;
+    case OPT_tev: o->tev = value; break;
     case OPT_frames: return set_frames(id, value, o);
     case OPT_turntable: return set_int(id, value, 1, PTR_MAX_FRAMES, &o->turntable);
     case OPT_skip_existing: o->skip_existing = 1; break;

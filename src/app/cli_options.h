@@ -60,6 +60,7 @@ typedef struct PtrOptions {
     double time_budget;     /* seconds; 0: none */
     int preview;
     int watch;
+    const char *live, *tev; /* [HOST:]PORT of the live view, of tev */
     int has_frames;         /* --frames A:B:STEP */
     long frame_first, frame_last, frame_step;
     int turntable;          /* frames in a full turn; 0: none */

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "app/color_by.h"
+#include "app/live_view.h"
 #include "app/output.h"
 #include "app/signals.h"
 #include "base/cpu.h"
@@ -76,6 +77,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
+    ptr_live_view_begin(report->scene, report->output, layout.width, layout.height, &passes);
     size_t pixels = (size_t)layout.width * (size_t)layout.height;
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
@@ -122,6 +124,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
     free(rgb);
     free(counts);
     free(alpha);
+    ptr_live_view_end(res == PTR_OK && !done.stopped);
     if (res == PTR_OK && done.stopped && o->skip_existing)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted after %u of %u samples; not written, so that "

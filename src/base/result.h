@@ -20,7 +20,7 @@ extern "C" {
     X(PTR_ERR_COLOR,            7,   "colour configuration cannot be used")  \
     X(PTR_ERR_INTERRUPTED,      8,   "interrupted: the image holds the samples done") \
     X(PTR_ERR_BATCH,            9,   "some scenes of a batch failed")          \
-    X(PTR_ERR_INSTALL,          10,  "ptr's image module cannot be loaded (a broken installation)")
+    X(PTR_ERR_INSTALL,          10,  "a module of ptr cannot be loaded (a broken installation)")
 
 typedef enum PtrResult {
 #define PTR_RESULT_ENUM(name, code, text) name,

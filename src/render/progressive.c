@@ -60,6 +60,12 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
         watch.progress.samples_done = done;
         watch.progress.rays = result->stats.rays;
         watch.progress.rays_seconds = elapsed;
+        if (options->pass_done) {
+            PtrProgress p = watch.progress;
+            p.fraction = (double)done / options->samples;
+            p.elapsed = elapsed;
+            options->pass_done(options->pass_user, acc, pixels, &p);
+        }
 
         if (options->stop && *options->stop) {
             result->stopped = done < options->samples;

@@ -4,6 +4,7 @@
 #define PTR_PROGRESSIVE_H
 
 #include <signal.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "render/render.h"
@@ -24,6 +25,11 @@ typedef struct PtrProgressiveOptions {
     /* Called about ten times a second (may be NULL). */
     void (*report)(void *user, const PtrProgress *progress);
     void *user;
+    /* Called after each pass (may be NULL), on the calling thread while the
+     * render's threads wait, with the film so far (film.h: pixels pixels of
+     * the region): to be read, never written. */
+    void (*pass_done)(void *user, const double *film, size_t pixels, const PtrProgress *progress);
+    void *pass_user;
 } PtrProgressiveOptions;
 
 typedef struct PtrProgressiveResult {

@@ -1,7 +1,9 @@
 #!/bin/sh
 # The commands that write no image never load OpenImageIO (whose 260 shared
 # libraries cost a quarter of a second and 128 MB before anything else), nor
-# does a render to EXR (OpenEXR is linked); a render to PNG loads it once. The dynamic loader's own log (LD_DEBUG=files) says which
+# does a render to EXR (OpenEXR is linked); a render to PNG loads it once.
+# Nothing but a render with --live or --tev loads the live module and
+# libmicrohttpd. The dynamic loader's own log (LD_DEBUG=files) says which
 # objects a process loaded, whatever the timings.
 # Usage: test_startup.sh PTR SOURCE_DIR
 set -u
@@ -20,6 +22,8 @@ for args in "--version" "--help" "--dump-scene $src/scenes/seed.gltf" "--print-d
     [ "$(loads libOpenColorIO)" = 1 ] || fail "ptr $args: LD_DEBUG=files did not log the libraries"
     [ "$(loads libOpenImageIO)" = 0 ] || fail "ptr $args loaded OpenImageIO"
     [ "$(loads ptr_image_oiio)" = 0 ] || fail "ptr $args loaded the image module"
+    [ "$(loads ptr_live)" = 0 ] || fail "ptr $args loaded the live module"
+    [ "$(loads libmicrohttpd)" = 0 ] || fail "ptr $args loaded libmicrohttpd"
 done
 
 # A render to EXR writes through OpenEXR alone; one to PNG loads the module once.
@@ -33,6 +37,19 @@ for ext in exr png; do
     [ "$(loads libOpenImageIO.so)" = "$want" ] ||
         fail "render to .$ext: OpenImageIO was not loaded $want times"
     [ "$(loads libOpenEXR-)" = 1 ] || fail "render to .$ext: OpenEXR was not loaded once"
+    # Without --live or --tev, no live view: neither its module nor the
+    # libraries only it needs (libpng comes with OpenImageIO for .png).
+    [ "$(loads ptr_live)" = 0 ] || fail "render to .$ext loaded the live module"
+    [ "$(loads libmicrohttpd)" = 0 ] || fail "render to .$ext loaded libmicrohttpd"
+done
+
+# --live and --tev load the live module once, and with it libmicrohttpd.
+for option in "--live 0" "--tev 1"; do
+    # shellcheck disable=SC2086 # the option and its value are split on purpose
+    LD_DEBUG=files "$ptr" "$src/scenes/seed.gltf" -o "$dir/b.exr" --width 8 --height 8 \
+        --samples 1 --quiet $option 2>"$dir/log" || fail "render with $option: exit code $?"
+    [ "$(loads ptr_live)" = 1 ] || fail "render with $option: the live module was not loaded once"
+    [ "$(loads libmicrohttpd)" = 1 ] || fail "render with $option: libmicrohttpd was not loaded once"
 done
 
 finish "startup: passed"

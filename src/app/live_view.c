@@ -1,0 +1,103 @@
+#include "app/live_view.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "live/live.h"
+#include "render/film.h"
+
+static const PtrLiveModule *module;
+static PtrLiveSession *session;
+static float *scratch; /* the resolved film of the render under way */
+static size_t scratch_pixels;
+static PtrLiveStatus last;
+
+/* The page's view: the output's transform, with the page's exposure on top
+ * (a gain in scene-linear, before the view, as --exposure is). */
+static int apply_view(void *user, float *rgb, size_t pixels, float stops)
+{
+    if (stops != 0.0f) {
+        float gain = exp2f(stops);
+        for (size_t i = 0; i < pixels * 3; i++)
+            rgb[i] *= gain;
+    }
+    PtrError err;
+    return ptr_color_apply(user, rgb, pixels, &err) == PTR_OK ? 0 : -1;
+}
+
+PtrResult ptr_live_view_open(const PtrOptions *o, const PtrColor *color, PtrError *err)
+{
+    if (!o->live && !o->tev)
+        return PTR_OK;
+    module = ptr_live_module(err);
+    if (!module)
+        return err->code;
+    PtrLiveOptions options = {
+        .http = o->live, .tev = o->tev, .view = apply_view, .view_user = (void *)color,
+    };
+    session = module->start(&options, err);
+    if (!session)
+        return err->code;
+    if (o->live)
+        fprintf(stderr, "ptr: live view at %s\n", module->url(session));
+    return PTR_OK;
+}
+
+void ptr_live_view_close(void)
+{
+    if (session)
+        module->stop(session);
+    session = NULL;
+    free(scratch);
+    scratch = NULL;
+    scratch_pixels = 0;
+}
+
+/* After each pass, on the thread that runs the render, while its threads
+ * wait: the film resolved (a read of it, as the final image's), handed
+ * over with the progress. */
+static void pass_done(void *user, const double *film, size_t pixels, const PtrProgress *p)
+{
+    (void)user;
+    if (pixels != scratch_pixels)
+        return;
+    ptr_accum_resolve(film, pixels, scratch, NULL, NULL);
+    double per_sample = p->samples_done ? p->elapsed / p->samples_done : 0;
+    last = (PtrLiveStatus){
+        .samples_done = p->samples_done, .samples_total = p->samples_total,
+        .elapsed = p->elapsed,
+        .remaining = p->samples_done ? per_sample * (p->samples_total - p->samples_done) : -1,
+        .mrays_per_second = p->rays_seconds > 0 ? 1e-6 * (double)p->rays / p->rays_seconds : 0,
+        .state = PTR_LIVE_RENDERING,
+    };
+    module->frame(session, scratch, &last);
+}
+
+void ptr_live_view_begin(const char *scene, const char *output, int width, int height,
+                         PtrProgressiveOptions *passes)
+{
+    if (!session)
+        return;
+    size_t pixels = (size_t)width * (size_t)height;
+    if (pixels != scratch_pixels) {
+        free(scratch);
+        scratch = malloc(pixels * 3 * sizeof *scratch);
+        scratch_pixels = scratch ? pixels : 0;
+    }
+    last = (PtrLiveStatus){ .remaining = -1 };
+    module->begin(session, scene, output, width, height);
+    if (scratch) {
+        passes->pass_done = pass_done;
+        passes->pass_user = NULL;
+    }
+}
+
+void ptr_live_view_end(int ok)
+{
+    if (!session)
+        return;
+    last.state = ok ? PTR_LIVE_DONE : PTR_LIVE_FAILED;
+    last.remaining = 0;
+    module->end(session, &last);
+}

@@ -1,0 +1,83 @@
+/* The live view: what a render shows while it refines, in a browser (an
+ * HTTP server, --live) and in tev (a TCP client, --tev). The server and the
+ * client live in a module of their own (live_module.c, live_http.c,
+ * live_tev.c, live_png.c: lib/ptr/ptr_live.so, linking libmicrohttpd and
+ * libpng), which live_loader.c loads only when a render asks for a live
+ * view: a render without one never maps them.
+ *
+ * The renderer hands each pass's image (scene-linear RGB) to frame(), which
+ * copies it under a lock and returns: everything else (the view transform,
+ * PNG encoding, sending) happens on the module's own threads, and only while
+ * a page is open or tev is connected. */
+#ifndef PTR_LIVE_H
+#define PTR_LIVE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "base/result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct PtrLiveSession PtrLiveSession;
+
+/* Where a render stands, after a pass or at its end. */
+typedef struct PtrLiveStatus {
+    uint32_t samples_done, samples_total;
+    double elapsed;   /* seconds since the render started */
+    double remaining; /* seconds, estimated; negative: unknown */
+    double mrays_per_second;
+    int state;        /* PTR_LIVE_RENDERING, PTR_LIVE_DONE or PTR_LIVE_FAILED */
+} PtrLiveStatus;
+
+enum { PTR_LIVE_RENDERING, PTR_LIVE_DONE, PTR_LIVE_FAILED };
+
+typedef struct PtrLiveOptions {
+    const char *http; /* --live [HOST:]PORT, or NULL */
+    const char *tev;  /* --tev [HOST:]PORT, or NULL */
+    /* Transforms rgb (pixels RGB triples, scene-linear) in place to the
+     * output's display, view and look, with stops of exposure on top of the
+     * output's; called on the module's threads, so it must be thread-safe.
+     * Returns 0 on success. */
+    int (*view)(void *user, float *rgb, size_t pixels, float stops);
+    void *view_user;
+} PtrLiveOptions;
+
+#define PTR_LIVE_MODULE_SYMBOL "ptr_live_module_table"
+
+/* The module's one exported symbol. */
+typedef struct PtrLiveModule {
+    /* sizeof(PtrLiveModule) and PTR_VERSION as the module was built. */
+    size_t size;
+    const char *version;
+
+    /* Binds the server and starts the threads. NULL on failure, with err
+     * filled: PTR_ERR_USAGE for an address that cannot be used (a port in
+     * use, an unknown host), PTR_ERR_NOMEM, PTR_ERR_INTERNAL. */
+    PtrLiveSession *(*start)(const PtrLiveOptions *options, PtrError *err);
+    /* The page's address, "http://HOST:PORT/" ("" without --live). */
+    const char *(*url)(const PtrLiveSession *session);
+    /* A render starts: the image it makes is width x height. */
+    void (*begin)(PtrLiveSession *session, const char *scene, const char *output, int width,
+                  int height);
+    /* The image after a pass (width x height RGB of begin, scene-linear):
+     * copied, never kept. */
+    void (*frame)(PtrLiveSession *session, const float *rgb, const PtrLiveStatus *status);
+    /* The render ended (status->state says how); the page keeps its image. */
+    void (*end)(PtrLiveSession *session, const PtrLiveStatus *status);
+    /* Lets open pages fetch the last image (a second at most), stops the
+     * threads and closes every connection. */
+    void (*stop)(PtrLiveSession *session);
+} PtrLiveModule;
+
+/* The module, loaded now (live_loader.c); NULL if it cannot be, with err
+ * saying why (PTR_ERR_INSTALL, PTR_ERR_NOMEM). */
+const PtrLiveModule *ptr_live_module(PtrError *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PTR_LIVE_H */

@@ -1,0 +1,88 @@
+/* What the live module's files share (the module only: live.h is the
+ * interface ptr sees). One session holds the latest image under one lock;
+ * the encoder (live_module.c), the server's connections (live_http.c) and
+ * tev's sender (live_tev.c) read it there and do their work outside it. */
+#ifndef PTR_LIVE_MODULE_H
+#define PTR_LIVE_MODULE_H
+
+#include <pthread.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <sys/socket.h>
+
+#include "live/live.h"
+
+typedef struct LiveTev LiveTev;
+
+struct PtrLiveSession {
+    PtrLiveOptions options;
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* broadcast on every change below */
+    int stopping;
+
+    /* The render under way, or the last one. */
+    char scene[256], output[256];
+    int width, height;
+    uint64_t render;        /* begin() calls so far */
+    float *frame;           /* width x height RGB, scene-linear; NULL before a frame */
+    size_t frame_capacity;  /* floats */
+    uint64_t frame_version; /* frame() calls so far, over all renders */
+    PtrLiveStatus status;
+    uint64_t event;         /* changes a page should hear about */
+
+    /* The page: open event streams, its exposure, and the PNG of the view. */
+    int pages;
+    void *streams;          /* live_http.c's list of them */
+    float stops;
+    uint64_t stops_version;
+    unsigned char *png;
+    size_t png_size;
+    uint64_t png_id;        /* encodings so far: the page asks for /frame.png?id */
+    uint64_t png_frame, png_stops; /* the frame_version and stops_version it shows */
+    uint64_t served_frame;  /* the newest frame_version a page has fetched */
+    pthread_t encoder;
+    int encoder_started;
+
+    /* The server. */
+    void *daemon;
+    void *http;             /* live_http.c's connections and their deadlines */
+    int listen_fd;
+    char url[128];
+
+    LiveTev *tev;
+};
+
+/* "[HOST:]PORT" ("[::1]:PORT" for IPv6) split into host (default
+ * 127.0.0.1) and port: 0 and a message in err if the text is not that. */
+int ptr_live_parse_address(const char *option, const char *text, char *host, size_t host_size,
+                           char *port, size_t port_size, PtrError *err);
+
+/* Fills err as ptr_error_set would (the module cannot call into ptr). */
+PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Seconds on a steady clock. */
+double ptr_live_now(void);
+
+/* Waits on the session's condition for at most seconds (the lock held). */
+void ptr_live_wait(PtrLiveSession *s, double seconds);
+
+/* The server (live_http.c): binds options->http and starts serving. */
+PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err);
+void ptr_live_http_stop(PtrLiveSession *s);
+/* Whether an open page has yet to hear of the latest change (the lock held). */
+int ptr_live_http_pages_behind(const PtrLiveSession *s);
+
+/* tev's sender (live_tev.c): a thread that connects to options->tev,
+ * reconnecting when the connection fails, and sends changed tiles. */
+PtrResult ptr_live_tev_start(PtrLiveSession *s, PtrError *err);
+void ptr_live_tev_stop(PtrLiveSession *s);
+
+/* 8-bit RGB rows to a PNG in memory (live_png.c): malloc'ed, NULL on failure. */
+unsigned char *ptr_live_png_encode(const unsigned char *rgb, int width, int height,
+                                   size_t *size);
+
+/* The page (src/live/page.html, embedded at build time). */
+extern const char ptr_live_page[];
+
+#endif /* PTR_LIVE_MODULE_H */

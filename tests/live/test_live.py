@@ -1,0 +1,327 @@
+#!/usr/bin/env python3
+"""--live: the server's routes, the address rules (loopback by default, a
+warning for any other, a port in use is one line and exit 2), images
+byte-identical with and without a page open, the page following a batch and
+--watch, a slow request cut off, and a flood of malformed and slow requests
+during a render that neither crashes ptr nor stalls it.
+
+Usage: test_live.py PTR SOURCE_DIR [SANITIZED]"""
+import os
+import random
+import shutil
+import socket
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
+from live_client import Ptr, Page, get, same_image_bytes, samples, wait_for  # noqa: E402
+
+ptr, src = sys.argv[1], sys.argv[2]
+scene = os.path.join(src, "scenes", "seed.gltf")
+failures = []
+
+
+def check(ok, message):
+    if not ok:
+        failures.append(message)
+        print("FAIL: " + message, file=sys.stderr)
+    return ok
+
+
+def render(out, extra=(), n=300, size=160):
+    return [ptr, scene, "-o", out, "--width", str(size), "--height", str(size), "--samples",
+            str(samples(n)), "--threads", "2", *extra]
+
+
+def plain(out, **kw):
+    p = Ptr(render(out, **kw))
+    code = p.wait()
+    check(code == 0, "%s without --live: exit %d: %s" % (out, code, p.stderr))
+
+
+def routes(url):
+    status, headers, body = get(url, "/")
+    check(status == 200 and headers.get("Content-Type", "").startswith("text/html") and
+          b"EventSource" in body, "GET /: %d %s" % (status, headers))
+    for path in ["/nope", "/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/frame.png/../x",
+                 "//etc/passwd", "/index.html"]:
+        status, _, body = get(url, path)
+        check(status == 404 and b"root:" not in body, "GET %s: %d, not 404" % (path, status))
+    for query in ["stops=abc", "stops=", "stops=1e9", "stops=nan", ""]:
+        status, _, _ = get(url, "/exposure?" + query)
+        check(status == 400, "GET /exposure?%s: %d, not 400" % (query, status))
+    u = url.split("/")[2].split(":")
+    c = socket.create_connection((u[0], int(u[1])), timeout=10)
+    c.sendall(b"POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\nhello")
+    reply = c.recv(100)
+    c.close()
+    check(reply.startswith(b"HTTP/1.1 405"), "POST /: %r" % reply[:40])
+
+
+def identical_with_page(d):
+    """The image written is the same bytes with a page open as without."""
+    for ext in ["exr", "png"]:
+        a, b = os.path.join(d, "plain." + ext), os.path.join(d, "live." + ext)
+        plain(a)
+        p = Ptr(render(b, ["--live", "0"]))
+        url = p.url()
+        if not check(url and url.startswith("http://127.0.0.1:"),
+                     "--live 0: no address on 127.0.0.1 printed: %s" % p.stderr):
+            p.process.kill()
+            continue
+        page = Page(url)
+        if ext == "png":
+            routes(url)
+        code = p.wait()
+        page.close()
+        check(code == 0, "--live render to .%s: exit %d: %s" % (ext, code, p.stderr))
+        check(page.error is None, "page: %s" % page.error)
+        check(len(page.frames) >= 2, "the page saw %d frames, not 2 or more" % len(page.frames))
+        check(len(page.states) and page.states[-1]["state"] == "done" and
+              page.states[-1]["samples"] == samples(300),
+              "the page's last state: %s" % (page.states[-1:] or None))
+        check(same_image_bytes(a, b), "%s and %s differ" % (a, b))
+        if ext == "png" and page.frames:
+            # The last frame the page showed is the output's view: the PNG ptr wrote.
+            last = os.path.join(d, "last_frame.png")
+            with open(last, "wb") as f:
+                f.write(page.frames[-1][1])
+            check(os.system("idiff -q -fail 0.0040 -failpercent 0 %s %s >/dev/null" %
+                            (last, b)) == 0, "the page's last frame is not the written PNG")
+
+
+def addresses(d):
+    out = os.path.join(d, "a.exr")
+    # A port in use: one line, exit 2, and no render.
+    taken = socket.socket()
+    taken.bind(("127.0.0.1", 0))
+    taken.listen(1)
+    port = taken.getsockname()[1]
+    p = Ptr(render(out, ["--live", str(port)]))
+    code = p.wait()
+    taken.close()
+    check(code == 2 and len(p.stderr_lines) == 1 and "in use" in p.stderr and
+          not os.path.exists(out), "port in use: exit %d, stderr %r" % (code, p.stderr))
+    for bad in ["abc", "70000", "host:", ":80", "-1", "1.2.3.4:x"]:
+        p = Ptr(render(out, ["--live", bad]))
+        code = p.wait()
+        check(code == 2 and len(p.stderr_lines) == 1,
+              "--live %s: exit %d, stderr %r" % (bad, code, p.stderr))
+    p = Ptr(render(out, ["--live", "no-such-host.invalid:0"]))
+    check(p.wait() == 2, "--live on an unknown host: not exit 2: %s" % p.stderr)
+    # Another address than the loopback: served, with a warning.
+    p = Ptr(render(out, ["--live", "0.0.0.0:0"], n=4))
+    code = p.wait()
+    check(code == 0 and "warning" in p.stderr and "loopback" in p.stderr,
+          "--live 0.0.0.0:0: exit %d, stderr %r" % (code, p.stderr))
+    p = Ptr(render(out, ["--live", "[::1]:0"], n=4))
+    code = p.wait()
+    check(code == 0 and "http://[::1]:" in p.stderr and "warning" not in p.stderr,
+          "--live [::1]:0: exit %d, stderr %r" % (code, p.stderr))
+
+
+class Flood:
+    """Malformed, oversized and slow requests on many threads until stopped."""
+
+    def __init__(self, host, port):
+        self.host, self.port = host, port
+        self.stop = False
+        self.sent = 0
+        self.threads = [threading.Thread(target=f, daemon=True) for f in
+                        [self.garbage] * 4 + [self.huge] * 2 + [self.slowloris] * 3 +
+                        [self.streams] * 2 + [self.bodies]]
+        for t in self.threads:
+            t.start()
+
+    def connect(self):
+        return socket.create_connection((self.host, self.port), timeout=5)
+
+    def attempt(self, f):
+        try:
+            s = self.connect()
+            try:
+                f(s)
+            finally:
+                s.close()
+            self.sent += 1
+        except OSError:
+            time.sleep(0.01)
+
+    def garbage(self):
+        rng = random.Random(1)
+        samples = [b"\x00\xff" * 100, b"GET\r\n\r\n", b"GET / HTTP/9.9\r\n\r\n",
+                   b"GET " + b"/" * 20000 + b" HTTP/1.1\r\n\r\n", b"\r\n" * 1000,
+                   b"GET / HTTP/1.1\r\nHost: x\r\nContent-Length: -5\r\n\r\n",
+                   b"GET / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\nzz\r\n",
+                   b"GET /events HTTP/1.1\r\nHost: x\r\nRange: bytes=99999-\r\n\r\n",
+                   b"GET /frame.png?id=\xff\xfe HTTP/1.1\r\n\r\n"]
+        while not self.stop:
+            data = rng.choice(samples) if rng.random() < 0.7 else rng.randbytes(rng.randrange(1, 3000))
+            self.attempt(lambda s: (s.sendall(data), s.recv(1024)))
+
+    def huge(self):
+        header = b"GET / HTTP/1.1\r\nHost: x\r\n" + b"X-Big: " + b"a" * 200000 + b"\r\n\r\n"
+        while not self.stop:
+            self.attempt(lambda s: (s.sendall(header), s.recv(1024)))
+
+    def slowloris(self):
+        held = []
+        while not self.stop:
+            try:
+                if len(held) < 20:
+                    s = self.connect()
+                    s.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n")
+                    held.append(s)
+                for s in list(held):
+                    try:
+                        s.sendall(b"X-a: b\r\n")
+                    except OSError:
+                        held.remove(s)
+                        s.close()
+            except OSError:
+                pass
+            time.sleep(0.2)
+        for s in held:
+            s.close()
+
+    def streams(self):
+        """Event streams opened and dropped, and never read."""
+        while not self.stop:
+            self.attempt(lambda s: (s.sendall(b"GET /events HTTP/1.1\r\nHost: x\r\n\r\n"),
+                                    time.sleep(0.3)))
+
+    def bodies(self):
+        while not self.stop:
+            self.attempt(lambda s: s.sendall(b"PUT /frame.png HTTP/1.1\r\nHost: x\r\n"
+                                             b"Content-Length: 100000000\r\n\r\n" + b"x" * 60000))
+
+    def close(self):
+        self.stop = True
+        for t in self.threads:
+            t.join(15)
+
+
+def flood(d):
+    a, b = os.path.join(d, "plain_flood.exr"), os.path.join(d, "flood.exr")
+    start = time.time()
+    plain(a, n=3000)
+    alone = time.time() - start
+    start = time.time()
+    p = Ptr(render(b, ["--live", "0"], n=3000))
+    url = p.url()
+    if not check(url, "no address: %s" % p.stderr):
+        p.process.kill()
+        return
+    host, port = url.split("/")[2].rsplit(":", 1)
+    page = Page(url)
+    f = Flood(host, int(port))
+    time.sleep(min(3, alone * 0.6))
+    f.close()
+    # Once the flood stops, the server answers again before the render ends.
+    def answers():
+        try:
+            return get(url, "/")[0] == 200
+        except OSError:
+            return p.process.poll() is not None  # ended meanwhile: nothing to ask
+
+    answered = wait_for(answers, 15, 0.2)
+    try:
+        code = p.wait(timeout=max(60, 10 * alone))
+    except Exception:  # noqa: BLE001 - a stalled render is the failure reported
+        p.process.kill()
+        code = "stalled"
+    took = time.time() - start
+    page.close()
+    check(code == 0, "render under a flood: exit %s: %s" % (code, p.stderr[-2000:]))
+    check(answered, "the server did not answer after the flood")
+    check(same_image_bytes(a, b), "the image rendered under a flood differs")
+    print("flood: %d requests during the render; render %.1f s alone, %.1f s under the flood"
+          % (f.sent, alone, took))
+
+
+def follows(d):
+    """In a batch the page follows the scene being rendered; with --watch,
+    each re-render after a save."""
+    folder = os.path.join(d, "batch")
+    os.mkdir(folder)
+    second = os.path.join(d, "second.gltf")
+    shutil.copy(scene, second)
+    # The first render lasts a second or more: the page connects during it.
+    p = Ptr([ptr, scene, second, "-o", folder + "/", "--width", "128", "--height", "128",
+             "--samples", str(samples(1500)), "--threads", "2", "--live", "0"])
+    page = Page(p.url())
+    code = p.wait()
+    page.close()
+    done = {s["render"]: s["scene"] for s in page.states if s["state"] == "done"}
+    check(code == 0 and done == {1: scene, 2: second},
+          "a batch: exit %d, the page saw %s done" % (code, done))
+
+    p = Ptr([ptr, second, "-o", os.path.join(d, "watched.exr"), "--width", "32", "--height",
+             "32", "--samples", "4", "--threads", "2", "--live", "0", "--watch"])
+    page = Page(p.url())
+    wait_for(lambda: any(s["state"] == "done" for s in page.states), 30)
+    with open(second, "a") as f:
+        f.write("\n")  # saved again
+    renders = lambda: {s["render"] for s in page.states if s["state"] == "done"}  # noqa: E731
+    wait_for(lambda: renders() == {1, 2}, 30)
+    p.process.send_signal(2)
+    code = p.wait(30)
+    page.close()
+    check(code == 0 and renders() == {1, 2},
+          "--watch: exit %d, the page saw renders %s done, not 1 and 2" % (code, renders()))
+
+
+def request_deadline(d):
+    """A client that sends a header line a second is never idle, yet its
+    request is cut off 10 s after it connected; a page's event stream stays.
+    With --watch, ptr serves after the render until Ctrl-C."""
+    p = Ptr(render(os.path.join(d, "watch.exr"), ["--live", "0", "--watch"], n=4, size=16))
+    url = p.url()
+    if not check(url, "--watch --live: no address: %s" % p.stderr):
+        p.process.kill()
+        return
+    host, port = url.split("/")[2].rsplit(":", 1)
+    page = Page(url)
+    slow = socket.create_connection((host, int(port)), timeout=5)
+    slow.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n")
+    start, cut = time.time(), None
+    while time.time() - start < 20:
+        try:
+            slow.sendall(b"X-a: b\r\n")
+            slow.settimeout(1)
+            if slow.recv(100) == b"":
+                cut = time.time() - start
+                break
+        except socket.timeout:
+            continue
+        except OSError:
+            cut = time.time() - start
+            break
+    slow.close()
+    check(cut is not None and 8 <= cut <= 13,
+          "a request trickling a header a second was cut after %s s, not about 10" % cut)
+    check(page.error is None and page.states, "the page's stream: %s, %d states"
+          % (page.error, len(page.states)))
+    p.process.send_signal(2)
+    code = p.wait(30)
+    page.close()
+    check(code == 0, "--watch stopped by SIGINT: exit %d: %s" % (code, p.stderr))
+
+
+def main():
+    with tempfile.TemporaryDirectory() as d:
+        identical_with_page(d)
+        addresses(d)
+        follows(d)
+        request_deadline(d)
+        flood(d)
+    if failures:
+        return 1
+    print("live: passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
