@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base/module.h"
 #include "base/version.h"
 
 enum { PATH_SIZE = 4096 };
@@ -23,48 +24,11 @@ static int exit_waits;      /* join_loader is registered with atexit */
 static PtrError load_error; /* why the load failed */
 static const PtrImageModule *module; /* set once the module works */
 
-/* PTR_IMAGE_MODULE_PATH ("../lib/ptr/NAME.so") from the executable's folder,
- * each leading "../" taken off that folder, so that messages show a plain
- * path. */
-static PtrResult module_path(char *path, size_t size, PtrError *err)
-{
-    ssize_t n = readlink("/proc/self/exe", path, size);
-    if (n <= 0 || (size_t)n >= size)
-        return ptr_error_set(err, PTR_ERR_INSTALL,
-                             "/proc/self/exe: cannot find ptr's own folder, where its image "
-                             "module lives: %s", n < 0 ? strerror(errno) : "path too long");
-    path[n] = '\0';
-    const char *relative = PTR_IMAGE_MODULE_PATH;
-    *strrchr(path, '/') = '\0'; /* the kernel gives an absolute path */
-    for (char *slash; !strncmp(relative, "../", 3) && (slash = strrchr(path, '/')); relative += 3)
-        *slash = '\0';
-    size_t used = strlen(path);
-    if ((size_t)snprintf(path + used, size - used, "/%s", relative) >= size - used)
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: path too long for ptr's image module",
-                             path);
-    return PTR_OK;
-}
-
-/* Whether dlopen failed for want of memory. It reports text alone (errno
- * does not survive it), so this knows glibc's words for the cases: a mapping
- * refused (a segment, the zero-filled pages) or an allocation failed. */
-static int dl_out_of_memory(const char *why)
-{
-    static const char *const signs[] = {
-        "failed to map segment", "cannot map zero-fill pages", "cannot allocate",
-        "Cannot allocate memory", "out of memory",
-    };
-    for (size_t i = 0; i < sizeof signs / sizeof signs[0]; i++)
-        if (strstr(why, signs[i]))
-            return 1;
-    return 0;
-}
-
 static void load(void)
 {
     char path[PATH_SIZE];
     const PtrImageModule *m = NULL;
-    if (module_path(path, sizeof path, &load_error) == PTR_OK) {
+    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, &load_error) == PTR_OK) {
         /* Lazy binding, as when a program links the libraries: binding all of
          * their functions up front costs a tenth more. */
         void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
@@ -74,7 +38,7 @@ static void load(void)
             size_t len = strlen(path);
             if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
                 why += len + 2;
-            if (dl_out_of_memory(why))
+            if (ptr_dl_out_of_memory(why))
                 ptr_error_set(&load_error, PTR_ERR_NOMEM,
                               "%s: out of memory: cannot load ptr's image module: %s", path, why);
             else
@@ -122,7 +86,7 @@ PtrResult ptr_image_preload(const char *output, PtrError *err)
     if (ptr_image_is_exr(output))
         return PTR_OK;
     char path[PATH_SIZE];
-    if (module_path(path, sizeof path, err) != PTR_OK)
+    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, err) != PTR_OK)
         return err->code;
     if (access(path, R_OK))
         return ptr_error_set(err, PTR_ERR_INSTALL, "%s: ptr's image module is missing: %s", path,
