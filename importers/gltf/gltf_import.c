@@ -629,41 +629,41 @@ static uint64_t node_sphere_count(const Importer *im, const GltfNode *node)
     return mul_saturating(spheres, a.count);
 }
 
+/* What walk_nodes does at each node, under its world transform. */
+typedef PtrResult (*NodeVisit)(Importer *im, size_t index, const GltfNode *node,
+                               const Mat4 *world, void *user);
+
 /* The spheres the default scene will hold, counted before anything is read
- * or allocated for them: instances can multiply a small file's accessors
- * into more spheres than the machine holds. Nodes met twice are counted once
- * (walk_nodes refuses them). Returns UINT64_MAX if out of memory. */
-static uint64_t scene_sphere_count(const Importer *im, const GltfScene *gs)
+ * or allocated for them (user: a uint64_t, saturating): instances can
+ * multiply a small file's accessors into more spheres than the machine
+ * holds. */
+static PtrResult count_spheres(Importer *im, size_t index, const GltfNode *node,
+                               const Mat4 *world, void *user)
 {
-    size_t n = gltf_doc_node_count(im->doc);
-    int *stack = malloc((n ? n : 1) * sizeof *stack);
-    unsigned char *seen = calloc(n ? n : 1, 1);
-    uint64_t spheres = stack && seen ? 0 : UINT64_MAX;
-    for (size_t r = 0; r < gs->root_count && stack && seen; r++) {
-        size_t top = 0;
-        stack[top++] = gs->roots[r];
-        while (top > 0) {
-            int index = stack[--top];
-            if (seen[index])
-                continue;
-            seen[index] = 1;
-            GltfNode node;
-            gltf_doc_node(im->doc, (size_t)index, &node);
-            if (node.mesh >= 0)
-                spheres = add_saturating(spheres, node_sphere_count(im, &node));
-            for (size_t c = 0; c < node.child_count && top < n; c++)
-                if (!seen[node.children[c]])
-                    stack[top++] = node.children[c];
-        }
-    }
-    free(stack);
-    free(seen);
-    return spheres;
+    (void)index, (void)world;
+    uint64_t *spheres = user;
+    if (node->mesh >= 0)
+        *spheres = add_saturating(*spheres, node_sphere_count(im, node));
+    return PTR_OK;
 }
 
-/* Depth-first, pre-order, over the default scene; glTF requires the nodes to
- * form trees, so a node met twice is an error (a cycle or a shared child). */
-static PtrResult walk_nodes(Importer *im, const GltfScene *gs)
+/* The node's spheres and camera into the scene. */
+static PtrResult import_node(Importer *im, size_t index, const GltfNode *node, const Mat4 *world,
+                             void *user)
+{
+    (void)user;
+    PtrResult res = PTR_OK;
+    if (node->mesh >= 0)
+        res = add_node_spheres(im, index, node, world);
+    if (res == PTR_OK && node->camera >= 0)
+        res = take_camera(im, node, world);
+    return res;
+}
+
+/* Depth-first, pre-order, over the default scene, visiting each node; glTF
+ * requires the nodes to form trees, so a node met twice is an error (a cycle
+ * or a shared child). */
+static PtrResult walk_nodes(Importer *im, const GltfScene *gs, NodeVisit visit, void *user)
 {
     size_t n = gltf_doc_node_count(im->doc);
     Mat4 *world = malloc((n ? n : 1) * sizeof *world);
@@ -699,10 +699,7 @@ static PtrResult walk_nodes(Importer *im, const GltfScene *gs)
                                     index, label(node.name, "unnamed"));
                 break;
             }
-            if (node.mesh >= 0)
-                res = add_node_spheres(im, (size_t)index, &node, &world[index]);
-            if (res == PTR_OK && node.camera >= 0)
-                res = take_camera(im, &node, &world[index]);
+            res = visit(im, (size_t)index, &node, &world[index], user);
             for (size_t c = node.child_count; c-- > 0 && res == PTR_OK;) {
                 int child = node.children[c];
                 if (seen[child] || top >= n) {
@@ -783,10 +780,13 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         for (size_t i = 0; i < materials; i++)
             im.material_index[i] = UINT32_MAX;
         res = read_scene_extras(&im, &gs);
+        uint64_t spheres = 0;
         if (res == PTR_OK)
-            res = ptr_import_check_memory(path, scene_sphere_count(&im, &gs), err);
+            res = walk_nodes(&im, &gs, count_spheres, &spheres);
         if (res == PTR_OK)
-            res = walk_nodes(&im, &gs);
+            res = ptr_import_check_memory(path, spheres, err);
+        if (res == PTR_OK)
+            res = walk_nodes(&im, &gs, import_node, NULL);
     }
     if (res == PTR_OK && im.camera_name && !im.camera_found && !(options && options->camera))
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,

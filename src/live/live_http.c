@@ -132,11 +132,7 @@ static Http *http_new(void)
     if (!http)
         return NULL;
     pthread_mutex_init(&http->lock, NULL);
-    pthread_condattr_t attr;
-    pthread_condattr_init(&attr);
-    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
-    pthread_cond_init(&http->wake, &attr);
-    pthread_condattr_destroy(&attr);
+    ptr_live_cond_init(&http->wake);
     if (pthread_create(&http->watchdog, NULL, watch_requests, http)) {
         pthread_cond_destroy(&http->wake);
         pthread_mutex_destroy(&http->lock);

@@ -225,11 +225,7 @@ static PtrLiveSession *session_start(const PtrLiveOptions *options, PtrError *er
     s->listen_fd = -1;
     s->status.remaining = -1;
     pthread_mutex_init(&s->lock, NULL);
-    pthread_condattr_t attr;
-    pthread_condattr_init(&attr);
-    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
-    pthread_cond_init(&s->changed, &attr);
-    pthread_condattr_destroy(&attr);
+    ptr_live_cond_init(&s->changed);
     if (options->http) {
         if (ptr_live_http_start(s, err) != PTR_OK) {
             session_free(s);

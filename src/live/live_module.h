@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <sys/socket.h>
+#include <time.h>
 
 #include "live/live.h"
 
@@ -84,5 +85,16 @@ unsigned char *ptr_live_png_encode(const unsigned char *rgb, int width, int heig
 
 /* The page (src/live/page.html, embedded at build time). */
 extern const char ptr_live_page[];
+
+/* A condition variable whose timed waits count on CLOCK_MONOTONIC, which
+ * a change of the wall clock does not move. */
+static inline void ptr_live_cond_init(pthread_cond_t *cond)
+{
+    pthread_condattr_t attr;
+    pthread_condattr_init(&attr);
+    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
+    pthread_cond_init(cond, &attr);
+    pthread_condattr_destroy(&attr);
+}
 
 #endif /* PTR_LIVE_MODULE_H */

@@ -97,18 +97,31 @@ static unsigned char *message_buffer(LiveTev *t, size_t size)
     return t->message;
 }
 
+/* The start every message has: its size (the whole message's), its type,
+ * whether tev should bring the image to the front, and the image's name. */
+static size_t header_size(const LiveTev *t)
+{
+    return 4 + 1 + 1 + strlen(t->name) + 1;
+}
+
+static void put_header(Writer *w, const LiveTev *t, size_t size, unsigned char type,
+                       unsigned char grab_focus)
+{
+    put_u32(w, (uint32_t)size);
+    put_bytes(w, &type, 1);
+    put_bytes(w, &grab_focus, 1);
+    put_string(w, t->name);
+}
+
 static int send_create(LiveTev *t)
 {
     static const char *const channels[] = { "R", "G", "B" };
-    size_t size = 4 + 1 + 1 + strlen(t->name) + 1 + 4 * 3 + 3 * 2;
+    size_t size = header_size(t) + 4 * 3 + 3 * 2;
     unsigned char *m = message_buffer(t, size);
     if (!m)
         return 0;
     Writer w = { m };
-    put_u32(&w, (uint32_t)size);
-    put_bytes(&w, &(unsigned char){ TYPE_CREATE_IMAGE }, 1);
-    put_bytes(&w, &(unsigned char){ 1 }, 1); /* grab focus */
-    put_string(&w, t->name);
+    put_header(&w, t, size, TYPE_CREATE_IMAGE, 1);
     put_u32(&w, (uint32_t)t->width);
     put_u32(&w, (uint32_t)t->height);
     put_u32(&w, 3);
@@ -121,15 +134,12 @@ static int send_tile(LiveTev *t, int x0, int y0, int w, int h)
 {
     static const char *const channels[] = { "R", "G", "B" };
     for (int c = 0; c < 3; c++) {
-        size_t size = 4 + 1 + 1 + strlen(t->name) + 1 + 2 + 4 * 4 + 4 * (size_t)w * (size_t)h;
+        size_t size = header_size(t) + 2 + 4 * 4 + 4 * (size_t)w * (size_t)h;
         unsigned char *m = message_buffer(t, size);
         if (!m)
             return 0;
         Writer wr = { m };
-        put_u32(&wr, (uint32_t)size);
-        put_bytes(&wr, &(unsigned char){ TYPE_UPDATE_IMAGE }, 1);
-        put_bytes(&wr, &(unsigned char){ 0 }, 1);
-        put_string(&wr, t->name);
+        put_header(&wr, t, size, TYPE_UPDATE_IMAGE, 0);
         put_string(&wr, channels[c]);
         put_u32(&wr, (uint32_t)x0);
         put_u32(&wr, (uint32_t)y0);
