@@ -64,16 +64,22 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-/* Arrays like s's with room for capacity entries, the first keep entries
- * copied from s in the order given (all of s if order is NULL) and the rest
+/* Fills entries from .. capacity - 1 of array a (capacity entries) with its
  * padding. Entries are 4-byte words (an entry of several words, such as a
- * colour, is moved word by word, its padding the pattern repeated). An
- * optional array s does not have (the colour) stays absent. */
-static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t capacity,
-                              PtrSpheres *out)
+ * colour, is padded word by word, the pattern repeated). */
+static void pad_array(const SphereArray *a, size_t from, size_t capacity)
 {
-    if (capacity > SIZE_MAX / 64)
-        return PTR_ERR_NOMEM;
+    uint32_t *words = *a->data;
+    const size_t per_entry = a->size / sizeof *words;
+    for (size_t i = from * per_entry; i < capacity * per_entry; i++)
+        words[i] = a->padding;
+}
+
+/* Arrays like s's with room for capacity entries, the first s->count copied
+ * from s and the rest padding. An optional array s does not have (the
+ * colour) stays absent. */
+static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, PtrSpheres *out)
+{
     PtrSpheres copy = { .count = s->count, .capacity = capacity };
     SphereArray from[SPHERE_ARRAYS_MAX], to[SPHERE_ARRAYS_MAX];
     sphere_arrays((PtrSpheres *)s, from);
@@ -86,25 +92,30 @@ static PtrResult spheres_copy(const PtrSpheres *s, const uint32_t *order, size_t
             spheres_free(&copy);
             return PTR_ERR_NOMEM;
         }
-        const uint32_t *src = *from[k].data;
-        uint32_t *dst = *to[k].data;
-        const size_t words = to[k].size / sizeof *dst;
-        for (size_t i = 0; i < capacity * words; i++)
-            dst[i] = to[k].padding;
-        for (size_t i = 0; i < s->count; i++) {
-            size_t from_entry = order ? order[i] : i;
-            for (size_t w = 0; w < words; w++)
-                dst[i * words + w] = src[from_entry * words + w];
-        }
+        if (s->count)
+            memcpy(*to[k].data, *from[k].data, s->count * to[k].size);
+        pad_array(&to[k], s->count, capacity);
     }
     *out = copy;
     return PTR_OK;
 }
 
-static PtrResult spheres_grow(PtrSpheres *s)
+/* The capacity that holds count spheres and the PTR_SPHERE_BLOCK padding
+ * entries that always follow the last (see ptr_spheres_permute). */
+static size_t capacity_for(size_t count)
 {
+    return (count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
+}
+
+PtrResult ptr_spheres_reserve(PtrSpheres *s, size_t count)
+{
+    if (count > SIZE_MAX / 128)
+        return PTR_ERR_NOMEM;
+    size_t capacity = capacity_for(count);
+    if (capacity <= s->capacity)
+        return PTR_OK;
     PtrSpheres grown;
-    PtrResult r = spheres_copy(s, NULL, s->capacity ? s->capacity * 2 : PTR_SPHERE_BLOCK, &grown);
+    PtrResult r = spheres_copy(s, capacity, &grown);
     if (r != PTR_OK)
         return r;
     spheres_free(s);
@@ -112,15 +123,31 @@ static PtrResult spheres_grow(PtrSpheres *s)
     return PTR_OK;
 }
 
+/* In place, through one spare array the size of the largest, so that ten
+ * million spheres need 8 bytes more a sphere, not all their bytes twice.
+ * The padding after the last sphere stays where it is. */
 PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
 {
-    PtrSpheres permuted;
-    size_t capacity = (s->count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
-    PtrResult r = spheres_copy(s, order, capacity, &permuted);
-    if (r != PTR_OK)
-        return r;
-    spheres_free(s);
-    *s = permuted;
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    int arrays = sphere_arrays(s, a);
+    size_t largest = 0;
+    for (int k = 0; k < arrays; k++)
+        if (*a[k].data && a[k].size > largest)
+            largest = a[k].size;
+    uint32_t *spare = malloc((s->count ? s->count : 1) * largest);
+    if (!spare)
+        return PTR_ERR_NOMEM;
+    for (int k = 0; k < arrays; k++) {
+        if (!*a[k].data)
+            continue;
+        const uint32_t *src = *a[k].data;
+        const size_t words = a[k].size / sizeof *src;
+        for (size_t i = 0; i < s->count; i++)
+            for (size_t w = 0; w < words; w++)
+                spare[i * words + w] = src[(size_t)order[i] * words + w];
+        memcpy(*a[k].data, spare, s->count * a[k].size);
+    }
+    free(spare);
     return PTR_OK;
 }
 
@@ -128,8 +155,8 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
                                uint32_t material)
 {
     PtrSpheres *s = &scene->spheres;
-    if (s->count == s->capacity) {
-        PtrResult r = spheres_grow(s);
+    if (capacity_for(s->count) > s->capacity) {
+        PtrResult r = ptr_spheres_reserve(s, s->capacity ? 2 * s->count : PTR_SPHERE_BLOCK);
         if (r != PTR_OK)
             return r;
     }

@@ -113,11 +113,16 @@ void ptr_scene_free(PtrScene *scene);
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
                                uint32_t material);
 
+/* Makes room for count spheres, so that an importer that knows how many it
+ * will add allocates once (the arrays otherwise double as they fill).
+ * Returns PTR_ERR_NOMEM (arrays unchanged) if they cannot grow. */
+PtrResult ptr_spheres_reserve(PtrSpheres *spheres, size_t count);
+
 /* Reorders every per-sphere array together: entry i becomes old entry
- * order[i] (order is a permutation of 0 .. count - 1). Afterwards at least
- * PTR_SPHERE_BLOCK padding entries follow the last sphere, so SIMD code may
- * read 16 lanes from any sphere on. Returns PTR_ERR_NOMEM (arrays unchanged)
- * if the new arrays cannot be allocated. */
+ * order[i] (order is a permutation of 0 .. count - 1). At least
+ * PTR_SPHERE_BLOCK padding entries always follow the last sphere, so SIMD
+ * code may read 16 lanes from any sphere on. Returns PTR_ERR_NOMEM (arrays
+ * unchanged) if the spare array it needs cannot be allocated. */
 PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
