@@ -56,33 +56,51 @@ static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
         (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
 
+enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
+
+/* Resizes every array to capacity spheres (while they fill, count stays
+ * below it; add_spheres shrinks them below count as it empties them). */
+static PtrResult resize(PtrSceneBuilder *b, size_t capacity)
+{
+    if (capacity > SIZE_MAX / (4 * sizeof *b->spheres))
+        return PTR_ERR_NOMEM;
+    const size_t entries = capacity ? capacity : 1;
+    double *spheres = realloc(b->spheres, entries * 4 * sizeof *spheres);
+    if (!spheres)
+        return PTR_ERR_NOMEM;
+    b->spheres = spheres;
+    uint32_t *materials = realloc(b->materials, entries * sizeof *materials);
+    if (!materials)
+        return PTR_ERR_NOMEM;
+    b->materials = materials;
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
+        float **array = optional_array(b, k);
+        if (!*array)
+            continue;
+        float *resized = realloc(*array, entries * (size_t)optional_arrays[k].width *
+                                             sizeof *resized);
+        if (!resized)
+            return PTR_ERR_NOMEM;
+        *array = resized;
+    }
+    b->capacity = capacity;
+    return PTR_OK;
+}
+
+PtrResult ptr_builder_reserve(PtrSceneBuilder *b, size_t count)
+{
+    return count > b->capacity ? resize(b, count) : PTR_OK;
+}
+
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material)
 {
-    const size_t optionals = sizeof optional_arrays / sizeof optional_arrays[0];
     if (b->count == b->capacity) {
-        size_t capacity = b->capacity ? 2 * b->capacity : 64;
-        double *spheres = realloc(b->spheres, capacity * 4 * sizeof *spheres);
-        if (!spheres)
-            return PTR_ERR_NOMEM;
-        b->spheres = spheres;
-        uint32_t *materials = realloc(b->materials, capacity * sizeof *materials);
-        if (!materials)
-            return PTR_ERR_NOMEM;
-        b->materials = materials;
-        for (size_t k = 0; k < optionals; k++) {
-            float **array = optional_array(b, k);
-            if (!*array)
-                continue;
-            float *grown = realloc(*array, capacity * (size_t)optional_arrays[k].width *
-                                               sizeof *grown);
-            if (!grown)
-                return PTR_ERR_NOMEM;
-            *array = grown;
-        }
-        b->capacity = capacity;
+        PtrResult r = resize(b, b->capacity ? 2 * b->capacity : 64);
+        if (r != PTR_OK)
+            return r;
     }
-    for (size_t k = 0; k < optionals; k++)
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k))
             fill_none(b, k, b->count, b->count + 1);
     double *s = &b->spheres[4 * b->count];
@@ -346,57 +364,75 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigne
     return count;
 }
 
-/* Adds sphere i of the builder (already relative to the scene's origin). */
-static PtrResult add_sphere(PtrSceneBuilder *b, size_t i)
+/* Puts sphere i of the builder (already relative to the scene's origin) at
+ * entry at of the scene's arrays. */
+static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
 {
-    const double *s = &b->spheres[4 * i];
-    PtrVec3 c = v3((float)s[0], (float)s[1], (float)s[2]);
-    float r = (float)s[3];
+    const double *d = &b->spheres[4 * i];
+    PtrVec3 c = v3((float)d[0], (float)d[1], (float)d[2]);
+    float r = (float)d[3];
     if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
         return PTR_ERR_SCENE_INVALID;
     PtrScene *scene = b->scene;
-    PtrResult res = ptr_scene_add_sphere(scene, c, r, b->materials[i]);
-    size_t added = scene->spheres.count - 1;
-    if (res == PTR_OK)
-        scene->spheres.id[added] = (uint32_t)i;
-    if (res == PTR_OK && b->colors) {
+    PtrSpheres *s = &scene->spheres;
+    s->cx[at] = c.x;
+    s->cy[at] = c.y;
+    s->cz[at] = c.z;
+    s->radius[at] = r;
+    s->material[at] = b->materials[i];
+    s->id[at] = (uint32_t)i;
+    PtrResult res = PTR_OK;
+    if (b->colors) {
         const float *rgb = &b->colors[3 * i];
-        res = ptr_scene_set_sphere_color(scene, added, v3(rgb[0], rgb[1], rgb[2]));
+        res = ptr_scene_set_sphere_color(scene, at, v3(rgb[0], rgb[1], rgb[2]));
     }
     if (res == PTR_OK && b->values)
-        res = ptr_scene_set_sphere_value(scene, added, b->values[i]);
+        res = ptr_scene_set_sphere_value(scene, at, b->values[i]);
     return res;
 }
 
+/* The builder's arrays give back this many spheres' memory at a time as
+ * add_spheres empties them: 32 MB of centres. */
+enum { SHRINK_STEP = 1 << 20 };
+
 /* The spheres in file order, the huge ones last (their ids keep the file's
- * order; see PtrSpheres.id), with the huge ones in double as well. */
+ * order; see PtrSpheres.id), with the huge ones in double as well. Moved
+ * from the last back, the builder's arrays shrinking behind, so that ten
+ * million spheres are never in memory twice. */
 static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double)
 {
     PtrScene *scene = b->scene;
-    unsigned char *huge = malloc(b->count ? b->count : 1);
+    const size_t count = b->count;
+    unsigned char *huge = calloc(count ? count : 1, 1);
     if (!huge)
         return PTR_ERR_NOMEM;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
-    for (size_t i = 0; i < b->count; i++)
+    for (size_t i = 0; i < count; i++)
         for (int k = 0; k < 3; k++)
             b->spheres[4 * i + k] -= origin[k];
-    memset(huge, 0, b->count);
-    size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
-    PtrResult res = PTR_OK;
-    for (size_t i = 0; i < b->count && res == PTR_OK; i++)
-        if (!huge[i])
-            res = add_sphere(b, i);
+    const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
+    PtrResult res = ptr_spheres_reserve(&scene->spheres, count);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)
             res = PTR_ERR_NOMEM;
     }
-    for (size_t i = 0; i < b->count && res == PTR_OK; i++) {
-        if (!huge[i])
-            continue;
-        res = add_sphere(b, i);
-        memcpy(&scene->huge.centre_radius[4 * scene->huge.count++], &b->spheres[4 * i],
-               4 * sizeof(double));
+    size_t huge_before = huge_count; /* of sphere i */
+    for (size_t i = count; i-- > 0 && res == PTR_OK;) {
+        size_t at = i - huge_before;
+        if (huge[i]) {
+            huge_before--;
+            at = count - huge_count + huge_before;
+            memcpy(&scene->huge.centre_radius[4 * huge_before], &b->spheres[4 * i],
+                   4 * sizeof(double));
+        }
+        res = add_sphere(b, i, at);
+        if (i % SHRINK_STEP == 0)
+            (void)resize(b, i); /* spheres i and on are moved; failing keeps more */
+    }
+    if (res == PTR_OK) {
+        scene->spheres.count = count;
+        scene->huge.count = huge_count;
     }
     free(huge);
     return res;

@@ -40,6 +40,10 @@ typedef struct PtrSceneBuilder {
 void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImportOptions *options);
 void ptr_builder_free(PtrSceneBuilder *builder);
 
+/* Makes room for count spheres, for an importer that knows how many it will
+ * add: its arrays are then allocated once, not doubled as they fill. */
+PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count);
+
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
                                  double radius, uint32_t material);
 

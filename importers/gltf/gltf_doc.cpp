@@ -475,8 +475,10 @@ extern "C" void gltf_doc_mesh(const GltfDoc *doc, size_t index, GltfMesh *out)
         out->max[k] = -HUGE_VAL;
     }
     for (const tinygltf::Primitive &p : mesh.primitives) {
-        if (p.mode == TINYGLTF_MODE_POINTS)
+        if (p.mode == TINYGLTF_MODE_POINTS) {
+            out->point_primitives++;
             continue;
+        }
         if (!out->has_surface)
             out->material = p.material;
         out->has_surface = 1;

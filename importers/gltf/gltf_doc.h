@@ -87,6 +87,7 @@ typedef struct GltfMesh {
     double min[3], max[3]; /* union over them */
     int material;      /* the first such primitive's material, -1 if none */
     size_t primitive_count;
+    size_t point_primitives; /* of them, POINTS (spheres of their own) */
 } GltfMesh;
 
 typedef struct GltfMaterial {

@@ -392,7 +392,10 @@ static PtrResult add_mesh_spheres(Importer *im, const Origin *o, const GltfNode 
     PtrResult res = PTR_OK;
     if (mesh->has_surface)
         res = add_surface_sphere(im, o, node, mesh, world, color, value, warned);
-    for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
+    /* Looked up only where there are points: an instance of a plain sphere
+     * is a million of these calls. */
+    for (size_t p = 0; mesh->point_primitives && p < mesh->primitive_count && res == PTR_OK;
+         p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
         int value_index = im->value_name ? gltf_doc_primitive_attribute(
@@ -785,6 +788,8 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
             res = walk_nodes(&im, &gs, count_spheres, &spheres);
         if (res == PTR_OK)
             res = ptr_import_check_memory(path, spheres, err);
+        if (res == PTR_OK && ptr_builder_reserve(&im.builder, (size_t)spheres) != PTR_OK)
+            res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
         if (res == PTR_OK)
             res = walk_nodes(&im, &gs, import_node, NULL);
     }
@@ -804,10 +809,11 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         check_far_plane(&im);
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
+    /* The file's buffers go before the scene's arrays are filled. */
+    gltf_doc_free(doc);
+    free(im.material_index);
     if (res == PTR_OK)
         res = ptr_import_finish(&im.builder, path, err);
     ptr_builder_free(&im.builder);
-    free(im.material_index);
-    gltf_doc_free(doc);
     return res;
 }

@@ -246,24 +246,39 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
     return 1;
 }
 
+/* The order the build gives the spheres: the ones kept out of the tree
+ * (unbounded, BVH_UNBOUNDED_MAX at most), the prims' spheres in the
+ * prims' order, then the spheres after the tree's. NULL if out of memory. */
+static uint32_t *sphere_order(const uint32_t *unbounded, size_t unbounded_count,
+                              const BvhPrim *prims, size_t prim_count, size_t sphere_count)
+{
+    uint32_t *order = malloc((sphere_count ? sphere_count : 1) * sizeof *order);
+    if (!order)
+        return NULL;
+    memcpy(order, unbounded, unbounded_count * sizeof *order);
+    for (size_t i = 0; i < prim_count; i++)
+        order[unbounded_count + i] = prims[i].index;
+    for (size_t i = unbounded_count + prim_count; i < sphere_count; i++)
+        order[i] = (uint32_t)i;
+    return order;
+}
+
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads)
 {
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return PTR_ERR_NOMEM;
-    uint32_t *order = malloc((spheres->count ? spheres->count : 1) * sizeof *order);
     Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
-    int ok = order && build.set.prims;
+    uint32_t unbounded[BVH_UNBOUNDED_MAX];
     size_t prim_count = 0;
+    int ok = build.set.prims != NULL;
     if (ok) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        ok = ptr_bvh_prims(&tree_part, order, &bvh->unbounded_count, build.set.prims,
+        ok = ptr_bvh_prims(&tree_part, unbounded, &bvh->unbounded_count, build.set.prims,
                            &prim_count);
-        for (size_t i = count; i < spheres->count; i++)
-            order[i] = (uint32_t)i;
     }
     build.first_sphere = bvh->unbounded_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
@@ -275,16 +290,16 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
              build_node(&build, &top, &root, 1, 0, &index, &top.depth) && run_tasks(&build) &&
              lay_out(&build, &top, bvh);
     }
-    if (ok) {
-        for (size_t i = 0; i < prim_count; i++)
-            order[bvh->unbounded_count + i] = build.set.prims[i].index;
-        ok = ptr_spheres_permute(spheres, order) == PTR_OK;
-    }
     for (size_t i = 0; i < build.task_count; i++)
         free(build.tasks[i].nodes.nodes);
     free(build.tasks);
     free(top.nodes);
+    /* The prims go before the spheres are reordered, which needs a spare array. */
+    uint32_t *order = ok ? sphere_order(unbounded, bvh->unbounded_count, build.set.prims,
+                                        prim_count, spheres->count)
+                         : NULL;
     free(build.set.prims);
+    ok = order && ptr_spheres_permute(spheres, order) == PTR_OK;
     free(order);
     if (!ok) {
         ptr_bvh_free(bvh);

@@ -7,9 +7,9 @@
 /* A sphere is kept out of the tree if its radius is more than UNBOUNDED_RATIO
  * times the median radius: a ground of radius 1000 under spheres of 0.2, or
  * 1e5 under 1, would otherwise make one box span the scene and every ray
- * visit much of the tree. At most UNBOUNDED_MAX of them (the largest), as
+ * visit much of the tree. At most BVH_UNBOUNDED_MAX of them (the largest), as
  * every ray tests them all. */
-enum { UNBOUNDED_RATIO = 100, UNBOUNDED_MAX = 16 };
+enum { UNBOUNDED_RATIO = 100 };
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
  * traversal's comment in bvh.c for why 2^-18. */
@@ -55,18 +55,16 @@ static int larger(const PtrSpheres *s, uint32_t i, uint32_t j)
     return s->radius[i] != s->radius[j] ? s->radius[i] > s->radius[j] : s->id[i] < s->id[j];
 }
 
-/* Keeps the UNBOUNDED_MAX largest of list[0 .. n - 1] at its start. */
-static void keep_largest(uint32_t *list, size_t n, const PtrSpheres *s)
+/* Offers sphere i to list[0 .. *n - 1], the largest so far, largest first:
+ * it is kept if among the BVH_UNBOUNDED_MAX largest. */
+static void offer_largest(uint32_t *list, size_t *n, uint32_t i, const PtrSpheres *s)
 {
-    for (size_t k = 0; k < UNBOUNDED_MAX; k++) {
-        size_t best = k;
-        for (size_t i = k + 1; i < n; i++)
-            if (larger(s, list[i], list[best]))
-                best = i;
-        uint32_t t = list[k];
-        list[k] = list[best];
-        list[best] = t;
-    }
+    size_t at = *n < BVH_UNBOUNDED_MAX ? (*n)++ : BVH_UNBOUNDED_MAX;
+    for (; at > 0 && larger(s, i, list[at - 1]); at--)
+        if (at < BVH_UNBOUNDED_MAX)
+            list[at] = list[at - 1];
+    if (at < BVH_UNBOUNDED_MAX)
+        list[at] = i;
 }
 
 static void sort_by_id(uint32_t *list, size_t n, const PtrSpheres *s)
@@ -104,13 +102,9 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
     size_t u = 0;
     for (size_t i = 0; i < s->count; i++)
         if (s->radius[i] > limit)
-            order[u++] = (uint32_t)i;
-    if (u > UNBOUNDED_MAX) {
-        keep_largest(order, u, s);
-        u = UNBOUNDED_MAX;
-    }
+            offer_largest(order, &u, (uint32_t)i, s);
     /* By index, to skip them below; then by id, their order in the arrays. */
-    uint32_t out[UNBOUNDED_MAX + 1];
+    uint32_t out[BVH_UNBOUNDED_MAX + 1];
     memcpy(out, order, u * sizeof *out);
     for (size_t i = 1; i < u; i++)
         for (size_t j = i; j > 0 && out[j - 1] > out[j]; j--) {
@@ -139,12 +133,10 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
         float r = s->radius[i];
         float extent = r + BOX_PAD_SCALE * (magnitude + r);
         BvhPrim *p = &prims[n++];
-        p->lower[0] = s->cx[i] - extent;
-        p->lower[1] = s->cy[i] - extent;
-        p->lower[2] = s->cz[i] - extent;
-        p->upper[0] = s->cx[i] + extent;
-        p->upper[1] = s->cy[i] + extent;
-        p->upper[2] = s->cz[i] + extent;
+        p->centre[0] = s->cx[i];
+        p->centre[1] = s->cy[i];
+        p->centre[2] = s->cz[i];
+        p->extent = extent;
         p->index = (uint32_t)i;
         p->id = s->id[i];
     }

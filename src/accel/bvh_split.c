@@ -44,7 +44,8 @@ static void bins_clear(Bins *b, int bins)
 
 static int bin_of(const BvhCandidate *c, const BvhPrim *p, int axis)
 {
-    float centre = p->lower[axis] + p->upper[axis];
+    /* Twice the centre, as the box gives it. */
+    float centre = (p->centre[axis] - p->extent) + (p->centre[axis] + p->extent);
     /* Clamped as a float, then converted: no branch, and a NaN-free range. */
     float k = (centre - c->bin_base[axis]) * c->bin_scale[axis];
     return (int)ptr_minf(ptr_maxf(k, 0.0f), (float)(c->bins - 1));
@@ -53,17 +54,22 @@ static int bin_of(const BvhCandidate *c, const BvhPrim *p, int axis)
 /* The box only (of a range split in the middle, or of the root). */
 static void bound_run(const BvhPrim *prims, size_t begin, size_t end, Bins *b)
 {
-    for (size_t i = begin; i < end; i++)
-        bounds_grow(b->box_lo, b->box_hi, prims[i].lower, prims[i].upper);
+    for (size_t i = begin; i < end; i++) {
+        float lower[3], upper[3];
+        bvh_prim_box(&prims[i], lower, upper);
+        bounds_grow(b->box_lo, b->box_hi, lower, upper);
+    }
 }
 
 static void bin_run(const BvhPrim *prims, size_t begin, size_t end, const BvhCandidate *c, Bins *b)
 {
     for (size_t i = begin; i < end; i++) {
         const BvhPrim *p = &prims[i];
+        float lower[3], upper[3];
+        bvh_prim_box(p, lower, upper);
         for (int a = 0; a < 3; a++) {
             int k = bin_of(c, p, a);
-            bounds_grow(b->lower[a][k], b->upper[a][k], p->lower, p->upper);
+            bounds_grow(b->lower[a][k], b->upper[a][k], lower, upper);
             b->count[a][k]++;
         }
     }

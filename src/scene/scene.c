@@ -123,29 +123,38 @@ PtrResult ptr_spheres_reserve(PtrSpheres *s, size_t count)
     return PTR_OK;
 }
 
-/* In place, through one spare array the size of the largest, so that ten
- * million spheres need 8 bytes more a sphere, not all their bytes twice.
- * The padding after the last sphere stays where it is. */
+/* Through one spare array the size of the largest, so that ten million
+ * spheres need 8 bytes more a sphere, not all their bytes twice: each array
+ * is gathered into the spare, which then takes its place if it has its
+ * size (else the gathered entries are copied back). */
 PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
-    int arrays = sphere_arrays(s, a);
+    const int arrays = sphere_arrays(s, a);
     size_t largest = 0;
     for (int k = 0; k < arrays; k++)
         if (*a[k].data && a[k].size > largest)
             largest = a[k].size;
-    uint32_t *spare = malloc((s->count ? s->count : 1) * largest);
+    if (s->count == 0)
+        return PTR_OK;
+    uint32_t *spare = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * largest);
     if (!spare)
         return PTR_ERR_NOMEM;
     for (int k = 0; k < arrays; k++) {
         if (!*a[k].data)
             continue;
-        const uint32_t *src = *a[k].data;
+        uint32_t *src = *a[k].data;
         const size_t words = a[k].size / sizeof *src;
         for (size_t i = 0; i < s->count; i++)
             for (size_t w = 0; w < words; w++)
                 spare[i * words + w] = src[(size_t)order[i] * words + w];
-        memcpy(*a[k].data, spare, s->count * a[k].size);
+        if (a[k].size == largest) {
+            *a[k].data = spare;
+            pad_array(&a[k], s->count, s->capacity);
+            spare = src;
+        } else {
+            memcpy(src, spare, s->count * a[k].size);
+        }
     }
     free(spare);
     return PTR_OK;
