@@ -66,8 +66,9 @@ typedef struct PtrBvh {
  * (see bvh.h's head) and leaving the rest in place after them (the scene's
  * huge spheres, which accel/huge.h tests); threads 0 means one per online
  * CPU. The tree's bytes depend only on
- * the spheres, never on the thread count. On failure the spheres keep their
- * order and *bvh is empty. */
+ * the spheres, never on the thread count. On failure (out of memory) *bvh
+ * is empty and the spheres may be part reordered: the scene can only be
+ * freed. */
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads);
 
 void ptr_bvh_free(PtrBvh *bvh);

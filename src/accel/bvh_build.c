@@ -95,9 +95,9 @@ static int add_task(Build *build, size_t begin, size_t end, int level, uint32_t 
 /* Builds the node at this level over c's range into nodes (its index in
  * *index), and its inner children below it; depth: levels below the node. In
  * the top level (top set), inner children of at most task_spheres spheres
- * become tasks. */
-static int build_node(Build *build, NodeArray *nodes, const BvhCandidate *range, int top,
-                      int level, size_t *index, int *depth)
+ * become tasks. scratch: see bvh_split (tasks have it, the top level not). */
+static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
+                      const BvhCandidate *range, int top, int level, size_t *index, int *depth)
 {
     BvhCandidate child[PTR_BVH_WIDTH];
     int n = 1;
@@ -114,8 +114,8 @@ static int build_node(Build *build, NodeArray *nodes, const BvhCandidate *range,
         }
         if (pick < 0)
             break;
-        if (!bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, &child[pick],
-                       &child[n]))
+        if (!bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch,
+                       &child[pick], &child[n]))
             return 0;
     }
 
@@ -156,7 +156,7 @@ static int build_node(Build *build, NodeArray *nodes, const BvhCandidate *range,
         }
         size_t below;
         int below_depth;
-        if (!build_node(build, nodes, c, top, level + 1, &below, &below_depth))
+        if (!build_node(build, nodes, scratch, c, top, level + 1, &below, &below_depth))
             return 0;
         node.child[k] = (uint32_t)below;
         if (below_depth + 1 > *depth)
@@ -176,8 +176,12 @@ static void *task_worker(void *arg)
         Task *t = &build->tasks[i];
         BvhCandidate range;
         size_t root;
-        t->failed = !bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL) ||
-                    !build_node(build, &t->nodes, &range, 0, t->level, &root, &t->nodes.depth);
+        BvhPrim *scratch = malloc((t->end - t->begin) * sizeof *scratch);
+        t->failed = !scratch ||
+                    !bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL) ||
+                    !build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
+                                &t->nodes.depth);
+        free(scratch);
     }
 }
 
@@ -247,8 +251,8 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
 }
 
 /* The order the build gives the spheres: the ones kept out of the tree
- * (unbounded, BVH_UNBOUNDED_MAX at most), the prims' spheres in the
- * prims' order, then the spheres after the tree's. NULL if out of memory. */
+ * (unbounded), the prims' spheres in the prims' order, then the spheres
+ * after the tree's. NULL if out of memory. */
 static uint32_t *sphere_order(const uint32_t *unbounded, size_t unbounded_count,
                               const BvhPrim *prims, size_t prim_count, size_t sphere_count)
 {
@@ -261,6 +265,44 @@ static uint32_t *sphere_order(const uint32_t *unbounded, size_t unbounded_count,
     for (size_t i = unbounded_count + prim_count; i < sphere_count; i++)
         order[i] = (uint32_t)i;
     return order;
+}
+
+typedef struct ShapeWrite {
+    PtrSpheres *spheres;
+    const BvhPrim *prims;
+    size_t first; /* where prims[0] goes */
+} ShapeWrite;
+
+static void write_shapes(void *arg, size_t begin, size_t end)
+{
+    const ShapeWrite *w = arg;
+    PtrSpheres *s = w->spheres;
+    for (size_t i = begin; i < end; i++) {
+        const BvhPrim *p = &w->prims[i];
+        const size_t at = w->first + i;
+        s->cx[at] = p->centre[0];
+        s->cy[at] = p->centre[1];
+        s->cz[at] = p->centre[2];
+        s->radius[at] = p->radius;
+        s->id[at] = p->id;
+    }
+}
+
+/* Puts the spheres' shapes and ids in the build's order (see sphere_order),
+ * from the prims, which hold them in that order already: a sequential
+ * write where a gather would read ten million scattered entries. */
+static void order_shapes(PtrSpheres *s, const uint32_t *unbounded, size_t unbounded_count,
+                         const BvhPrim *prims, size_t prim_count, int threads)
+{
+    BvhPrim kept_out[BVH_UNBOUNDED_MAX];
+    for (size_t k = 0; k < unbounded_count; k++) {
+        const uint32_t i = unbounded[k];
+        kept_out[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], i, s->id[i] };
+    }
+    ShapeWrite tree = { s, prims, unbounded_count };
+    ptr_parallel_ranges(threads, prim_count, write_shapes, &tree);
+    ShapeWrite first = { s, kept_out, 0 };
+    write_shapes(&first, 0, unbounded_count);
 }
 
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads)
@@ -278,7 +320,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
         ok = ptr_bvh_prims(&tree_part, unbounded, &bvh->unbounded_count, build.set.prims,
-                           &prim_count);
+                           &prim_count, &build.set.magnitude);
     }
     build.first_sphere = bvh->unbounded_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
@@ -287,19 +329,23 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         BvhCandidate root;
         size_t index;
         ok = bvh_candidate_init(&build.set, &root, 0, prim_count, NULL, NULL) &&
-             build_node(&build, &top, &root, 1, 0, &index, &top.depth) && run_tasks(&build) &&
-             lay_out(&build, &top, bvh);
+             build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
+             run_tasks(&build) && lay_out(&build, &top, bvh);
     }
     for (size_t i = 0; i < build.task_count; i++)
         free(build.tasks[i].nodes.nodes);
     free(build.tasks);
     free(top.nodes);
-    /* The prims go before the spheres are reordered, which needs a spare array. */
     uint32_t *order = ok ? sphere_order(unbounded, bvh->unbounded_count, build.set.prims,
                                         prim_count, spheres->count)
                          : NULL;
+    if (order)
+        order_shapes(spheres, unbounded, bvh->unbounded_count, build.set.prims, prim_count,
+                     build.set.threads);
+    /* The prims go before the other arrays are reordered, which needs a spare. */
     free(build.set.prims);
-    ok = order && ptr_spheres_permute(spheres, order) == PTR_OK;
+    ok = order && ptr_spheres_permute(spheres, order, PTR_PERMUTE_SKIP_SHAPES,
+                                      build.set.threads) == PTR_OK;
     free(order);
     if (!ok) {
         ptr_bvh_free(bvh);

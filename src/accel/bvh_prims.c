@@ -11,9 +11,6 @@
  * every ray tests them all. */
 enum { UNBOUNDED_RATIO = 100 };
 
-/* Box padding, relative to the magnitude of the numbers involved: see the
- * traversal's comment in bvh.c for why 2^-18. */
-#define BOX_PAD_SCALE 0x1.0p-18f
 
 /* The k-th smallest of values[0 .. n - 1] (reorders values). */
 static float select_kth(float *values, size_t n, size_t k)
@@ -91,9 +88,10 @@ static float unbounded_radius(const PtrSpheres *s)
 }
 
 int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
-                  BvhPrim *prims, size_t *prim_count)
+                  BvhPrim *prims, size_t *prim_count, float *magnitude_out)
 {
     *unbounded_count = *prim_count = 0;
+    *magnitude_out = 0.0f;
     if (s->count == 0)
         return 1;
     float limit = unbounded_radius(s);
@@ -114,8 +112,6 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
         }
     out[u] = UINT32_MAX;
     sort_by_id(order, u, s);
-    /* The largest magnitude in the tree bounds both the spheres' and the
-     * rays' origins (the camera sits at 0, other rays start on spheres). */
     float magnitude = 0.0f;
     for (size_t i = 0, k = 0; i < s->count; i++) {
         float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
@@ -130,18 +126,17 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
             k++;
             continue;
         }
-        float r = s->radius[i];
-        float extent = r + BOX_PAD_SCALE * (magnitude + r);
         BvhPrim *p = &prims[n++];
         p->centre[0] = s->cx[i];
         p->centre[1] = s->cy[i];
         p->centre[2] = s->cz[i];
-        p->extent = extent;
+        p->radius = s->radius[i];
         p->index = (uint32_t)i;
         p->id = s->id[i];
     }
     *unbounded_count = u;
     *prim_count = n;
+    *magnitude_out = magnitude;
     return 1;
 }
 

@@ -10,29 +10,40 @@
 
 enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
 
-/* 24 bytes: at 10^8 spheres the prims are the build's largest array. */
+/* A sphere as the build moves it: 24 bytes, for at 10^8 spheres the prims
+ * are the build's largest array. The tree's leaves are written back to the
+ * scene's arrays from them, in their final order. */
 typedef struct BvhPrim {
-    float centre[3];
-    float extent;   /* the padded box's half width */
+    float centre[3], radius;
     uint32_t index; /* of the sphere in the arrays as they were before the build */
     uint32_t id;    /* the sphere's id, which orders a leaf */
 } BvhPrim;
 
-/* The padded box of a prim, the same bits wherever it is computed. */
-static inline void bvh_prim_box(const BvhPrim *p, float lower[3], float upper[3])
+/* Box padding, relative to the magnitude of the numbers involved: see the
+ * traversal's comment in bvh.c for why 2^-18. */
+#define BVH_BOX_PAD_SCALE 0x1.0p-18f
+
+/* The padded box of a prim, the same bits wherever it is computed;
+ * magnitude: see ptr_bvh_prims. */
+static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3],
+                                float upper[3])
 {
+    const float extent = p->radius + BVH_BOX_PAD_SCALE * (magnitude + p->radius);
     for (int a = 0; a < 3; a++) {
-        lower[a] = p->centre[a] - p->extent;
-        upper[a] = p->centre[a] + p->extent;
+        lower[a] = p->centre[a] - extent;
+        upper[a] = p->centre[a] + extent;
     }
 }
 
 /* Puts the spheres kept out of the tree at order[0 .. *unbounded_count - 1]
- * (by ascending id; order has room for BVH_UNBOUNDED_MAX) and a box for
- * each of the others in prims (their count
- * in *prim_count, in the arrays' order). Returns 0 if out of memory. */
+ * (by ascending id; order has room for BVH_UNBOUNDED_MAX), a prim for each
+ * of the others in prims (their count in *prim_count, in the arrays' order),
+ * and in *magnitude the largest coordinate magnitude in the tree, which
+ * bounds both the spheres' and the rays' origins (the camera sits at 0,
+ * other rays start on spheres) and so scales the boxes' padding. Returns 0
+ * if out of memory. */
 int ptr_bvh_prims(const PtrSpheres *spheres, uint32_t *order, size_t *unbounded_count,
-                  BvhPrim *prims, size_t *prim_count);
+                  BvhPrim *prims, size_t *prim_count, float *magnitude);
 
 /* Sorts a leaf's prims by ascending sphere id. */
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count);

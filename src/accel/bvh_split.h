@@ -11,6 +11,7 @@
 /* The prims being built over, and the threads that may bin large ranges. */
 typedef struct BvhPrimSet {
     BvhPrim *prims;
+    float magnitude; /* of the coordinates, for the boxes (see ptr_bvh_prims) */
     int threads;
 } BvhPrimSet;
 
@@ -22,6 +23,7 @@ typedef struct BvhCandidate {
     int axis;         /* of the best split; -1: split in the middle of the range */
     int bins;         /* BINS, fewer for small ranges */
     int split_bin;    /* prims in bins <= split_bin go left */
+    int sampled;      /* the split was chosen from samples, the halves' boxes are not known */
     float left_lower[3], left_upper[3], right_lower[3], right_upper[3];
     /* Binning: a prim's bin on axis a is (lower + upper - bin_base) * bin_scale,
      * over the candidate's box (cheaper than the box of the centres, which
@@ -43,9 +45,10 @@ int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, siz
                        const float lower[3], const float upper[3]);
 
 /* Splits c in two (into *left and *right, which may be c): by its best split,
- * or in the middle of its order if it has none or middle is set. Returns 0 if
- * out of memory. */
-int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhCandidate *left,
-              BvhCandidate *right);
+ * or in the middle of its order if it has none or middle is set. scratch
+ * (room for c's prims, or NULL) makes the partition faster. Returns 0 if out
+ * of memory. */
+int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
+              BvhCandidate *left, BvhCandidate *right);
 
 #endif /* PTR_BVH_SPLIT_H */

@@ -90,3 +90,36 @@ void ptr_thread_join(PtrThread *t)
     waiting = t;
     pthread_mutex_unlock(&lock);
 }
+
+typedef struct Piece {
+    void (*fn)(void *arg, size_t begin, size_t end);
+    void *arg;
+    size_t begin, end;
+} Piece;
+
+static void *run_piece(void *arg)
+{
+    Piece *p = arg;
+    p->fn(p->arg, p->begin, p->end);
+    return NULL;
+}
+
+enum { PIECES_MAX = 64 };
+
+void ptr_parallel_ranges(int threads, size_t count,
+                         void (*fn)(void *arg, size_t begin, size_t end), void *arg)
+{
+    Piece pieces[PIECES_MAX];
+    PtrThread *ids[PIECES_MAX];
+    const size_t n = threads < 1 ? 1 : threads > PIECES_MAX ? PIECES_MAX : (size_t)threads;
+    for (size_t i = 0; i < n; i++) {
+        pieces[i] = (Piece){ fn, arg, count * i / n, count * (i + 1) / n };
+        ids[i] = i > 0 ? ptr_thread_start(run_piece, &pieces[i]) : NULL;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (!ids[i])
+            run_piece(&pieces[i]);
+    for (size_t i = 1; i < n; i++)
+        if (ids[i])
+            ptr_thread_join(ids[i]);
+}

@@ -6,6 +6,8 @@
 #ifndef PTR_THREADS_H
 #define PTR_THREADS_H
 
+#include <stddef.h>
+
 typedef struct PtrThread PtrThread;
 
 /* Makes sure count threads exist to take work, starting those missing (fewer
@@ -18,5 +20,12 @@ PtrThread *ptr_thread_start(void *(*fn)(void *), void *arg);
 
 /* Waits until fn has returned; the thread then waits for other work. */
 void ptr_thread_join(PtrThread *thread);
+
+/* Runs fn(arg, begin, end) over 0 .. count - 1 cut into one contiguous
+ * piece a thread, the calling thread taking the first (and any a thread
+ * could not be started for). For work whose result does not depend on how
+ * it is cut. */
+void ptr_parallel_ranges(int threads, size_t count,
+                         void (*fn)(void *arg, size_t begin, size_t end), void *arg);
 
 #endif /* PTR_THREADS_H */

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/threads.h"
+
 void ptr_scene_init(PtrScene *scene)
 {
     memset(scene, 0, sizeof *scene);
@@ -23,6 +25,7 @@ typedef struct SphereArray {
     size_t size;     /* of one entry */
     uint32_t padding; /* bits of a padding entry */
     int optional;     /* may be NULL: then it stays so */
+    int shape;        /* see PTR_PERMUTE_SKIP_SHAPES */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -33,14 +36,14 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
     /* Entries are whole 4-byte words (see spheres_copy). */
     SphereArray list[] = {
-        { (void **)&s->cx, sizeof *s->cx, zero.u, 0 },
-        { (void **)&s->cy, sizeof *s->cy, zero.u, 0 },
-        { (void **)&s->cz, sizeof *s->cz, zero.u, 0 },
-        { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0 }, /* never hit */
-        { (void **)&s->material, sizeof *s->material, 0, 0 },
-        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0 },
-        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1 }, /* white */
-        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1 },      /* none */
+        { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1 },
+        { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1 },
+        { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1 },
+        { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
+        { (void **)&s->material, sizeof *s->material, 0, 0, 0 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0, 1 },
+        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 0 }, /* white */
+        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -127,10 +130,29 @@ PtrResult ptr_spheres_reserve(PtrSpheres *s, size_t count)
  * spheres need 8 bytes more a sphere, not all their bytes twice: each array
  * is gathered into the spare, which then takes its place if it has its
  * size (else the gathered entries are copied back). */
-PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
+typedef struct Gather {
+    const uint32_t *src, *order;
+    uint32_t *dst;
+    size_t words; /* an entry's */
+} Gather;
+
+static void gather(void *arg, size_t begin, size_t end)
+{
+    const Gather *g = arg;
+    for (size_t i = begin; i < end; i++)
+        for (size_t w = 0; w < g->words; w++)
+            g->dst[i * g->words + w] = g->src[(size_t)g->order[i] * g->words + w];
+}
+
+PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order, PtrPermuteSkip skip,
+                              int threads)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
     const int arrays = sphere_arrays(s, a);
+    void *skipped = NULL;
+    for (int k = 0; k < arrays; k++)
+        if (skip == PTR_PERMUTE_SKIP_SHAPES && a[k].shape)
+            a[k].data = &skipped; /* left as if absent */
     size_t largest = 0;
     for (int k = 0; k < arrays; k++)
         if (*a[k].data && a[k].size > largest)
@@ -144,10 +166,8 @@ PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order)
         if (!*a[k].data)
             continue;
         uint32_t *src = *a[k].data;
-        const size_t words = a[k].size / sizeof *src;
-        for (size_t i = 0; i < s->count; i++)
-            for (size_t w = 0; w < words; w++)
-                spare[i * words + w] = src[(size_t)order[i] * words + w];
+        Gather g = { src, order, spare, a[k].size / sizeof *src };
+        ptr_parallel_ranges(threads, s->count, gather, &g);
         if (a[k].size == largest) {
             *a[k].data = spare;
             pad_array(&a[k], s->count, s->capacity);

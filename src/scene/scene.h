@@ -118,12 +118,22 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * Returns PTR_ERR_NOMEM (arrays unchanged) if they cannot grow. */
 PtrResult ptr_spheres_reserve(PtrSpheres *spheres, size_t count);
 
-/* Reorders every per-sphere array together: entry i becomes old entry
- * order[i] (order is a permutation of 0 .. count - 1). At least
- * PTR_SPHERE_BLOCK padding entries always follow the last sphere, so SIMD
- * code may read 16 lanes from any sphere on. Returns PTR_ERR_NOMEM (arrays
- * unchanged) if the spare array it needs cannot be allocated. */
-PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order);
+/* Which arrays ptr_spheres_permute leaves alone. */
+typedef enum PtrPermuteSkip {
+    PTR_PERMUTE_ALL,
+    /* cx, cy, cz, radius and id, which the caller has put in order itself
+     * (the tree's build writes them from its own copy). */
+    PTR_PERMUTE_SKIP_SHAPES,
+} PtrPermuteSkip;
+
+/* Reorders the per-sphere arrays together (see skip): entry i becomes old
+ * entry order[i] (order is a permutation of 0 .. count - 1), on threads
+ * threads. At least PTR_SPHERE_BLOCK padding entries always follow the last
+ * sphere, so SIMD code may read 16 lanes from any sphere on. Returns
+ * PTR_ERR_NOMEM (arrays unchanged) if the spare array it needs cannot be
+ * allocated. */
+PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order, PtrPermuteSkip skip,
+                              int threads);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
