@@ -411,7 +411,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
         for (int k = 0; k < 3; k++)
             b->spheres[4 * i + k] -= origin[k];
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
-    PtrResult res = ptr_spheres_reserve(&scene->spheres, count);
+    PtrResult res = ptr_spheres_resize(&scene->spheres, count);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)
@@ -430,10 +430,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
         if (i % SHRINK_STEP == 0)
             (void)resize(b, i); /* spheres i and on are moved; failing keeps more */
     }
-    if (res == PTR_OK) {
-        scene->spheres.count = count;
+    if (res == PTR_OK)
         scene->huge.count = huge_count;
-    }
     free(huge);
     return res;
 }

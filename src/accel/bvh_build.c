@@ -223,9 +223,11 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
     }
     size_t at = top->count;
     for (size_t i = 0; i < build->task_count; i++) {
-        const NodeArray *a = &build->tasks[i].nodes;
+        NodeArray *a = &build->tasks[i].nodes;
         start[i] = at;
         memcpy(nodes + at, a->nodes, a->count * sizeof *nodes);
+        free(a->nodes); /* as it goes, so the tree is not in memory twice */
+        a->nodes = NULL;
         for (size_t j = at; j < at + a->count; j++)
             for (int k = 0; k < PTR_BVH_WIDTH; k++)
                 if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
@@ -330,22 +332,25 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         size_t index;
         ok = bvh_candidate_init(&build.set, &root, 0, prim_count, NULL, NULL) &&
              build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
-             run_tasks(&build) && lay_out(&build, &top, bvh);
+             run_tasks(&build);
     }
-    for (size_t i = 0; i < build.task_count; i++)
-        free(build.tasks[i].nodes.nodes);
-    free(build.tasks);
-    free(top.nodes);
+    /* The prims give the spheres' new order, then go: laying the tree out in
+     * one array and reordering the other per-sphere arrays each need
+     * memory of their own. */
     uint32_t *order = ok ? sphere_order(unbounded, bvh->unbounded_count, build.set.prims,
                                         prim_count, spheres->count)
                          : NULL;
     if (order)
         order_shapes(spheres, unbounded, bvh->unbounded_count, build.set.prims, prim_count,
                      build.set.threads);
-    /* The prims go before the other arrays are reordered, which needs a spare. */
     free(build.set.prims);
-    ok = order && ptr_spheres_permute(spheres, order, PTR_PERMUTE_SKIP_SHAPES,
-                                      build.set.threads) == PTR_OK;
+    ok = order && (prim_count == 0 || lay_out(&build, &top, bvh)) &&
+         ptr_spheres_permute(spheres, order, PTR_PERMUTE_SKIP_SHAPES, build.set.threads) ==
+             PTR_OK;
+    for (size_t i = 0; i < build.task_count; i++)
+        free(build.tasks[i].nodes.nodes);
+    free(build.tasks);
+    free(top.nodes);
     free(order);
     if (!ok) {
         ptr_bvh_free(bvh);

@@ -67,21 +67,22 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-/* Fills entries from .. capacity - 1 of array a (capacity entries) with its
- * padding. Entries are 4-byte words (an entry of several words, such as a
+/* Fills entries from .. to - 1 of array a with its padding. Entries are 4-byte words (an entry of several words, such as a
  * colour, is padded word by word, the pattern repeated). */
-static void pad_array(const SphereArray *a, size_t from, size_t capacity)
+static void pad_array(const SphereArray *a, size_t from, size_t to)
 {
     uint32_t *words = *a->data;
     const size_t per_entry = a->size / sizeof *words;
-    for (size_t i = from * per_entry; i < capacity * per_entry; i++)
+    for (size_t i = from * per_entry; i < to * per_entry; i++)
         words[i] = a->padding;
 }
 
 /* Arrays like s's with room for capacity entries, the first s->count copied
- * from s and the rest padding. An optional array s does not have (the
- * colour) stays absent. */
-static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, PtrSpheres *out)
+ * from s and those from pad_from on padding (those between are left for the
+ * caller to write). An optional array s does not have (the colour) stays
+ * absent. */
+static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, size_t pad_from,
+                              PtrSpheres *out)
 {
     PtrSpheres copy = { .count = s->count, .capacity = capacity };
     SphereArray from[SPHERE_ARRAYS_MAX], to[SPHERE_ARRAYS_MAX];
@@ -97,7 +98,7 @@ static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, PtrSpheres *
         }
         if (s->count)
             memcpy(*to[k].data, *from[k].data, s->count * to[k].size);
-        pad_array(&to[k], s->count, capacity);
+        pad_array(&to[k], pad_from, capacity);
     }
     *out = copy;
     return PTR_OK;
@@ -110,15 +111,13 @@ static size_t capacity_for(size_t count)
     return (count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
 }
 
-PtrResult ptr_spheres_reserve(PtrSpheres *s, size_t count)
+/* Gives s room for count spheres, entries from pad_from on padding. */
+static PtrResult spheres_grow(PtrSpheres *s, size_t count, size_t pad_from)
 {
     if (count > SIZE_MAX / 128)
         return PTR_ERR_NOMEM;
-    size_t capacity = capacity_for(count);
-    if (capacity <= s->capacity)
-        return PTR_OK;
     PtrSpheres grown;
-    PtrResult r = spheres_copy(s, capacity, &grown);
+    PtrResult r = spheres_copy(s, capacity_for(count), pad_from, &grown);
     if (r != PTR_OK)
         return r;
     spheres_free(s);
@@ -126,10 +125,23 @@ PtrResult ptr_spheres_reserve(PtrSpheres *s, size_t count)
     return PTR_OK;
 }
 
-/* Through one spare array the size of the largest, so that ten million
- * spheres need 8 bytes more a sphere, not all their bytes twice: each array
- * is gathered into the spare, which then takes its place if it has its
- * size (else the gathered entries are copied back). */
+PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count)
+{
+    if (capacity_for(count) > s->capacity) {
+        PtrResult r = spheres_grow(s, count, count);
+        if (r != PTR_OK)
+            return r;
+    } else if (count < s->count) {
+        SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+        const int arrays = sphere_arrays(s, a);
+        for (int k = 0; k < arrays; k++)
+            if (*a[k].data)
+                pad_array(&a[k], count, s->count);
+    }
+    s->count = count;
+    return PTR_OK;
+}
+
 typedef struct Gather {
     const uint32_t *src, *order;
     uint32_t *dst;
@@ -185,7 +197,7 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
 {
     PtrSpheres *s = &scene->spheres;
     if (capacity_for(s->count) > s->capacity) {
-        PtrResult r = ptr_spheres_reserve(s, s->capacity ? 2 * s->count : PTR_SPHERE_BLOCK);
+        PtrResult r = spheres_grow(s, 2 * s->count, s->count);
         if (r != PTR_OK)
             return r;
     }

@@ -113,10 +113,13 @@ void ptr_scene_free(PtrScene *scene);
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
                                uint32_t material);
 
-/* Makes room for count spheres, so that an importer that knows how many it
- * will add allocates once (the arrays otherwise double as they fill).
- * Returns PTR_ERR_NOMEM (arrays unchanged) if they cannot grow. */
-PtrResult ptr_spheres_reserve(PtrSpheres *spheres, size_t count);
+/* Sets the sphere count, making room as needed, for an importer that knows
+ * how many spheres it has: the arrays are allocated once (not doubled as
+ * they fill), and memory is only used as they are written. Entries from the
+ * old count on hold no sphere until the caller writes every array's entry
+ * (colour and value through their functions). Returns PTR_ERR_NOMEM (arrays
+ * unchanged) if they cannot grow. */
+PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
 
 /* Which arrays ptr_spheres_permute leaves alone. */
 typedef enum PtrPermuteSkip {
