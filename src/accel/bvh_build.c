@@ -290,21 +290,44 @@ static void write_shapes(void *arg, size_t begin, size_t end)
     }
 }
 
-/* Puts the spheres' shapes and ids in the build's order (see sphere_order),
- * from the prims, which hold them in that order already: a sequential
- * write where a gather would read ten million scattered entries. */
-static void order_shapes(PtrSpheres *s, const uint32_t *unbounded, size_t unbounded_count,
-                         const BvhPrim *prims, size_t prim_count, int threads)
+/* The shapes of spheres first .. first + count - 1, or of spheres at[0 ..
+ * count - 1] if at is given, as prims: those the prims leave out. NULL if
+ * out of memory. */
+static BvhPrim *save_shapes(const PtrSpheres *s, const uint32_t *at, size_t first, size_t count)
 {
-    BvhPrim kept_out[BVH_UNBOUNDED_MAX];
-    for (size_t k = 0; k < unbounded_count; k++) {
-        const uint32_t i = unbounded[k];
-        kept_out[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], i, s->id[i] };
+    BvhPrim *saved = malloc((count ? count : 1) * sizeof *saved);
+    for (size_t k = 0; saved && k < count; k++) {
+        const size_t i = at ? at[k] : first + k;
+        saved[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], (uint32_t)i,
+                              s->id[i] };
     }
-    ShapeWrite tree = { s, prims, unbounded_count };
-    ptr_parallel_ranges(threads, prim_count, write_shapes, &tree);
-    ShapeWrite first = { s, kept_out, 0 };
-    write_shapes(&first, 0, unbounded_count);
+    return saved;
+}
+
+/* The prims give back this many spheres' memory at a time as their shapes
+ * are written back: 24 MB. */
+enum { SHRINK_STEP = 1 << 20 };
+
+/* Writes the shapes and ids of the tree's spheres in the build's order (see
+ * sphere_order) from the prims, which hold them in that order already: a
+ * sequential write where a gather would read ten million scattered
+ * entries. From the last prim back, the prims shrinking behind, so that the
+ * two copies are never both whole. Frees the prims. */
+static void write_shapes_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
+                              int threads)
+{
+    ShapeWrite w = { s, prims, first };
+    for (size_t end = prim_count; end > 0;) {
+        const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
+        w.prims = prims + begin;
+        w.first = first + begin;
+        ptr_parallel_ranges(threads, end - begin, write_shapes, &w);
+        BvhPrim *shrunk = begin ? realloc(prims, begin * sizeof *prims) : NULL;
+        if (shrunk) /* failing to shrink keeps them whole */
+            prims = shrunk;
+        end = begin;
+    }
+    free(prims);
 }
 
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads)
@@ -327,6 +350,15 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     build.first_sphere = bvh->unbounded_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
+    /* The prims hold every shape but those of the spheres kept out of the
+     * tree or after it: with those saved, the build has the shapes' memory
+     * for itself. */
+    const size_t after = spheres->count - count;
+    BvhPrim *kept_out = ok ? save_shapes(spheres, unbounded, 0, bvh->unbounded_count) : NULL;
+    BvhPrim *after_tree = ok ? save_shapes(spheres, NULL, count, after) : NULL;
+    ok = kept_out && after_tree;
+    if (ok)
+        ptr_spheres_drop_shapes(spheres);
     if (ok && prim_count > 0) {
         BvhCandidate root;
         size_t index;
@@ -334,17 +366,25 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
              build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
              run_tasks(&build);
     }
-    /* The prims give the spheres' new order, then go: laying the tree out in
-     * one array and reordering the other per-sphere arrays each need
-     * memory of their own. */
     uint32_t *order = ok ? sphere_order(unbounded, bvh->unbounded_count, build.set.prims,
                                         prim_count, spheres->count)
                          : NULL;
-    if (order)
-        order_shapes(spheres, unbounded, bvh->unbounded_count, build.set.prims, prim_count,
-                     build.set.threads);
+    ok = order && ptr_spheres_restore_shapes(spheres) == PTR_OK;
+    if (ok) {
+        write_shapes_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
+                          build.set.threads);
+        build.set.prims = NULL;
+        ShapeWrite kept = { spheres, kept_out, 0 }, rest = { spheres, after_tree, count };
+        write_shapes(&kept, 0, bvh->unbounded_count);
+        write_shapes(&rest, 0, after);
+    }
     free(build.set.prims);
-    ok = order && (prim_count == 0 || lay_out(&build, &top, bvh)) &&
+    free(kept_out);
+    free(after_tree);
+    /* Laying the tree out in one array and reordering the other per-sphere
+     * arrays each need memory of their own: they come once the prims are
+     * gone. */
+    ok = ok && (prim_count == 0 || lay_out(&build, &top, bvh)) &&
          ptr_spheres_permute(spheres, order, PTR_PERMUTE_SKIP_SHAPES, build.set.threads) ==
              PTR_OK;
     for (size_t i = 0; i < build.task_count; i++)

@@ -142,6 +142,32 @@ PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count)
     return PTR_OK;
 }
 
+void ptr_spheres_drop_shapes(PtrSpheres *s)
+{
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    const int arrays = sphere_arrays(s, a);
+    for (int k = 0; k < arrays; k++)
+        if (a[k].shape) {
+            free(*a[k].data);
+            *a[k].data = NULL;
+        }
+}
+
+PtrResult ptr_spheres_restore_shapes(PtrSpheres *s)
+{
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    const int arrays = sphere_arrays(s, a);
+    for (int k = 0; k < arrays; k++) {
+        if (!a[k].shape || *a[k].data)
+            continue;
+        *a[k].data = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * a[k].size);
+        if (!*a[k].data)
+            return PTR_ERR_NOMEM;
+        pad_array(&a[k], s->count, s->capacity);
+    }
+    return PTR_OK;
+}
+
 typedef struct Gather {
     const uint32_t *src, *order;
     uint32_t *dst;

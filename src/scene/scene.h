@@ -121,6 +121,17 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * unchanged) if they cannot grow. */
 PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
 
+/* Frees the shapes (cx, cy, cz, radius and id) for a caller that holds a
+ * copy of them and puts them back in a new order (the tree's build: at 10^8
+ * spheres, 2 GB it then has for itself). Until ptr_spheres_restore_shapes
+ * the spheres can only be freed. */
+void ptr_spheres_drop_shapes(PtrSpheres *spheres);
+
+/* Allocates the shape arrays again, with their padding; the caller writes
+ * every entry below count. Returns PTR_ERR_NOMEM if out of memory (then the
+ * spheres can only be freed). */
+PtrResult ptr_spheres_restore_shapes(PtrSpheres *spheres);
+
 /* Which arrays ptr_spheres_permute leaves alone. */
 typedef enum PtrPermuteSkip {
     PTR_PERMUTE_ALL,
