@@ -9,7 +9,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <strings.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -20,8 +24,60 @@
 
 extern "C" const char *const ptr_gltf_extensions[]; /* importer.h */
 
+// A file's bytes: mapped where it can be, so that a .glb's BIN chunk is read
+// where it lies (and its pages given back as the importer is done with
+// them: see gltf_doc_release); read into memory where not (a pipe).
+class FileBytes {
+public:
+    FileBytes() = default;
+    FileBytes(const FileBytes &) = delete;
+    FileBytes &operator=(const FileBytes &) = delete;
+    ~FileBytes()
+    {
+        if (map_)
+            munmap(map_, size_);
+    }
+
+    // False, with errno saying why, if the file cannot be read.
+    bool open(const char *path)
+    {
+        const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+        struct stat st;
+        if (fd >= 0 && fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+            void *map = mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+            if (map != MAP_FAILED) {
+                map_ = static_cast<unsigned char *>(map);
+                size_ = size_t(st.st_size);
+            }
+        }
+        if (fd >= 0)
+            close(fd);
+        return map_ || read_all(path);
+    }
+
+    const unsigned char *data() const { return map_ ? map_ : read_.data(); }
+    size_t size() const { return map_ ? size_ : read_.size(); }
+    bool mapped() const { return map_ != nullptr; }
+
+private:
+    bool read_all(const char *path)
+    {
+        std::ifstream file(path, std::ios::binary);
+        if (!file)
+            return false;
+        read_.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+        return !file.bad();
+    }
+
+    unsigned char *map_ = nullptr;
+    size_t size_ = 0;
+    std::vector<unsigned char> read_;
+};
+
 struct GltfDoc {
+    FileBytes file;
     tinygltf::Model model;
+    std::vector<GltfBytes> buffers; /* each buffer's bytes (see gltf_meshopt.h) */
     int scene = -1;
     std::vector<std::string> files;
     std::map<int, std::vector<unsigned char>> decoded; /* buffer views, decompressed */
@@ -89,7 +145,7 @@ std::string required_extension_fault(const std::vector<std::string> &required)
 
 // tinygltf leaves most cross-references unchecked; check every one ptr
 // follows, so the C side can index without looking.
-std::string check_indices(const tinygltf::Model &m,
+std::string check_indices(const tinygltf::Model &m, const std::vector<GltfBytes> &buffers,
                           const std::map<int, std::vector<unsigned char>> &decoded)
 {
     const size_t nodes = m.nodes.size();
@@ -144,7 +200,7 @@ std::string check_indices(const tinygltf::Model &m,
                    std::to_string(v.buffer) + ", which does not exist";
         if (decoded.count(int(i))) /* its byteLength, decoded */
             continue;
-        const size_t size = m.buffers[size_t(v.buffer)].data.size();
+        const size_t size = buffers[size_t(v.buffer)].size;
         if (v.byteOffset > size || v.byteLength > size - v.byteOffset)
             return "buffer view " + std::to_string(i) + " lies past the end of buffer " +
                    std::to_string(v.buffer) + " (" + std::to_string(size) + " bytes)";
@@ -179,19 +235,7 @@ std::string check_indices(const tinygltf::Model &m,
     return "";
 }
 
-// The whole file; false, with errno saying why, if it cannot be read.
-bool read_file(const char *path, std::vector<unsigned char> *bytes)
-{
-    std::ifstream file(path, std::ios::binary | std::ios::ate);
-    const std::streamoff size = file ? std::streamoff(file.tellg()) : -1;
-    if (size < 0)
-        return false;
-    bytes->resize(size_t(size));
-    file.seekg(0);
-    return bool(file.read(reinterpret_cast<char *>(bytes->data()), std::streamsize(bytes->size())));
-}
-
-bool is_glb(const std::vector<unsigned char> &bytes)
+bool is_glb(const FileBytes &bytes)
 {
     return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
 }
@@ -200,7 +244,7 @@ bool is_glb(const std::vector<unsigned char> &bytes)
 // BIN chunk end up to 8 bytes past the data it is given (it leaves the
 // chunk's own header out of its bound): such a file is refused before it
 // gets there, and so is one shorter than its header says.
-std::string glb_chunk_fault(const std::vector<unsigned char> &bytes)
+std::string glb_chunk_fault(const FileBytes &bytes)
 {
     uint32_t header[5]; /* magic, version, length, JSON length, type */
     if (bytes.size() < sizeof header)
@@ -213,7 +257,7 @@ std::string glb_chunk_fault(const std::vector<unsigned char> &bytes)
     if (bin_at + 8 > length)
         return ""; /* no BIN chunk, or tinygltf says what is wrong */
     uint32_t bin;
-    std::memcpy(&bin, &bytes[size_t(bin_at)], 4);
+    std::memcpy(&bin, bytes.data() + bin_at, 4);
     return bin_at + 8 + bin > length ? "the BIN chunk runs past the end of the file" : "";
 }
 
@@ -233,32 +277,31 @@ bool load(tinygltf::TinyGLTF &loader, const unsigned char *data, size_t size, bo
 
 // The JSON of a glTF file's bytes: all of a .gltf, a .glb's JSON chunk (rest:
 // where the chunks after it start). False if there is none.
-bool json_of(const std::vector<unsigned char> &bytes, bool binary, std::string *json,
-             size_t *rest)
+bool json_of(const FileBytes &bytes, bool binary, std::string *json, size_t *rest)
 {
+    const unsigned char *b = bytes.data();
     if (!binary) {
-        json->assign(bytes.begin(), bytes.end());
+        json->assign(reinterpret_cast<const char *>(b), bytes.size());
         *rest = bytes.size();
         return true;
     }
     uint32_t length = 0;
-    if (bytes.size() < 20 || std::memcmp(&bytes[16], "JSON", 4) != 0)
+    if (bytes.size() < 20 || std::memcmp(b + 16, "JSON", 4) != 0)
         return false;
-    std::memcpy(&length, &bytes[12], 4);
+    std::memcpy(&length, b + 12, 4);
     if (length > bytes.size() - 20)
         return false;
-    json->assign(reinterpret_cast<const char *>(&bytes[20]), length);
+    json->assign(reinterpret_cast<const char *>(b + 20), length);
     *rest = 20 + size_t(length);
     return true;
 }
 
-// A .glb's bytes with its JSON chunk replaced by json.
-std::vector<unsigned char> with_json(const std::vector<unsigned char> &glb, size_t rest,
-                                     std::string json)
+// A .glb of a JSON chunk json and the chunks rest (size bytes) after it.
+std::vector<unsigned char> glb_of(std::string json, const unsigned char *rest, size_t size)
 {
     json.resize((json.size() + 3) / 4 * 4, ' ');
     const uint32_t version = 2, json_length = uint32_t(json.size());
-    const uint32_t total = uint32_t(20 + json.size() + (glb.size() - rest));
+    const uint32_t total = uint32_t(20 + json.size() + size);
     unsigned char header[20];
     std::memcpy(&header[0], "glTF", 4);
     std::memcpy(&header[4], &version, 4);
@@ -268,8 +311,37 @@ std::vector<unsigned char> with_json(const std::vector<unsigned char> &glb, size
     std::vector<unsigned char> out(header, header + sizeof header);
     out.reserve(total);
     out.insert(out.end(), json.begin(), json.end());
-    out.insert(out.end(), glb.begin() + long(rest), glb.end());
+    out.insert(out.end(), rest, rest + size);
     return out;
+}
+
+// A mapped .glb's BIN chunk as buffer 0 (its first buffer, with no uri),
+// which tinygltf would copy whole: the JSON it is given instead, that
+// buffer cut to 4 bytes, and the chunk's bytes. False (json untouched) if the
+// file has no such buffer, or its JSON does not parse.
+bool bin_kept_out(const FileBytes &bytes, size_t rest, std::string *json, GltfBytes *bin)
+{
+    uint32_t chunk[2]; /* length, type */
+    if (bytes.size() - rest < sizeof chunk + 4)
+        return false;
+    std::memcpy(chunk, bytes.data() + rest, sizeof chunk);
+    if (std::memcmp(&chunk[1], "BIN", 4) != 0 || chunk[0] > bytes.size() - rest - sizeof chunk)
+        return false;
+    nlohmann::json doc = nlohmann::json::parse(*json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") ||
+        !doc["buffers"].is_array() || doc["buffers"].empty())
+        return false;
+    nlohmann::json &buffer = doc["buffers"][0];
+    if (!buffer.is_object() || buffer.contains("uri") || !buffer.contains("byteLength") ||
+        !buffer["byteLength"].is_number_unsigned() ||
+        buffer["byteLength"].get<unsigned long long>() > chunk[0] ||
+        buffer["byteLength"].get<unsigned long long>() < 4)
+        return false;
+    *bin = GltfBytes{ bytes.data() + rest + sizeof chunk,
+                      size_t(buffer["byteLength"].get<unsigned long long>()) };
+    buffer["byteLength"] = 4;
+    *json = doc.dump();
+    return true;
 }
 
 const char *const draco_extension = "KHR_draco_mesh_compression";
@@ -366,8 +438,9 @@ extern "C" const char *const ptr_gltf_extensions[] = {
 extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
 {
     try {
-        std::vector<unsigned char> bytes;
-        if (!read_file(path, &bytes)) {
+        auto doc = std::make_unique<GltfDoc>();
+        const FileBytes &bytes = doc->file;
+        if (!doc->file.open(path)) {
             ptr_shim_error(err, PTR_ERR_SCENE_UNREADABLE,
                            std::string(path) + ": " + std::strerror(errno));
             return nullptr;
@@ -377,18 +450,39 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         const std::string scene_path = path;
         const size_t slash = scene_path.rfind('/');
         const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
-        auto doc = std::make_unique<GltfDoc>();
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
         std::string error;
         std::string fault = bytes.size() > UINT32_MAX ? "larger than 4 GiB, the most glTF holds"
                             : binary                  ? glb_chunk_fault(bytes)
                                                       : "";
-        bool ok = fault.empty() &&
-                  load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
         std::string json;
         size_t rest = 0;
-        if (!ok && fault.empty() && json_of(bytes, binary, &json, &rest)) {
+        const bool has_json = fault.empty() && json_of(bytes, binary, &json, &rest);
+        GltfBytes bin = { nullptr, 0 };
+        const bool bin_mapped = has_json && binary && bytes.mapped() &&
+                                bin_kept_out(bytes, rest, &json, &bin);
+        // The file, or a .glb with JSON patched (else the file's own);
+        // with its BIN chunk mapped, a 4-byte stand-in for it.
+        const auto load_json = [&](const std::string *patched) {
+            static const unsigned char stand_in[12] = { 4, 0, 0, 0, 'B', 'I', 'N', 0 };
+            const std::string &text = patched ? *patched : json;
+            if (bin_mapped) {
+                const std::vector<unsigned char> glb = glb_of(text, stand_in, sizeof stand_in);
+                return load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
+            }
+            if (!patched)
+                return load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
+            if (binary) {
+                const std::vector<unsigned char> glb =
+                    glb_of(text, bytes.data() + rest, bytes.size() - rest);
+                return load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
+            }
+            return load(loader, reinterpret_cast<const unsigned char *>(text.data()), text.size(),
+                        false, dir, &doc->model, &error);
+        };
+        bool ok = fault.empty() && load_json(nullptr);
+        if (!ok && has_json) {
             // tinygltf stops at what it cannot load before ptr sees the
             // extensions: say first what the file requires that ptr lacks,
             // and load a compressed file again without what tinygltf refuses
@@ -398,22 +492,22 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
                 fault.empty() && (json.find(meshopt_extension) != std::string::npos ||
                                   json.find(draco_extension) != std::string::npos)
                     ? loadable_by_tinygltf(json) : "";
-            if (!patched.empty() && binary) {
-                const std::vector<unsigned char> glb = with_json(bytes, rest, patched);
-                ok = load(loader, glb.data(), glb.size(), binary, dir, &doc->model, &error);
-            } else if (!patched.empty()) {
-                ok = load(loader, reinterpret_cast<const unsigned char *>(patched.data()),
-                          patched.size(), binary, dir, &doc->model, &error);
-            }
+            if (!patched.empty())
+                ok = load_json(&patched);
         }
         if (!ok && fault.empty())
             fault = error.empty() ? "not a valid glTF file" : error;
         if (fault.empty())
             fault = required_extension_fault(doc->model.extensionsRequired);
+        for (size_t b = 0; ok && b < doc->model.buffers.size(); b++) {
+            const std::vector<unsigned char> &copy = doc->model.buffers[b].data;
+            doc->buffers.push_back(b == 0 && bin_mapped ? bin
+                                                        : GltfBytes{ copy.data(), copy.size() });
+        }
         if (fault.empty())
-            fault = meshopt_decode(doc->model, doc->decoded);
+            fault = meshopt_decode(doc->model, doc->buffers, doc->decoded);
         if (fault.empty())
-            fault = check_indices(doc->model, doc->decoded);
+            fault = check_indices(doc->model, doc->buffers, doc->decoded);
         if (!fault.empty()) {
             ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": " + fault);
             return nullptr;
@@ -574,7 +668,23 @@ extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor
     auto decoded = doc->decoded.find(a.bufferView);
     out->data = decoded != doc->decoded.end()
                     ? decoded->second.data() + a.byteOffset
-                    : m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+                    : doc->buffers[size_t(v.buffer)].data + v.byteOffset + a.byteOffset;
+}
+
+extern "C" void gltf_doc_release(const GltfDoc *doc, const GltfAccessor *a, size_t first,
+                                 size_t end)
+{
+    const FileBytes &file = doc->file;
+    if (!file.mapped() || !a->data || first >= end)
+        return;
+    // The whole pages between, and only within the mapping.
+    const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+    const uintptr_t map_lo = uintptr_t(file.data()), map_hi = map_lo + file.size();
+    const uintptr_t lo = std::max(uintptr_t(a->data) + first * a->stride, map_lo);
+    const uintptr_t hi = std::min(uintptr_t(a->data) + end * a->stride, map_hi);
+    const uintptr_t from = (lo + page - 1) / page * page, to = hi / page * page;
+    if (from < to)
+        madvise(reinterpret_cast<void *>(from), to - from, MADV_DONTNEED);
 }
 
 extern "C" void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *out)

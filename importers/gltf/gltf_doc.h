@@ -147,6 +147,13 @@ void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *material)
 void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *camera);
 void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index, GltfPrimitive *primitive);
 void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *accessor);
+
+/* Gives back the memory of elements first .. end - 1 of an accessor, which
+ * the importer has read and will not read again soon: where they lie in a
+ * mapped .glb, their pages go (and are read from the file again if need
+ * be), so that ten million instances' attributes and the spheres made of
+ * them are not all in memory at once. Elsewhere it does nothing. */
+void gltf_doc_release(const GltfDoc *doc, const GltfAccessor *accessor, size_t first, size_t end);
 /* The accessor of a node's EXT_mesh_gpu_instancing attribute, or of a
  * primitive's attribute, named `name` in any case, its leading underscore
  * optional (docs/scenes.md, --color-by): -1 if there is none, -2 if the

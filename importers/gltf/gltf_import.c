@@ -318,6 +318,24 @@ static PtrResult read_value(Importer *im, const Origin *o, const GltfAccessor *a
                          im->path, where, im->value_name);
 }
 
+/* Every this many instances or points, the import gives back the pages of
+ * the file it has read (see gltf_doc_release). */
+enum { RELEASE_STEP = 1 << 16 };
+
+/* Called after element i of count of the accessors given (NULL: absent) is
+ * read: at every RELEASE_STEP-th and the last, those read since *released
+ * are given back. */
+static void release_read(const Importer *im, size_t i, size_t count, size_t *released,
+                         const GltfAccessor *const *accessors, size_t n)
+{
+    if ((i + 1) % RELEASE_STEP != 0 && i + 1 != count)
+        return;
+    for (size_t k = 0; k < n; k++)
+        if (accessors[k])
+            gltf_doc_release(im->doc, accessors[k], *released, i + 1);
+    *released = i + 1;
+}
+
 /* The spheres of a POINTS primitive under world (times color, if any), each
  * with its own value of the attribute value_index (-1: none) names, else
  * value (if any). */
@@ -360,6 +378,12 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
     const double scale = largest_scale(world, im, node_origin, warned);
     Origin o = *node_origin;
     o.part = "point";
+    /* Points an instance repeats are read again by the next one. */
+    const GltfAccessor *read[] = { &pos, prim->radius >= 0 ? &rad : NULL,
+                                   prim->color >= 0 ? &col : NULL,
+                                   value_index != -1 ? &val : NULL };
+    const size_t release = node_origin->part ? 0 : sizeof read / sizeof read[0];
+    size_t released = 0;
     for (size_t i = 0; i < count && res == PTR_OK; i++) {
         double p[4], r[4], c[4], centre[3], rgb[3], own_value;
         element(&pos, i, p);
@@ -380,6 +404,7 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
             res = add_sphere(im, &o, centre, r[0] * scale, material,
                              prim->color >= 0 ? rgb : color,
                              value_index != -1 ? &own_value : value);
+        release_read(im, i, count, &released, read, release);
     }
     return res;
 }
@@ -468,6 +493,10 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
         res = value_accessor(im, o, "instance", value_index, &count, &v);
     Origin instance = *o;
     instance.part = "instance";
+    const GltfAccessor *read[] = { in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
+                                   in->scale >= 0 ? &s : NULL, in->color >= 0 ? &c : NULL,
+                                   value_index != -1 ? &v : NULL };
+    size_t released = 0;
     for (size_t i = 0; i < count && res == PTR_OK; i++) {
         Mat4 local, instance_world;
         instance.part_index = i;
@@ -489,6 +518,7 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
             res = add_mesh_spheres(im, &instance, node, mesh, &instance_world,
                                    in->color >= 0 ? color : NULL,
                                    value_index != -1 ? &value : NULL, warned);
+        release_read(im, i, count, &released, read, sizeof read / sizeof read[0]);
     }
     return res;
 }

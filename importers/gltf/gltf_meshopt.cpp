@@ -85,7 +85,7 @@ void unfilter(const Stream &s, unsigned char *data)
 
 } // namespace
 
-std::string meshopt_decode(const tinygltf::Model &m,
+std::string meshopt_decode(const tinygltf::Model &m, const std::vector<GltfBytes> &buffers,
                            std::map<int, std::vector<unsigned char>> &views)
 {
     for (size_t i = 0; i < m.bufferViews.size(); i++) {
@@ -102,8 +102,8 @@ std::string meshopt_decode(const tinygltf::Model &m,
         if (s.buffer >= int(m.buffers.size()))
             return view_error(i, "refers to buffer " + std::to_string(s.buffer) +
                                      ", which does not exist");
-        const std::vector<unsigned char> &source = m.buffers[size_t(s.buffer)].data;
-        if (s.offset > source.size() || s.length > source.size() - s.offset)
+        const GltfBytes &source = buffers[size_t(s.buffer)];
+        if (s.offset > source.size || s.length > source.size - s.offset)
             return view_error(i, "has a compressed stream past the end of buffer " +
                                      std::to_string(s.buffer));
         // In 64 bits, so that no count can wrap the product.
@@ -120,7 +120,7 @@ std::string meshopt_decode(const tinygltf::Model &m,
                                      std::to_string(s.length) + ", more than the codec holds");
         std::vector<unsigned char> &out = views[int(i)];
         out.resize(view.byteLength);
-        const unsigned char *stream = source.data() + s.offset;
+        const unsigned char *stream = source.data + s.offset;
         unsigned char *to = out.data();
         int failed = s.mode == "ATTRIBUTES"
                          ? meshopt_decodeVertexBuffer(to, s.count, s.stride, stream, s.length)

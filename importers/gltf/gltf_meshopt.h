@@ -15,9 +15,16 @@
 
 extern const char *const meshopt_extension; /* "EXT_meshopt_compression" */
 
-/* Decodes every compressed buffer view of the model into views[index], of the
- * view's byteLength. Returns "" or what is wrong, naming the extension. */
-std::string meshopt_decode(const tinygltf::Model &model,
+/* A buffer's bytes: tinygltf's copy, or a mapped .glb's BIN chunk. */
+struct GltfBytes {
+    const unsigned char *data;
+    size_t size;
+};
+
+/* Decodes every compressed buffer view of the model (buffers: each buffer's
+ * bytes) into views[index], of the view's byteLength. Returns "" or what is
+ * wrong, naming the extension. */
+std::string meshopt_decode(const tinygltf::Model &model, const std::vector<GltfBytes> &buffers,
                            std::map<int, std::vector<unsigned char>> &views);
 
 #endif /* PTR_GLTF_MESHOPT_H */
