@@ -16,5 +16,5 @@ set ytics nomirror
 set y2tics
 set grid
 set key top right
-plot data using 1:11 with linespoints pointtype 7 title "Mrays/s" axes x1y1, \
-     data using 1:($1 >= 1e5 ? $10 : 1/0) with linespoints pointtype 5 title "bytes a sphere (right)" axes x1y2
+plot data using 1:12 with linespoints pointtype 7 title "Mrays/s" axes x1y1, \
+     data using 1:($1 >= 1e5 ? $11 : 1/0) with linespoints pointtype 5 title "bytes a sphere (right)" axes x1y2
