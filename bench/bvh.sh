@@ -10,11 +10,7 @@ cd "$(dirname "$0")/.."
 build=${1:-build}
 [ $# -gt 0 ] && shift
 cmake --build "$build" --target bvh >/dev/null
-if ! command -v gnuplot >/dev/null; then
-    run() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
-    run apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends gnuplot-nox >/dev/null
-fi
+. bench/need_gnuplot.sh
 "$build/bench/bvh" docs/bvh-scaling.csv 1000000 "${1:-400}" "${2:-225}" "${3:-2}"
 gnuplot -e "data='docs/bvh-scaling.csv'; out='docs/images/bvh-scaling.png'" bench/bvh.gp
 echo "wrote docs/bvh-scaling.csv and docs/images/bvh-scaling.png"

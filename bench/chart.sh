@@ -17,11 +17,7 @@ estimators) data=docs/estimators.csv image=docs/images/estimators.png plot=bench
 *) echo "bench/chart.sh: no chart '$chart' (intersectors or estimators)" >&2; exit 2 ;;
 esac
 cmake --build "$build" --target accuracy >/dev/null
-if ! command -v gnuplot >/dev/null; then
-    run() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
-    run apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends gnuplot-nox >/dev/null
-fi
+. bench/need_gnuplot.sh
 "$build/bench/accuracy" "$chart" "$data" "${3:-256}" "${4:-4096}" ${5:-}
 gnuplot -e "data='$data'; out='$image'" "$plot"
 echo "wrote $data and $image"
