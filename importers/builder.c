@@ -31,28 +31,30 @@ void ptr_builder_free(PtrSceneBuilder *builder)
     builder->count = builder->capacity = 0;
 }
 
-/* The optional per-sphere arrays (width floats a sphere, and the value of a
- * sphere that has none): they exist from the first sphere that has one. */
+/* The optional per-sphere arrays (words 4-byte words a sphere, and the bits
+ * of each word of a sphere that has none): they exist from the first sphere
+ * that has one. */
 enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
 static const struct {
     size_t offset;
-    int width;
-    float none;
+    size_t words;
+    uint32_t none;
 } optional_arrays[] = {
-    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 3, 1.0f }, /* white */
-    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, NAN },
+    /* As the scene stores them (PtrSpheres.color): 8 bytes, not 12 floats' */
+    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 2, UINT32_MAX }, /* white */
+    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, 0x7fc00000u }, /* NaN */
 };
 
-static float **optional_array(PtrSceneBuilder *b, size_t k)
+static uint32_t **optional_array(PtrSceneBuilder *b, size_t k)
 {
-    return (float **)((char *)b + optional_arrays[k].offset);
+    return (uint32_t **)((char *)b + optional_arrays[k].offset);
 }
 
 /* Entries from .. to - 1 of optional array k get its value for none. */
 static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
 {
-    const int width = optional_arrays[k].width;
-    for (size_t i = from * (size_t)width; i < to * (size_t)width; i++)
+    const size_t words = optional_arrays[k].words;
+    for (size_t i = from * words; i < to * words; i++)
         (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
 
@@ -74,11 +76,10 @@ static PtrResult resize(PtrSceneBuilder *b, size_t capacity)
         return PTR_ERR_NOMEM;
     b->materials = materials;
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
-        float **array = optional_array(b, k);
+        uint32_t **array = optional_array(b, k);
         if (!*array)
             continue;
-        float *resized = realloc(*array, entries * (size_t)optional_arrays[k].width *
-                                             sizeof *resized);
+        uint32_t *resized = realloc(*array, entries * optional_arrays[k].words * sizeof *resized);
         if (!resized)
             return PTR_ERR_NOMEM;
         *array = resized;
@@ -114,26 +115,25 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
 
 /* Optional array k's entry for the sphere added last, the array created if
  * it is the first. NULL if memory runs out. */
-static float *last_entry(PtrSceneBuilder *b, size_t k)
+static void *last_entry(PtrSceneBuilder *b, size_t k)
 {
-    float **array = optional_array(b, k);
-    const int width = optional_arrays[k].width;
+    uint32_t **array = optional_array(b, k);
+    const size_t words = optional_arrays[k].words;
     if (!*array) {
-        *array = malloc(b->capacity * (size_t)width * sizeof **array);
+        *array = malloc(b->capacity * words * sizeof **array);
         if (!*array)
             return NULL;
         fill_none(b, k, 0, b->capacity);
     }
-    return &(*array)[(b->count - 1) * (size_t)width];
+    return &(*array)[(b->count - 1) * words];
 }
 
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
 {
-    float *entry = last_entry(b, OPTIONAL_COLORS);
+    uint16_t *entry = last_entry(b, OPTIONAL_COLORS);
     if (!entry)
         return PTR_ERR_NOMEM;
-    for (int k = 0; k < 3; k++)
-        entry[k] = (float)rgb[k];
+    ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]), entry);
     return PTR_OK;
 }
 
@@ -382,10 +382,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     s->material[at] = b->materials[i];
     s->id[at] = (uint32_t)i;
     PtrResult res = PTR_OK;
-    if (b->colors) {
-        const float *rgb = &b->colors[3 * i];
-        res = ptr_scene_set_sphere_color(scene, at, v3(rgb[0], rgb[1], rgb[2]));
-    }
+    if (b->colors)
+        res = ptr_scene_set_sphere_color16(scene, at, &b->colors[4 * i]);
     if (res == PTR_OK && b->values)
         res = ptr_scene_set_sphere_value(scene, at, b->values[i]);
     return res;

@@ -23,7 +23,7 @@ typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
-    float *colors;    /* r, g, b of each sphere; NULL while none has its own */
+    uint16_t *colors; /* as PtrSpheres.color; NULL while no sphere has its own */
     float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
     size_t count, capacity;
     int has_camera;

@@ -237,7 +237,15 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     return PTR_OK;
 }
 
-PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
+void ptr_color_quantize(PtrVec3 color, uint16_t out[4])
+{
+    const float channels[3] = { color.x, color.y, color.z };
+    for (int c = 0; c < 3; c++)
+        out[c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
+    out[3] = UINT16_MAX;
+}
+
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4])
 {
     PtrSpheres *s = &scene->spheres;
     if (!s->color) {
@@ -246,10 +254,15 @@ PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
             return PTR_ERR_NOMEM;
         memset(s->color, 0xff, s->capacity * 4 * sizeof *s->color);
     }
-    const float channels[3] = { color.x, color.y, color.z };
-    for (int c = 0; c < 3; c++)
-        s->color[4 * i + c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
+    memcpy(&s->color[4 * i], color, 4 * sizeof *color);
     return PTR_OK;
+}
+
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
+{
+    uint16_t quantized[4];
+    ptr_color_quantize(color, quantized);
+    return ptr_scene_set_sphere_color16(scene, i, quantized);
 }
 
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)

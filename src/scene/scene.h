@@ -153,6 +153,12 @@ PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order, PtrPer
  * creates the colour array, white for every other sphere. */
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
 
+/* The same with the colour as PtrSpheres.color stores it. */
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4]);
+
+/* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
+void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
+
 /* Gives sphere i a value (see PtrSpheres.value); the first call creates the
  * array, NaN for every other sphere. */
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
