@@ -18,6 +18,7 @@
  * never depend on the number of threads. */
 #include "accel/bvh.h"
 
+#include <malloc.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -226,8 +227,11 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
         NodeArray *a = &build->tasks[i].nodes;
         start[i] = at;
         memcpy(nodes + at, a->nodes, a->count * sizeof *nodes);
-        free(a->nodes); /* as it goes, so the tree is not in memory twice */
+        /* As it goes, so that the tree is not in memory twice; trimmed, for
+         * glibc keeps freed blocks of a few megabytes for itself. */
+        free(a->nodes);
         a->nodes = NULL;
+        malloc_trim(0);
         for (size_t j = at; j < at + a->count; j++)
             for (int k = 0; k < PTR_BVH_WIDTH; k++)
                 if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
