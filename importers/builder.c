@@ -113,6 +113,29 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     return PTR_OK;
 }
 
+PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_colors,
+                                  size_t *first)
+{
+    if (b->count + count > b->capacity) {
+        PtrResult r = resize(b, b->count + count);
+        if (r != PTR_OK)
+            return r;
+    }
+    uint32_t **colors = optional_array(b, OPTIONAL_COLORS);
+    if (with_colors && !*colors) {
+        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_COLORS].words * sizeof **colors);
+        if (!*colors)
+            return PTR_ERR_NOMEM;
+        fill_none(b, OPTIONAL_COLORS, 0, b->capacity);
+    }
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
+        if (*optional_array(b, k) && !(k == OPTIONAL_COLORS && with_colors))
+            fill_none(b, k, b->count, b->count + count);
+    *first = b->count;
+    b->count += count;
+    return PTR_OK;
+}
+
 /* Optional array k's entry for the sphere added last, the array created if
  * it is the first. NULL if memory runs out. */
 static void *last_entry(PtrSceneBuilder *b, size_t k)

@@ -47,6 +47,13 @@ PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count);
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
                                  double radius, uint32_t material);
 
+/* Adds count spheres at once for an importer that fills them itself, on as
+ * many threads as it likes: for each sphere first + i, the centre and radius
+ * at spheres[4 * (first + i)], the material, and with with_colors the
+ * colour at colors[4 * (first + i)] (see ptr_color_quantize). */
+PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
+                                  size_t *first);
+
 /* Gives the sphere added last its own colour (see PtrSpheres.color). */
 PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
 

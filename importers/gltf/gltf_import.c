@@ -1,10 +1,13 @@
 /* glTF nodes to spheres, following docs/scenes.md. */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/cpu.h"
+#include "base/threads.h"
 #include "builder.h"
 #include "gltf_doc.h"
 #include "importer_internal.h"
@@ -161,32 +164,57 @@ static void origin_text(const Origin *o, char *out, size_t size)
         snprintf(out + n, size - (size_t)n, ", %s %zu", o->part, o->part_index);
 }
 
-static double largest_scale(const Mat4 *world, Importer *im, const Origin *o, int *warned)
+/* The largest of world's axis scales; *nonuniform set if they differ. */
+static double axis_scale(const Mat4 *world, int *nonuniform)
 {
     double scale[3] = { column_length(world, 0), column_length(world, 1),
                         column_length(world, 2) };
     double smin = fmin(scale[0], fmin(scale[1], scale[2]));
     double smax = fmax(scale[0], fmax(scale[1], scale[2]));
-    if (smax - smin > 1e-6 * smax && !*warned) {
-        *warned = 1;
-        ptr_warn(im->warnings,
-                 "%s: node '%s' has a non-uniform scale; its spheres take the largest axis",
-                 im->path, o->node_name);
-    }
+    if (smax - smin > 1e-6 * smax)
+        *nonuniform = 1;
     return smax;
+}
+
+static void warn_nonuniform(Importer *im, const Origin *o, int *warned)
+{
+    if (*warned)
+        return;
+    *warned = 1;
+    ptr_warn(im->warnings, "%s: node '%s' has a non-uniform scale; its spheres take the largest axis",
+             im->path, o->node_name);
+}
+
+static double largest_scale(const Mat4 *world, Importer *im, const Origin *o, int *warned)
+{
+    int nonuniform = 0;
+    double scale = axis_scale(world, &nonuniform);
+    if (nonuniform)
+        warn_nonuniform(im, o, warned);
+    return scale;
+}
+
+/* Whether a sphere cannot be rendered: its centre or radius in float. */
+static int sphere_fault(const double centre[3], double radius)
+{
+    float r = (float)radius;
+    return !(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3);
+}
+
+static PtrResult sphere_error(Importer *im, const Origin *o)
+{
+    char where[160];
+    origin_text(o, where, sizeof where);
+    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                         "%s: %s gives a sphere with a non-finite centre or a radius that is not "
+                         "positive and finite", im->path, where);
 }
 
 static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3], double radius,
                             uint32_t material, const double *color, const double *value)
 {
-    float r = (float)radius;
-    if (!(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3)) {
-        char where[160];
-        origin_text(o, where, sizeof where);
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: %s gives a sphere with a non-finite centre or a radius that "
-                             "is not positive and finite", im->path, where);
-    }
+    if (sphere_fault(centre, radius))
+        return sphere_error(im, o);
     if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK ||
         (color && ptr_builder_set_color(&im->builder, color) != PTR_OK) ||
         (value && ptr_builder_set_value(&im->builder, *value) != PTR_OK))
@@ -194,29 +222,40 @@ static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3
     return PTR_OK;
 }
 
-/* The sphere of a node's mesh surface under world. */
+/* The sphere of a node's mesh surface under world, where the node has a
+ * radius or the mesh bounds; *nonuniform set if world's scale is not
+ * uniform. */
+static void surface_sphere(const GltfNode *node, const GltfMesh *mesh, const Mat4 *world,
+                           double centre[3], double *radius, int *nonuniform)
+{
+    if (node->has_radius) {
+        const double origin[3] = { 0, 0, 0 };
+        mat4_point(world, origin, centre);
+        *radius = node->radius;
+        return;
+    }
+    double local[3], extent = 0.0;
+    for (int k = 0; k < 3; k++) {
+        local[k] = 0.5 * (mesh->min[k] + mesh->max[k]);
+        extent = fmax(extent, mesh->max[k] - mesh->min[k]);
+    }
+    mat4_point(world, local, centre);
+    *radius = 0.5 * extent * axis_scale(world, nonuniform);
+}
+
 static PtrResult add_surface_sphere(Importer *im, const Origin *o, const GltfNode *node,
                                     const GltfMesh *mesh, const Mat4 *world, const double *color,
                                     const double *value, int *warned)
 {
+    if (!node->has_radius && !mesh->has_bounds)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
+                             im->path, o->node_index, o->node_name, node->mesh);
     double centre[3], radius;
-    if (node->has_radius) {
-        const double origin[3] = { 0, 0, 0 };
-        mat4_point(world, origin, centre);
-        radius = node->radius;
-    } else {
-        if (!mesh->has_bounds)
-            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                 "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
-                                 im->path, o->node_index, o->node_name, node->mesh);
-        double local[3], extent = 0.0;
-        for (int k = 0; k < 3; k++) {
-            local[k] = 0.5 * (mesh->min[k] + mesh->max[k]);
-            extent = fmax(extent, mesh->max[k] - mesh->min[k]);
-        }
-        mat4_point(world, local, centre);
-        radius = 0.5 * extent * largest_scale(world, im, o, warned);
-    }
+    int nonuniform = 0;
+    surface_sphere(node, mesh, world, centre, &radius, &nonuniform);
+    if (nonuniform)
+        warn_nonuniform(im, o, warned);
     uint32_t material = 0;
     PtrResult res = map_material(im, mesh->material, &material);
     return res != PTR_OK ? res : add_sphere(im, o, centre, radius, material, color, value);
@@ -461,6 +500,113 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
     return all_finite(out->m, 16);
 }
 
+static PtrResult transform_error(Importer *im, const Origin *o)
+{
+    char where[160];
+    origin_text(o, where, sizeof where);
+    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                         "%s: %s has a non-finite transform, a zero rotation or a scale that is "
+                         "not positive", im->path, where);
+}
+
+/* Instanced nodes of this many instances of a plain sphere (no points, no
+ * --color-by value) are turned into spheres on all cores, this many at a
+ * time (the file's pages read are given back after each). */
+enum { PARALLEL_INSTANCES = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
+
+typedef struct InstanceRun {
+    PtrSceneBuilder *builder;
+    const GltfNode *node;
+    const GltfMesh *mesh;
+    const Mat4 *world;
+    const GltfAccessor *t, *r, *s, *c; /* NULL: absent */
+    uint32_t material;
+    size_t first;           /* the builder's sphere for instance 0 */
+    atomic_size_t failed;   /* the first instance that cannot be a sphere; SIZE_MAX: none */
+    atomic_int nonuniform;
+} InstanceRun;
+
+static void note_failure(InstanceRun *run, size_t i)
+{
+    size_t seen = atomic_load(&run->failed);
+    while (i < seen && !atomic_compare_exchange_weak(&run->failed, &seen, i))
+        ;
+}
+
+/* Instances begin .. end - 1 as add_instances would add them one by one. */
+static void convert_instances(void *arg, size_t begin, size_t end)
+{
+    InstanceRun *run = arg;
+    PtrSceneBuilder *b = run->builder;
+    int nonuniform = 0;
+    for (size_t i = begin; i < end; i++) {
+        Mat4 local, world;
+        double centre[3], radius;
+        if (!instance_local(run->t, run->r, run->s, i, &local)) {
+            note_failure(run, i);
+            break;
+        }
+        world = mat4_mul(run->world, &local);
+        surface_sphere(run->node, run->mesh, &world, centre, &radius, &nonuniform);
+        if (sphere_fault(centre, radius)) {
+            note_failure(run, i);
+            break;
+        }
+        double *out = &b->spheres[4 * (run->first + i)];
+        memcpy(out, centre, sizeof centre);
+        out[3] = radius;
+        b->materials[run->first + i] = run->material;
+        if (run->c) {
+            double rgb[4];
+            element(run->c, i, rgb);
+            ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]),
+                               &b->colors[4 * (run->first + i)]);
+        }
+    }
+    if (nonuniform)
+        atomic_store(&run->nonuniform, 1);
+}
+
+/* add_instances' loop for count instances of a plain sphere (accessors t,
+ * r, s, c: NULL where absent), the same spheres, warnings and first error. */
+static PtrResult add_instances_parallel(Importer *im, const Origin *instance,
+                                        const GltfNode *node, const GltfMesh *mesh,
+                                        const Mat4 *world, const GltfAccessor *const tsrc[4],
+                                        size_t count, int *warned)
+{
+    InstanceRun run = { .builder = &im->builder, .node = node, .mesh = mesh, .world = world,
+                        .t = tsrc[0], .r = tsrc[1], .s = tsrc[2], .c = tsrc[3] };
+    atomic_init(&run.failed, SIZE_MAX);
+    atomic_init(&run.nonuniform, 0);
+    PtrResult res = map_material(im, mesh->material, &run.material);
+    if (res == PTR_OK &&
+        ptr_builder_add_spheres(&im->builder, count, run.c != NULL, &run.first) != PTR_OK)
+        res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    const int threads = ptr_online_cpus();
+    for (size_t begin = 0; res == PTR_OK && begin < count; begin += PARALLEL_BLOCK) {
+        const size_t end = count - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : count;
+        ptr_parallel_ranges(threads, begin, end, convert_instances, &run);
+        for (int k = 0; k < 4; k++)
+            if (tsrc[k])
+                gltf_doc_release(im->doc, tsrc[k], begin, end);
+        if (atomic_load(&run.failed) != SIZE_MAX)
+            break;
+    }
+    if (res != PTR_OK)
+        return res;
+    const size_t failed = atomic_load(&run.failed);
+    if (failed != SIZE_MAX) {
+        Origin at = *instance;
+        at.part_index = failed;
+        Mat4 local;
+        return instance_local(run.t, run.r, run.s, failed, &local) ? sphere_error(im, &at)
+                                                                    : transform_error(im, &at);
+    }
+    if (atomic_load(&run.nonuniform))
+        warn_nonuniform(im, instance, warned);
+    return PTR_OK;
+}
+
 /* EXT_mesh_gpu_instancing: the node's spheres once per instance. */
 static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *node,
                                const GltfMesh *mesh, const Mat4 *world, int *warned)
@@ -493,6 +639,14 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
         res = value_accessor(im, o, "instance", value_index, &count, &v);
     Origin instance = *o;
     instance.part = "instance";
+    if (res == PTR_OK && count >= PARALLEL_INSTANCES && value_index == -1 &&
+        mesh->has_surface && !mesh->point_primitives && (node->has_radius || mesh->has_bounds)) {
+        const GltfAccessor *const tsrc[4] = { in->translation >= 0 ? &t : NULL,
+                                              in->rotation >= 0 ? &r : NULL,
+                                              in->scale >= 0 ? &s : NULL,
+                                              in->color >= 0 ? &c : NULL };
+        return add_instances_parallel(im, &instance, node, mesh, world, tsrc, count, warned);
+    }
     const GltfAccessor *read[] = { in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
                                    in->scale >= 0 ? &s : NULL, in->color >= 0 ? &c : NULL,
                                    value_index != -1 ? &v : NULL };
@@ -501,13 +655,8 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
         Mat4 local, instance_world;
         instance.part_index = i;
         if (!instance_local(in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
-                            in->scale >= 0 ? &s : NULL, i, &local)) {
-            char where[160];
-            origin_text(&instance, where, sizeof where);
-            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                 "%s: %s has a non-finite transform, a zero rotation or a "
-                                 "scale that is not positive", im->path, where);
-        }
+                            in->scale >= 0 ? &s : NULL, i, &local))
+            return transform_error(im, &instance);
         instance_world = mat4_mul(world, &local);
         double color[4], value;
         if (in->color >= 0)

@@ -325,7 +325,7 @@ static void write_shapes_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, 
         const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
         w.prims = prims + begin;
         w.first = first + begin;
-        ptr_parallel_ranges(threads, end - begin, write_shapes, &w);
+        ptr_parallel_ranges(threads, 0, end - begin, write_shapes, &w);
         BvhPrim *shrunk = begin ? realloc(prims, begin * sizeof *prims) : NULL;
         if (shrunk) /* failing to shrink keeps them whole */
             prims = shrunk;

@@ -106,14 +106,15 @@ static void *run_piece(void *arg)
 
 enum { PIECES_MAX = 64 };
 
-void ptr_parallel_ranges(int threads, size_t count,
+void ptr_parallel_ranges(int threads, size_t begin, size_t end,
                          void (*fn)(void *arg, size_t begin, size_t end), void *arg)
 {
     Piece pieces[PIECES_MAX];
     PtrThread *ids[PIECES_MAX];
     const size_t n = threads < 1 ? 1 : threads > PIECES_MAX ? PIECES_MAX : (size_t)threads;
     for (size_t i = 0; i < n; i++) {
-        pieces[i] = (Piece){ fn, arg, count * i / n, count * (i + 1) / n };
+        const size_t count = end - begin;
+        pieces[i] = (Piece){ fn, arg, begin + count * i / n, begin + count * (i + 1) / n };
         ids[i] = i > 0 ? ptr_thread_start(run_piece, &pieces[i]) : NULL;
     }
     for (size_t i = 0; i < n; i++)

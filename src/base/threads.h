@@ -21,11 +21,11 @@ PtrThread *ptr_thread_start(void *(*fn)(void *), void *arg);
 /* Waits until fn has returned; the thread then waits for other work. */
 void ptr_thread_join(PtrThread *thread);
 
-/* Runs fn(arg, begin, end) over 0 .. count - 1 cut into one contiguous
+/* Runs fn(arg, from, to) over begin .. end - 1 cut into one contiguous
  * piece a thread, the calling thread taking the first (and any a thread
  * could not be started for). For work whose result does not depend on how
  * it is cut. */
-void ptr_parallel_ranges(int threads, size_t count,
-                         void (*fn)(void *arg, size_t begin, size_t end), void *arg);
+void ptr_parallel_ranges(int threads, size_t begin, size_t end,
+                         void (*fn)(void *arg, size_t from, size_t to), void *arg);
 
 #endif /* PTR_THREADS_H */

@@ -205,7 +205,7 @@ PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order, PtrPermuteSk
             continue;
         uint32_t *src = *a[k].data;
         Gather g = { src, order, spare, a[k].size / sizeof *src };
-        ptr_parallel_ranges(threads, s->count, gather, &g);
+        ptr_parallel_ranges(threads, 0, s->count, gather, &g);
         if (a[k].size == largest) {
             *a[k].data = spare;
             pad_array(&a[k], s->count, s->capacity);
