@@ -235,33 +235,112 @@ int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, siz
     return 1;
 }
 
-/* Moves the prims begin .. end - 1 that go left by c's split before those
- * that go right; returns the first right one. Hoare's partition. */
-static size_t partition_run(BvhPrim *p, size_t begin, size_t end, const BvhCandidate *c)
+/* The boxes of the prims a partition sends left ([0]) and right ([1]): a
+ * split chosen from samples learns its halves' boxes in the pass that moves
+ * them, not in one more over all of them. */
+typedef struct SideBoxes {
+    float lower[2][3], upper[2][3];
+} SideBoxes;
+
+static void sides_empty(SideBoxes *b)
 {
+    for (int side = 0; side < 2; side++)
+        bounds_empty(b->lower[side], b->upper[side]);
+}
+
+static void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim *p, size_t side)
+{
+    if (!b)
+        return;
+    float lower[3], upper[3];
+    bvh_prim_box(p, set->magnitude, lower, upper);
+    bounds_grow(b->lower[side], b->upper[side], lower, upper);
+}
+
+/* Moves the prims begin .. end - 1 that go left by c's split before those
+ * that go right, adding their boxes to *sides if given; returns the first
+ * right one. Hoare's partition. */
+static size_t partition_run(const BvhPrimSet *set, size_t begin, size_t end,
+                            const BvhCandidate *c, SideBoxes *sides)
+{
+    BvhPrim *p = set->prims;
     size_t i = begin, j = end;
     for (;;) {
         while (i < j && bin_of(c, &p[i], c->axis) <= c->split_bin)
-            i++;
+            sides_add(sides, set, &p[i++], 0);
         while (i < j && bin_of(c, &p[j - 1], c->axis) > c->split_bin)
-            j--;
+            sides_add(sides, set, &p[--j], 1);
         if (i >= j)
             return i;
         BvhPrim t = p[i];
         p[i] = p[j - 1];
         p[j - 1] = t;
-        i++;
-        j--;
+        sides_add(sides, set, &p[i++], 0);
+        sides_add(sides, set, &p[--j], 1);
     }
+}
+
+/* The same split as partition_run, without its unpredictable branches
+ * (Edelkamp and Weiss's BlockQuicksort): blocks at each end are classified
+ * into lists of the prims on the wrong side, without a branch, and the
+ * lists swapped pairwise; the few prims left in the middle go to
+ * partition_run. Everything before the left block belongs left, everything
+ * after the right block right. */
+static size_t partition_blocks(const BvhPrimSet *set, size_t begin, size_t end,
+                               const BvhCandidate *c, SideBoxes *sides)
+{
+    enum { BLOCK = 128 };
+    BvhPrim *p = set->prims;
+    unsigned char wrong_left[BLOCK], wrong_right[BLOCK]; /* offsets in each block */
+    size_t l = begin, r = end, left_count = 0, right_count = 0, left_at = 0, right_at = 0;
+    while (r - l >= 2 * BLOCK) {
+        if (left_count == 0) {
+            left_at = 0;
+            for (size_t i = 0; i < BLOCK; i++) {
+                const size_t goes_right = bin_of(c, &p[l + i], c->axis) > c->split_bin;
+                wrong_left[left_count] = (unsigned char)i;
+                left_count += goes_right;
+                sides_add(sides, set, &p[l + i], goes_right);
+            }
+        }
+        if (right_count == 0) {
+            right_at = 0;
+            for (size_t i = 0; i < BLOCK; i++) {
+                const size_t goes_right = bin_of(c, &p[r - 1 - i], c->axis) > c->split_bin;
+                wrong_right[right_count] = (unsigned char)i;
+                right_count += 1 - goes_right;
+                sides_add(sides, set, &p[r - 1 - i], goes_right);
+            }
+        }
+        const size_t swaps = left_count < right_count ? left_count : right_count;
+        for (size_t k = 0; k < swaps; k++) {
+            BvhPrim *a = &p[l + wrong_left[left_at + k]], *b = &p[r - 1 - wrong_right[right_at + k]];
+            const BvhPrim t = *a;
+            *a = *b;
+            *b = t;
+        }
+        left_count -= swaps;
+        right_count -= swaps;
+        left_at += swaps;
+        right_at += swaps;
+        if (left_count == 0)
+            l += BLOCK;
+        if (right_count == 0)
+            r -= BLOCK;
+    }
+    /* A block half done is classified again: its boxes are added again to
+     * the same side, which changes no box. */
+    return partition_run(set, l, r, c, sides);
 }
 
 /* The same split as partition_run, keeping each side's order, through
  * scratch (room for the run): no branch on the side a prim goes to, which
  * for a random cloud is a coin toss the processor mispredicts half the
  * time. */
-static size_t partition_stable(BvhPrim *p, size_t begin, size_t end, const BvhCandidate *c,
-                               BvhPrim *scratch)
+static size_t partition_stable(const BvhPrimSet *set, size_t begin, size_t end,
+                               const BvhCandidate *c, BvhPrim *scratch, SideBoxes *sides)
 {
+    BvhPrim *p = set->prims;
     size_t left = begin, right = 0;
     for (size_t i = begin; i < end; i++) {
         const BvhPrim prim = p[i];
@@ -270,46 +349,59 @@ static size_t partition_stable(BvhPrim *p, size_t begin, size_t end, const BvhCa
         scratch[right] = prim;
         left += 1 - goes_right;
         right += goes_right;
+        sides_add(sides, set, &prim, goes_right);
     }
     memcpy(p + left, scratch, right * sizeof *p);
     return left;
 }
 
 typedef struct PartitionHalf {
-    BvhPrim *prims;
+    const BvhPrimSet *set;
     size_t begin, end, first_right;
     const BvhCandidate *c;
+    SideBoxes sides, *want_sides;
 } PartitionHalf;
 
 static void *partition_half(void *arg)
 {
     PartitionHalf *h = arg;
-    h->first_right = partition_run(h->prims, h->begin, h->end, h->c);
+    if (h->want_sides)
+        sides_empty(&h->sides);
+    h->first_right = partition_blocks(h->set, h->begin, h->end, h->c,
+                                      h->want_sides ? &h->sides : NULL);
     return NULL;
 }
 
-/* Moves the prims of c that go left before those that go right; returns
- * the first right one. With scratch, partition_stable; without, a large run is cut in two halves, partitioned on two
- * threads when there are two, and the right part of the first half swapped
- * with the left part of the second (the smaller of the two moves): the
- * same moves whatever the thread count, so the tree is too. */
-static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch)
+/* Moves the prims of c that go left before those that go right, adding
+ * their boxes to *sides if given (emptied first); returns the first right
+ * one. With scratch, partition_stable; without, a large run is cut in two
+ * halves, partitioned on two threads when there are two, and the right part
+ * of the first half swapped with the left part of the second (the smaller
+ * of the two moves): the same moves whatever the thread count, so the tree
+ * is too. */
+static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch,
+                        SideBoxes *sides)
 {
     size_t begin = c->begin, end = c->end;
-    if (c->axis < 0)
-        return begin + (end - begin) / 2;
+    if (sides)
+        sides_empty(sides);
     if (scratch)
-        return partition_stable(set->prims, begin, end, c, scratch);
+        return partition_stable(set, begin, end, c, scratch, sides);
     if (end - begin < PARALLEL_PRIMS)
-        return partition_run(set->prims, begin, end, c);
+        return partition_blocks(set, begin, end, c, sides);
     size_t mid = begin + (end - begin) / 2;
-    PartitionHalf half[2] = { { set->prims, begin, mid, 0, c }, { set->prims, mid, end, 0, c } };
+    PartitionHalf half[2] = { { .set = set, .begin = begin, .end = mid, .c = c, .want_sides = sides },
+                              { .set = set, .begin = mid, .end = end, .c = c, .want_sides = sides } };
     PtrThread *other = set->threads > 1 ? ptr_thread_start(partition_half, &half[1]) : NULL;
     partition_half(&half[0]);
     if (other)
         ptr_thread_join(other);
     else
         partition_half(&half[1]);
+    for (int h = 0; sides && h < 2; h++)
+        for (int side = 0; side < 2; side++)
+            bounds_grow(sides->lower[side], sides->upper[side], half[h].sides.lower[side],
+                        half[h].sides.upper[side]);
     /* [left A | right A | left B | right B]: swap right A with the end of
      * left B, or left B with the start of right A. */
     size_t right_a = mid - half[0].first_right, left_b = half[1].first_right - mid;
@@ -327,14 +419,20 @@ static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *s
 int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
               BvhCandidate *left, BvhCandidate *right)
 {
-    BvhCandidate whole = *c;
-    if (middle)
-        whole.axis = -1;
-    size_t mid = partition(set, &whole, scratch);
-    /* A split chosen from samples knows its halves' boxes only roughly. */
-    if (whole.axis < 0 || whole.sampled)
-        return bvh_candidate_init(set, left, whole.begin, mid, NULL, NULL) &&
-               bvh_candidate_init(set, right, mid, whole.end, NULL, NULL);
-    return bvh_candidate_init(set, left, whole.begin, mid, whole.left_lower, whole.left_upper) &&
-           bvh_candidate_init(set, right, mid, whole.end, whole.right_lower, whole.right_upper);
+    const size_t begin = c->begin, end = c->end;
+    if (middle || c->axis < 0) {
+        const size_t mid = begin + (end - begin) / 2;
+        return bvh_candidate_init(set, left, begin, mid, NULL, NULL) &&
+               bvh_candidate_init(set, right, mid, end, NULL, NULL);
+    }
+    /* A split chosen from samples knows its halves' boxes only once they
+     * are moved; the bins of one from every prim know them already. */
+    SideBoxes sides;
+    const BvhCandidate whole = *c;
+    const size_t mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
+    if (whole.sampled)
+        return bvh_candidate_init(set, left, begin, mid, sides.lower[0], sides.upper[0]) &&
+               bvh_candidate_init(set, right, mid, end, sides.lower[1], sides.upper[1]);
+    return bvh_candidate_init(set, left, begin, mid, whole.left_lower, whole.left_upper) &&
+           bvh_candidate_init(set, right, mid, end, whole.right_lower, whole.right_upper);
 }
