@@ -170,20 +170,25 @@ static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
 static void *task_worker(void *arg)
 {
     Build *build = arg;
+    /* One scratch for all of a thread's tasks (none is larger than
+     * task_spheres): fresh memory for each would be cleared page by page. */
+    BvhPrim *scratch = NULL;
     for (;;) {
         size_t i = atomic_fetch_add(&build->next_task, 1);
         if (i >= build->task_count)
-            return NULL;
+            break;
         Task *t = &build->tasks[i];
         BvhCandidate range;
         size_t root;
-        BvhPrim *scratch = malloc((t->end - t->begin) * sizeof *scratch);
+        if (!scratch)
+            scratch = malloc(build->task_spheres * sizeof *scratch);
         t->failed = !scratch ||
                     !bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL) ||
                     !build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
                                 &t->nodes.depth);
-        free(scratch);
     }
+    free(scratch);
+    return NULL;
 }
 
 static int run_tasks(Build *build)

@@ -248,7 +248,8 @@ static void sides_empty(SideBoxes *b)
         bounds_empty(b->lower[side], b->upper[side]);
 }
 
-static void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim *p, size_t side)
+static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim *p,
+                             size_t side)
 {
     if (!b)
         return;
