@@ -213,11 +213,16 @@ static void use_override(PtrSceneBuilder *b)
  * camera should frame. */
 #define SMALL_RATIO 16.0
 
+/* fmin and fmax for the loops over every sphere: inline where the library's
+ * are calls (they order NaN, which no sphere that renders has). */
+static inline double least(double a, double b) { return b < a ? b : a; }
+static inline double most(double a, double b) { return b > a ? b : a; }
+
 static double smallest_radius(const PtrSceneBuilder *b)
 {
     double smallest = INFINITY;
     for (size_t i = 0; i < b->count; i++)
-        smallest = fmin(smallest, b->spheres[4 * i + 3]);
+        smallest = least(smallest, b->spheres[4 * i + 3]);
     return smallest;
 }
 
@@ -236,8 +241,8 @@ static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
         if (!is_framed(b, i, smallest))
             continue;
         for (int k = 0; k < 3; k++) {
-            lo[k] = any ? fmin(lo[k], s[k] - s[3]) : s[k] - s[3];
-            hi[k] = any ? fmax(hi[k], s[k] + s[3]) : s[k] + s[3];
+            lo[k] = any ? least(lo[k], s[k] - s[3]) : s[k] - s[3];
+            hi[k] = any ? most(hi[k], s[k] + s[3]) : s[k] + s[3];
         }
         any = 1;
     }
@@ -261,8 +266,8 @@ static void fit_axis(const PtrSceneBuilder *b, int axis, double half_angle, doub
         const double *s = &b->spheres[4 * i];
         if (!is_framed(b, i, smallest))
             continue;
-        hi = fmax(hi, s[axis] * ca + s[2] * sa + s[3]);
-        lo = fmax(lo, -s[axis] * ca + s[2] * sa + s[3]);
+        hi = most(hi, s[axis] * ca + s[2] * sa + s[3]);
+        lo = most(lo, -s[axis] * ca + s[2] * sa + s[3]);
     }
     *eye_axis = 0.5 * (hi - lo) / ca;
     *eye_z = 0.5 * (hi + lo) / sa;
