@@ -15,11 +15,12 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
  * out of memory, or a sphere too far from the camera. */
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err);
 
-/* Bytes a sphere takes at the peak of its import and the tree's build:
- * the builder's arrays, the scene's, the build's boxes and order and the
- * nodes (measured: 95 to 130 a sphere at 10^5 and 10^6 spheres, of which up
- * to 36 are the file's, already read). */
-#define PTR_SPHERE_PEAK_BYTES 128
+/* Bytes a sphere takes at the peak of its import and the tree's build
+ * (bench/scale.sh measures 54 to 56 a sphere above an empty render from
+ * 10^6 to 10^8 spheres with their own colours: the scene's 32, the tree's
+ * nodes, and the order and spare array its reordering needs), with room for
+ * a --color-by value. */
+#define PTR_SPHERE_PEAK_BYTES 64
 
 /* Before a file's spheres are allocated: refuses (PTR_ERR_NOMEM, one line
  * with what they would need and what there is) a count that would not fit
