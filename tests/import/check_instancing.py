@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The same 40 spheres under a transformed parent, written as nodes, as
-EXT_mesh_gpu_instancing instances (float, and quantized rotations and colours)
-and as a POINTS primitive (tests/fixtures/make_instancing.py), import to the
+EXT_mesh_gpu_instancing instances (float, in a .gltf and in a .glb whose BIN
+chunk is read where it lies, and quantized rotations and colours) and as a
+POINTS primitive (tests/fixtures/make_instancing.py), import to the
 same sphere list: centres and radii within float rounding (relative 1e-6 of
 the scene's size), the same materials, and the same per-sphere colours where
 the form carries them (within 1/65535, ptr's colour precision).
@@ -14,12 +15,13 @@ ptr, folder = sys.argv[1], sys.argv[2]
 
 
 def dump(name):
-    out = subprocess.run([ptr, "--dump-scene", f"{folder}/{name}.gltf"], check=True,
+    file = name if "." in name else f"{name}.gltf"
+    out = subprocess.run([ptr, "--dump-scene", f"{folder}/{file}"], check=True,
                          capture_output=True, text=True).stdout
     return json.loads(out)["spheres"]
 
 
-forms = {name: dump(name) for name in ("nodes", "instances", "quantized", "points")}
+forms = {name: dump(name) for name in ("nodes", "instances", "instances.glb", "quantized", "points")}
 reference = forms["nodes"]
 size = max(abs(x) for s in reference for x in s["center"])
 failures = []
