@@ -201,20 +201,24 @@ static int sphere_fault(const double centre[3], double radius)
     return !(r > 0.0f) || !isfinite(r) || !all_finite(centre, 3);
 }
 
-static PtrResult sphere_error(Importer *im, const Origin *o)
+/* "FILE: node 3 ('name'), instance 17 PROBLEM" (see Origin). */
+static PtrResult part_error(Importer *im, const Origin *o, const char *problem)
 {
     char where[160];
     origin_text(o, where, sizeof where);
-    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                         "%s: %s gives a sphere with a non-finite centre or a radius that is not "
-                         "positive and finite", im->path, where);
+    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: %s %s", im->path, where, problem);
 }
+
+static const char *const sphere_fault_text =
+    "gives a sphere with a non-finite centre or a radius that is not positive and finite";
+static const char *const transform_fault_text =
+    "has a non-finite transform, a zero rotation or a scale that is not positive";
 
 static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3], double radius,
                             uint32_t material, const double *color, const double *value)
 {
     if (sphere_fault(centre, radius))
-        return sphere_error(im, o);
+        return part_error(im, o, sphere_fault_text);
     if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK ||
         (color && ptr_builder_set_color(&im->builder, color) != PTR_OK) ||
         (value && ptr_builder_set_value(&im->builder, *value) != PTR_OK))
@@ -500,15 +504,6 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
     return all_finite(out->m, 16);
 }
 
-static PtrResult transform_error(Importer *im, const Origin *o)
-{
-    char where[160];
-    origin_text(o, where, sizeof where);
-    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                         "%s: %s has a non-finite transform, a zero rotation or a scale that is "
-                         "not positive", im->path, where);
-}
-
 /* Instanced nodes of this many instances of a plain sphere (no points, no
  * --color-by value) are turned into spheres on all cores, this many at a
  * time (the file's pages read are given back after each). */
@@ -599,8 +594,8 @@ static PtrResult add_instances_parallel(Importer *im, const Origin *instance,
         Origin at = *instance;
         at.part_index = failed;
         Mat4 local;
-        return instance_local(run.t, run.r, run.s, failed, &local) ? sphere_error(im, &at)
-                                                                    : transform_error(im, &at);
+        return part_error(im, &at, instance_local(run.t, run.r, run.s, failed, &local)
+                                       ? sphere_fault_text : transform_fault_text);
     }
     if (atomic_load(&run.nonuniform))
         warn_nonuniform(im, instance, warned);
@@ -656,7 +651,7 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
         instance.part_index = i;
         if (!instance_local(in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
                             in->scale >= 0 ? &s : NULL, i, &local))
-            return transform_error(im, &instance);
+            return part_error(im, &instance, transform_fault_text);
         instance_world = mat4_mul(world, &local);
         double color[4], value;
         if (in->color >= 0)

@@ -10,11 +10,14 @@ refuses by count, not by shape.
 usage: check_claimed_spheres.py PTR"""
 import json, os, resource, struct, subprocess, sys, tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from glb import write_glb  # noqa: E402
+
 ptr = sys.argv[1]
 INSTANCES = 100_000
 
 
-def write_glb(path, nodes):
+def write_claim(path, nodes):
     translations = b"".join(struct.pack("<3f", (i % 100) * 0.1, (i // 100 % 100) * 0.1,
                                         (i // 10000) * 0.1) for i in range(INSTANCES))
     box = struct.pack("<9f", -0.01, -0.01, -0.01, 0.01, 0.01, 0.01, 0.01, -0.01, 0.01)
@@ -35,13 +38,7 @@ def write_glb(path, nodes):
         "scenes": [{"nodes": list(range(nodes))}],
         "scene": 0,
     }
-    text = json.dumps(doc, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    with open(path, "wb") as f:
-        f.write(struct.pack("<3I", 0x46546C67, 2, 12 + 8 + len(text) + 8 + len(binary)))
-        f.write(struct.pack("<2I", len(text), 0x4E4F534A) + text)
-        f.write(struct.pack("<2I", len(binary), 0x004E4942) + binary)
+    write_glb(path, doc, binary)
 
 
 def run(args):
@@ -54,7 +51,7 @@ def run(args):
 failures = []
 with tempfile.TemporaryDirectory() as d:
     claim = os.path.join(d, "billion.glb")
-    write_glb(claim, 10_000)
+    write_claim(claim, 10_000)
     out = os.path.join(d, "out.exr")
     with open(out, "w") as f:
         f.write("an existing image")
@@ -72,7 +69,7 @@ with tempfile.TemporaryDirectory() as d:
         failures.append(f"peak resident size {peak_kb} kB: memory was taken for the spheres")
 
     one = os.path.join(d, "one.glb")
-    write_glb(one, 1)
+    write_claim(one, 1)
     p, _ = run([one, "-o", out, "--samples", "1", "--width", "16", "--quiet", "--json"])
     spheres = json.loads(p.stdout)["spheres"] if p.returncode == 0 else None
     if p.returncode != 0 or spheres != INSTANCES:

@@ -9,6 +9,9 @@ thread meets after it.
 usage: check_parallel_instances.py PTR"""
 import json, math, os, random, struct, subprocess, sys, tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from glb import write_glb  # noqa: E402
+
 ptr = sys.argv[1]
 COUNT = 40_000  # above importers' PARALLEL_INSTANCES (32,768); each half below it
 
@@ -29,7 +32,7 @@ def instances(broken):
     return t, r, s, c
 
 
-def write_glb(path, nodes, broken):
+def write_cloud(path, nodes, broken):
     t, r, s, c = instances(broken)
     blocks = [b"".join(struct.pack("<3f", *v) for v in t), b"".join(struct.pack("<4f", *v) for v in r),
               b"".join(struct.pack("<3f", *v) for v in s), b"".join(struct.pack("<3f", *v) for v in c)]
@@ -63,13 +66,7 @@ def write_glb(path, nodes, broken):
         "scenes": [{"nodes": list(range(nodes + 1))}],
         "scene": 0,
     }
-    text = json.dumps(doc, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    with open(path, "wb") as f:
-        f.write(struct.pack("<3I", 0x46546C67, 2, 12 + 8 + len(text) + 8 + len(binary)))
-        f.write(struct.pack("<2I", len(text), 0x4E4F534A) + text)
-        f.write(struct.pack("<2I", len(binary), 0x004E4942) + binary)
+    write_glb(path, doc, binary)
 
 
 failures = []
@@ -78,7 +75,7 @@ with tempfile.TemporaryDirectory() as d:
     for broken in (False, True):
         for nodes in (1, 2):
             path = os.path.join(d, f"cloud-{nodes}-{broken}.glb")
-            write_glb(path, nodes, broken)
+            write_cloud(path, nodes, broken)
             runs[nodes, broken] = subprocess.run([ptr, "--dump-scene", path], capture_output=True,
                                                  text=True, timeout=120)
     whole, halves = runs[1, False], runs[2, False]
