@@ -34,7 +34,7 @@ enum { SPHERE_ARRAYS_MAX = 16 };
 static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
-    /* Entries are whole 4-byte words (see spheres_copy). */
+    /* Entries are whole 4-byte words (see pad_array). */
     SphereArray list[] = {
         { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1 },
         { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1 },
@@ -67,8 +67,9 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-/* Fills entries from .. to - 1 of array a with its padding. Entries are 4-byte words (an entry of several words, such as a
- * colour, is padded word by word, the pattern repeated). */
+/* Fills entries from .. to - 1 of array a with its padding. Entries are
+ * 4-byte words (an entry of several words, such as a colour, is padded word
+ * by word, the pattern repeated). */
 static void pad_array(const SphereArray *a, size_t from, size_t to)
 {
     uint32_t *words = *a->data;
@@ -185,6 +186,8 @@ static void gather(void *arg, size_t begin, size_t end)
 PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order, PtrPermuteSkip skip,
                               int threads)
 {
+    if (s->count == 0)
+        return PTR_OK;
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
     const int arrays = sphere_arrays(s, a);
     void *skipped = NULL;
@@ -195,7 +198,7 @@ PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order, PtrPermuteSk
     for (int k = 0; k < arrays; k++)
         if (*a[k].data && a[k].size > largest)
             largest = a[k].size;
-    if (s->count == 0)
+    if (largest == 0)
         return PTR_OK;
     uint32_t *spare = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * largest);
     if (!spare)
