@@ -393,7 +393,8 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigne
 }
 
 /* Puts sphere i of the builder (already relative to the scene's origin) at
- * entry at of the scene's arrays. */
+ * entry at of the scene's shape arrays, its attributes at entry i (its id:
+ * see PtrSpheres). */
 static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
 {
     const double *d = &b->spheres[4 * i];
@@ -407,13 +408,13 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     s->cy[at] = c.y;
     s->cz[at] = c.z;
     s->radius[at] = r;
-    s->material[at] = b->materials[i];
+    s->material[i] = b->materials[i];
     s->id[at] = (uint32_t)i;
     PtrResult res = PTR_OK;
     if (b->colors)
-        res = ptr_scene_set_sphere_color16(scene, at, &b->colors[4 * i]);
+        res = ptr_scene_set_sphere_color16(scene, i, &b->colors[4 * i]);
     if (res == PTR_OK && b->values)
-        res = ptr_scene_set_sphere_value(scene, at, b->values[i]);
+        res = ptr_scene_set_sphere_value(scene, i, b->values[i]);
     return res;
 }
 

@@ -261,23 +261,6 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
     return 1;
 }
 
-/* The order the build gives the spheres: the ones kept out of the tree
- * (unbounded), the prims' spheres in the prims' order, then the spheres
- * after the tree's. NULL if out of memory. */
-static uint32_t *sphere_order(const uint32_t *unbounded, size_t unbounded_count,
-                              const BvhPrim *prims, size_t prim_count, size_t sphere_count)
-{
-    uint32_t *order = malloc((sphere_count ? sphere_count : 1) * sizeof *order);
-    if (!order)
-        return NULL;
-    memcpy(order, unbounded, unbounded_count * sizeof *order);
-    for (size_t i = 0; i < prim_count; i++)
-        order[unbounded_count + i] = prims[i].index;
-    for (size_t i = unbounded_count + prim_count; i < sphere_count; i++)
-        order[i] = (uint32_t)i;
-    return order;
-}
-
 typedef struct ShapeWrite {
     PtrSpheres *spheres;
     const BvhPrim *prims;
@@ -299,29 +282,27 @@ static void write_shapes(void *arg, size_t begin, size_t end)
     }
 }
 
-/* The shapes of spheres first .. first + count - 1, or of spheres at[0 ..
- * count - 1] if at is given, as prims: those the prims leave out. NULL if
- * out of memory. */
-static BvhPrim *save_shapes(const PtrSpheres *s, const uint32_t *at, size_t first, size_t count)
+/* The shapes of spheres first .. first + count - 1 as prims. NULL if out of
+ * memory. */
+static BvhPrim *save_shapes(const PtrSpheres *s, size_t first, size_t count)
 {
     BvhPrim *saved = malloc((count ? count : 1) * sizeof *saved);
     for (size_t k = 0; saved && k < count; k++) {
-        const size_t i = at ? at[k] : first + k;
-        saved[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], (uint32_t)i,
-                              s->id[i] };
+        const size_t i = first + k;
+        saved[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i] };
     }
     return saved;
 }
 
 /* The prims give back this many spheres' memory at a time as their shapes
- * are written back: 24 MB. */
+ * are written back: 20 MB. */
 enum { SHRINK_STEP = 1 << 20 };
 
-/* Writes the shapes and ids of the tree's spheres in the build's order (see
- * sphere_order) from the prims, which hold them in that order already: a
- * sequential write where a gather would read ten million scattered
- * entries. From the last prim back, the prims shrinking behind, so that the
- * two copies are never both whole. Frees the prims. */
+/* Writes the shapes of the tree's spheres in the tree's order from the
+ * prims, which hold them in that order already: a sequential write where a
+ * gather would read 10^8 scattered entries. From the last prim back, the
+ * prims shrinking behind, so that the two copies are never both whole.
+ * Frees the prims. */
 static void write_shapes_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
                               int threads)
 {
@@ -345,27 +326,25 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (spheres->count >= TASK_FLAG)
         return PTR_ERR_NOMEM;
     Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
+    /* The prims and kept_out take the shapes of the tree's spheres, and
+     * after_tree those of the spheres after it: the build then has the
+     * shapes' memory for itself. */
+    const size_t after = spheres->count - count;
+    BvhPrim kept_out[BVH_UNBOUNDED_MAX];
+    BvhPrim *after_tree = save_shapes(spheres, count, after);
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
-    uint32_t unbounded[BVH_UNBOUNDED_MAX];
     size_t prim_count = 0;
-    int ok = build.set.prims != NULL;
+    int ok = after_tree && build.set.prims;
     if (ok) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        ok = ptr_bvh_prims(&tree_part, unbounded, &bvh->unbounded_count, build.set.prims,
+        ok = ptr_bvh_prims(&tree_part, kept_out, &bvh->unbounded_count, build.set.prims,
                            &prim_count, &build.set.magnitude);
     }
     build.first_sphere = bvh->unbounded_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
-    /* The prims hold every shape but those of the spheres kept out of the
-     * tree or after it: with those saved, the build has the shapes' memory
-     * for itself. */
-    const size_t after = spheres->count - count;
-    BvhPrim *kept_out = ok ? save_shapes(spheres, unbounded, 0, bvh->unbounded_count) : NULL;
-    BvhPrim *after_tree = ok ? save_shapes(spheres, NULL, count, after) : NULL;
-    ok = kept_out && after_tree;
     if (ok)
         ptr_spheres_drop_shapes(spheres);
     if (ok && prim_count > 0) {
@@ -375,10 +354,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
              build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
              run_tasks(&build);
     }
-    uint32_t *order = ok ? sphere_order(unbounded, bvh->unbounded_count, build.set.prims,
-                                        prim_count, spheres->count)
-                         : NULL;
-    ok = order && ptr_spheres_restore_shapes(spheres) == PTR_OK;
+    ok = ok && ptr_spheres_restore_shapes(spheres) == PTR_OK;
     if (ok) {
         write_shapes_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
                           build.set.threads);
@@ -388,19 +364,14 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         write_shapes(&rest, 0, after);
     }
     free(build.set.prims);
-    free(kept_out);
     free(after_tree);
-    /* Laying the tree out in one array and reordering the other per-sphere
-     * arrays each need memory of their own: they come once the prims are
-     * gone. */
-    ok = ok && (prim_count == 0 || lay_out(&build, &top, bvh)) &&
-         ptr_spheres_permute(spheres, order, PTR_PERMUTE_SKIP_SHAPES, build.set.threads) ==
-             PTR_OK;
+    /* Laying the tree out in one array needs memory of its own: it comes
+     * once the prims are gone. */
+    ok = ok && (prim_count == 0 || lay_out(&build, &top, bvh));
     for (size_t i = 0; i < build.task_count; i++)
         free(build.tasks[i].nodes.nodes);
     free(build.tasks);
     free(top.nodes);
-    free(order);
     if (!ok) {
         ptr_bvh_free(bvh);
         return PTR_ERR_NOMEM;

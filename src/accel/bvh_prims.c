@@ -87,16 +87,26 @@ static float unbounded_radius(const PtrSpheres *s)
     return median * UNBOUNDED_RATIO;
 }
 
-int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
-                  BvhPrim *prims, size_t *prim_count, float *magnitude_out)
+static BvhPrim prim_of(const PtrSpheres *s, size_t i)
 {
-    *unbounded_count = *prim_count = 0;
+    return (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i] };
+}
+
+/* Spheres copied between two releases of the shapes' memory: 4 MB of each
+ * array. */
+enum { RELEASE_STEP = 1 << 20 };
+
+int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhPrim *prims,
+                  size_t *prim_count, float *magnitude_out)
+{
+    *kept_out_count = *prim_count = 0;
     *magnitude_out = 0.0f;
     if (s->count == 0)
         return 1;
     float limit = unbounded_radius(s);
     if (isnan(limit))
         return 0;
+    uint32_t order[BVH_UNBOUNDED_MAX];
     size_t u = 0;
     for (size_t i = 0; i < s->count; i++)
         if (s->radius[i] > limit)
@@ -112,29 +122,25 @@ int ptr_bvh_prims(const PtrSpheres *s, uint32_t *order, size_t *unbounded_count,
         }
     out[u] = UINT32_MAX;
     sort_by_id(order, u, s);
+    for (size_t k = 0; k < u; k++)
+        kept_out[k] = prim_of(s, order[k]);
     float magnitude = 0.0f;
-    for (size_t i = 0, k = 0; i < s->count; i++) {
-        float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
-        if (out[k] == i)
-            k++;
-        else if (m > magnitude)
-            magnitude = m;
-    }
-    size_t n = 0;
-    for (size_t i = 0, k = 0; i < s->count; i++) {
-        if (out[k] == i) {
-            k++;
-            continue;
+    size_t n = 0, k = 0;
+    for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
+        const size_t end = s->count - begin > RELEASE_STEP ? begin + RELEASE_STEP : s->count;
+        for (size_t i = begin; i < end; i++) {
+            if (out[k] == i) {
+                k++;
+                continue;
+            }
+            const float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
+            if (m > magnitude)
+                magnitude = m;
+            prims[n++] = prim_of(s, i);
         }
-        BvhPrim *p = &prims[n++];
-        p->centre[0] = s->cx[i];
-        p->centre[1] = s->cy[i];
-        p->centre[2] = s->cz[i];
-        p->radius = s->radius[i];
-        p->index = (uint32_t)i;
-        p->id = s->id[i];
+        ptr_spheres_release_shapes(s, begin, end);
     }
-    *unbounded_count = u;
+    *kept_out_count = u;
     *prim_count = n;
     *magnitude_out = magnitude;
     return 1;

@@ -10,13 +10,13 @@
 
 enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
 
-/* A sphere as the build moves it: 24 bytes, for at 10^8 spheres the prims
- * are the build's largest array. The tree's leaves are written back to the
- * scene's arrays from them, in their final order. */
+/* A sphere as the build moves it: its shape, 20 bytes, for at 10^8 spheres
+ * the prims are the build's largest array. The tree's leaves are written
+ * back to the scene's shape arrays from them, in their final order; the
+ * attributes stay where they are (see PtrSpheres). */
 typedef struct BvhPrim {
     float centre[3], radius;
-    uint32_t index; /* of the sphere in the arrays as they were before the build */
-    uint32_t id;    /* the sphere's id, which orders a leaf */
+    uint32_t id; /* which orders a leaf */
 } BvhPrim;
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
@@ -35,14 +35,16 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
     }
 }
 
-/* Puts the spheres kept out of the tree at order[0 .. *unbounded_count - 1]
- * (by ascending id; order has room for BVH_UNBOUNDED_MAX), a prim for each
- * of the others in prims (their count in *prim_count, in the arrays' order),
- * and in *magnitude the largest coordinate magnitude in the tree, which
- * bounds both the spheres' and the rays' origins (the camera sits at 0,
- * other rays start on spheres) and so scales the boxes' padding. Returns 0
- * if out of memory. */
-int ptr_bvh_prims(const PtrSpheres *spheres, uint32_t *order, size_t *unbounded_count,
+/* Puts the spheres kept out of the tree in kept_out[0 .. *kept_out_count -
+ * 1] (by ascending id; room for BVH_UNBOUNDED_MAX), a prim for each of the
+ * others in prims (their count in *prim_count, in the arrays' order), and
+ * in *magnitude the largest coordinate magnitude in the tree, which bounds
+ * both the spheres' and the rays' origins (the camera sits at 0, other rays
+ * start on spheres) and so scales the boxes' padding. Gives back the
+ * shapes' memory as it goes (ptr_spheres_release_shapes): on success the
+ * prims and kept_out hold the spheres' only copy of their shapes. Returns 0
+ * if out of memory (the spheres untouched). */
+int ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
                   BvhPrim *prims, size_t *prim_count, float *magnitude);
 
 /* Sorts a leaf's prims by ascending sphere id. */

@@ -1,8 +1,11 @@
+#define _DEFAULT_SOURCE /* madvise */
 #include "base/memory.h"
 
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 /* The number after key in a "key value" text file (kB scaled by unit), or
  * UINT64_MAX if the file or the key is missing. */
@@ -57,4 +60,16 @@ uint64_t ptr_memory_available(void)
             room = min_u64(room, limit.rlim_cur > mapped ? limit.rlim_cur - mapped : 0);
     }
     return room;
+}
+
+void ptr_memory_release(void *base, size_t from, size_t to)
+{
+    const uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE), start = (uintptr_t)base;
+    const uintptr_t first = (start + page - 1) & ~(page - 1); /* base's page may hold more */
+    uintptr_t lo = (start + from) & ~(page - 1);
+    const uintptr_t hi = (start + to) & ~(page - 1);
+    if (lo < first)
+        lo = first;
+    if (hi > lo) /* a hint: where refused, the memory is only given back later */
+        (void)madvise((void *)lo, hi - lo, MADV_DONTNEED);
 }

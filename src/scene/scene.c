@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "base/threads.h"
+#include "base/memory.h"
 
 void ptr_scene_init(PtrScene *scene)
 {
@@ -19,13 +19,14 @@ void ptr_scene_init(PtrScene *scene)
 }
 
 /* Every per-sphere array, with the value its padding entries hold: growing,
- * freeing and reordering go through this list, so a new array is one line. */
+ * freeing and dropping the shapes go through this list, so a new array is
+ * one line. */
 typedef struct SphereArray {
     void **data;
     size_t size;     /* of one entry */
     uint32_t padding; /* bits of a padding entry */
     int optional;     /* may be NULL: then it stays so */
-    int shape;        /* see PTR_PERMUTE_SKIP_SHAPES */
+    int shape;        /* cx, cy, cz, radius, id: see PtrSpheres */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -106,7 +107,7 @@ static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, size_t pad_f
 }
 
 /* The capacity that holds count spheres and the PTR_SPHERE_BLOCK padding
- * entries that always follow the last (see ptr_spheres_permute). */
+ * entries that always follow the last (see scene.h). */
 static size_t capacity_for(size_t count)
 {
     return (count / PTR_SPHERE_BLOCK + 2) * PTR_SPHERE_BLOCK;
@@ -143,6 +144,15 @@ PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count)
     return PTR_OK;
 }
 
+void ptr_spheres_release_shapes(PtrSpheres *s, size_t begin, size_t end)
+{
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    const int arrays = sphere_arrays(s, a);
+    for (int k = 0; k < arrays; k++)
+        if (a[k].shape)
+            ptr_memory_release(*a[k].data, begin * a[k].size, end * a[k].size);
+}
+
 void ptr_spheres_drop_shapes(PtrSpheres *s)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
@@ -166,58 +176,6 @@ PtrResult ptr_spheres_restore_shapes(PtrSpheres *s)
             return PTR_ERR_NOMEM;
         pad_array(&a[k], s->count, s->capacity);
     }
-    return PTR_OK;
-}
-
-typedef struct Gather {
-    const uint32_t *src, *order;
-    uint32_t *dst;
-    size_t words; /* an entry's */
-} Gather;
-
-static void gather(void *arg, size_t begin, size_t end)
-{
-    const Gather *g = arg;
-    for (size_t i = begin; i < end; i++)
-        for (size_t w = 0; w < g->words; w++)
-            g->dst[i * g->words + w] = g->src[(size_t)g->order[i] * g->words + w];
-}
-
-PtrResult ptr_spheres_permute(PtrSpheres *s, const uint32_t *order, PtrPermuteSkip skip,
-                              int threads)
-{
-    if (s->count == 0)
-        return PTR_OK;
-    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
-    const int arrays = sphere_arrays(s, a);
-    void *skipped = NULL;
-    for (int k = 0; k < arrays; k++)
-        if (skip == PTR_PERMUTE_SKIP_SHAPES && a[k].shape)
-            a[k].data = &skipped; /* left as if absent */
-    size_t largest = 0;
-    for (int k = 0; k < arrays; k++)
-        if (*a[k].data && a[k].size > largest)
-            largest = a[k].size;
-    if (largest == 0)
-        return PTR_OK;
-    uint32_t *spare = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * largest);
-    if (!spare)
-        return PTR_ERR_NOMEM;
-    for (int k = 0; k < arrays; k++) {
-        if (!*a[k].data)
-            continue;
-        uint32_t *src = *a[k].data;
-        Gather g = { src, order, spare, a[k].size / sizeof *src };
-        ptr_parallel_ranges(threads, 0, s->count, gather, &g);
-        if (a[k].size == largest) {
-            *a[k].data = spare;
-            pad_array(&a[k], s->count, s->capacity);
-            spare = src;
-        } else {
-            memcpy(src, spare, s->count * a[k].size);
-        }
-    }
-    free(spare);
     return PTR_OK;
 }
 
@@ -331,10 +289,10 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
-    /* A tree reorders the spheres; the hash takes them in file order, so
-     * that parts rendered with and without one merge. (Out of memory, it
-     * takes them as they are: callers that may be short of memory hash
-     * before building a tree, as the renderer does.) */
+    /* A tree reorders the shapes; the hash takes them in file order, as
+     * the attributes are, so that parts rendered with and without one
+     * merge. (Out of memory, it takes them as they are: callers that may be
+     * short of memory hash before building a tree, as the renderer does.) */
     size_t reordered = 0;
     while (reordered < s->count && s->id[reordered] == reordered)
         reordered++;
@@ -347,9 +305,9 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     h = hash_in_file_order(h, s->cy, sizeof *s->cy, by_id, s->count);
     h = hash_in_file_order(h, s->cz, sizeof *s->cz, by_id, s->count);
     h = hash_in_file_order(h, s->radius, sizeof *s->radius, by_id, s->count);
-    h = hash_in_file_order(h, s->material, sizeof *s->material, by_id, s->count);
+    h = hash_bytes(h, s->material, s->count * sizeof *s->material);
     if (s->color)
-        h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
+        h = hash_bytes(h, s->color, s->count * 4 * sizeof *s->color);
     free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {

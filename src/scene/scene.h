@@ -2,8 +2,17 @@
  *
  * Spheres are stored as a structure of arrays so that SIMD kernels can test
  * 4, 8 or 16 of them per instruction. Each array is 64-byte aligned and
- * padded to a multiple of PTR_SPHERE_BLOCK entries; padding entries have a NaN
- * radius, which fails every ordered comparison and so can never be hit. */
+ * padded to a multiple of PTR_SPHERE_BLOCK entries, at least
+ * PTR_SPHERE_BLOCK of them after the last sphere, so SIMD code may read 16
+ * lanes from any sphere on; padding entries have a NaN radius, which fails
+ * every ordered comparison and so can never be hit.
+ *
+ * Two kinds of array: the shapes (cx, cy, cz, radius and id), which an
+ * acceleration structure may reorder, and the attributes (material, colour,
+ * value), which always stay in the scene file's order and are read through
+ * the sphere's id (ptr_sphere_material, ptr_sphere_color). A tree over 10^8
+ * spheres then reorders 20 bytes a sphere, not 36, and needs no spare copy
+ * of an attribute to do it. */
 #ifndef PTR_SCENE_H
 #define PTR_SCENE_H
 
@@ -18,18 +27,20 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
-    uint32_t *material;  /* index into PtrScene.materials */
-    /* The sphere's position in the scene file's order. An acceleration
-     * structure may reorder the arrays; on equal hit distances the lowest id
-     * wins, so the order never shows in an image. */
+    /* Attribute: index into PtrScene.materials. */
+    uint32_t *material;
+    /* The sphere's position in the scene file's order, where its attributes
+     * are. An acceleration structure may reorder the shapes; on equal hit
+     * distances the lowest id wins, so the order never shows in an image. */
     uint32_t *id;
-    /* Each sphere's own colour, multiplying its material's base colour
-     * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
-     * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
-     * a million colours are a million of these, never a million materials. */
+    /* Attribute: each sphere's own colour, multiplying its material's base
+     * colour (albedo or attenuation): r, g, b in units of 1/65535 and one
+     * unused entry, 8 bytes a sphere. NULL while no sphere has one (then
+     * white), so a million colours are a million of these, never a million
+     * materials. */
     uint16_t *color;
-    /* Each sphere's value of the quantity --color-by names (NaN: none), 4
-     * bytes a sphere, NULL unless asked for (see scene/colormap.h). */
+    /* Attribute: each sphere's value of the quantity --color-by names (NaN:
+     * none), 4 bytes a sphere, NULL unless asked for (see scene/colormap.h). */
     float *value;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
@@ -121,10 +132,16 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * unchanged) if they cannot grow. */
 PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
 
-/* Frees the shapes (cx, cy, cz, radius and id) for a caller that holds a
- * copy of them and puts them back in a new order (the tree's build: at 10^8
- * spheres, 2 GB it then has for itself). Until ptr_spheres_restore_shapes
- * the spheres can only be freed. */
+/* Gives back the memory of the shapes (cx, cy, cz, radius and id) of
+ * spheres begin .. end - 1, page by page, for a caller that has copied them
+ * and puts them back in a new order (the tree's build: at 10^8 spheres,
+ * 2 GB it then has for itself). Called as the copy grows, each begin the
+ * last call's end (see ptr_memory_release); the entries given back read as
+ * zero until written again. */
+void ptr_spheres_release_shapes(PtrSpheres *spheres, size_t begin, size_t end);
+
+/* Frees the shapes, every entry of them given back or copied. Until
+ * ptr_spheres_restore_shapes the spheres can only be freed. */
 void ptr_spheres_drop_shapes(PtrSpheres *spheres);
 
 /* Allocates the shape arrays again, with their padding; the caller writes
@@ -132,25 +149,8 @@ void ptr_spheres_drop_shapes(PtrSpheres *spheres);
  * spheres can only be freed). */
 PtrResult ptr_spheres_restore_shapes(PtrSpheres *spheres);
 
-/* Which arrays ptr_spheres_permute leaves alone. */
-typedef enum PtrPermuteSkip {
-    PTR_PERMUTE_ALL,
-    /* cx, cy, cz, radius and id, which the caller has put in order itself
-     * (the tree's build writes them from its own copy). */
-    PTR_PERMUTE_SKIP_SHAPES,
-} PtrPermuteSkip;
-
-/* Reorders the per-sphere arrays together (see skip): entry i becomes old
- * entry order[i] (order is a permutation of 0 .. count - 1), on threads
- * threads. At least PTR_SPHERE_BLOCK padding entries always follow the last
- * sphere, so SIMD code may read 16 lanes from any sphere on. Returns
- * PTR_ERR_NOMEM (arrays unchanged) if the spare array it needs cannot be
- * allocated. */
-PtrResult ptr_spheres_permute(PtrSpheres *spheres, const uint32_t *order, PtrPermuteSkip skip,
-                              int threads);
-
-/* Gives sphere i its own colour (each channel in [0, 1]); the first call
- * creates the colour array, white for every other sphere. */
+/* Gives the sphere of id i its own colour (each channel in [0, 1]); the
+ * first call creates the colour array, white for every other sphere. */
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
 
 /* The same with the colour as PtrSpheres.color stores it. */
@@ -159,20 +159,28 @@ PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
 
-/* Gives sphere i a value (see PtrSpheres.value); the first call creates the
- * array, NaN for every other sphere. */
+/* Gives the sphere of id i a value (see PtrSpheres.value); the first call
+ * creates the array, NaN for every other sphere. */
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
 
+/* The colour of the sphere at position i of the shape arrays (s->color is
+ * not NULL). */
 static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 {
     const float unit = 1.0f / 65535.0f;
-    const uint16_t *c = &s->color[4 * i];
+    const uint16_t *c = &s->color[4 * (size_t)s->id[i]];
     return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
 }
 
 /* Appends a material and stores its index in *index. */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index);
+
+/* The material of the sphere at position i of the shape arrays. */
+static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
+{
+    return s->material[s->id[i]];
+}
 
 static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
 {

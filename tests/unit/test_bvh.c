@@ -270,7 +270,9 @@ static void test_renders_files(void)
     }
 }
 
-/* The hard sets with mixed materials, seen from outside their bounds. */
+/* The hard sets with mixed materials and some spheres' own colours (the
+ * attributes the tree leaves in file order), seen from outside their
+ * bounds. */
 static void test_renders_hard(void)
 {
     const PtrMaterial materials[3] = {
@@ -291,6 +293,10 @@ static void test_renders_hard(void)
             PtrSpheres *sp = &s[k].spheres;
             for (size_t i = 0; i < sp->count; i++) {
                 sp->material[i] = (uint32_t)(i % 3);
+                if (i % 4 == 0)
+                    CHECK_INT(ptr_scene_set_sphere_color(&s[k], i, v3((float)(i % 5) / 4.0f, 0.5f,
+                                                                      (float)(i % 7) / 6.0f)),
+                              PTR_OK);
                 if (sp->radius[i] > 100.0f) /* a ground: look at what stands on it */
                     continue;
                 float c[3] = { sp->cx[i], sp->cy[i], sp->cz[i] };
