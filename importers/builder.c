@@ -126,7 +126,9 @@ PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_col
         *colors = malloc(b->capacity * optional_arrays[OPTIONAL_COLORS].words * sizeof **colors);
         if (!*colors)
             return PTR_ERR_NOMEM;
-        fill_none(b, OPTIONAL_COLORS, 0, b->capacity);
+        /* The earlier spheres only: the caller writes the new ones' (at
+         * 10^8 spheres, 800 MB), and each later one fills its own. */
+        fill_none(b, OPTIONAL_COLORS, 0, b->count);
     }
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k) && !(k == OPTIONAL_COLORS && with_colors))
@@ -393,8 +395,7 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigne
 }
 
 /* Puts sphere i of the builder (already relative to the scene's origin) at
- * entry at of the scene's shape arrays, its attributes at entry i (its id:
- * see PtrSpheres). */
+ * entry at of the scene's arrays (its value at entry i: see PtrSpheres). */
 static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
 {
     const double *d = &b->spheres[4 * i];
@@ -408,11 +409,11 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     s->cy[at] = c.y;
     s->cz[at] = c.z;
     s->radius[at] = r;
-    s->material[i] = b->materials[i];
+    s->material[at] = b->materials[i];
     s->id[at] = (uint32_t)i;
     PtrResult res = PTR_OK;
     if (b->colors)
-        res = ptr_scene_set_sphere_color16(scene, i, &b->colors[4 * i]);
+        res = ptr_scene_set_sphere_color16(scene, at, &b->colors[4 * i]);
     if (res == PTR_OK && b->values)
         res = ptr_scene_set_sphere_value(scene, i, b->values[i]);
     return res;
@@ -439,6 +440,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
             b->spheres[4 * i + k] -= origin[k];
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count);
+    if (res == PTR_OK && b->colors) /* written below, every one */
+        res = ptr_spheres_make_colors(&scene->spheres);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)

@@ -261,57 +261,36 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
     return 1;
 }
 
-typedef struct ShapeWrite {
+typedef struct SphereWrite {
     PtrSpheres *spheres;
     const BvhPrim *prims;
     size_t first; /* where prims[0] goes */
-} ShapeWrite;
+} SphereWrite;
 
-static void write_shapes(void *arg, size_t begin, size_t end)
+static void write_spheres(void *arg, size_t begin, size_t end)
 {
-    const ShapeWrite *w = arg;
-    PtrSpheres *s = w->spheres;
-    for (size_t i = begin; i < end; i++) {
-        const BvhPrim *p = &w->prims[i];
-        const size_t at = w->first + i;
-        s->cx[at] = p->centre[0];
-        s->cy[at] = p->centre[1];
-        s->cz[at] = p->centre[2];
-        s->radius[at] = p->radius;
-        s->id[at] = p->id;
-    }
+    const SphereWrite *w = arg;
+    for (size_t i = begin; i < end; i++)
+        bvh_prim_store(&w->prims[i], w->spheres, w->first + i);
 }
 
-/* The shapes of spheres first .. first + count - 1 as prims. NULL if out of
- * memory. */
-static BvhPrim *save_shapes(const PtrSpheres *s, size_t first, size_t count)
-{
-    BvhPrim *saved = malloc((count ? count : 1) * sizeof *saved);
-    for (size_t k = 0; saved && k < count; k++) {
-        const size_t i = first + k;
-        saved[k] = (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i] };
-    }
-    return saved;
-}
-
-/* The prims give back this many spheres' memory at a time as their shapes
- * are written back: 20 MB. */
+/* The prims give back this many spheres' memory at a time as they are
+ * written back: 32 MB. */
 enum { SHRINK_STEP = 1 << 20 };
 
-/* Writes the shapes of the tree's spheres in the tree's order from the
- * prims, which hold them in that order already: a sequential write where a
- * gather would read 10^8 scattered entries. From the last prim back, the
- * prims shrinking behind, so that the two copies are never both whole.
- * Frees the prims. */
-static void write_shapes_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
-                              int threads)
+/* Writes the tree's spheres back to the scene's arrays from the prims, in
+ * the tree's order: a sequential write where a gather would read 10^8
+ * scattered entries. From the last prim back, the prims shrinking behind,
+ * so that the two copies are never both whole. Frees the prims. */
+static void write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
+                       int threads)
 {
-    ShapeWrite w = { s, prims, first };
+    SphereWrite w = { s, prims, first };
     for (size_t end = prim_count; end > 0;) {
         const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
         w.prims = prims + begin;
         w.first = first + begin;
-        ptr_parallel_ranges(threads, 0, end - begin, write_shapes, &w);
+        ptr_parallel_ranges(threads, 0, end - begin, write_spheres, &w);
         BvhPrim *shrunk = begin ? realloc(prims, begin * sizeof *prims) : NULL;
         if (shrunk) /* failing to shrink keeps them whole */
             prims = shrunk;
@@ -326,16 +305,13 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (spheres->count >= TASK_FLAG)
         return PTR_ERR_NOMEM;
     Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
-    /* The prims and kept_out take the shapes of the tree's spheres, and
-     * after_tree those of the spheres after it: the build then has the
-     * shapes' memory for itself. */
-    const size_t after = spheres->count - count;
+    /* The prims and kept_out take the tree's spheres, whose memory the
+     * scene's arrays give back meanwhile; the spheres after them stay. */
     BvhPrim kept_out[BVH_UNBOUNDED_MAX];
-    BvhPrim *after_tree = save_shapes(spheres, count, after);
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
     size_t prim_count = 0;
-    int ok = after_tree && build.set.prims;
+    int ok = build.set.prims != NULL;
     if (ok) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
@@ -345,8 +321,6 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     build.first_sphere = bvh->unbounded_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
-    if (ok)
-        ptr_spheres_drop_shapes(spheres);
     if (ok && prim_count > 0) {
         BvhCandidate root;
         size_t index;
@@ -354,17 +328,14 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
              build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
              run_tasks(&build);
     }
-    ok = ok && ptr_spheres_restore_shapes(spheres) == PTR_OK;
     if (ok) {
-        write_shapes_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
-                          build.set.threads);
+        write_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
+                   build.set.threads);
         build.set.prims = NULL;
-        ShapeWrite kept = { spheres, kept_out, 0 }, rest = { spheres, after_tree, count };
-        write_shapes(&kept, 0, bvh->unbounded_count);
-        write_shapes(&rest, 0, after);
+        SphereWrite kept = { spheres, kept_out, 0 };
+        write_spheres(&kept, 0, bvh->unbounded_count);
     }
     free(build.set.prims);
-    free(after_tree);
     /* Laying the tree out in one array needs memory of its own: it comes
      * once the prims are gone. */
     ok = ok && (prim_count == 0 || lay_out(&build, &top, bvh));

@@ -87,13 +87,29 @@ static float unbounded_radius(const PtrSpheres *s)
     return median * UNBOUNDED_RATIO;
 }
 
-static BvhPrim prim_of(const PtrSpheres *s, size_t i)
+BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    return (BvhPrim){ { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i] };
+    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i], s->material[i],
+                  { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
+    if (s->color)
+        memcpy(p.color, &s->color[4 * i], sizeof p.color);
+    return p;
 }
 
-/* Spheres copied between two releases of the shapes' memory: 4 MB of each
- * array. */
+void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
+{
+    s->cx[i] = p->centre[0];
+    s->cy[i] = p->centre[1];
+    s->cz[i] = p->centre[2];
+    s->radius[i] = p->radius;
+    s->id[i] = p->id;
+    s->material[i] = p->material;
+    if (s->color)
+        memcpy(&s->color[4 * i], p->color, sizeof p->color);
+}
+
+/* Spheres copied between two releases of the arrays' memory: 4 MB of each
+ * float array. */
 enum { RELEASE_STEP = 1 << 20 };
 
 int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhPrim *prims,
@@ -123,7 +139,7 @@ int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhP
     out[u] = UINT32_MAX;
     sort_by_id(order, u, s);
     for (size_t k = 0; k < u; k++)
-        kept_out[k] = prim_of(s, order[k]);
+        kept_out[k] = bvh_prim_of(s, order[k]);
     float magnitude = 0.0f;
     size_t n = 0, k = 0;
     for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
@@ -136,9 +152,9 @@ int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhP
             const float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
             if (m > magnitude)
                 magnitude = m;
-            prims[n++] = prim_of(s, i);
+            prims[n++] = bvh_prim_of(s, i);
         }
-        ptr_spheres_release_shapes(s, begin, end);
+        ptr_spheres_release(s, begin, end);
     }
     *kept_out_count = u;
     *prim_count = n;

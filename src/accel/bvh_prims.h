@@ -10,13 +10,15 @@
 
 enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
 
-/* A sphere as the build moves it: its shape, 20 bytes, for at 10^8 spheres
- * the prims are the build's largest array. The tree's leaves are written
- * back to the scene's shape arrays from them, in their final order; the
- * attributes stay where they are (see PtrSpheres). */
+/* A sphere as the build moves it, whole: 32 bytes. At 10^8 spheres the
+ * prims are the build's largest array, and the scene's arrays give their
+ * memory back as the prims are filled; the tree's leaves are written back
+ * to them from the prims, in their final order. */
 typedef struct BvhPrim {
     float centre[3], radius;
     uint32_t id; /* which orders a leaf */
+    uint32_t material;
+    uint16_t color[4]; /* white where the scene has no colours */
 } BvhPrim;
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
@@ -41,11 +43,15 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
  * in *magnitude the largest coordinate magnitude in the tree, which bounds
  * both the spheres' and the rays' origins (the camera sits at 0, other rays
  * start on spheres) and so scales the boxes' padding. Gives back the
- * shapes' memory as it goes (ptr_spheres_release_shapes): on success the
- * prims and kept_out hold the spheres' only copy of their shapes. Returns 0
- * if out of memory (the spheres untouched). */
+ * spheres' memory as it goes (ptr_spheres_release): on success the prims
+ * and kept_out hold the only copy of spheres 0 .. count - 1 but their
+ * values. Returns 0 if out of memory (the spheres untouched). */
 int ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
                   BvhPrim *prims, size_t *prim_count, float *magnitude);
+
+/* Sphere i of s as a prim, and back. */
+BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);
+void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i);
 
 /* Sorts a leaf's prims by ascending sphere id. */
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count);

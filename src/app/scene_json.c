@@ -42,7 +42,7 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
                                const PtrStrings *warnings)
 {
     const PtrSpheres *s = &scene->spheres;
-    /* In the file's order (the attributes'), whatever order the shapes are in. */
+    /* In the file's order, whatever order the arrays are in. */
     size_t *by_id = malloc((s->count ? s->count : 1) * sizeof *by_id);
     if (!by_id)
         return PTR_ERR_NOMEM;
@@ -55,7 +55,7 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
         size_t i = by_id[n];
         fprintf(out, "%s\n    {\"center\": ", n ? "," : "");
         write_point(out, scene, ptr_sphere_centre(s, i));
-        fprintf(out, ", \"radius\": %.9g, \"material\": %u", s->radius[i], s->material[n]);
+        fprintf(out, ", \"radius\": %.9g, \"material\": %u", s->radius[i], s->material[i]);
         if (s->color) {
             fputs(", \"color\": ", out);
             write_vec(out, ptr_sphere_color(s, i));

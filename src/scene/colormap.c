@@ -48,7 +48,8 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         white[m] = UINT32_MAX;
     PtrResult res = PTR_OK;
     for (size_t i = 0; i < s->count && res == PTR_OK; i++) {
-        if (isnan(s->value[i]))
+        const float value = s->value[s->id[i]]; /* in file order: see PtrSpheres */
+        if (isnan(value))
             continue;
         uint32_t m = s->material[i];
         if (white[m] == UINT32_MAX) {
@@ -59,7 +60,7 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         if (res == PTR_OK) {
             s->material[i] = white[m];
             res = ptr_scene_set_sphere_color(scene, i,
-                                             ptr_colormap_linear(map, s->value[i], lo, hi));
+                                             ptr_colormap_linear(map, value, lo, hi));
         }
     }
     free(white);

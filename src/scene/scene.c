@@ -19,14 +19,13 @@ void ptr_scene_init(PtrScene *scene)
 }
 
 /* Every per-sphere array, with the value its padding entries hold: growing,
- * freeing and dropping the shapes go through this list, so a new array is
- * one line. */
+ * freeing and releasing go through this list, so a new array is one line. */
 typedef struct SphereArray {
     void **data;
     size_t size;     /* of one entry */
     uint32_t padding; /* bits of a padding entry */
     int optional;     /* may be NULL: then it stays so */
-    int shape;        /* cx, cy, cz, radius, id: see PtrSpheres */
+    int moves;        /* with the spheres when reordered: all but value */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -41,9 +40,9 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1 },
         { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1 },
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
-        { (void **)&s->material, sizeof *s->material, 0, 0, 0 },
+        { (void **)&s->material, sizeof *s->material, 0, 0, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0, 1 },
-        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 0 }, /* white */
+        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 1 }, /* white */
         { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
@@ -144,39 +143,13 @@ PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count)
     return PTR_OK;
 }
 
-void ptr_spheres_release_shapes(PtrSpheres *s, size_t begin, size_t end)
+void ptr_spheres_release(PtrSpheres *s, size_t begin, size_t end)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
     const int arrays = sphere_arrays(s, a);
     for (int k = 0; k < arrays; k++)
-        if (a[k].shape)
+        if (a[k].moves && *a[k].data)
             ptr_memory_release(*a[k].data, begin * a[k].size, end * a[k].size);
-}
-
-void ptr_spheres_drop_shapes(PtrSpheres *s)
-{
-    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
-    const int arrays = sphere_arrays(s, a);
-    for (int k = 0; k < arrays; k++)
-        if (a[k].shape) {
-            free(*a[k].data);
-            *a[k].data = NULL;
-        }
-}
-
-PtrResult ptr_spheres_restore_shapes(PtrSpheres *s)
-{
-    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
-    const int arrays = sphere_arrays(s, a);
-    for (int k = 0; k < arrays; k++) {
-        if (!a[k].shape || *a[k].data)
-            continue;
-        *a[k].data = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * a[k].size);
-        if (!*a[k].data)
-            return PTR_ERR_NOMEM;
-        pad_array(&a[k], s->count, s->capacity);
-    }
-    return PTR_OK;
 }
 
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
@@ -206,17 +179,36 @@ void ptr_color_quantize(PtrVec3 color, uint16_t out[4])
     out[3] = UINT16_MAX;
 }
 
+/* Creates the optional array at data (one of s's) if absent, entries from
+ * pad_from on holding its value for none. */
+static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from)
+{
+    if (*data)
+        return PTR_OK;
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    const int arrays = sphere_arrays(s, a);
+    int k = 0;
+    while (k < arrays - 1 && a[k].data != data)
+        k++;
+    *data = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * a[k].size);
+    if (!*data)
+        return PTR_ERR_NOMEM;
+    pad_array(&a[k], pad_from, s->capacity);
+    return PTR_OK;
+}
+
+PtrResult ptr_spheres_make_colors(PtrSpheres *s)
+{
+    return create_optional(s, (void **)&s->color, s->count);
+}
+
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4])
 {
     PtrSpheres *s = &scene->spheres;
-    if (!s->color) {
-        s->color = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * 4 * sizeof *s->color);
-        if (!s->color)
-            return PTR_ERR_NOMEM;
-        memset(s->color, 0xff, s->capacity * 4 * sizeof *s->color);
-    }
-    memcpy(&s->color[4 * i], color, 4 * sizeof *color);
-    return PTR_OK;
+    PtrResult res = create_optional(s, (void **)&s->color, 0);
+    if (res == PTR_OK)
+        memcpy(&s->color[4 * i], color, 4 * sizeof *color);
+    return res;
 }
 
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
@@ -229,15 +221,10 @@ PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)
 {
     PtrSpheres *s = &scene->spheres;
-    if (!s->value) {
-        s->value = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * sizeof *s->value);
-        if (!s->value)
-            return PTR_ERR_NOMEM;
-        for (size_t k = 0; k < s->capacity; k++)
-            s->value[k] = NAN;
-    }
-    s->value[i] = value;
-    return PTR_OK;
+    PtrResult res = create_optional(s, (void **)&s->value, 0);
+    if (res == PTR_OK)
+        s->value[i] = value;
+    return res;
 }
 
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
@@ -289,10 +276,10 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
-    /* A tree reorders the shapes; the hash takes them in file order, as
-     * the attributes are, so that parts rendered with and without one
-     * merge. (Out of memory, it takes them as they are: callers that may be
-     * short of memory hash before building a tree, as the renderer does.) */
+    /* A tree reorders the spheres; the hash takes them in file order, so
+     * that parts rendered with and without one merge. (Out of memory, it
+     * takes them as they are: callers that may be short of memory hash
+     * before building a tree, as the renderer does.) */
     size_t reordered = 0;
     while (reordered < s->count && s->id[reordered] == reordered)
         reordered++;
@@ -305,9 +292,9 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     h = hash_in_file_order(h, s->cy, sizeof *s->cy, by_id, s->count);
     h = hash_in_file_order(h, s->cz, sizeof *s->cz, by_id, s->count);
     h = hash_in_file_order(h, s->radius, sizeof *s->radius, by_id, s->count);
-    h = hash_bytes(h, s->material, s->count * sizeof *s->material);
+    h = hash_in_file_order(h, s->material, sizeof *s->material, by_id, s->count);
     if (s->color)
-        h = hash_bytes(h, s->color, s->count * 4 * sizeof *s->color);
+        h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
     free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {

@@ -7,12 +7,9 @@
  * lanes from any sphere on; padding entries have a NaN radius, which fails
  * every ordered comparison and so can never be hit.
  *
- * Two kinds of array: the shapes (cx, cy, cz, radius and id), which an
- * acceleration structure may reorder, and the attributes (material, colour,
- * value), which always stay in the scene file's order and are read through
- * the sphere's id (ptr_sphere_material, ptr_sphere_color). A tree over 10^8
- * spheres then reorders 20 bytes a sphere, not 36, and needs no spare copy
- * of an attribute to do it. */
+ * An acceleration structure may reorder the spheres: every array moves with
+ * them but value, which only the import and the scene dump read, in the
+ * file's order (through the id). */
 #ifndef PTR_SCENE_H
 #define PTR_SCENE_H
 
@@ -27,20 +24,19 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
-    /* Attribute: index into PtrScene.materials. */
-    uint32_t *material;
-    /* The sphere's position in the scene file's order, where its attributes
-     * are. An acceleration structure may reorder the shapes; on equal hit
-     * distances the lowest id wins, so the order never shows in an image. */
+    uint32_t *material;  /* index into PtrScene.materials */
+    /* The sphere's position in the scene file's order. An acceleration
+     * structure may reorder the arrays; on equal hit distances the lowest id
+     * wins, so the order never shows in an image. */
     uint32_t *id;
-    /* Attribute: each sphere's own colour, multiplying its material's base
-     * colour (albedo or attenuation): r, g, b in units of 1/65535 and one
-     * unused entry, 8 bytes a sphere. NULL while no sphere has one (then
-     * white), so a million colours are a million of these, never a million
-     * materials. */
+    /* Each sphere's own colour, multiplying its material's base colour
+     * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
+     * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
+     * a million colours are a million of these, never a million materials. */
     uint16_t *color;
-    /* Attribute: each sphere's value of the quantity --color-by names (NaN:
-     * none), 4 bytes a sphere, NULL unless asked for (see scene/colormap.h). */
+    /* The value of the quantity --color-by names of the sphere of id i (NaN:
+     * none) at entry i, in the file's order whatever the order of the other
+     * arrays; 4 bytes a sphere, NULL unless asked for (see scene/colormap.h). */
     float *value;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
@@ -132,29 +128,26 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * unchanged) if they cannot grow. */
 PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
 
-/* Gives back the memory of the shapes (cx, cy, cz, radius and id) of
- * spheres begin .. end - 1, page by page, for a caller that has copied them
- * and puts them back in a new order (the tree's build: at 10^8 spheres,
- * 2 GB it then has for itself). Called as the copy grows, each begin the
- * last call's end (see ptr_memory_release); the entries given back read as
- * zero until written again. */
-void ptr_spheres_release_shapes(PtrSpheres *spheres, size_t begin, size_t end);
+/* Gives back the memory of the entries of spheres begin .. end - 1 in every
+ * array but value, page by page, for a caller that has copied them and
+ * writes them back in a new order (the tree's build: at 10^8 spheres, 3 GB
+ * it then has for itself). Called as the copy grows, each begin the last
+ * call's end (see ptr_memory_release); the entries given back read as zero
+ * until written again. */
+void ptr_spheres_release(PtrSpheres *spheres, size_t begin, size_t end);
 
-/* Frees the shapes, every entry of them given back or copied. Until
- * ptr_spheres_restore_shapes the spheres can only be freed. */
-void ptr_spheres_drop_shapes(PtrSpheres *spheres);
-
-/* Allocates the shape arrays again, with their padding; the caller writes
- * every entry below count. Returns PTR_ERR_NOMEM if out of memory (then the
- * spheres can only be freed). */
-PtrResult ptr_spheres_restore_shapes(PtrSpheres *spheres);
-
-/* Gives the sphere of id i its own colour (each channel in [0, 1]); the
- * first call creates the colour array, white for every other sphere. */
+/* Gives sphere i its own colour (each channel in [0, 1]); the first call
+ * creates the colour array, white for every other sphere. */
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
 
 /* The same with the colour as PtrSpheres.color stores it. */
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4]);
+
+/* Creates the colour array, if absent, for a caller that writes every
+ * sphere's colour: only the padding is set, so at 10^8 spheres memory is
+ * used as the colours are written, not 800 MB at once. Returns
+ * PTR_ERR_NOMEM if out of memory. */
+PtrResult ptr_spheres_make_colors(PtrSpheres *spheres);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
@@ -163,24 +156,16 @@ void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
  * creates the array, NaN for every other sphere. */
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
 
-/* The colour of the sphere at position i of the shape arrays (s->color is
- * not NULL). */
 static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 {
     const float unit = 1.0f / 65535.0f;
-    const uint16_t *c = &s->color[4 * (size_t)s->id[i]];
+    const uint16_t *c = &s->color[4 * i];
     return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
 }
 
 /* Appends a material and stores its index in *index. */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index);
-
-/* The material of the sphere at position i of the shape arrays. */
-static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
-{
-    return s->material[s->id[i]];
-}
 
 static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
 {
