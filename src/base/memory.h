@@ -13,11 +13,12 @@
  * beyond what is mapped now. UINT64_MAX where none of them can be read. */
 uint64_t ptr_memory_available(void);
 
-/* Gives the machine back the whole pages of base[from .. to - 1] that
- * base[0 .. from - 1] did not cover (a caller releasing an array as it
- * goes passes the last call's to as from), keeping them mapped: they read
- * as zero afterwards. For an allocation the caller has finished reading
- * and will free, at 10^8 spheres hundreds of megabytes sooner. */
+/* Gives the machine back the pages that lie wholly inside base[0 .. to - 1]
+ * but not wholly inside base[0 .. from - 1], keeping them mapped: they read
+ * as zero afterwards. For a caller that has finished with base[0 .. to - 1]
+ * and releases an allocation as it goes through it, each call's from the
+ * last one's to, so that every whole page is given back once: at 10^8
+ * spheres, gigabytes the build then has for itself. */
 void ptr_memory_release(void *base, size_t from, size_t to);
 
 #endif /* PTR_MEMORY_H */

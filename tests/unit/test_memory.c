@@ -1,0 +1,166 @@
+/* Giving memory back (ptr_memory_release, and ptr_spheres_release over a
+ * scene's arrays): exactly the pages the contract names leave the process
+ * (mincore says which pages are resident), every byte the caller has not
+ * finished with keeps its value, and releasing a range in steps, each from
+ * where the last ended, leaves no page of it behind. */
+#define _DEFAULT_SOURCE /* mincore */
+#include "test.h"
+
+#include <stdint.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include "base/memory.h"
+#include "scene/scene.h"
+
+enum { PAGES = 64 };
+
+static size_t page_size(void)
+{
+    return (size_t)sysconf(_SC_PAGESIZE);
+}
+
+/* A buffer of PAGES pages starting mid-page, as a malloc block may: the
+ * mapping around it, and where the buffer starts in it. */
+typedef struct Buffer {
+    unsigned char *map, *data;
+    size_t bytes;
+} Buffer;
+
+static Buffer buffer_make(void)
+{
+    const size_t page = page_size();
+    Buffer b = { mmap(NULL, (PAGES + 2) * page, PROT_READ | PROT_WRITE,
+                      MAP_PRIVATE | MAP_ANONYMOUS, -1, 0), NULL, PAGES * page };
+    if (b.map == MAP_FAILED)
+        abort();
+    b.data = b.map + page / 2;
+    for (size_t i = 0; i < (PAGES + 2) * page; i++)
+        b.map[i] = (unsigned char)(1 + i % 251);
+    return b;
+}
+
+static int resident(const Buffer *b, size_t page_index)
+{
+    unsigned char in_core = 0;
+    if (mincore(b->map + page_index * page_size(), page_size(), &in_core) != 0)
+        abort();
+    return in_core & 1;
+}
+
+/* Whether exactly pages expect_first .. expect_end - 1 of b->map are
+ * released, no byte outside data[0 .. to - 1] (which the caller has
+ * finished with) changed, and none inside it other than zero or its old
+ * value. */
+static void check_released(const Buffer *b, size_t to, size_t expect_first, size_t expect_end,
+                           const char *what)
+{
+    const size_t page = page_size();
+    size_t wrong_pages = 0, changed_outside = 0, garbled_inside = 0;
+    for (size_t p = 0; p < PAGES + 2; p++)
+        wrong_pages += resident(b, p) != !(p >= expect_first && p < expect_end);
+    for (size_t i = 0; i < (PAGES + 2) * page; i++) {
+        const unsigned char old = (unsigned char)(1 + i % 251);
+        const size_t at = i - (size_t)(b->data - b->map); /* wraps below data */
+        if (i < (size_t)(b->data - b->map) || at >= to)
+            changed_outside += b->map[i] != old;
+        else
+            garbled_inside += b->map[i] != old && b->map[i] != 0;
+    }
+    if (wrong_pages || changed_outside || garbled_inside)
+        fprintf(stderr, "%s: %zu pages wrongly resident or released, %zu bytes changed "
+                        "outside, %zu garbled inside\n", what, wrong_pages, changed_outside,
+                garbled_inside);
+    CHECK_INT(wrong_pages, 0);
+    CHECK_INT(changed_outside, 0);
+    CHECK_INT(garbled_inside, 0);
+}
+
+/* data starts half a page into map[0]: pages 1 .. are data's whole pages. */
+static void test_release_whole_pages_only(void)
+{
+    const size_t page = page_size();
+    Buffer b = buffer_make();
+    /* From mid-page 3 of the map to mid-page 9: pages 1 and 2 lie wholly
+     * below from, released by an earlier call if any; 3 .. 8 are released,
+     * 9 holds bytes past to. */
+    const size_t from = 3 * page, to = 9 * page;
+    ptr_memory_release(b.data, from, to);
+    check_released(&b, to, 3, 9, "one range");
+    munmap(b.map, (PAGES + 2) * page);
+
+    /* From 0: data's own first page is shared with what comes before. */
+    b = buffer_make();
+    ptr_memory_release(b.data, 0, b.bytes);
+    check_released(&b, b.bytes, 1, PAGES, "the whole buffer");
+    munmap(b.map, (PAGES + 2) * page);
+
+    /* Nothing whole inside: nothing released. */
+    b = buffer_make();
+    ptr_memory_release(b.data, page / 4, page / 4 + page / 2);
+    check_released(&b, page / 4 + page / 2, 0, 0, "less than a page");
+    munmap(b.map, (PAGES + 2) * page);
+}
+
+/* Steps that end mid-page leave no page behind: each starts at the page the
+ * last one stopped before. */
+static void test_release_in_steps(void)
+{
+    const size_t page = page_size();
+    Buffer b = buffer_make();
+    const size_t step = 3 * page + 1000;
+    size_t from = 0;
+    for (size_t to = step; from < b.bytes; to += step) {
+        if (to > b.bytes)
+            to = b.bytes;
+        ptr_memory_release(b.data, from, to);
+        from = to;
+    }
+    check_released(&b, b.bytes, 1, PAGES, "in steps");
+    munmap(b.map, (PAGES + 2) * page);
+}
+
+/* The tree's use: a scene's arrays, released up to a count, keep the rest
+ * (the spheres after the tree and the padding) and value whole. */
+static void test_spheres_release(void)
+{
+    PtrScene scene;
+    ptr_scene_init(&scene);
+    const size_t count = 300000, kept = 1000;
+    CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept), PTR_OK);
+    PtrSpheres *s = &scene.spheres;
+    size_t failed_values = 0;
+    for (size_t i = 0; i < count + kept; i++) {
+        s->cx[i] = s->cy[i] = s->cz[i] = (float)i;
+        s->radius[i] = 1.0f;
+        s->material[i] = 7;
+        s->id[i] = (uint32_t)i;
+        failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f) != PTR_OK;
+    }
+    CHECK_INT(failed_values, 0);
+    ptr_spheres_release(s, 0, count / 2);
+    ptr_spheres_release(s, count / 2, count);
+    size_t zeroed = 0, changed_after = 0, values_changed = 0;
+    for (size_t i = 0; i < count; i++)
+        zeroed += s->cx[i] == 0.0f && s->radius[i] == 0.0f && s->id[i] == 0;
+    for (size_t i = count; i < count + kept; i++)
+        changed_after += s->cx[i] != (float)i || s->radius[i] != 1.0f || s->material[i] != 7 ||
+                         s->id[i] != i;
+    for (size_t i = 0; i < count + kept; i++)
+        values_changed += s->value[i] != 2.0f;
+    /* All but the first and the last page of each array below count, which
+     * hold bytes of its own and of what lies past it. */
+    CHECK(zeroed >= count - 2 * page_size() / sizeof(float));
+    CHECK_INT(changed_after, 0);
+    CHECK_INT(values_changed, 0);
+    CHECK(isnan(s->radius[count + kept])); /* padding */
+    ptr_scene_free(&scene);
+}
+
+int main(void)
+{
+    test_release_whole_pages_only();
+    test_release_in_steps();
+    test_spheres_release();
+    return test_report();
+}
