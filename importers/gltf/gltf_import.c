@@ -32,16 +32,13 @@ static Mat4 mat4_mul(const Mat4 *a, const Mat4 *b)
     return r;
 }
 
-/* T * R * S, as glTF composes a node's TRS properties. */
-static Mat4 node_local(const GltfNode *n)
+/* T * R * S, as glTF composes a node's TRS properties (rotation a unit
+ * quaternion x, y, z, w). */
+static Mat4 trs_matrix(const double translation[3], const double rotation[4],
+                       const double scale[3])
 {
     Mat4 r;
-    if (n->has_matrix) {
-        memcpy(r.m, n->matrix, sizeof r.m);
-        return r;
-    }
-    const double x = n->rotation[0], y = n->rotation[1], z = n->rotation[2],
-                 w = n->rotation[3];
+    const double x = rotation[0], y = rotation[1], z = rotation[2], w = rotation[3];
     const double rot[9] = {
         1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
@@ -49,13 +46,22 @@ static Mat4 node_local(const GltfNode *n)
     };
     for (int c = 0; c < 3; c++) {
         for (int row = 0; row < 3; row++)
-            r.m[c * 4 + row] = rot[c * 3 + row] * n->scale[c];
+            r.m[c * 4 + row] = rot[c * 3 + row] * scale[c];
         r.m[c * 4 + 3] = 0.0;
     }
-    r.m[12] = n->translation[0];
-    r.m[13] = n->translation[1];
-    r.m[14] = n->translation[2];
+    r.m[12] = translation[0];
+    r.m[13] = translation[1];
+    r.m[14] = translation[2];
     r.m[15] = 1.0;
+    return r;
+}
+
+static Mat4 node_local(const GltfNode *n)
+{
+    if (!n->has_matrix)
+        return trs_matrix(n->translation, n->rotation, n->scale);
+    Mat4 r;
+    memcpy(r.m, n->matrix, sizeof r.m);
     return r;
 }
 
@@ -169,8 +175,12 @@ static double axis_scale(const Mat4 *world, int *nonuniform)
 {
     double scale[3] = { column_length(world, 0), column_length(world, 1),
                         column_length(world, 2) };
-    double smin = fmin(scale[0], fmin(scale[1], scale[2]));
-    double smax = fmax(scale[0], fmax(scale[1], scale[2]));
+    /* Not fmin and fmax, library calls here: lengths are never NaN. */
+    double smin = scale[0], smax = scale[0];
+    for (int k = 1; k < 3; k++) {
+        smin = scale[k] < smin ? scale[k] : smin;
+        smax = scale[k] > smax ? scale[k] : smax;
+    }
     if (smax - smin > 1e-6 * smax)
         *nonuniform = 1;
     return smax;
@@ -313,6 +323,13 @@ static PtrResult attribute_accessor(Importer *im, const Origin *o, const char *w
 static void element(const GltfAccessor *a, size_t i, double out[4])
 {
     const unsigned char *p = a->data + i * a->stride;
+    if (a->component_type == GLTF_FLOAT) { /* the common case, without a switch a component */
+        float f[4] = { 0, 0, 0, 0 };
+        memcpy(f, p, (size_t)a->components * sizeof *f);
+        for (int c = 0; c < 4; c++)
+            out[c] = f[c];
+        return;
+    }
     for (int c = 0; c < 4; c++) {
         double raw = 0;
         if (c < a->components) {
@@ -479,11 +496,11 @@ static PtrResult add_mesh_spheres(Importer *im, const Origin *o, const GltfNode 
 static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const GltfAccessor *s,
                           size_t i, Mat4 *out)
 {
-    GltfNode trs = { .rotation = { 0, 0, 0, 1 }, .scale = { 1, 1, 1 } };
+    double translation[3] = { 0, 0, 0 }, rotation[4] = { 0, 0, 0, 1 }, scale[3] = { 1, 1, 1 };
     double v[4];
     if (t) {
         element(t, i, v);
-        memcpy(trs.translation, v, sizeof trs.translation);
+        memcpy(translation, v, sizeof translation);
     }
     if (r) {
         element(r, i, v);
@@ -491,16 +508,16 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
         if (!(length > 0) || !isfinite(length))
             return 0;
         for (int k = 0; k < 4; k++)
-            trs.rotation[k] = v[k] / length; /* quantized rotations are not quite unit */
+            rotation[k] = v[k] / length; /* quantized rotations are not quite unit */
     }
     if (s) {
         element(s, i, v);
         for (int k = 0; k < 3; k++)
             if (!(v[k] > 0) || !isfinite(v[k]))
                 return 0;
-        memcpy(trs.scale, v, sizeof trs.scale);
+        memcpy(scale, v, sizeof scale);
     }
-    *out = node_local(&trs);
+    *out = trs_matrix(translation, rotation, scale);
     return all_finite(out->m, 16);
 }
 

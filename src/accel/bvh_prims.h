@@ -25,12 +25,17 @@ typedef struct BvhPrim {
  * traversal's comment in bvh.c for why 2^-18. */
 #define BVH_BOX_PAD_SCALE 0x1.0p-18f
 
-/* The padded box of a prim, the same bits wherever it is computed;
- * magnitude: see ptr_bvh_prims. */
+/* Half the side of a prim's padded box; magnitude: see ptr_bvh_prims. */
+static inline float bvh_prim_extent(const BvhPrim *p, float magnitude)
+{
+    return p->radius + BVH_BOX_PAD_SCALE * (magnitude + p->radius);
+}
+
+/* The padded box of a prim, the same bits wherever it is computed. */
 static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3],
                                 float upper[3])
 {
-    const float extent = p->radius + BVH_BOX_PAD_SCALE * (magnitude + p->radius);
+    const float extent = bvh_prim_extent(p, magnitude);
     for (int a = 0; a < 3; a++) {
         lower[a] = p->centre[a] - extent;
         upper[a] = p->centre[a] + extent;
