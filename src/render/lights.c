@@ -21,6 +21,16 @@ static int is_emitter(const PtrScene *scene, uint32_t i)
            scene->spheres.radius[i] > 0.0f;
 }
 
+/* Whether any material emits: where none does, no sphere is looked at (at
+ * 10^8 spheres, a second's pass over 800 MB before the first ray). */
+static int any_emissive_material(const PtrScene *scene)
+{
+    for (size_t m = 0; m < scene->material_count; m++)
+        if (v3_max_comp(scene->materials[m].emission) > 0.0f)
+            return 1;
+    return 0;
+}
+
 static int compare_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -30,6 +40,8 @@ static int compare_u64(const void *a, const void *b)
 PtrResult ptr_lights_init(PtrLights *l, const PtrScene *scene, PtrError *err)
 {
     *l = (PtrLights){ 0 };
+    if (!any_emissive_material(scene))
+        return PTR_OK;
     size_t n = 0;
     for (size_t i = 0; i < scene->spheres.count; i++)
         n += is_emitter(scene, (uint32_t)i);
