@@ -2,9 +2,13 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "base/cpu.h"
+#include "base/threads.h"
 
 void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImportOptions *options)
 {
@@ -357,12 +361,13 @@ static PtrVec3 relative(const double p[3], const double origin[3])
  * quarter of the rays per second on a four-sphere scene). A radius-1e5
  * ground under a scene a few units (or a room 100) across is huge; the
  * radius-100 and radius-1000 grounds of seed.gltf and final.gltf are not;
- * a cloud of like spheres has none. At most PTR_HUGE_MAX, the largest first
- * (every ray tests them all). Marks them in huge[] (all zero on entry) and
- * returns how many. */
+ * a cloud of like spheres has none. At most PTR_HUGE_MAX, the largest (every
+ * ray tests them all). Puts their indices in huge[], ascending, and returns
+ * how many. */
 #define HUGE_RATIO 256.0
 
-static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigned char *huge)
+static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
+                          size_t huge[PTR_HUGE_MAX])
 {
     double lo[3], hi[3];
     memcpy(lo, eye, sizeof lo);
@@ -389,8 +394,12 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3], unsigne
         if (at < PTR_HUGE_MAX)
             top[at] = i;
     }
-    for (size_t k = 0; k < count; k++)
-        huge[top[k]] = 1;
+    for (size_t k = 0; k < count; k++) {
+        size_t at = k;
+        for (; at > 0 && huge[at - 1] > top[k]; at--)
+            huge[at] = huge[at - 1];
+        huge[at] = top[k];
+    }
     return count;
 }
 
@@ -423,46 +432,74 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
  * add_spheres empties them: 32 MB of centres. */
 enum { SHRINK_STEP = 1 << 20 };
 
+typedef struct SphereMove {
+    PtrSceneBuilder *builder;
+    const size_t *huge; /* ascending */
+    size_t huge_count;
+    atomic_int invalid; /* a sphere the scene cannot hold */
+} SphereMove;
+
+/* Puts spheres begin .. end - 1 but the huge ones at their entries, each
+ * moved forward by the huge spheres before it. */
+static void move_spheres(void *arg, size_t begin, size_t end)
+{
+    SphereMove *m = arg;
+    size_t huge_before = 0;
+    while (huge_before < m->huge_count && m->huge[huge_before] < begin)
+        huge_before++;
+    int invalid = 0;
+    for (size_t i = begin; i < end; i++) {
+        if (huge_before < m->huge_count && m->huge[huge_before] == i)
+            huge_before++;
+        else
+            invalid |= add_sphere(m->builder, i, i - huge_before) != PTR_OK;
+    }
+    if (invalid)
+        atomic_store(&m->invalid, 1);
+}
+
 /* The spheres in file order, the huge ones last (their ids keep the file's
- * order; see PtrSpheres.id), with the huge ones in double as well. Moved
- * from the last back, the builder's arrays shrinking behind, so that ten
- * million spheres are never in memory twice. */
+ * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
+ * all cores from the last back, the builder's arrays shrinking behind, so
+ * that 10^8 spheres are never in memory twice. */
 static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double)
 {
     PtrScene *scene = b->scene;
     const size_t count = b->count;
-    unsigned char *huge = calloc(count ? count : 1, 1);
-    if (!huge)
-        return PTR_ERR_NOMEM;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
     for (size_t i = 0; i < count; i++)
         for (int k = 0; k < 3; k++)
             b->spheres[4 * i + k] -= origin[k];
+    size_t huge[PTR_HUGE_MAX];
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count);
-    if (res == PTR_OK && b->colors) /* written below, every one */
+    /* Made here, not by the first sphere's, so the threads only write them. */
+    if (res == PTR_OK && b->colors)
         res = ptr_spheres_make_colors(&scene->spheres);
+    if (res == PTR_OK && b->values)
+        res = ptr_spheres_make_values(&scene->spheres);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)
             res = PTR_ERR_NOMEM;
     }
-    size_t huge_before = huge_count; /* of sphere i */
-    for (size_t i = count; i-- > 0 && res == PTR_OK;) {
-        size_t at = i - huge_before;
-        if (huge[i]) {
-            huge_before--;
-            at = count - huge_count + huge_before;
-            memcpy(&scene->huge.centre_radius[4 * huge_before], &b->spheres[4 * i],
-                   4 * sizeof(double));
-        }
-        res = add_sphere(b, i, at);
-        if (i % SHRINK_STEP == 0)
-            (void)resize(b, i); /* spheres i and on are moved; failing keeps more */
+    for (size_t k = 0; k < huge_count && res == PTR_OK; k++) {
+        memcpy(&scene->huge.centre_radius[4 * k], &b->spheres[4 * huge[k]], 4 * sizeof(double));
+        res = add_sphere(b, huge[k], count - huge_count + k);
+    }
+    SphereMove move = { .builder = b, .huge = huge, .huge_count = huge_count };
+    atomic_init(&move.invalid, 0);
+    const int threads = ptr_online_cpus();
+    for (size_t end = count; end > 0 && res == PTR_OK;) {
+        const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
+        ptr_parallel_ranges(threads, begin, end, move_spheres, &move);
+        if (atomic_load(&move.invalid))
+            res = PTR_ERR_SCENE_INVALID;
+        (void)resize(b, begin); /* spheres begin and on are moved; failing keeps more */
+        end = begin;
     }
     if (res == PTR_OK)
         scene->huge.count = huge_count;
-    free(huge);
     return res;
 }
 

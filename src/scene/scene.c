@@ -202,6 +202,11 @@ PtrResult ptr_spheres_make_colors(PtrSpheres *s)
     return create_optional(s, (void **)&s->color, s->count);
 }
 
+PtrResult ptr_spheres_make_values(PtrSpheres *s)
+{
+    return create_optional(s, (void **)&s->value, s->count);
+}
+
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4])
 {
     PtrSpheres *s = &scene->spheres;

@@ -149,6 +149,9 @@ PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t
  * PTR_ERR_NOMEM if out of memory. */
 PtrResult ptr_spheres_make_colors(PtrSpheres *spheres);
 
+/* The same for the values (PtrSpheres.value). */
+PtrResult ptr_spheres_make_values(PtrSpheres *spheres);
+
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
 
