@@ -3,8 +3,8 @@
  * all eight, and leaves that are short runs of the scene's own sphere arrays,
  * so the leaf test is the brute-force kernel's arithmetic on a few lanes.
  *
- * The build reorders the scene's sphere shapes (the attributes stay in the
- * file's order, see PtrSpheres) so that every leaf is contiguous, and keeps the
+ * The build reorders the scene's spheres (every per-sphere array but the
+ * --color-by values, see PtrSpheres) so that every leaf is contiguous, and keeps the
  * few spheres much larger than the rest out of the tree: they come first in
  * the arrays and every ray tests them, as the brute-force kernel would.
  *
@@ -62,8 +62,8 @@ typedef struct PtrBvh {
     int depth; /* levels below the root at most, for the traversal stack */
 } PtrBvh;
 
-/* Builds the tree over the first count spheres, reordering their shapes
- * (see bvh.h's head) and leaving the rest in place after them (the scene's
+/* Builds the tree over the first count spheres, reordering them (see
+ * bvh.h's head) and leaving the rest in place after them (the scene's
  * huge spheres, which accel/huge.h tests); threads 0 means one per online
  * CPU. The tree's bytes depend only on
  * the spheres, never on the thread count. On failure (out of memory) *bvh
