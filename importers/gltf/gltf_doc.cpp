@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -24,9 +25,10 @@
 
 extern "C" const char *const ptr_gltf_extensions[]; /* importer.h */
 
-// A file's bytes: mapped where it can be, so that a .glb's BIN chunk is read
-// where it lies (and its pages given back as the importer is done with
-// them: see gltf_doc_release); read into memory where not (a pipe).
+// A file's bytes: mapped where it can be, so that a .glb's BIN chunk or an
+// external buffer is read where it lies (and its pages given back as the
+// importer is done with them: see gltf_doc_release); read into memory where
+// not (a pipe).
 class FileBytes {
 public:
     FileBytes() = default;
@@ -39,7 +41,10 @@ public:
     }
 
     // False, with errno saying why, if the file cannot be read.
-    bool open(const char *path)
+    bool open(const char *path) { return map(path) || read_all(path); }
+
+    // False if the file is not a regular file that can be mapped.
+    bool map(const char *path)
     {
         const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
         struct stat st;
@@ -52,7 +57,7 @@ public:
         }
         if (fd >= 0)
             close(fd);
-        return map_ || read_all(path);
+        return map_ != nullptr;
     }
 
     const unsigned char *data() const { return map_ ? map_ : read_.data(); }
@@ -74,8 +79,19 @@ private:
     std::vector<unsigned char> read_;
 };
 
+// A .gltf's (or .glb's) buffers in files of their own, mapped by ptr rather
+// than read whole by tinygltf: for buffer b, file[b] (null where tinygltf
+// read it), its byteLength, and the uri the JSON named before ptr gave
+// tinygltf a stand-in.
+struct ExternalBuffers {
+    std::vector<std::unique_ptr<FileBytes>> file;
+    std::vector<size_t> length;
+    std::vector<std::string> uri;
+};
+
 struct GltfDoc {
     FileBytes file;
+    ExternalBuffers external;
     tinygltf::Model model;
     std::vector<GltfBytes> buffers; /* each buffer's bytes (see gltf_meshopt.h) */
     int scene = -1;
@@ -344,6 +360,71 @@ bool bin_kept_out(const FileBytes &bytes, size_t rest, std::string *json, GltfBy
     return true;
 }
 
+// A URI's %XX escapes decoded, as tinygltf decodes a buffer's; false if one
+// is malformed.
+bool uri_decoded(const std::string &uri, std::string *out)
+{
+    out->clear();
+    for (size_t i = 0; i < uri.size(); i++) {
+        if (uri[i] != '%') {
+            out->push_back(uri[i]);
+            continue;
+        }
+        if (i + 2 >= uri.size() || !std::isxdigit(static_cast<unsigned char>(uri[i + 1])) ||
+            !std::isxdigit(static_cast<unsigned char>(uri[i + 2])))
+            return false;
+        out->push_back(char(std::stoi(uri.substr(i + 1, 2), nullptr, 16)));
+        i += 2;
+    }
+    return true;
+}
+
+// The buffers of a glTF JSON that name a file (not a data: URI), which
+// tinygltf would read whole into memory: each that is a regular file at
+// least its byteLength long is mapped into external and given to tinygltf as
+// a 4-byte data: stand-in. The others are left to tinygltf, which reads
+// them or says what is wrong with them. Returns whether any was (json then
+// rewritten).
+bool external_buffers_kept_out(const std::string &dir, std::string *json,
+                               ExternalBuffers *external)
+{
+    if (json->find("\"uri\"") == std::string::npos)
+        return false;
+    nlohmann::json doc = nlohmann::json::parse(*json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") ||
+        !doc["buffers"].is_array())
+        return false;
+    nlohmann::json &buffers = doc["buffers"];
+    external->file.resize(buffers.size());
+    external->length.resize(buffers.size());
+    external->uri.resize(buffers.size());
+    bool any = false;
+    for (size_t b = 0; b < buffers.size(); b++) {
+        nlohmann::json &buffer = buffers[b];
+        std::string name;
+        if (!buffer.is_object() || !buffer.contains("uri") || !buffer["uri"].is_string() ||
+            !buffer.contains("byteLength") || !buffer["byteLength"].is_number_unsigned())
+            continue;
+        const std::string uri = buffer["uri"].get<std::string>();
+        const unsigned long long length = buffer["byteLength"].get<unsigned long long>();
+        if (uri.compare(0, 5, "data:") == 0 || length < 4 || !uri_decoded(uri, &name) ||
+            name.empty())
+            continue;
+        auto file = std::make_unique<FileBytes>();
+        if (!file->map((name[0] == '/' ? name : dir + name).c_str()) || file->size() < length)
+            continue;
+        external->file[b] = std::move(file);
+        external->length[b] = size_t(length);
+        external->uri[b] = uri;
+        buffer["uri"] = "data:application/octet-stream;base64,AAAAAA==";
+        buffer["byteLength"] = 4;
+        any = true;
+    }
+    if (any)
+        *json = doc.dump();
+    return any;
+}
+
 const char *const draco_extension = "KHR_draco_mesh_compression";
 
 // An object's extensions[name], or null.
@@ -462,8 +543,10 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         GltfBytes bin = { nullptr, 0 };
         const bool bin_mapped = has_json && binary && bytes.mapped() &&
                                 bin_kept_out(bytes, rest, &json, &bin);
-        // The file, or a .glb with JSON patched (else the file's own);
-        // with its BIN chunk mapped, a 4-byte stand-in for it.
+        const bool external_mapped =
+            has_json && external_buffers_kept_out(dir, &json, &doc->external);
+        // The file, or its JSON as patched here (json) or for tinygltf
+        // (patched); with a .glb's BIN chunk mapped, a 4-byte stand-in for it.
         const auto load_json = [&](const std::string *patched) {
             static const unsigned char stand_in[12] = { 4, 0, 0, 0, 'B', 'I', 'N', 0 };
             const std::string &text = patched ? *patched : json;
@@ -471,7 +554,7 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
                 const std::vector<unsigned char> glb = glb_of(text, stand_in, sizeof stand_in);
                 return load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
             }
-            if (!patched)
+            if (!patched && !external_mapped)
                 return load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
             if (binary) {
                 const std::vector<unsigned char> glb =
@@ -499,10 +582,13 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
             fault = error.empty() ? "not a valid glTF file" : error;
         if (fault.empty())
             fault = required_extension_fault(doc->model.extensionsRequired);
+        const ExternalBuffers &external = doc->external;
         for (size_t b = 0; ok && b < doc->model.buffers.size(); b++) {
             const std::vector<unsigned char> &copy = doc->model.buffers[b].data;
+            const bool mapped = b < external.file.size() && external.file[b];
             doc->buffers.push_back(b == 0 && bin_mapped ? bin
-                                                        : GltfBytes{ copy.data(), copy.size() });
+                                   : mapped ? GltfBytes{ external.file[b]->data(), external.length[b] }
+                                            : GltfBytes{ copy.data(), copy.size() });
         }
         if (fault.empty())
             fault = meshopt_decode(doc->model, doc->buffers, doc->decoded);
@@ -514,9 +600,12 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         }
         const tinygltf::Model &m = doc->model;
         doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
-        for (const tinygltf::Buffer &b : m.buffers)
-            if (!b.uri.empty() && b.uri.compare(0, 5, "data:") != 0)
-                doc->files.push_back(b.uri[0] == '/' ? b.uri : dir + b.uri);
+        for (size_t b = 0; b < m.buffers.size(); b++) {
+            const std::string &uri = b < external.uri.size() && !external.uri[b].empty()
+                                         ? external.uri[b] : m.buffers[b].uri;
+            if (!uri.empty() && uri.compare(0, 5, "data:") != 0)
+                doc->files.push_back(uri[0] == '/' ? uri : dir + uri);
+        }
         return doc.release();
     } catch (...) {
         ptr_shim_caught(err, PTR_ERR_SCENE_INVALID, path);
@@ -671,15 +760,29 @@ extern "C" void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor
                     : doc->buffers[size_t(v.buffer)].data + v.byteOffset + a.byteOffset;
 }
 
+// The mapped file a's elements lie in, or null.
+static const FileBytes *mapping_of(const GltfDoc *doc, const GltfAccessor *a)
+{
+    const auto holds = [a](const FileBytes &f) {
+        return f.mapped() && a->data >= f.data() && a->data < f.data() + f.size();
+    };
+    if (holds(doc->file))
+        return &doc->file;
+    for (const auto &f : doc->external.file)
+        if (f && holds(*f))
+            return f.get();
+    return nullptr;
+}
+
 extern "C" void gltf_doc_release(const GltfDoc *doc, const GltfAccessor *a, size_t first,
                                  size_t end)
 {
-    const FileBytes &file = doc->file;
-    if (!file.mapped() || !a->data || first >= end)
+    const FileBytes *file = a->data ? mapping_of(doc, a) : nullptr;
+    if (!file || first >= end)
         return;
     // The whole pages between, and only within the mapping.
     const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
-    const uintptr_t map_lo = uintptr_t(file.data()), map_hi = map_lo + file.size();
+    const uintptr_t map_lo = uintptr_t(file->data()), map_hi = map_lo + file->size();
     const uintptr_t lo = std::max(uintptr_t(a->data) + first * a->stride, map_lo);
     const uintptr_t hi = std::min(uintptr_t(a->data) + end * a->stride, map_hi);
     const uintptr_t from = (lo + page - 1) / page * page, to = hi / page * page;

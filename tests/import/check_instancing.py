@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The same 40 spheres under a transformed parent, written as nodes, as
-EXT_mesh_gpu_instancing instances (float, in a .gltf and in a .glb whose BIN
-chunk is read where it lies, and quantized rotations and colours) and as a
+EXT_mesh_gpu_instancing instances (float, in a .gltf, in a .gltf whose buffer is
+an external .bin and in a .glb whose BIN chunk, both read where they lie, and
+quantized rotations and colours) and as a
 POINTS primitive (tests/fixtures/make_instancing.py), import to the
 same sphere list: centres and radii within float rounding (relative 1e-6 of
 the scene's size), the same materials, and the same per-sphere colours where
@@ -21,7 +22,8 @@ def dump(name):
     return json.loads(out)["spheres"]
 
 
-forms = {name: dump(name) for name in ("nodes", "instances", "instances.glb", "quantized", "points")}
+forms = {name: dump(name) for name in ("nodes", "instances", "instances.glb", "instances_bin",
+                                       "quantized", "points")}
 reference = forms["nodes"]
 size = max(abs(x) for s in reference for x in s["center"])
 failures = []
