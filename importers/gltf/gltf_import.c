@@ -396,6 +396,93 @@ static void release_read(const Importer *im, size_t i, size_t count, size_t *rel
     *released = i + 1;
 }
 
+/* Instanced nodes of this many instances of a plain sphere, and POINTS
+ * primitives of this many points, with no --color-by value, are turned into
+ * spheres on all cores, PARALLEL_BLOCK at a time (the file's pages read are
+ * given back after each). */
+enum { PARALLEL_PARTS = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
+
+/* Keeps in *failed the least part index that fails: the one a serial import
+ * reports, whichever thread meets it first. */
+static void note_failure(atomic_size_t *failed, size_t i)
+{
+    size_t seen = atomic_load(failed);
+    while (i < seen && !atomic_compare_exchange_weak(failed, &seen, i))
+        ;
+}
+
+/* Runs convert over parts 0 .. count - 1 on all cores, a block at a time,
+ * giving back the pages of the n accessors read (NULL entries: none) after
+ * each, and stops after the block where a part failed (*failed below
+ * SIZE_MAX). */
+static void convert_in_blocks(Importer *im, size_t count, void (*convert)(void *, size_t, size_t),
+                              void *run, atomic_size_t *failed,
+                              const GltfAccessor *const *read, size_t n)
+{
+    const int threads = ptr_online_cpus();
+    for (size_t begin = 0; begin < count; begin += PARALLEL_BLOCK) {
+        const size_t end = count - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : count;
+        ptr_parallel_ranges(threads, begin, end, convert, run);
+        for (size_t k = 0; k < n; k++)
+            if (read[k])
+                gltf_doc_release(im->doc, read[k], begin, end);
+        if (atomic_load(failed) != SIZE_MAX)
+            break;
+    }
+}
+
+/* A point's colour: its COLOR_0 c (NULL: none) times the colour of the
+ * instance it is part of (NULL: none); one of them is given. */
+static void point_color(const double *c, const double *instance, double rgb[3])
+{
+    for (int k = 0; k < 3; k++)
+        rgb[k] = c ? c[k] * (instance ? instance[k] : 1.0) : instance[k];
+}
+
+typedef struct PointRun {
+    PtrSceneBuilder *builder;
+    const GltfAccessor *pos, *rad, *col; /* rad, col NULL: absent */
+    const Mat4 *world;
+    const double *color;  /* the instance's, if any */
+    double radius, scale; /* without rad, the node's radius; world's largest axis scale */
+    uint32_t material;
+    size_t first;         /* the builder's sphere for point 0 */
+    atomic_size_t failed; /* the first point that cannot be a sphere; SIZE_MAX: none */
+} PointRun;
+
+/* Points begin .. end - 1 as add_points would add them one by one. */
+static void convert_points(void *arg, size_t begin, size_t end)
+{
+    PointRun *run = arg;
+    PtrSceneBuilder *b = run->builder;
+    for (size_t i = begin; i < end; i++) {
+        double p[4], r[4], centre[3];
+        element(run->pos, i, p);
+        mat4_point(run->world, p, centre);
+        if (run->rad)
+            element(run->rad, i, r);
+        else
+            r[0] = run->radius;
+        const double radius = r[0] * run->scale;
+        if (sphere_fault(centre, radius)) {
+            note_failure(&run->failed, i);
+            break;
+        }
+        double *out = &b->spheres[4 * (run->first + i)];
+        memcpy(out, centre, sizeof centre);
+        out[3] = radius;
+        b->materials[run->first + i] = run->material;
+        if (run->col || run->color) {
+            double c[4], rgb[3];
+            if (run->col)
+                element(run->col, i, c);
+            point_color(run->col ? c : NULL, run->color, rgb);
+            ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]),
+                               &b->colors[4 * (run->first + i)]);
+        }
+    }
+}
+
 /* The spheres of a POINTS primitive under world (times color, if any), each
  * with its own value of the attribute value_index (-1: none) names, else
  * value (if any). */
@@ -443,6 +530,18 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
                                    prim->color >= 0 ? &col : NULL,
                                    value_index != -1 ? &val : NULL };
     const size_t release = node_origin->part ? 0 : sizeof read / sizeof read[0];
+    if (count >= PARALLEL_PARTS && value_index == -1 && !value) {
+        PointRun run = { .builder = &im->builder, .pos = &pos,
+                         .rad = prim->radius >= 0 ? &rad : NULL,
+                         .col = prim->color >= 0 ? &col : NULL, .world = world, .color = color,
+                         .radius = node->radius, .scale = scale, .material = material };
+        atomic_init(&run.failed, SIZE_MAX);
+        if (ptr_builder_add_spheres(&im->builder, count, run.col || color, &run.first) != PTR_OK)
+            return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+        convert_in_blocks(im, count, convert_points, &run, &run.failed, read, release);
+        o.part_index = atomic_load(&run.failed);
+        return o.part_index == SIZE_MAX ? PTR_OK : part_error(im, &o, sphere_fault_text);
+    }
     size_t released = 0;
     for (size_t i = 0; i < count && res == PTR_OK; i++) {
         double p[4], r[4], c[4], centre[3], rgb[3], own_value;
@@ -454,8 +553,7 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
             r[0] = node->radius;
         if (prim->color >= 0) {
             element(&col, i, c);
-            for (int k = 0; k < 3; k++)
-                rgb[k] = c[k] * (color ? color[k] : 1.0);
+            point_color(c, color, rgb);
         }
         o.part_index = i;
         if (value_index != -1)
@@ -521,11 +619,6 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
     return all_finite(out->m, 16);
 }
 
-/* Instanced nodes of this many instances of a plain sphere (no points, no
- * --color-by value) are turned into spheres on all cores, this many at a
- * time (the file's pages read are given back after each). */
-enum { PARALLEL_INSTANCES = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
-
 typedef struct InstanceRun {
     PtrSceneBuilder *builder;
     const GltfNode *node;
@@ -538,13 +631,6 @@ typedef struct InstanceRun {
     atomic_int nonuniform;
 } InstanceRun;
 
-static void note_failure(InstanceRun *run, size_t i)
-{
-    size_t seen = atomic_load(&run->failed);
-    while (i < seen && !atomic_compare_exchange_weak(&run->failed, &seen, i))
-        ;
-}
-
 /* Instances begin .. end - 1 as add_instances would add them one by one. */
 static void convert_instances(void *arg, size_t begin, size_t end)
 {
@@ -555,13 +641,13 @@ static void convert_instances(void *arg, size_t begin, size_t end)
         Mat4 local, world;
         double centre[3], radius;
         if (!instance_local(run->t, run->r, run->s, i, &local)) {
-            note_failure(run, i);
+            note_failure(&run->failed, i);
             break;
         }
         world = mat4_mul(run->world, &local);
         surface_sphere(run->node, run->mesh, &world, centre, &radius, &nonuniform);
         if (sphere_fault(centre, radius)) {
-            note_failure(run, i);
+            note_failure(&run->failed, i);
             break;
         }
         double *out = &b->spheres[4 * (run->first + i)];
@@ -594,18 +680,9 @@ static PtrResult add_instances_parallel(Importer *im, const Origin *instance,
     if (res == PTR_OK &&
         ptr_builder_add_spheres(&im->builder, count, run.c != NULL, &run.first) != PTR_OK)
         res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    const int threads = ptr_online_cpus();
-    for (size_t begin = 0; res == PTR_OK && begin < count; begin += PARALLEL_BLOCK) {
-        const size_t end = count - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : count;
-        ptr_parallel_ranges(threads, begin, end, convert_instances, &run);
-        for (int k = 0; k < 4; k++)
-            if (tsrc[k])
-                gltf_doc_release(im->doc, tsrc[k], begin, end);
-        if (atomic_load(&run.failed) != SIZE_MAX)
-            break;
-    }
     if (res != PTR_OK)
         return res;
+    convert_in_blocks(im, count, convert_instances, &run, &run.failed, tsrc, 4);
     const size_t failed = atomic_load(&run.failed);
     if (failed != SIZE_MAX) {
         Origin at = *instance;
@@ -651,7 +728,7 @@ static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *no
         res = value_accessor(im, o, "instance", value_index, &count, &v);
     Origin instance = *o;
     instance.part = "instance";
-    if (res == PTR_OK && count >= PARALLEL_INSTANCES && value_index == -1 &&
+    if (res == PTR_OK && count >= PARALLEL_PARTS && value_index == -1 &&
         mesh->has_surface && !mesh->point_primitives && (node->has_radius || mesh->has_bounds)) {
         const GltfAccessor *const tsrc[4] = { in->translation >= 0 ? &t : NULL,
                                               in->rotation >= 0 ? &r : NULL,

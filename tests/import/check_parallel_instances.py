@@ -13,7 +13,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from glb import write_glb  # noqa: E402
 
 ptr = sys.argv[1]
-COUNT = 40_000  # above importers' PARALLEL_INSTANCES (32,768); each half below it
+COUNT = 40_000  # above importers' PARALLEL_PARTS (32,768); each half below it
 
 
 def instances(broken):
