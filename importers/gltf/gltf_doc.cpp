@@ -43,10 +43,11 @@ public:
     // False, with errno saying why, if the file cannot be read.
     bool open(const char *path) { return map(path) || read_all(path); }
 
-    // False if the file is not a regular file that can be mapped.
+    // False if the file is not a regular file that can be mapped. Opened
+    // without blocking, so that a FIFO is refused rather than waited on.
     bool map(const char *path)
     {
-        const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+        const int fd = ::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
         struct stat st;
         if (fd >= 0 && fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
             void *map = mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
@@ -105,6 +106,28 @@ namespace {
 bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
                 const unsigned char *, int, void *)
 {
+    return true;
+}
+
+// tinygltf's file access, for the buffers ptr does not map and for images:
+// regular files only. Its own opens whatever a URI names, so a URI naming a
+// FIFO waits for a writer forever and one naming a folder reads as 2^63 bytes
+// (lseek's end of a directory on ext4); to ptr both are files not found.
+bool regular_file_exists(const std::string &path, void *)
+{
+    struct stat st;
+    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool read_regular_file(std::vector<unsigned char> *out, std::string *error,
+                       const std::string &path, void *)
+{
+    FileBytes file;
+    if (!file.map(path.c_str())) {
+        *error = "not a regular file with bytes in it";
+        return false;
+    }
+    out->assign(file.data(), file.data() + file.size());
     return true;
 }
 
@@ -533,6 +556,8 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
+        loader.SetFsCallbacks({ regular_file_exists, tinygltf::ExpandFilePath, read_regular_file,
+                                tinygltf::WriteWholeFile, nullptr });
         std::string error;
         std::string fault = bytes.size() > UINT32_MAX ? "larger than 4 GiB, the most glTF holds"
                             : binary                  ? glb_chunk_fault(bytes)
