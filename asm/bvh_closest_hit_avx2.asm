@@ -44,10 +44,9 @@ FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32    ; the rsp in the la
 ; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
 ; every lane whose t beats the best, (t, id) lexicographically; the smallest
 ; such t, at its lowest lane (its lowest id), becomes the best.
-; In: r8-r11 cx, cy, cz, radius; r12 ids; ymm0-2 direction; ymm3 tmin;
-; ymm4 best t and ymm5 best id in every lane; ymm6 lane indices; ymm7 sign
-; mask; rbp the frame. Out: ymm4, ymm5, r15d (best sphere) and
-; [rbp + BEST_UP] updated.
+; In: r8-r11 cx, cy, cz, radius; r12 ids; r15d the best sphere; ymm0-2
+; direction; ymm3 tmin; ymm4 best t in every lane; ymm6 lane indices; ymm7
+; sign mask; rbp the frame. Out: ymm4, r15d and [rbp + BEST_UP] updated.
 ; Clobbers rdx, rcx, ymm8-15.
 test_leaf:
     OFFSETS_AVX2
@@ -63,13 +62,13 @@ test_leaf:
     ROOT_AVX2
     vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
     vandps      ymm14, ymm14, ymm12             ; tmin < t
-    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
     vcmpps      ymm12, ymm9, ymm4, CMP_EQ_OQ
-    vpcmpgtd    ymm15, ymm5, ymm13
-    vandps      ymm12, ymm12, ymm15             ; t == best and id < best id
+    vandps      ymm12, ymm12, ymm14             ; t == best: the ids decide
     vcmpps      ymm15, ymm9, ymm4, CMP_LT_OQ
-    vorps       ymm12, ymm12, ymm15             ; ... or t < best
-    vandps      ymm14, ymm14, ymm12
+    vandps      ymm14, ymm14, ymm15             ; t < best
+    vtestps     ymm12, ymm12
+    jnz         .tie
+.settled:
     vmovmskps   edx, ymm14
     test        edx, edx
     jz          .done
@@ -86,11 +85,22 @@ test_leaf:
     add         edx, eax
     mov         r15d, edx
     vbroadcastss ymm4, xmm8                     ; best
-    vpbroadcastd ymm5, [r12 + rdx*4]            ; best id
     vmulps      ymm8, ymm4, [slack]
     vmovaps     [rbp + BEST_UP], ymm8
 .done:
     ret
+    ; A t equal to the best one's (rare): the ids decide, read only now, as
+    ; at 10^8 spheres their line is one more cache miss a leaf. Before any
+    ; hit the best t is tmax, which no t in range equals.
+.tie:
+    cmp         r15d, -1                        ; PTR_NO_HIT
+    je          .settled
+    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
+    vpbroadcastd ymm15, [r12 + r15*4]           ; the best one's
+    vpcmpgtd    ymm15, ymm15, ymm13
+    vandps      ymm12, ymm12, ymm15             ; id < best id
+    vorps       ymm14, ymm14, ymm12
+    jmp         .settled
 
 ; int ptr_bvh_closest_hit_avx2(const PtrRay *ray, const PtrBvh *bvh,
 ;                              const PtrSpheres *spheres, PtrHit *hit);
@@ -100,8 +110,8 @@ test_leaf:
 ; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 stack top
 ; r15d best sphere (PTR_NO_HIT)   rbx where the nearest child was pushed
 ; rbp the frame
-; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm5 best id   ymm6 lane
-; indices   ymm7 sign mask   ymm8-15 scratch
+; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 lane indices
+; ymm7 sign mask   ymm8-15 scratch
 FUNCTION ptr_bvh_closest_hit_avx2
     TREE_ENTRY  FRAME, 32
     mov         [rbp + KEPT_OUT], rbx
@@ -110,7 +120,6 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
     vbroadcastss ymm3, [rdi + RAY_TMIN]
     vbroadcastss ymm4, [rdi + RAY_TMAX]
-    vpxor       ymm5, ymm5, ymm5                ; best id 0: no tie wins before a hit
     vmovdqu     ymm6, [lane_index]
     vmovups     ymm7, [sign_mask]
     mov         r15d, -1                        ; PTR_NO_HIT

@@ -45,10 +45,10 @@ FRAME       equ 3 * STACK_SIZE + 8
 ; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
 ; every lane whose t beats the best, (t, id) lexicographically; the smallest
 ; such t, at its lowest lane (its lowest id), becomes the best.
-; In: r8-r11 cx, cy, cz, radius; r12 ids; ymm0-2 direction; ymm3 tmin;
-; ymm4 best t and ymm5 best id in every lane; ymm6 lane indices; ymm7 sign
-; mask; ymm16-18 the origin; ymm22 the slack, ymm23 +inf, ymm25 zero.
-; Out: ymm4, ymm5, r15d (best sphere) and ymm24 (best * slack) updated.
+; In: r8-r11 cx, cy, cz, radius; r12 ids; r15d the best sphere; ymm0-2
+; direction; ymm3 tmin; ymm4 best t in every lane; ymm6 lane indices; ymm7
+; sign mask; ymm16-18 the origin; ymm22 the slack, ymm23 +inf, ymm25 zero.
+; Out: ymm4, r15d and ymm24 (best * slack) updated.
 ; Clobbers rdx, ymm8-15, k1-k4.
 test_leaf:
     vsubps      ymm8, ymm16, [r8 + rax*4]       ; fx = ox - cx
@@ -62,12 +62,11 @@ test_leaf:
     jz          .done                           ; no lane can hit: skip sqrt, div
     ROOT_AVX2
     vcmpps      k2{k1}, ymm9, ymm3, CMP_GT_OQ   ; tmin < t
-    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
-    vcmpps      k3, ymm9, ymm4, CMP_EQ_OQ
-    vpcmpgtd    k3{k3}, ymm5, ymm13             ; t == best and id < best id
-    vcmpps      k4, ymm9, ymm4, CMP_LT_OQ
-    korw        k3, k3, k4                      ; ... or t < best
-    kandw       k2, k2, k3
+    vcmpps      k3{k2}, ymm9, ymm4, CMP_EQ_OQ   ; t == best: the ids decide
+    vcmpps      k2{k2}, ymm9, ymm4, CMP_LT_OQ   ; t < best
+    kortestw    k3, k3
+    jnz         .tie
+.settled:
     kortestw    k2, k2
     jz          .done
     vblendmps   ymm11{k2}, ymm23, ymm9          ; the winners' t, else +inf
@@ -80,10 +79,20 @@ test_leaf:
     bsf         edx, edx                        ; the lowest winning lane
     add         edx, eax
     mov         r15d, edx
-    vpbroadcastd ymm5, [r12 + rdx*4]            ; best id
     vmulps      ymm24, ymm4, ymm22
 .done:
     ret
+    ; A t equal to the best one's (rare): the ids decide, read only now, as
+    ; at 10^8 spheres their line is one more cache miss a leaf. Before any
+    ; hit the best t is tmax, which no t in range equals.
+.tie:
+    cmp         r15d, -1                        ; PTR_NO_HIT
+    je          .settled
+    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
+    vpbroadcastd ymm14, [r12 + r15*4]           ; the best one's
+    vpcmpgtd    k3{k3}, ymm14, ymm13            ; id < best id
+    korw        k2, k2, k3
+    jmp         .settled
 
 ; int ptr_bvh_closest_hit_avx512(const PtrRay *ray, const PtrBvh *bvh,
 ;                                const PtrSpheres *spheres, PtrHit *hit);
@@ -92,8 +101,8 @@ test_leaf:
 ; rcx hit (pushed; then scratch)
 ; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 entries on the stacks
 ; r15d best sphere (PTR_NO_HIT)   rbx spheres kept out of the tree   rbp the frame
-; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm5 best id   ymm6 lane
-; indices   ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
+; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 lane indices
+; ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
 ; ymm19-21 1 / d clamped   ymm22 slack   ymm23 +inf   ymm24 best * slack
 ; ymm25 zero   k5-k7 the lanes of each axis whose 1 / d is negative (all or
 ; none)
@@ -104,7 +113,6 @@ FUNCTION ptr_bvh_closest_hit_avx512
     vbroadcastss ymm2, [rdi + RAY_DIR_Z]
     vbroadcastss ymm3, [rdi + RAY_TMIN]
     vbroadcastss ymm4, [rdi + RAY_TMAX]
-    vpxor       ymm5, ymm5, ymm5                ; best id 0: no tie wins before a hit
     vmovdqu     ymm6, [lane_index]
     vbroadcastss ymm7, [sign_mask]
     vbroadcastss ymm16, [rdi + RAY_ORG_X]
