@@ -142,6 +142,22 @@ PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_col
     return PTR_OK;
 }
 
+static void quantize_color(const double rgb[3], uint16_t *entry)
+{
+    ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]), entry);
+}
+
+void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3], double radius,
+                             uint32_t material, const double *rgb)
+{
+    double *out = &b->spheres[4 * n];
+    memcpy(out, centre, 3 * sizeof *centre);
+    out[3] = radius;
+    b->materials[n] = material;
+    if (rgb)
+        quantize_color(rgb, &b->colors[4 * n]);
+}
+
 /* Optional array k's entry for the sphere added last, the array created if
  * it is the first. NULL if memory runs out. */
 static void *last_entry(PtrSceneBuilder *b, size_t k)
@@ -162,7 +178,7 @@ PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
     uint16_t *entry = last_entry(b, OPTIONAL_COLORS);
     if (!entry)
         return PTR_ERR_NOMEM;
-    ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]), entry);
+    quantize_color(rgb, entry);
     return PTR_OK;
 }
 

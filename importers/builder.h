@@ -54,6 +54,12 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
                                   size_t *first);
 
+/* Fills sphere n of those ptr_builder_add_spheres added, from any thread:
+ * centre, radius, material and, where rgb is not NULL (only if they were
+ * added with_colors), its colour. */
+void ptr_builder_fill_sphere(PtrSceneBuilder *builder, size_t n, const double centre[3],
+                             double radius, uint32_t material, const double *rgb);
+
 /* Gives the sphere added last its own colour (see PtrSpheres.color). */
 PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
 

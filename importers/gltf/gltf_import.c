@@ -454,7 +454,6 @@ typedef struct PointRun {
 static void convert_points(void *arg, size_t begin, size_t end)
 {
     PointRun *run = arg;
-    PtrSceneBuilder *b = run->builder;
     for (size_t i = begin; i < end; i++) {
         double p[4], r[4], centre[3];
         element(run->pos, i, p);
@@ -468,18 +467,14 @@ static void convert_points(void *arg, size_t begin, size_t end)
             note_failure(&run->failed, i);
             break;
         }
-        double *out = &b->spheres[4 * (run->first + i)];
-        memcpy(out, centre, sizeof centre);
-        out[3] = radius;
-        b->materials[run->first + i] = run->material;
-        if (run->col || run->color) {
-            double c[4], rgb[3];
-            if (run->col)
-                element(run->col, i, c);
+        double c[4], rgb[3];
+        const int colored = run->col || run->color;
+        if (run->col)
+            element(run->col, i, c);
+        if (colored)
             point_color(run->col ? c : NULL, run->color, rgb);
-            ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]),
-                               &b->colors[4 * (run->first + i)]);
-        }
+        ptr_builder_fill_sphere(run->builder, run->first + i, centre, radius, run->material,
+                                colored ? rgb : NULL);
     }
 }
 
@@ -635,7 +630,6 @@ typedef struct InstanceRun {
 static void convert_instances(void *arg, size_t begin, size_t end)
 {
     InstanceRun *run = arg;
-    PtrSceneBuilder *b = run->builder;
     int nonuniform = 0;
     for (size_t i = begin; i < end; i++) {
         Mat4 local, world;
@@ -650,16 +644,11 @@ static void convert_instances(void *arg, size_t begin, size_t end)
             note_failure(&run->failed, i);
             break;
         }
-        double *out = &b->spheres[4 * (run->first + i)];
-        memcpy(out, centre, sizeof centre);
-        out[3] = radius;
-        b->materials[run->first + i] = run->material;
-        if (run->c) {
-            double rgb[4];
+        double rgb[4];
+        if (run->c)
             element(run->c, i, rgb);
-            ptr_color_quantize(v3((float)rgb[0], (float)rgb[1], (float)rgb[2]),
-                               &b->colors[4 * (run->first + i)]);
-        }
+        ptr_builder_fill_sphere(run->builder, run->first + i, centre, radius, run->material,
+                                run->c ? rgb : NULL);
     }
     if (nonuniform)
         atomic_store(&run->nonuniform, 1);
