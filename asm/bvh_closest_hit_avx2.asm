@@ -89,9 +89,8 @@ test_leaf:
     vmovaps     [rbp + BEST_UP], ymm8
 .done:
     ret
-    ; A t equal to the best one's (rare): the ids decide, read only now, as
-    ; at 10^8 spheres their line is one more cache miss a leaf. Before any
-    ; hit the best t is tmax, which no t in range equals.
+    ; A t equal to the best one's: the ids decide (as in the AVX-512 kernel,
+    ; read only on such a rare tie).
 .tie:
     cmp         r15d, -1                        ; PTR_NO_HIT
     je          .settled

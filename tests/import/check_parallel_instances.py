@@ -7,10 +7,11 @@ where instances are broken, the same first error: a zero scale at instance
 1,000 is reported, not the NaN translation at instance 39,000 that another
 thread meets after it.
 usage: check_parallel_instances.py PTR"""
-import json, math, os, random, struct, subprocess, sys, tempfile
+import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from glb import write_glb  # noqa: E402
+from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
 
 ptr = sys.argv[1]
 COUNT = 40_000  # above importers' PARALLEL_PARTS (32,768); each half below it
@@ -69,33 +70,15 @@ def write_cloud(path, nodes, broken):
     write_glb(path, doc, binary)
 
 
-failures = []
-with tempfile.TemporaryDirectory() as d:
-    runs = {}
-    for broken in (False, True):
-        for nodes in (1, 2):
-            path = os.path.join(d, f"cloud-{nodes}-{broken}.glb")
-            write_cloud(path, nodes, broken)
-            runs[nodes, broken] = subprocess.run([ptr, "--dump-scene", path], capture_output=True,
-                                                 text=True, timeout=120)
-    whole, halves = runs[1, False], runs[2, False]
-    if whole.returncode or halves.returncode:
-        failures.append(f"valid files refused: {whole.stderr.strip()} / {halves.stderr.strip()}")
-    else:
-        a, b = json.loads(whole.stdout)["spheres"], json.loads(halves.stdout)["spheres"]
-        if len(a) != COUNT or a != b:
-            differ = next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), None)
-            failures.append(f"{len(a)} and {len(b)} spheres; first difference at sphere {differ}")
-        for run in (whole, halves):
-            if run.stderr.count("non-uniform scale") != 1:
-                failures.append(f"non-uniform scale warned {run.stderr.count('non-uniform scale')} "
-                                f"times: {run.stderr.strip()}")
-    broken = runs[1, True]
-    if broken.returncode != 4 or "instance 1000 has a non-finite transform" not in broken.stderr:
-        failures.append(f"broken instances: exit {broken.returncode}: {broken.stderr.strip()}")
-    if "instance 1000 has a non-finite transform" not in runs[2, True].stderr:
-        failures.append(f"broken halves: {runs[2, True].stderr.strip()}")
-for f in failures:
-    print(f)
-print(f"{5 - len(failures)} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+runs = dump_clouds(ptr, write_cloud)
+failures = [f for f in [spheres_differ(runs, COUNT)] if f]
+for run in (runs[1, False], runs[2, False]):
+    if run.returncode == 0 and run.stderr.count("non-uniform scale") != 1:
+        failures.append(f"non-uniform scale warned {run.stderr.count('non-uniform scale')} "
+                        f"times: {run.stderr.strip()}")
+broken = runs[1, True]
+if broken.returncode != 4 or "instance 1000 has a non-finite transform" not in broken.stderr:
+    failures.append(f"broken instances: exit {broken.returncode}: {broken.stderr.strip()}")
+if "instance 1000 has a non-finite transform" not in runs[2, True].stderr:
+    failures.append(f"broken halves: {runs[2, True].stderr.strip()}")
+report(failures, 5)

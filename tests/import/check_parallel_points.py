@@ -6,10 +6,11 @@ the same scene bit for bit (--dump-scene) and, where points are broken, the
 same first error: the zero radius at point 1,000 is reported, not the NaN
 position at point 39,000 that another thread meets after it.
 usage: check_parallel_points.py PTR"""
-import json, math, os, random, struct, subprocess, sys, tempfile
+import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from glb import write_glb  # noqa: E402
+from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
 
 ptr = sys.argv[1]
 COUNT = 40_000  # above importers' PARALLEL_PARTS (32,768); each half below it
@@ -62,29 +63,11 @@ def write_cloud(path, primitives, broken):
     write_glb(path, doc, binary)
 
 
-failures = []
-with tempfile.TemporaryDirectory() as d:
-    runs = {}
-    for broken in (False, True):
-        for primitives in (1, 2):
-            path = os.path.join(d, f"cloud-{primitives}-{broken}.glb")
-            write_cloud(path, primitives, broken)
-            runs[primitives, broken] = subprocess.run([ptr, "--dump-scene", path],
-                                                      capture_output=True, text=True, timeout=120)
-    whole, halves = runs[1, False], runs[2, False]
-    if whole.returncode or halves.returncode:
-        failures.append(f"valid files refused: {whole.stderr.strip()} / {halves.stderr.strip()}")
-    else:
-        a, b = json.loads(whole.stdout)["spheres"], json.loads(halves.stdout)["spheres"]
-        if len(a) != COUNT or a != b:
-            differ = next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), None)
-            failures.append(f"{len(a)} and {len(b)} spheres; first difference at sphere {differ}")
-    for primitives in (1, 2):
-        run = runs[primitives, True]
-        if run.returncode != 4 or "point 1000 gives a sphere" not in run.stderr:
-            failures.append(f"broken points in {primitives} primitives: exit {run.returncode}: "
-                            f"{run.stderr.strip()}")
-for f in failures:
-    print(f)
-print(f"{3 - len(failures)} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+runs = dump_clouds(ptr, write_cloud)
+failures = [f for f in [spheres_differ(runs, COUNT)] if f]
+for primitives in (1, 2):
+    run = runs[primitives, True]
+    if run.returncode != 4 or "point 1000 gives a sphere" not in run.stderr:
+        failures.append(f"broken points in {primitives} primitives: exit {run.returncode}: "
+                        f"{run.stderr.strip()}")
+report(failures, 3)
