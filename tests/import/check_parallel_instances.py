@@ -71,7 +71,8 @@ def write_cloud(path, nodes, broken):
 
 
 runs = dump_clouds(ptr, write_cloud)
-failures = [f for f in [spheres_differ(runs, COUNT)] if f]
+differ = spheres_differ(runs, COUNT)
+failures = [differ] if differ else []
 for run in (runs[1, False], runs[2, False]):
     if run.returncode == 0 and run.stderr.count("non-uniform scale") != 1:
         failures.append(f"non-uniform scale warned {run.stderr.count('non-uniform scale')} "

@@ -64,7 +64,8 @@ def write_cloud(path, primitives, broken):
 
 
 runs = dump_clouds(ptr, write_cloud)
-failures = [f for f in [spheres_differ(runs, COUNT)] if f]
+differ = spheres_differ(runs, COUNT)
+failures = [differ] if differ else []
 for primitives in (1, 2):
     run = runs[primitives, True]
     if run.returncode != 4 or "point 1000 gives a sphere" not in run.stderr:

@@ -70,9 +70,9 @@ run "$dir/does-not-exist.gltf" error            # a missing file
 
 # A buffer or an image named by a FIFO no one writes to: not waited on.
 mkfifo "$dir/fifo"
-sed 's|"uri": "."|"uri": "fifo"|' "$src/tests/fixtures/hostile/buffer_uri_folder.gltf" \
+sed 's|"uri": "\."|"uri": "fifo"|' "$src/tests/fixtures/hostile/buffer_uri_folder.gltf" \
     >"$dir/buffer_uri_fifo.gltf"
-sed 's|"uri": "."|"uri": "fifo"|' "$src/tests/fixtures/hostile/image_uri_folder.gltf" \
+sed 's|"uri": "\."|"uri": "fifo"|' "$src/tests/fixtures/hostile/image_uri_folder.gltf" \
     >"$dir/image_uri_fifo.gltf"
 run "$dir/buffer_uri_fifo.gltf" error
 run "$dir/image_uri_fifo.gltf" ok
