@@ -114,6 +114,19 @@ STAGE void camera_rays(const PtrPathJob *job, CameraBatch *batch)
     }
 }
 
+/* Starts loading what find_surfaces reads of a hit's sphere that its
+ * intersection test did not: its material and colour entries. From 10^7
+ * spheres on they are cache misses, which then overlap the other lanes'
+ * tracing instead of following it. */
+static inline void prefetch_surface(const PtrSpheres *spheres, uint32_t sphere)
+{
+    if (sphere == PTR_NO_HIT)
+        return;
+    __builtin_prefetch(&spheres->material[sphere]);
+    if (spheres->color)
+        __builtin_prefetch(&spheres->color[4 * (size_t)sphere]);
+}
+
 /* A batch's camera rays through the tree as one packet: they leave one
  * pixel (items are a pixel's samples), so they go down the tree together.
  * Brute force traces all lanes together anyway, and huge spheres need
@@ -122,8 +135,11 @@ STAGE void trace_camera_rays(const PtrPathJob *job, CameraBatch *batch)
 {
     const PtrAccel *accel = job->accel;
     batch->traced = accel->kind == PTR_ACCEL_BVH && !job->scene->huge.count;
-    if (batch->traced)
+    if (batch->traced) {
         accel->isect.bvh_closest_hit_packet(&batch->ray, &accel->bvh, accel->spheres, &batch->hit);
+        for (int l = 0; l < LANES; l++)
+            prefetch_surface(accel->spheres, batch->hit.sphere[l]);
+    }
 }
 
 STAGE void make_camera_batch(const PtrPathJob *job, const Round *round, uint32_t first,
@@ -189,6 +205,7 @@ STAGE void trace(const PtrPathJob *job, Lanes *lanes)
             PtrRay ray = lane_ray(lanes, l);
             PtrHit hit;
             ptr_trace(accel, &ray, &hit);
+            prefetch_surface(accel->spheres, hit.sphere);
             lanes->hit.t[l] = hit.t;
             lanes->hit.sphere[l] = hit.sphere;
         }
