@@ -6,9 +6,11 @@
  * a flat sheet, grounds of radius 1000 and 1e5 under tiny spheres, radii from
  * 1e-4 to 1e3, far from the origin, overlapping clusters, of 1 to 3000
  * spheres, with rays from the origin, from sphere surfaces, at spheres and
- * grazing them, and random tmin and tmax. */
+ * grazing them, and random tmin and tmax, or tmax at the nearest hit. */
 #include <inttypes.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bvh_scenes.h"
@@ -19,14 +21,21 @@ enum { RAYS_PER_SCENE = 2000 };
 static const int sizes[] = { 1, 2, 7, 8, 9, 40, 333, 3000 };
 
 /* A ray of bvh_scene_ray with tmin and tmax of every kind the renderer uses
- * and a few it does not. */
+ * and a few it does not: among them tmax exactly the t of the nearest hit,
+ * which must not count (a t equal to the best one's goes to the ids, and
+ * before any hit there is no best sphere to read an id of). */
 static PtrRay checked_ray(const PtrSpheres *s, PtrRng *rng)
 {
     PtrRay ray = bvh_scene_ray(s, rng);
-    switch (ptr_rng_next(rng) % 4) {
+    PtrHit nearest;
+    switch (ptr_rng_next(rng) % 5) {
     case 0: ray.tmin = 1e-3f; break;
     case 1: ray.tmax = bvh_uniform(rng, 0.01f, 30.0f); break;
     case 2: ray.tmin = bvh_uniform(rng, 0.0f, 5.0f); ray.tmax = ray.tmin + bvh_uniform(rng, 1e-3f, 20.0f); break;
+    case 3:
+        if (ptr_closest_hit_c(&ray, s, s->count, &nearest))
+            ray.tmax = nearest.t;
+        break;
     default: break;
     }
     return ray;
@@ -71,7 +80,20 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                 fprintf(stderr, "check_bvh: cannot build %s %d\n", bvh_scene_names[kind], sizes[z]);
                 return 1;
             }
-            const PtrSpheres *t = &tree_scene.spheres, *f = &file_scene.spheres;
+            /* The kernels see the tree's spheres with the ids one entry on,
+             * after the largest id: one that read the id of no hit (entry
+             * PTR_NO_HIT, -1 as a gather's index) would let a tie at tmax
+             * win. */
+            uint32_t *guarded = malloc((tree_scene.spheres.capacity + 1) * sizeof *guarded);
+            if (!guarded) {
+                fprintf(stderr, "check_bvh: out of memory\n");
+                return 1;
+            }
+            guarded[0] = INT32_MAX;
+            memcpy(guarded + 1, tree_scene.spheres.id, tree_scene.spheres.capacity * sizeof *guarded);
+            PtrSpheres view = tree_scene.spheres;
+            view.id = guarded + 1;
+            const PtrSpheres *t = &view, *f = &file_scene.spheres;
             PtrRng rng = ptr_rng_for_sample(scene_seed, (uint64_t)kind, 1);
             for (int r = 0; r < RAYS_PER_SCENE; r++, rays++) {
                 const PtrRay ray = checked_ray(f, &rng);
@@ -109,6 +131,7 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
             }
             packets += check_bvh_closest_hit_packet(tables, top, &bvh, t, checked_ray, &rng,
                                                     &packet_tally);
+            free(guarded);
             ptr_bvh_free(&bvh);
             ptr_scene_free(&tree_scene);
             ptr_scene_free(&file_scene);
