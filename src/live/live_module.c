@@ -19,9 +19,9 @@
 
 enum { FRAMES_PER_SECOND = 4, VIEW_PIXELS = 4096, ENCODER_NICE = 10 };
 /* At the end, for a page to hear the last state and fetch the last image,
- * then for its event stream to end: each wait at most this long. Seconds,
- * not one: the encoder runs niced, and on a loaded machine the last image
- * took over a second (test_live's page saw its request cut off). */
+ * then for its event stream to end: each wait at most this long. Three
+ * seconds: the encoder runs niced, and on a loaded machine the last image
+ * took over one (test_live's page saw its request for it cut off). */
 static const double linger_seconds = 3.0;
 
 PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)

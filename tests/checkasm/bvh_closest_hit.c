@@ -82,8 +82,9 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
             }
             /* The kernels see the tree's spheres with the ids one entry on,
              * after the largest id: one that read the id of no hit (entry
-             * PTR_NO_HIT, -1 as a gather's index) would let a tie at tmax
-             * win. */
+             * PTR_NO_HIT: -1 as a signed 32-bit index, which reads the
+             * guard; far past the end as an unsigned one, which faults)
+             * would let a tie at tmax win. */
             uint32_t *guarded = malloc((tree_scene.spheres.capacity + 1) * sizeof *guarded);
             if (!guarded) {
                 fprintf(stderr, "check_bvh: out of memory\n");
