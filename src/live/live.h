@@ -67,7 +67,7 @@ typedef struct PtrLiveModule {
     void (*frame)(PtrLiveSession *session, const float *rgb, const PtrLiveStatus *status);
     /* The render ended (status->state says how); the page keeps its image. */
     void (*end)(PtrLiveSession *session, const PtrLiveStatus *status);
-    /* Lets open pages fetch the last image (a second at most), stops the
+    /* Lets open pages fetch the last image (a second or two at most), stops the
      * threads and closes every connection. */
     void (*stop)(PtrLiveSession *session);
 } PtrLiveModule;

@@ -29,6 +29,7 @@ enum {
     THREAD_STACK = 256 * 1024,
     KEEPALIVE_SECONDS = 2,
     EVENT_SIZE = 1024,
+    FRAME_BLOCK = 4096,        /* a /frame.png response's writes, within the memory above */
 };
 
 /* One connection, from its start to its close. */
@@ -311,24 +312,63 @@ static enum MHD_Result serve_events(PtrLiveSession *s, struct MHD_Connection *co
     return send_response(connection, MHD_HTTP_OK, r, "text/event-stream");
 }
 
+/* A /frame.png response: a copy of the PNG, counted in frames_sending
+ * until the server releases it (sent in full, or the connection gone), so
+ * that stopping waits for the last image to leave instead of cutting it
+ * off when it closes the connections. */
+typedef struct FrameResponse {
+    PtrLiveSession *session;
+    unsigned char *png;
+    size_t size;
+} FrameResponse;
+
+static ssize_t read_frame(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    const FrameResponse *f = cls;
+    if (pos >= f->size)
+        return MHD_CONTENT_READER_END_OF_STREAM;
+    size_t n = f->size - (size_t)pos < max ? f->size - (size_t)pos : max;
+    memcpy(buf, f->png + pos, n);
+    return (ssize_t)n;
+}
+
+static void release_frame(void *cls)
+{
+    FrameResponse *f = cls;
+    PtrLiveSession *s = f->session;
+    pthread_mutex_lock(&s->lock);
+    s->frames_sending--;
+    pthread_cond_broadcast(&s->changed); /* stop() waits for the last one */
+    pthread_mutex_unlock(&s->lock);
+    free(f->png);
+    free(f);
+}
+
 static enum MHD_Result serve_frame(PtrLiveSession *s, struct MHD_Connection *connection)
 {
+    FrameResponse *f = malloc(sizeof *f);
     pthread_mutex_lock(&s->lock);
-    unsigned char *copy = s->png ? malloc(s->png_size) : NULL;
+    unsigned char *copy = f && s->png ? malloc(s->png_size) : NULL;
     size_t size = s->png_size;
     if (copy) {
         memcpy(copy, s->png, size);
         if (s->png_frame > s->served_frame)
             s->served_frame = s->png_frame;
+        s->frames_sending++;
         pthread_cond_broadcast(&s->changed);
     }
     int none = !s->png;
     pthread_mutex_unlock(&s->lock);
-    if (!copy)
+    if (!copy) {
+        free(f);
         return none ? send_text(connection, MHD_HTTP_NOT_FOUND, "no image yet\n") : MHD_NO;
-    return send_response(connection, MHD_HTTP_OK,
-                         MHD_create_response_from_buffer(size, copy, MHD_RESPMEM_MUST_FREE),
-                         "image/png");
+    }
+    *f = (FrameResponse){ s, copy, size };
+    struct MHD_Response *r =
+        MHD_create_response_from_callback(size, FRAME_BLOCK, read_frame, f, release_frame);
+    if (!r)
+        release_frame(f);
+    return send_response(connection, MHD_HTTP_OK, r, "image/png");
 }
 
 static enum MHD_Result set_exposure(PtrLiveSession *s, struct MHD_Connection *connection)

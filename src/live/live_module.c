@@ -19,10 +19,9 @@
 
 enum { FRAMES_PER_SECOND = 4, VIEW_PIXELS = 4096, ENCODER_NICE = 10 };
 /* At the end, for a page to hear the last state and fetch the last image,
- * then for its event stream to end: each wait at most this long. Three
- * seconds: the encoder runs niced, and on a loaded machine the last image
- * took over one (test_live's page saw its request for it cut off). */
-static const double linger_seconds = 3.0;
+ * then for its event stream to end and the image to leave: each wait at
+ * most this long. */
+static const double linger_seconds = 1.0;
 
 PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
 {
@@ -203,10 +202,11 @@ static void session_stop(PtrLiveSession *s)
         ptr_live_wait(s, deadline - ptr_live_now());
     s->stopping = 1;
     pthread_cond_broadcast(&s->changed);
-    /* The event streams send what they have not sent yet, then end: let them
-     * end before the server closes their connections. */
+    /* The event streams send what they have not sent yet, then end, and the
+     * last image may still be on its way: let both finish before the server
+     * closes their connections. */
     deadline = ptr_live_now() + linger_seconds;
-    while (s->pages > 0 && ptr_live_now() < deadline)
+    while ((s->pages > 0 || s->frames_sending > 0) && ptr_live_now() < deadline)
         ptr_live_wait(s, deadline - ptr_live_now());
     pthread_mutex_unlock(&s->lock);
     if (s->encoder_started)

@@ -41,6 +41,7 @@ struct PtrLiveSession {
     uint64_t png_id;        /* encodings so far: the page asks for /frame.png?id */
     uint64_t png_frame, png_stops; /* the frame_version and stops_version it shows */
     uint64_t served_frame;  /* the newest frame_version a page has fetched */
+    int frames_sending;     /* /frame.png responses not yet sent in full */
     pthread_t encoder;
     int encoder_started;
 
