@@ -41,10 +41,10 @@ KEPT_OUT equ 256
 STACK   equ 288
 FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32    ; the rsp in the last 8
 
-; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
-; every lane whose t beats the best, (t, id) lexicographically; the smallest
-; such t, at its lowest lane (its lowest id), becomes the best.
-; In: r8-r11 cx, cy, cz, radius; r12 ids; r15d the best sphere; ymm0-2
+; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8): for every lane
+; whose t beats the best, (t, position) lexicographically; the smallest such
+; t, at its lowest lane, becomes the best.
+; In: r8-r11 cx, cy, cz, radius; r15d the best sphere; ymm0-2
 ; direction; ymm3 tmin; ymm4 best t in every lane; ymm6 lane indices; ymm7
 ; sign mask; rbp the frame. Out: ymm4, r15d and [rbp + BEST_UP] updated.
 ; Clobbers rdx, rcx, ymm8-15.
@@ -63,7 +63,7 @@ test_leaf:
     vcmpps      ymm12, ymm9, ymm3, CMP_GT_OQ
     vandps      ymm14, ymm14, ymm12             ; tmin < t
     vcmpps      ymm12, ymm9, ymm4, CMP_EQ_OQ
-    vandps      ymm12, ymm12, ymm14             ; t == best: the ids decide
+    vandps      ymm12, ymm12, ymm14             ; t == best: the positions decide
     vcmpps      ymm15, ymm9, ymm4, CMP_LT_OQ
     vandps      ymm14, ymm14, ymm15             ; t < best
     vtestps     ymm12, ymm12
@@ -89,15 +89,11 @@ test_leaf:
     vmovaps     [rbp + BEST_UP], ymm8
 .done:
     ret
-    ; A t equal to the best one's: the ids decide (as in the AVX-512 kernel,
-    ; read only on such a rare tie).
+    ; A t equal to the best one's: the first in the arrays wins, decided for
+    ; every lane by the first one's position (as in the AVX-512 kernel).
 .tie:
-    cmp         r15d, -1                        ; PTR_NO_HIT
-    je          .settled
-    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
-    vpbroadcastd ymm15, [r12 + r15*4]           ; the best one's
-    vpcmpgtd    ymm15, ymm15, ymm13
-    vandps      ymm12, ymm12, ymm15             ; id < best id
+    cmp         eax, r15d
+    jge         .settled
     vorps       ymm14, ymm14, ymm12
     jmp         .settled
 
@@ -106,7 +102,7 @@ test_leaf:
 ;
 ; rdi ray, rsi bvh (then the node being tested), rdx spheres (then scratch),
 ; rcx hit (pushed; then scratch)
-; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 stack top
+; r8-r11 cx, cy, cz, radius   r13 nodes   r14 stack top
 ; r15d best sphere (PTR_NO_HIT)   rbx where the nearest child was pushed
 ; rbp the frame
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 lane indices

@@ -42,10 +42,10 @@ STACK_CHILD equ STACK_SIZE
 STACK_COUNT equ 2 * STACK_SIZE
 FRAME       equ 3 * STACK_SIZE + 8
 
-; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8), ids ascending: for
-; every lane whose t beats the best, (t, id) lexicographically; the smallest
-; such t, at its lowest lane (its lowest id), becomes the best.
-; In: r8-r11 cx, cy, cz, radius; r12 ids; r15d the best sphere; ymm0-2
+; Tests spheres eax .. eax + ecx - 1 (1 <= ecx <= 8): for every lane
+; whose t beats the best, (t, position) lexicographically; the smallest such
+; t, at its lowest lane, becomes the best.
+; In: r8-r11 cx, cy, cz, radius; r15d the best sphere; ymm0-2
 ; direction; ymm3 tmin; ymm4 best t in every lane; ymm6 lane indices; ymm7
 ; sign mask; ymm16-18 the origin; ymm22 the slack, ymm23 +inf, ymm25 zero.
 ; Out: ymm4, r15d and ymm24 (best * slack) updated.
@@ -62,7 +62,7 @@ test_leaf:
     jz          .done                           ; no lane can hit: skip sqrt, div
     ROOT_AVX2
     vcmpps      k2{k1}, ymm9, ymm3, CMP_GT_OQ   ; tmin < t
-    vcmpps      k3{k2}, ymm9, ymm4, CMP_EQ_OQ   ; t == best: the ids decide
+    vcmpps      k3{k2}, ymm9, ymm4, CMP_EQ_OQ   ; t == best: the positions decide
     vcmpps      k2{k2}, ymm9, ymm4, CMP_LT_OQ   ; t < best
     kortestw    k3, k3
     jnz         .tie
@@ -82,15 +82,14 @@ test_leaf:
     vmulps      ymm24, ymm4, ymm22
 .done:
     ret
-    ; A t equal to the best one's (rare): the ids decide, read only now, as
-    ; at 10^8 spheres their line is one more cache miss a leaf. Before any
-    ; hit the best t is tmax, which no t in range equals.
+    ; A t equal to the best one's (rare): the first in the arrays wins. The
+    ; best was found by an earlier call, so these spheres all come before it
+    ; or all after: the first one's position decides for every lane. Signed:
+    ; positions are below 2^31 and PTR_NO_HIT, -1, below them all, so before
+    ; any hit (when the best t is tmax) no tie wins.
 .tie:
-    cmp         r15d, -1                        ; PTR_NO_HIT
-    je          .settled
-    vmovdqu     ymm13, [r12 + rax*4]            ; ids (below 2^31: signed compares)
-    vpbroadcastd ymm14, [r12 + r15*4]           ; the best one's
-    vpcmpgtd    k3{k3}, ymm14, ymm13            ; id < best id
+    cmp         eax, r15d
+    jge         .settled
     korw        k2, k2, k3
     jmp         .settled
 
@@ -99,7 +98,7 @@ test_leaf:
 ;
 ; rdi ray, rsi bvh (then the node being tested), rdx spheres (then scratch),
 ; rcx hit (pushed; then scratch)
-; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 entries on the stacks
+; r8-r11 cx, cy, cz, radius   r13 nodes   r14 entries on the stacks
 ; r15d best sphere (PTR_NO_HIT)   rbx spheres kept out of the tree   rbp the frame
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 lane indices
 ; ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz

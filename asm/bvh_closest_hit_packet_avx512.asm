@@ -40,10 +40,12 @@ STACK       equ 0
 FRAME       equ ENTRY_SIZE * (PTR_BVH_MAX_DEPTH * 7 + 8) + 8
 
 ; Tests spheres eax .. eax + ecx - 1 (ecx >= 1) against the rays of mask k1:
-; a ray takes a sphere whose (t, id) is below its best, lexicographically.
-; In: r8-r11 cx, cy, cz, radius; r12 ids; ymm0-2 direction; ymm3 tmin;
-; ymm4 best t, ymm5 best id, ymm6 best sphere; ymm7 sign mask; ymm16-18 the
-; origin; ymm22 the slack, ymm25 zero. Out: ymm4-6 and ymm24 (best * slack)
+; a ray takes a sphere whose (t, position) is below its best,
+; lexicographically (positions are below 2^31, so signed compares, and
+; PTR_NO_HIT, -1, is below them all: no tie wins before a hit).
+; In: r8-r11 cx, cy, cz, radius; ymm0-2 direction; ymm3 tmin;
+; ymm4 best t, ymm6 best sphere; ymm7 sign mask; ymm16-18 the
+; origin; ymm22 the slack, ymm25 zero. Out: ymm4, ymm6 and ymm24 (best * slack)
 ; updated. Clobbers rax, rcx, ymm8-15, k2-k4.
 test_leaf:
     vsubps      ymm8, ymm16, [r8 + rax*4]{1to8}     ; fx = ox - cx
@@ -55,15 +57,14 @@ test_leaf:
     jz          .next                               ; no ray can hit: skip sqrt, div
     ROOT_AVX2
     vcmpps      k2{k2}, ymm9, ymm3, CMP_GT_OQ       ; tmin < t
-    vpbroadcastd ymm13, [r12 + rax*4]               ; id (below 2^31: signed compares)
+    vpbroadcastd ymm13, eax                         ; the position
     vcmpps      k3, ymm9, ymm4, CMP_EQ_OQ
-    vpcmpgtd    k3{k3}, ymm5, ymm13                 ; t == best and id < best id
+    vpcmpgtd    k3{k3}, ymm6, ymm13                 ; t == best and position < the best's
     vcmpps      k4, ymm9, ymm4, CMP_LT_OQ
     korw        k3, k3, k4                          ; ... or t < best
     kandw       k2, k2, k3
     vmovaps     ymm4{k2}, ymm9
-    vmovdqa32   ymm5{k2}, ymm13
-    vpbroadcastd ymm6{k2}, eax
+    vmovdqa32   ymm6{k2}, ymm13
     vmulps      ymm24{k2}, ymm9, ymm22              ; best * slack
 .next:
     inc         eax
@@ -78,11 +79,11 @@ test_leaf:
 ;
 ; rdi rays, rsi bvh (then the node being tested), rdx spheres (then scratch),
 ; rcx hits (pushed; then scratch)
-; r8-r11 cx, cy, cz, radius   r12 ids   r13 nodes   r14 stack top
+; r8-r11 cx, cy, cz, radius   r13 nodes   r14 stack top
 ; r15 the node's child lanes still to test   rbx the nearest child's entry
 ; rbp the frame
-; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm5 best id   ymm6 best
-; sphere   ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
+; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 best sphere
+; ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
 ; ymm19-21 1 / d clamped   ymm22 slack   ymm23 +inf   ymm24 best * slack
 ; ymm25 zero   ymm26-31 scratch   xmm15 the nearest child's distance   ymm10
 ; quiet NaN in a node
@@ -94,7 +95,6 @@ FUNCTION ptr_bvh_closest_hit_packet_avx512
     vmovaps     ymm2, [rdi + PACKET_DIR_Z]
     vmovaps     ymm3, [rdi + PACKET_TMIN]
     vmovaps     ymm4, [rdi + PACKET_TMAX]
-    vpxor       ymm5, ymm5, ymm5                ; best id 0: no tie wins before a hit
     vpcmpeqd    ymm6, ymm6, ymm6                ; PTR_NO_HIT
     vbroadcastss ymm7, [sign_mask]
     vmovaps     ymm16, [rdi + PACKET_ORG_X]

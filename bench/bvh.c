@@ -134,7 +134,8 @@ int main(int argc, char **argv)
             fprintf(stderr, "bvh: out of memory building the tree over %zu spheres\n", n);
             return 1;
         }
-        double bytes = (double)(scene.spheres.capacity * 6 * sizeof(float) +
+        /* The renderer's arrays (centre, radius, material) and nodes. */
+        double bytes = (double)(scene.spheres.capacity * (4 * sizeof(float) + sizeof(uint32_t)) +
                                 tree.bvh.node_count * sizeof(PtrBvhNode)) / (double)scene.spheres.count;
         rate[2] = mrays(&scene, &tree, &setup, &seconds[2]);
         tree.isect = fastest;

@@ -435,7 +435,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     s->cz[at] = c.z;
     s->radius[at] = r;
     s->material[at] = b->materials[i];
-    s->id[at] = (uint32_t)i;
+    if (s->id)
+        s->id[at] = (uint32_t)i;
     PtrResult res = PTR_OK;
     if (b->colors)
         res = ptr_scene_set_sphere_color16(scene, at, &b->colors[4 * i]);
@@ -474,7 +475,7 @@ static void move_spheres(void *arg, size_t begin, size_t end)
         atomic_store(&m->invalid, 1);
 }
 
-/* The spheres in file order, the huge ones last (their ids keep the file's
+/* The spheres in file order, the huge ones last (then ids keep the file's
  * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
  * all cores from the last back, the builder's arrays shrinking behind, so
  * that 10^8 spheres are never in memory twice. */
@@ -494,6 +495,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
         res = ptr_spheres_make_colors(&scene->spheres);
     if (res == PTR_OK && b->values)
         res = ptr_spheres_make_values(&scene->spheres);
+    if (res == PTR_OK && huge_count)
+        res = ptr_spheres_make_ids(&scene->spheres);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)

@@ -15,15 +15,18 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
                          int packets, PtrScene *scene, int threads)
 {
     *accel = ptr_accel_brute(isect, scene);
-    if (choice == PTR_ACCEL_BRUTE ||
-        (choice == PTR_ACCEL_AUTO && accel->searched < ptr_accel_crossover(isect, packets)))
-        return PTR_OK;
+    /* Built for brute force too, for its order: on equal t the sphere first
+     * in the arrays wins, so both must search the same arrays (PtrSpheres). */
     double start = ptr_now_seconds();
     PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads);
     if (r != PTR_OK)
         return r;
-    accel->kind = PTR_ACCEL_BVH;
     accel->build_seconds = ptr_now_seconds() - start;
+    if (choice == PTR_ACCEL_BRUTE ||
+        (choice == PTR_ACCEL_AUTO && accel->searched < ptr_accel_crossover(isect, packets)))
+        ptr_bvh_free(&accel->bvh);
+    else
+        accel->kind = PTR_ACCEL_BVH;
     return PTR_OK;
 }
 
@@ -34,18 +37,16 @@ size_t ptr_accel_crossover(const PtrIsectTable *isect, int packets)
     return packets ? PTR_ACCEL_CROSSOVER_AVX2 : PTR_ACCEL_CROSSOVER_SSE41;
 }
 
-/* The huge spheres in double, then the rest up to that distance (ties
- * included, so that the lowest id wins as among spheres of one kind). */
+/* The huge spheres in double, then the rest up to that distance, ties
+ * included: the huge spheres are last in the arrays, so on equal t the
+ * others win, as the first in the arrays always does. */
 int ptr_trace_huge_first(const PtrAccel *accel, const PtrRay *ray, PtrHit *hit)
 {
     PtrHit huge;
     PtrRay rest = *ray;
     if (ptr_huge_closest_hit(ray, accel->scene, &huge))
         rest.tmax = nextafterf(huge.t, INFINITY);
-    const uint32_t *id = accel->spheres->id;
-    if (ptr_search(accel, &rest, hit) &&
-        (huge.sphere == PTR_NO_HIT || hit->t < huge.t ||
-         (hit->t == huge.t && id[hit->sphere] < id[huge.sphere])))
+    if (ptr_search(accel, &rest, hit))
         return 1;
     *hit = huge;
     return huge.sphere != PTR_NO_HIT;

@@ -47,13 +47,16 @@ typedef struct PtrAccel {
 } PtrAccel;
 
 /* Chooses and prepares the structure for the scene's spheres with the
- * kernels of isect; the tree reorders the spheres (all arrays together; see
- * bvh.h); packets as for ptr_accel_crossover. threads: for the build, 0 for
+ * kernels of isect; the tree's build reorders the spheres (all arrays
+ * together; see bvh.h), for brute force too, which then searches them in
+ * that order; packets as for ptr_accel_crossover. threads: for the build, 0 for
  * one per CPU. Only PTR_ERR_NOMEM can fail. */
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
                          int packets, PtrScene *scene, int threads);
 
-/* Brute force over the scene's spheres as they are: nothing to build or free. */
+/* Brute force over the scene's spheres as they are: nothing to build or
+ * free. (A render's brute force, ptr_accel_init's, searches them in the
+ * build's order.) */
 PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene);
 
 void ptr_accel_free(PtrAccel *accel);
@@ -65,7 +68,7 @@ const char *ptr_accel_name(const PtrAccel *accel);
 int ptr_accel_parse(const char *text, PtrAccelChoice *choice);
 
 /* The closest hit along ray, as PTR_DECL_CLOSEST_HIT describes it; on equal
- * distances the sphere first in the scene file wins, whichever structure. */
+ * distances the sphere first in the arrays wins, whichever structure. */
 static inline int ptr_search(const PtrAccel *accel, const PtrRay *ray, PtrHit *hit)
 {
     if (accel->kind == PTR_ACCEL_BVH)

@@ -5,8 +5,8 @@
  * first and stacks the others, and it skips any child whose box it enters
  * beyond the best hit so far. Skipping never changes the answer: a box
  * contains its spheres' hits, so a sphere in a skipped box cannot do better
- * than the best hit; and on equal t the lowest id wins wherever it was found,
- * so the order of the visits does not matter either.
+ * than the best hit; and on equal t the sphere first in the arrays wins
+ * wherever it was found, so the order of the visits does not matter either.
  *
  * The node test, which the assembly versions compute with exactly these
  * operations in this order (per lane, no FMA; max(a, b) is maxps's
@@ -54,7 +54,6 @@ static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x
               offsetof(PtrBvhNode, lower_y) == 64 && offsetof(PtrBvhNode, lower_z) == 128 &&
               offsetof(PtrBvhNode, child) == 192 && offsetof(PtrBvhNode, leaf_count) == 224 &&
               sizeof(PtrBvhNode) == 256, "PtrBvhNode layout");
-static_assert(offsetof(PtrSpheres, id) == 40, "PtrSpheres layout");
 /* asm/layout.inc repeats PTR_BVH_SLACK as the float bits 0x3f800020. */
 static_assert(PTR_BVH_MAX_DEPTH == 64, "asm/layout.inc's stack size");
 
@@ -63,10 +62,11 @@ typedef struct StackEntry {
     float entry;
 } StackEntry;
 
-/* Whether sphere i at distance t beats the best so far. */
-static inline int better(float t, uint32_t id, float tmin, float best, uint32_t best_id)
+/* Whether sphere i at distance t beats the best so far; an equal t wins
+ * below position tie. */
+static inline int better(float t, uint32_t i, float tmin, float best, uint32_t tie)
 {
-    return t > tmin && (t < best || (t == best && id < best_id));
+    return t > tmin && (t < best || (t == best && i < tie));
 }
 
 PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
@@ -75,15 +75,14 @@ PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
     assert(bvh->depth <= PTR_BVH_MAX_DEPTH);
     const float tmin = ray->tmin;
     float best = ray->tmax;
-    uint32_t best_id = 0; /* no tie can win before a first hit */
     uint32_t best_index = PTR_NO_HIT;
+    uint32_t tie = 0; /* the best's position; 0 before a first hit: no tie with tmax wins */
 
     for (size_t i = 0; i < bvh->unbounded_count; i++) {
         const float t = ptr_sphere_hit(ray, spheres, i);
-        if (better(t, spheres->id[i], tmin, best, best_id)) {
+        if (better(t, (uint32_t)i, tmin, best, tie)) {
             best = t;
-            best_id = spheres->id[i];
-            best_index = (uint32_t)i;
+            best_index = tie = (uint32_t)i;
         }
     }
 
@@ -115,10 +114,9 @@ PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
             if (e.leaf_count) {
                 for (uint32_t i = e.child; i < e.child + e.leaf_count; i++) {
                     const float t = ptr_sphere_hit(ray, spheres, i);
-                    if (better(t, spheres->id[i], tmin, best, best_id)) {
+                    if (better(t, i, tmin, best, tie)) {
                         best = t;
-                        best_id = spheres->id[i];
-                        best_index = i;
+                        best_index = tie = i;
                         best_up = best * PTR_BVH_SLACK;
                     }
                 }

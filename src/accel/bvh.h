@@ -8,10 +8,10 @@
  * few spheres much larger than the rest out of the tree: they come first in
  * the arrays and every ray tests them, as the brute-force kernel would.
  *
- * The result contract is the brute-force kernel's: the closest hit with its
- * t bit for bit, and on equal t the sphere that came first in the scene
- * file (the lowest PtrSpheres.id), so that an image never depends on
- * whether a tree was used. */
+ * The result contract is the brute-force kernel's over the reordered
+ * arrays: the closest hit with its t bit for bit, and on equal t the sphere
+ * first in the arrays, so that an image never depends on whether the tree
+ * or brute force searched them (the renderer always builds: accel.h). */
 #ifndef PTR_BVH_H
 #define PTR_BVH_H
 
@@ -75,10 +75,9 @@ void ptr_bvh_free(PtrBvh *bvh);
 
 /* The closest hit among the spheres of a tree built over them (bvh.c says
  * how). Same contract as PTR_DECL_CLOSEST_HIT over all spheres->count
- * spheres, and the same answer bit for bit, except that on equal t the
- * sphere with the lowest id wins (the arrays are reordered, the ids are the
- * file order); hit->sphere is the position in the reordered arrays. Writes
- * *hit in every case and returns 1 on a hit. */
+ * spheres, and the same answer bit for bit: on equal t the sphere first in
+ * the (reordered) arrays wins, wherever the traversal found it. Writes *hit
+ * in every case and returns 1 on a hit. */
 #define PTR_DECL_BVH_CLOSEST_HIT(name)                                        \
     int name(const PtrRay *ray, const PtrBvh *bvh, const PtrSpheres *spheres, PtrHit *hit)
 

@@ -334,6 +334,10 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         build.set.prims = NULL;
         SphereWrite kept = { spheres, kept_out, 0 };
         write_spheres(&kept, 0, bvh->unbounded_count);
+        /* The ids have done their work (the leaves' order): from here on a
+         * sphere's position decides a tie (see PtrSpheres). */
+        free(spheres->id);
+        spheres->id = NULL;
     }
     free(build.set.prims);
     /* Laying the tree out in one array needs memory of its own: it comes

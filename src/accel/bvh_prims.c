@@ -49,7 +49,8 @@ static float select_kth(float *values, size_t n, size_t k)
  * first, then lower id. */
 static int larger(const PtrSpheres *s, uint32_t i, uint32_t j)
 {
-    return s->radius[i] != s->radius[j] ? s->radius[i] > s->radius[j] : s->id[i] < s->id[j];
+    return s->radius[i] != s->radius[j] ? s->radius[i] > s->radius[j]
+                                        : ptr_sphere_id(s, i) < ptr_sphere_id(s, j);
 }
 
 /* Offers sphere i to list[0 .. *n - 1], the largest so far, largest first:
@@ -69,7 +70,7 @@ static void sort_by_id(uint32_t *list, size_t n, const PtrSpheres *s)
     for (size_t i = 1; i < n; i++) {
         uint32_t v = list[i];
         size_t j = i;
-        for (; j > 0 && s->id[list[j - 1]] > s->id[v]; j--)
+        for (; j > 0 && ptr_sphere_id(s, list[j - 1]) > ptr_sphere_id(s, v); j--)
             list[j] = list[j - 1];
         list[j] = v;
     }
@@ -89,7 +90,7 @@ static float unbounded_radius(const PtrSpheres *s)
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], s->id[i], s->material[i],
+    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i), s->material[i],
                   { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
     if (s->color)
         memcpy(p.color, &s->color[4 * i], sizeof p.color);
@@ -102,7 +103,6 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
     s->cy[i] = p->centre[1];
     s->cz[i] = p->centre[2];
     s->radius[i] = p->radius;
-    s->id[i] = p->id;
     s->material[i] = p->material;
     if (s->color)
         memcpy(&s->color[4 * i], p->color, sizeof p->color);

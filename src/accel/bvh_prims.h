@@ -16,7 +16,7 @@ enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
  * to them from the prims, in their final order. */
 typedef struct BvhPrim {
     float centre[3], radius;
-    uint32_t id; /* which orders a leaf */
+    uint32_t id; /* the sphere's in the file (ptr_sphere_id), which orders a leaf */
     uint32_t material;
     uint16_t color[4]; /* white where the scene has no colours */
 } BvhPrim;

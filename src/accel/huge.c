@@ -43,7 +43,7 @@ int ptr_huge_closest_hit(const PtrRay *ray, const PtrScene *scene, PtrHit *hit)
         const double near = t0 < t1 ? t0 : t1;
         const double far = t0 > t1 ? t0 : t1;
         const double t = near > tmin ? near : far;
-        /* Huge spheres are stored in id order: strict < keeps the lowest. */
+        /* Strict <: on equal t the first in the arrays wins, as everywhere. */
         if (t > tmin && t < best) {
             best = t;
             best_index = (uint32_t)(first + i);

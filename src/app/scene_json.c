@@ -47,7 +47,7 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
     if (!by_id)
         return PTR_ERR_NOMEM;
     for (size_t i = 0; i < s->count; i++)
-        by_id[s->id[i]] = i;
+        by_id[ptr_sphere_id(s, i)] = i;
     fputs("{\n  \"scene\": ", out);
     ptr_json_string(out, path);
     fputs(",\n  \"spheres\": [", out);

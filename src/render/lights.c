@@ -31,12 +31,6 @@ static int any_emissive_material(const PtrScene *scene)
     return 0;
 }
 
-static int compare_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 PtrResult ptr_lights_init(PtrLights *l, const PtrScene *scene, PtrError *err)
 {
     *l = (PtrLights){ 0 };
@@ -52,24 +46,19 @@ PtrResult ptr_lights_init(PtrLights *l, const PtrScene *scene, PtrError *err)
     l->alias = malloc(n * sizeof *l->alias);
     double *scaled = malloc(n * sizeof *scaled);
     uint32_t *small = malloc(n * sizeof *small), *large = malloc(n * sizeof *large);
-    uint64_t *by_id = malloc(n * sizeof *by_id);
-    if (!l->sphere || !l->keep || !l->alias || !scaled || !small || !large || !by_id) {
-        free(scaled), free(small), free(large), free(by_id);
+    if (!l->sphere || !l->keep || !l->alias || !scaled || !small || !large) {
+        free(scaled), free(small), free(large);
         ptr_lights_free(l);
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a table of %zu emitters", n);
     }
-    /* The table is built in the scene file's order (sphere ids), not the
-     * arrays' (which the tree reorders): the same emitter then answers the
-     * same random numbers whatever the acceleration structure. */
+    /* In the arrays' order, which the renderer's every structure shares
+     * (the build's: see PtrSpheres), so the same emitter answers the same
+     * random numbers whichever searches the spheres. */
     for (size_t i = 0; i < scene->spheres.count; i++)
-        if (is_emitter(scene, (uint32_t)i))
-            by_id[l->count++] = (uint64_t)scene->spheres.id[i] << 32 | i;
-    qsort(by_id, l->count, sizeof *by_id, compare_u64);
-    for (uint32_t i = 0; i < l->count; i++) {
-        l->sphere[i] = (uint32_t)by_id[i];
-        l->total_power += sphere_power(scene, l->sphere[i]);
-    }
-    free(by_id);
+        if (is_emitter(scene, (uint32_t)i)) {
+            l->sphere[l->count++] = (uint32_t)i;
+            l->total_power += sphere_power(scene, (uint32_t)i);
+        }
     /* Vose's construction: columns below the mean are topped up from one
      * above it, which then counts as below or above in its turn. */
     size_t ns = 0, nl = 0;

@@ -48,7 +48,7 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         white[m] = UINT32_MAX;
     PtrResult res = PTR_OK;
     for (size_t i = 0; i < s->count && res == PTR_OK; i++) {
-        const float value = s->value[s->id[i]]; /* in file order: see PtrSpheres */
+        const float value = s->value[ptr_sphere_id(s, i)]; /* in file order: see PtrSpheres */
         if (isnan(value))
             continue;
         uint32_t m = s->material[i];

@@ -41,7 +41,7 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1 },
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
         { (void **)&s->material, sizeof *s->material, 0, 0, 1 },
-        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 0, 1 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1 },
         { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 1 }, /* white */
         { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
     };
@@ -167,7 +167,8 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     s->cz[i] = centre.z;
     s->radius[i] = radius;
     s->material[i] = material;
-    s->id[i] = (uint32_t)i;
+    if (s->id)
+        s->id[i] = (uint32_t)i;
     return PTR_OK;
 }
 
@@ -205,6 +206,11 @@ PtrResult ptr_spheres_make_colors(PtrSpheres *s)
 PtrResult ptr_spheres_make_values(PtrSpheres *s)
 {
     return create_optional(s, (void **)&s->value, s->count);
+}
+
+PtrResult ptr_spheres_make_ids(PtrSpheres *s)
+{
+    return create_optional(s, (void **)&s->id, s->count);
 }
 
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4])
@@ -281,12 +287,11 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
-    /* A tree reorders the spheres; the hash takes them in file order, so
-     * that parts rendered with and without one merge. (Out of memory, it
-     * takes them as they are: callers that may be short of memory hash
-     * before building a tree, as the renderer does.) */
+    /* In the file's order, through the ids where the importer put the huge
+     * spheres last (out of memory, as they are: the renderer hashes before
+     * the build, while nothing else holds memory). */
     size_t reordered = 0;
-    while (reordered < s->count && s->id[reordered] == reordered)
+    while (reordered < s->count && ptr_sphere_id(s, reordered) == reordered)
         reordered++;
     uint32_t *by_id = reordered < s->count ? malloc(s->count * sizeof *by_id) : NULL;
     for (size_t j = 0; by_id && j < s->count; j++)

@@ -7,9 +7,12 @@
  * lanes from any sphere on; padding entries have a NaN radius, which fails
  * every ordered comparison and so can never be hit.
  *
- * An acceleration structure may reorder the spheres: every array moves with
- * them but value, which only the import and the scene dump read, in the
- * file's order (through the id). */
+ * The tree's build (accel/bvh.h) puts the spheres in its own order, every
+ * array moving with them but value, and from then on a sphere is its
+ * position in that order: on equal hit distances the lowest position wins,
+ * whether the tree or brute force found the hits (both search the spheres
+ * in the build's order). What reads the file's order (the hash, the scene
+ * dump, --color-by) reads the arrays before the build. */
 #ifndef PTR_SCENE_H
 #define PTR_SCENE_H
 
@@ -25,9 +28,11 @@ typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
     uint32_t *material;  /* index into PtrScene.materials */
-    /* The sphere's position in the scene file's order. An acceleration
-     * structure may reorder the arrays; on equal hit distances the lowest id
-     * wins, so the order never shows in an image. */
+    /* The sphere's position in the scene file's order (the importer puts
+     * the huge ones last), until the tree's build, which keeps that order
+     * within a leaf (coincident spheres sharing one show the first in the
+     * file) and frees the array: the renderer needs no ids. NULL: the arrays
+     * are in the file's order. */
     uint32_t *id;
     /* Each sphere's own colour, multiplying its material's base colour
      * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
@@ -36,7 +41,8 @@ typedef struct PtrSpheres {
     uint16_t *color;
     /* The value of the quantity --color-by names of the sphere of id i (NaN:
      * none) at entry i, in the file's order whatever the order of the other
-     * arrays; 4 bytes a sphere, NULL unless asked for (see scene/colormap.h). */
+     * arrays; 4 bytes a sphere, NULL unless asked for (see scene/colormap.h),
+     * and read before the build. */
     float *value;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
@@ -152,6 +158,10 @@ PtrResult ptr_spheres_make_colors(PtrSpheres *spheres);
 /* The same for the values (PtrSpheres.value). */
 PtrResult ptr_spheres_make_values(PtrSpheres *spheres);
 
+/* The same for the ids (PtrSpheres.id), for an importer that puts spheres
+ * out of the file's order. */
+PtrResult ptr_spheres_make_ids(PtrSpheres *spheres);
+
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
 
@@ -170,14 +180,22 @@ static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index);
 
+/* The position in the file of sphere i (see PtrSpheres.id). */
+static inline uint32_t ptr_sphere_id(const PtrSpheres *s, size_t i)
+{
+    return s->id ? s->id[i] : (uint32_t)i;
+}
+
 static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
 {
     return v3(s->cx[i], s->cy[i], s->cz[i]);
 }
 
 /* A 64-bit fingerprint of everything in the scene that shapes an image
- * (spheres, materials, camera, sky, origin): parts of one render match, parts
- * of different scenes almost surely do not. */
+ * (spheres, materials, camera, sky, origin), the spheres taken in the file's
+ * order: parts of one render match, parts of different scenes almost surely
+ * do not. Taken before the tree's build (as the renderer does), whose order
+ * it does not know. */
 uint64_t ptr_scene_hash(const PtrScene *scene);
 
 /* The gradient sky's radiance along a unit direction. */

@@ -1,7 +1,7 @@
 /* The table's bvh_closest_hit, the tree traversal: every assembly level's
  * against the C traversal (the same answer to the bit: return value, t and
- * sphere) and the C traversal against brute force over the scene in file
- * order (the same t and the same sphere, by id), on the hard sets of
+ * sphere) and the C traversal against brute force over the same reordered
+ * arrays (the same t and the same sphere), on the hard sets of
  * tests/support/bvh_scenes.h: duplicates, concentric, collinear, one centre,
  * a flat sheet, grounds of radius 1000 and 1e5 under tiny spheres, radii from
  * 1e-4 to 1e3, far from the origin, overlapping clusters, of 1 to 3000
@@ -22,8 +22,8 @@ static const int sizes[] = { 1, 2, 7, 8, 9, 40, 333, 3000 };
 
 /* A ray of bvh_scene_ray with tmin and tmax of every kind the renderer uses
  * and a few it does not: among them tmax exactly the t of the nearest hit,
- * which must not count (a t equal to the best one's goes to the ids, and
- * before any hit there is no best sphere to read an id of). */
+ * which must not count (a t equal to the best one's goes to the positions,
+ * and before any hit there is no best position to win against). */
 static PtrRay checked_ray(const PtrSpheres *s, PtrRng *rng)
 {
     PtrRay ray = bvh_scene_ray(s, rng);
@@ -41,10 +41,10 @@ static PtrRay checked_ray(const PtrSpheres *s, PtrRng *rng)
     return ray;
 }
 
-static void print_hit(const char *who, int ret, const PtrHit *h, const PtrSpheres *s)
+static void print_hit(const char *who, int ret, const PtrHit *h)
 {
-    fprintf(stderr, "    %-7s returned %d, t = %.9g (%a), sphere = %" PRIu32 " (id %" PRIu32 ")\n",
-            who, ret, h->t, h->t, h->sphere, h->sphere == PTR_NO_HIT ? h->sphere : s->id[h->sphere]);
+    fprintf(stderr, "    %-7s returned %d, t = %.9g (%a), sphere = %" PRIu32 "\n", who, ret, h->t,
+            h->t, h->sphere);
 }
 
 int check_bvh_closest_hit(uint64_t seed, int *passed)
@@ -61,56 +61,37 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
     }
     for (int kind = 0; kind < BVH_SCENE_KIND_COUNT; kind++) {
         for (size_t z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
-            PtrScene tree_scene, file_scene;
+            PtrScene tree_scene;
             ptr_scene_init(&tree_scene);
-            ptr_scene_init(&file_scene);
             PtrBvh bvh;
             uint64_t scene_seed = seed * 1000 + z;
-            if (!bvh_scene_make(&tree_scene, (BvhSceneKind)kind, sizes[z], scene_seed) ||
-                !bvh_scene_make(&file_scene, (BvhSceneKind)kind, sizes[z], scene_seed)) {
+            if (!bvh_scene_make(&tree_scene, (BvhSceneKind)kind, sizes[z], scene_seed)) {
                 fprintf(stderr, "check_bvh: out of memory\n");
                 return 1;
             }
             if (tree_scene.spheres.count == 0) { /* duplicates of fewer than 3 */
                 ptr_scene_free(&tree_scene);
-                ptr_scene_free(&file_scene);
                 continue;
             }
             if (ptr_bvh_build(&bvh, &tree_scene.spheres, tree_scene.spheres.count, 0) != PTR_OK) {
                 fprintf(stderr, "check_bvh: cannot build %s %d\n", bvh_scene_names[kind], sizes[z]);
                 return 1;
             }
-            /* The kernels see the tree's spheres with the ids one entry on,
-             * after the largest id: one that read the id of no hit (entry
-             * PTR_NO_HIT: -1 as a signed 32-bit index, which reads the
-             * guard; far past the end as an unsigned one, which faults)
-             * would let a tie at tmax win. */
-            uint32_t *guarded = malloc((tree_scene.spheres.capacity + 1) * sizeof *guarded);
-            if (!guarded) {
-                fprintf(stderr, "check_bvh: out of memory\n");
-                return 1;
-            }
-            guarded[0] = INT32_MAX;
-            memcpy(guarded + 1, tree_scene.spheres.id, tree_scene.spheres.capacity * sizeof *guarded);
-            PtrSpheres view = tree_scene.spheres;
-            view.id = guarded + 1;
-            const PtrSpheres *t = &view, *f = &file_scene.spheres;
+            const PtrSpheres *t = &tree_scene.spheres;
             PtrRng rng = ptr_rng_for_sample(scene_seed, (uint64_t)kind, 1);
             for (int r = 0; r < RAYS_PER_SCENE; r++, rays++) {
-                const PtrRay ray = checked_ray(f, &rng);
+                const PtrRay ray = checked_ray(t, &rng);
                 PtrHit ref, brute;
                 memset(&ref, 0xaa, sizeof ref);
                 int ref_ret = ptr_bvh_closest_hit_c(&ray, &bvh, t, &ref);
-                int brute_ret = ptr_closest_hit_c(&ray, f, f->count, &brute);
+                int brute_ret = ptr_closest_hit_c(&ray, t, t->count, &brute);
                 hits += ref_ret;
-                if (ref_ret != brute_ret || ref.t != brute.t ||
-                    (ref_ret && t->id[ref.sphere] != brute.sphere)) {
+                if (ref_ret != brute_ret || ref.t != brute.t || ref.sphere != brute.sphere) {
                     if (brute_mismatches++ < 5) {
                         fprintf(stderr, "the C traversal differs from brute force (%s, %d spheres):\n",
                                 bvh_scene_names[kind], sizes[z]);
-                        print_hit("tree", ref_ret, &ref, t);
-                        fprintf(stderr, "    brute   returned %d, t = %.9g, sphere = %" PRIu32 "\n",
-                                brute_ret, brute.t, brute.sphere);
+                        print_hit("tree", ref_ret, &ref);
+                        print_hit("brute", brute_ret, &brute);
                     }
                 }
                 for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
@@ -125,17 +106,15 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                     if (mismatches[l]++ < 5) {
                         fprintf(stderr, "%s traversal differs from c (%s, %d spheres, tmin %a, tmax %a):\n",
                                 tables[l].name, bvh_scene_names[kind], sizes[z], ray.tmin, ray.tmax);
-                        print_hit("c", ref_ret, &ref, t);
-                        print_hit(tables[l].name, ret, &got, t);
+                        print_hit("c", ref_ret, &ref);
+                        print_hit(tables[l].name, ret, &got);
                     }
                 }
             }
             packets += check_bvh_closest_hit_packet(tables, top, &bvh, t, checked_ray, &rng,
                                                     &packet_tally);
-            free(guarded);
             ptr_bvh_free(&bvh);
             ptr_scene_free(&tree_scene);
-            ptr_scene_free(&file_scene);
         }
     }
     int failed = brute_mismatches != 0;

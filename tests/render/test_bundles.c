@@ -181,10 +181,10 @@ int main(void)
     variants[8].settings.noise_threshold = 0.05f;
     variants[8].settings.min_samples = 16;
     for (int k = 0; k < SCENE_KINDS; k++) {
-        /* A scene of its own for each side: the tree reorders the spheres,
-         * and each cluster goes to the tree with the C kernels (68 spheres,
-         * above their crossover) and to brute force with assembly, so the
-         * two sides also see the spheres in different orders. */
+        /* A scene of its own for each side, as every render builds over
+         * it again: each cluster goes to the tree with the C kernels (68
+         * spheres, above their crossover) and to brute force with assembly,
+         * which searches the spheres in the build's order too. */
         PtrScene scene = make_scene((SceneKind)k), other = make_scene((SceneKind)k);
         for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
             const Variant *var = &variants[v];

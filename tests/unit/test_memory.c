@@ -129,6 +129,7 @@ static void test_spheres_release(void)
     const size_t count = 300000, kept = 1000;
     CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept), PTR_OK);
     PtrSpheres *s = &scene.spheres;
+    CHECK_INT(ptr_spheres_make_ids(s), PTR_OK);
     size_t failed_values = 0;
     for (size_t i = 0; i < count + kept; i++) {
         s->cx[i] = s->cy[i] = s->cz[i] = (float)i;
