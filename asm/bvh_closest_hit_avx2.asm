@@ -1,5 +1,5 @@
 ; Closest hit of one ray in the tree (src/accel/bvh.h), AVX2: a node's eight
-; child boxes in one step, a leaf's spheres (up to eight) in one step.
+; child boxes in one step, a leaf's spheres (up to sixteen) eight at a time.
 ; Returns exactly what ptr_bvh_closest_hit_c returns: the box test and the
 ; sphere arithmetic are the same operations in the same order (no FMA; maxps
 ; and minps where C writes its max and min), so the same boxes are visited
@@ -48,7 +48,7 @@ FRAME   equ STACK + 16 * (PTR_BVH_MAX_DEPTH * 7 + 1) + 32    ; the rsp in the la
 ; direction; ymm3 tmin; ymm4 best t in every lane; ymm6 lane indices; ymm7
 ; sign mask; rbp the frame. Out: ymm4, r15d and [rbp + BEST_UP] updated.
 ; Clobbers rdx, rcx, ymm8-15.
-test_leaf:
+test_eight:
     OFFSETS_AVX2
     DISCRIMINANT y, vmovups
     vxorps      ymm14, ymm14, ymm14
@@ -96,6 +96,8 @@ test_leaf:
     jge         .settled
     vorps       ymm14, ymm14, ymm12
     jmp         .settled
+
+TEST_LEAF_BY_EIGHT
 
 ; int ptr_bvh_closest_hit_avx2(const PtrRay *ray, const PtrBvh *bvh,
 ;                              const PtrSpheres *spheres, PtrHit *hit);

@@ -50,7 +50,7 @@ FRAME       equ 3 * STACK_SIZE + 8
 ; sign mask; ymm16-18 the origin; ymm22 the slack, ymm23 +inf, ymm25 zero.
 ; Out: ymm4, r15d and ymm24 (best * slack) updated.
 ; Clobbers rdx, ymm8-15, k1-k4.
-test_leaf:
+test_eight:
     vsubps      ymm8, ymm16, [r8 + rax*4]       ; fx = ox - cx
     vsubps      ymm9, ymm17, [r9 + rax*4]       ; fy
     vsubps      ymm10, ymm18, [r10 + rax*4]     ; fz
@@ -92,6 +92,8 @@ test_leaf:
     jge         .settled
     korw        k2, k2, k3
     jmp         .settled
+
+TEST_LEAF_BY_EIGHT
 
 ; int ptr_bvh_closest_hit_avx512(const PtrRay *ray, const PtrBvh *bvh,
 ;                                const PtrSpheres *spheres, PtrHit *hit);

@@ -24,7 +24,7 @@
 
 enum {
     PTR_BVH_WIDTH = 8,    /* children per node */
-    PTR_BVH_LEAF_MAX = 8, /* spheres per leaf at most */
+    PTR_BVH_LEAF_MAX = 16, /* spheres per leaf at most (the SIMD test takes 8 a step) */
     /* Levels below the root at most (the build splits ranges in the middle
      * when the heuristic goes this deep), so a traversal stack of
      * PTR_BVH_MAX_DEPTH * (PTR_BVH_WIDTH - 1) + 1 entries always suffices. */

@@ -4,11 +4,19 @@
  * A node is grown Embree's way: its range is split in two by the binned
  * surface area heuristic, then the child with the largest box is split
  * again, until there are eight children or none has more spheres than a
- * leaf holds. Ranges of up to PTR_BVH_LEAF_MAX spheres are never split: the
- * SIMD leaf test takes 8 spheres in one step, and larger leaves keep the
- * tree small (a first version that split by the heuristic down to single
+ * leaf holds. Ranges of up to PTR_BVH_LEAF_MAX (16) spheres are never
+ * split: the SIMD leaf test takes 8 spheres a step, and larger leaves keep
+ * the tree small (a first version that split by the heuristic down to single
  * spheres had three times the bytes a sphere and traced 1.3 to 1.6 times
  * slower in C; measured with bench/bvh).
+ *
+ * A node over more than BOTTOM_SPHERES spheres leaves any child of at most
+ * that many unsplit: it becomes a node of its own, whose leaves then fill
+ * most of its lanes. Split there too, it would be cut into eighths that
+ * each took a node for two or three leaves: so, with leaves of up to 8,
+ * bench/bvh's 10^6-sphere cloud took 10.6 bytes a sphere in nodes; with
+ * leaves of 16 and this rule, 6.4, at the same rays per second
+ * (docs/intersectors.md, "Full nodes at the bottom").
  *
  * Threads: the top of the tree is built on the calling thread, with the
  * binning of large ranges spread over all threads; every subtree of at most
@@ -36,6 +44,9 @@ enum {
     TASK_SPHERES_MIN = 4096, /* smaller subtrees are never split among tasks */
     TASKS_PER_TREE = 64,     /* about this many tasks, for an even load */
     TASK_FLAG = 1u << 31,    /* a top-level child that is a task, not yet laid out */
+    /* See the head: 6 leaves' worth (7 or 5 gave 0.2 and 0.05 bytes a sphere
+     * more on a uniform 10^6 cloud). */
+    BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
 };
 
 /* Node arrays: the top level's, and one per task. */
@@ -103,12 +114,16 @@ static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
     BvhCandidate child[PTR_BVH_WIDTH];
     int n = 1;
     child[0] = *range;
+    const int over_bottom = range->end - range->begin > BOTTOM_SPHERES;
     for (; n < PTR_BVH_WIDTH; n++) {
         int pick = -1;
         float pick_area = -1.0f;
         for (int k = 0; k < n; k++) {
             float area = bvh_half_area(child[k].lower, child[k].upper);
-            if (child[k].end - child[k].begin > PTR_BVH_LEAF_MAX && area > pick_area) {
+            size_t count = child[k].end - child[k].begin;
+            if (over_bottom && count <= BOTTOM_SPHERES)
+                continue;
+            if (count > PTR_BVH_LEAF_MAX && area > pick_area) {
                 pick = k;
                 pick_area = area;
             }
