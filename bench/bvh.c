@@ -135,7 +135,7 @@ int main(int argc, char **argv)
             return 1;
         }
         /* The renderer's arrays (centre, radius, material) and nodes. */
-        double bytes = (double)(scene.spheres.capacity * (4 * sizeof(float) + sizeof(uint32_t)) +
+        double bytes = (double)(scene.spheres.capacity * (4 * sizeof(float) + scene.spheres.material_size) +
                                 tree.bvh.node_count * sizeof(PtrBvhNode)) / (double)scene.spheres.count;
         rate[2] = mrays(&scene, &tree, &setup, &seconds[2]);
         tree.isect = fastest;

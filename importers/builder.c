@@ -434,7 +434,7 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     s->cy[at] = c.y;
     s->cz[at] = c.z;
     s->radius[at] = r;
-    s->material[at] = b->materials[i];
+    ptr_sphere_set_material(s, at, b->materials[i]);
     if (s->id)
         s->id[at] = (uint32_t)i;
     PtrResult res = PTR_OK;

@@ -90,7 +90,7 @@ static float unbounded_radius(const PtrSpheres *s)
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i), s->material[i],
+    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i), ptr_sphere_material(s, i),
                   { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
     if (s->color)
         memcpy(p.color, &s->color[4 * i], sizeof p.color);
@@ -103,7 +103,7 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
     s->cy[i] = p->centre[1];
     s->cz[i] = p->centre[2];
     s->radius[i] = p->radius;
-    s->material[i] = p->material;
+    ptr_sphere_set_material(s, i, p->material);
     if (s->color)
         memcpy(&s->color[4 * i], p->color, sizeof p->color);
 }

@@ -55,7 +55,8 @@ PtrResult ptr_scene_write_json(FILE *out, const char *path, const PtrScene *scen
         size_t i = by_id[n];
         fprintf(out, "%s\n    {\"center\": ", n ? "," : "");
         write_point(out, scene, ptr_sphere_centre(s, i));
-        fprintf(out, ", \"radius\": %.9g, \"material\": %u", s->radius[i], s->material[i]);
+        fprintf(out, ", \"radius\": %.9g, \"material\": %u", s->radius[i],
+                ptr_sphere_material(s, i));
         if (s->color) {
             fputs(", \"color\": ", out);
             write_vec(out, ptr_sphere_color(s, i));

@@ -122,7 +122,7 @@ static inline void prefetch_surface(const PtrSpheres *spheres, uint32_t sphere)
 {
     if (sphere == PTR_NO_HIT)
         return;
-    __builtin_prefetch(&spheres->material[sphere]);
+    __builtin_prefetch((const char *)spheres->material + sphere * spheres->material_size);
     if (spheres->color)
         __builtin_prefetch(&spheres->color[4 * (size_t)sphere]);
 }
@@ -226,14 +226,14 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
         /* Local restrict pointers: the arrays do not alias v, so the
          * loop's loads become gathers. */
         const PtrMaterial *restrict materials = scene->materials;
-        const uint32_t *restrict material = spheres->material;
         const float *restrict cx = spheres->cx, *restrict cy = spheres->cy,
                     *restrict cz = spheres->cz, *restrict radius = spheres->radius;
         for (int l = 0; l < LANES; l++) {
             v->hit[l] = lanes->hit.sphere[l] != PTR_NO_HIT;
             /* Sphere 0 stands in for a miss (masked, not selected: a
              * select would become a pointer the gathers cannot use). */
-            uint32_t s = lanes->hit.sphere[l] & (0u - (uint32_t)v->hit[l]), m = material[s];
+            uint32_t s = lanes->hit.sphere[l] & (0u - (uint32_t)v->hit[l]);
+            uint32_t m = ptr_sphere_material(spheres, s);
             v->sphere[l] = s;
             v->kind[l] = materials[m].kind;
             v->ior[l] = materials[m].ior;
@@ -331,7 +331,7 @@ STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const V
                                lane_v3(v->point, l), v->sphere[l], v3_dot(dir, normal) < 0.0f);
         if (!lit->sampled)
             continue;
-        PtrMaterial m = scene->materials[scene->spheres.material[v->sphere[l]]];
+        PtrMaterial m = scene->materials[ptr_sphere_material(&scene->spheres, v->sphere[l])];
         m.albedo = lane_v3(v->albedo, l);
         PtrSampler sampler = { job->settings->sampler, lanes->key[l], lanes->index[l] };
         PtrVec3 light = ptr_path_sample_emitter(job, &sampler, lanes->depth[l], &m, lit,
@@ -383,7 +383,7 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
     for (int l = 0; l < LANES; l++) {
         if (lanes->slot[l] == FREE || !v->hit[l] || v->kind[l] != PTR_MATERIAL_METAL)
             continue;
-        float fuzz = scene->materials[scene->spheres.material[v->sphere[l]]].fuzz;
+        float fuzz = scene->materials[ptr_sphere_material(&scene->spheres, v->sphere[l])].fuzz;
         if (!(fuzz > 0.0f))
             continue;
         const float ul[3] = { u[0][l], u[1][l], u[2][l] };

@@ -10,14 +10,14 @@
  * times its area. */
 static double sphere_power(const PtrScene *scene, uint32_t i)
 {
-    PtrVec3 e = scene->materials[scene->spheres.material[i]].emission;
+    PtrVec3 e = scene->materials[ptr_sphere_material(&scene->spheres, i)].emission;
     double r = scene->spheres.radius[i];
     return ((double)e.x + e.y + e.z) * r * r;
 }
 
 static int is_emitter(const PtrScene *scene, uint32_t i)
 {
-    return v3_max_comp(scene->materials[scene->spheres.material[i]].emission) > 0.0f &&
+    return v3_max_comp(scene->materials[ptr_sphere_material(&scene->spheres, i)].emission) > 0.0f &&
            scene->spheres.radius[i] > 0.0f;
 }
 

@@ -88,7 +88,7 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
     shadow.tmax = ptr_maxf(distance * 1.001f, 2.0f * shadow.tmin);
     if (!reaches_emitter(job, &shadow, emitter, rays))
         return v3_splat(0.0f);
-    PtrVec3 emission = scene->materials[spheres->material[emitter]].emission;
+    PtrVec3 emission = scene->materials[ptr_sphere_material(spheres, emitter)].emission;
     float weight = power_heuristic(pdf, scatter_pdf) / pdf;
     return v3_scale(v3_mul(ptr_diffuse_eval(m, n, dir), emission), weight);
 }

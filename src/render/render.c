@@ -39,7 +39,7 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
             break;
         }
         *covered = 1;
-        PtrMaterial m = scene->materials[spheres->material[hit.sphere]];
+        PtrMaterial m = scene->materials[ptr_sphere_material(spheres, hit.sphere)];
         m.albedo = ptr_path_albedo(spheres, hit.sphere, m.albedo);
         PtrVec3 normal, point;
         ptr_path_surface(job, &ray, &hit, &point, &normal);

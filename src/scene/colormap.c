@@ -51,14 +51,14 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         const float value = s->value[ptr_sphere_id(s, i)]; /* in file order: see PtrSpheres */
         if (isnan(value))
             continue;
-        uint32_t m = s->material[i];
+        uint32_t m = ptr_sphere_material(s, i);
         if (white[m] == UINT32_MAX) {
             PtrMaterial copy = scene->materials[m];
             copy.albedo = v3_splat(1.0f);
             res = ptr_scene_add_material(scene, &copy, &white[m]);
         }
         if (res == PTR_OK) {
-            s->material[i] = white[m];
+            ptr_sphere_set_material(s, i, white[m]);
             res = ptr_scene_set_sphere_color(scene, i,
                                              ptr_colormap_linear(map, value, lo, hi));
         }

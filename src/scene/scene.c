@@ -11,6 +11,7 @@
 void ptr_scene_init(PtrScene *scene)
 {
     memset(scene, 0, sizeof *scene);
+    scene->spheres.material_size = 1;
     scene->sky.kind = PTR_SKY_GRADIENT;
     scene->camera = (PtrCamera){
         .lookfrom = v3(0, 0, 0), .lookat = v3(0, 0, -1), .up = v3(0, 1, 0),
@@ -34,13 +35,14 @@ enum { SPHERE_ARRAYS_MAX = 16 };
 static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
-    /* Entries are whole 4-byte words (see pad_array). */
+    /* Entries are whole 4-byte words, or smaller ones padded with 0 (see
+     * pad_array). */
     SphereArray list[] = {
         { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1 },
         { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1 },
         { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1 },
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
-        { (void **)&s->material, sizeof *s->material, 0, 0, 1 },
+        { (void **)&s->material, s->material_size, 0, 0, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1 },
         { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 1 }, /* white */
         { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
@@ -56,7 +58,16 @@ static void spheres_free(PtrSpheres *s)
     int arrays = sphere_arrays(s, a);
     for (int k = 0; k < arrays; k++)
         free(*a[k].data);
-    memset(s, 0, sizeof *s);
+    *s = (PtrSpheres){ .material_size = s->material_size };
+}
+
+/* An array of capacity entries of size bytes, 64-byte aligned (its size a
+ * multiple of that, as aligned_alloc asks). */
+static void *array_alloc(size_t capacity, size_t size)
+{
+    size_t bytes = capacity * size;
+    return aligned_alloc(PTR_SPHERE_ALIGN, (bytes + PTR_SPHERE_ALIGN - 1) / PTR_SPHERE_ALIGN *
+                                               PTR_SPHERE_ALIGN);
 }
 
 void ptr_scene_free(PtrScene *scene)
@@ -69,9 +80,13 @@ void ptr_scene_free(PtrScene *scene)
 
 /* Fills entries from .. to - 1 of array a with its padding. Entries are
  * 4-byte words (an entry of several words, such as a colour, is padded word
- * by word, the pattern repeated). */
+ * by word, the pattern repeated), or smaller ones whose padding is 0. */
 static void pad_array(const SphereArray *a, size_t from, size_t to)
 {
+    if (a->size < sizeof(uint32_t)) {
+        memset((char *)*a->data + from * a->size, 0, (to - from) * a->size);
+        return;
+    }
     uint32_t *words = *a->data;
     const size_t per_entry = a->size / sizeof *words;
     for (size_t i = from * per_entry; i < to * per_entry; i++)
@@ -85,14 +100,15 @@ static void pad_array(const SphereArray *a, size_t from, size_t to)
 static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, size_t pad_from,
                               PtrSpheres *out)
 {
-    PtrSpheres copy = { .count = s->count, .capacity = capacity };
+    PtrSpheres copy = { .count = s->count, .capacity = capacity,
+                        .material_size = s->material_size };
     SphereArray from[SPHERE_ARRAYS_MAX], to[SPHERE_ARRAYS_MAX];
     sphere_arrays((PtrSpheres *)s, from);
     int arrays = sphere_arrays(&copy, to);
     for (int k = 0; k < arrays; k++) {
         if (to[k].optional && !*from[k].data)
             continue;
-        *to[k].data = aligned_alloc(PTR_SPHERE_ALIGN, capacity * to[k].size);
+        *to[k].data = array_alloc(capacity, to[k].size);
         if (!*to[k].data) {
             spheres_free(&copy);
             return PTR_ERR_NOMEM;
@@ -166,7 +182,7 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     s->cy[i] = centre.y;
     s->cz[i] = centre.z;
     s->radius[i] = radius;
-    s->material[i] = material;
+    ptr_sphere_set_material(s, i, material);
     if (s->id)
         s->id[i] = (uint32_t)i;
     return PTR_OK;
@@ -191,7 +207,7 @@ static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from)
     int k = 0;
     while (k < arrays - 1 && a[k].data != data)
         k++;
-    *data = aligned_alloc(PTR_SPHERE_ALIGN, s->capacity * a[k].size);
+    *data = array_alloc(s->capacity, a[k].size);
     if (!*data)
         return PTR_ERR_NOMEM;
     pad_array(&a[k], pad_from, s->capacity);
@@ -238,11 +254,37 @@ PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)
     return res;
 }
 
+/* Gives the spheres' material array entries of size bytes, the indices
+ * kept. */
+static PtrResult widen_materials(PtrSpheres *s, size_t size)
+{
+    void *wide = NULL;
+    if (s->material) {
+        wide = array_alloc(s->capacity, size);
+        if (!wide)
+            return PTR_ERR_NOMEM;
+        PtrSpheres to = { .material = wide, .material_size = size };
+        for (size_t i = 0; i < s->capacity; i++)
+            ptr_sphere_set_material(&to, i, ptr_sphere_material(s, i));
+        free(s->material);
+    }
+    s->material = wide;
+    s->material_size = size;
+    return PTR_OK;
+}
+
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index)
 {
     if (scene->material_count >= UINT32_MAX)
         return PTR_ERR_NOMEM;
+    const size_t count = scene->material_count + 1;
+    const size_t size = count > 65536 ? 4 : count > 256 ? 2 : 1;
+    if (size > scene->spheres.material_size) {
+        PtrResult r = widen_materials(&scene->spheres, size);
+        if (r != PTR_OK)
+            return r;
+    }
     PtrMaterial *grown = realloc(scene->materials,
                                  (scene->material_count + 1) * sizeof *grown);
     if (!grown)
@@ -302,7 +344,10 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     h = hash_in_file_order(h, s->cy, sizeof *s->cy, by_id, s->count);
     h = hash_in_file_order(h, s->cz, sizeof *s->cz, by_id, s->count);
     h = hash_in_file_order(h, s->radius, sizeof *s->radius, by_id, s->count);
-    h = hash_in_file_order(h, s->material, sizeof *s->material, by_id, s->count);
+    for (size_t k = 0; k < s->count; k++) { /* as 4-byte indices, whatever their size */
+        const uint32_t m = ptr_sphere_material(s, by_id ? by_id[k] : k);
+        h = hash_bytes(h, &m, sizeof m);
+    }
     if (s->color)
         h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
     free(by_id);

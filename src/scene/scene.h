@@ -27,7 +27,12 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
-    uint32_t *material;  /* index into PtrScene.materials */
+    /* Each sphere's index into PtrScene.materials, material_size bytes an
+     * entry: 1 while the scene has at most 256 materials, 2 up to 65,536,
+     * else 4 (ptr_scene_add_material widens it), so that most scenes spend
+     * 1 byte a sphere on it. Read through ptr_sphere_material, written
+     * through ptr_sphere_set_material. */
+    void *material;
     /* The sphere's position in the scene file's order (the importer puts
      * the huge ones last), until the tree's build, which keeps that order
      * within a leaf (coincident spheres sharing one show the first in the
@@ -46,6 +51,7 @@ typedef struct PtrSpheres {
     float *value;
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
+    size_t material_size; /* 1, 2 or 4 (see material) */
 } PtrSpheres;
 
 typedef enum PtrMaterialKind {
@@ -169,6 +175,25 @@ void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
  * creates the array, NaN for every other sphere. */
 PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
 
+static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
+{
+    switch (s->material_size) {
+    case 1: return ((const uint8_t *)s->material)[i];
+    case 2: return ((const uint16_t *)s->material)[i];
+    default: return ((const uint32_t *)s->material)[i];
+    }
+}
+
+/* Gives sphere i material m, an index the scene has (so one that fits). */
+static inline void ptr_sphere_set_material(PtrSpheres *s, size_t i, uint32_t m)
+{
+    switch (s->material_size) {
+    case 1: ((uint8_t *)s->material)[i] = (uint8_t)m; break;
+    case 2: ((uint16_t *)s->material)[i] = (uint16_t)m; break;
+    default: ((uint32_t *)s->material)[i] = m; break;
+    }
+}
+
 static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 {
     const float unit = 1.0f / 65535.0f;
@@ -176,7 +201,8 @@ static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
     return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
 }
 
-/* Appends a material and stores its index in *index. */
+/* Appends a material and stores its index in *index; the spheres' material
+ * array widens if the count needs it (PtrSpheres.material). */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index);
 

@@ -55,7 +55,7 @@ static void check_file(const char *path, int pbr, int has_camera)
             TEST_FAIL_("%s: no sphere for the %s", path, x->what);
             continue;
         }
-        const PtrMaterial *m = &s.materials[s.spheres.material[i]];
+        const PtrMaterial *m = &s.materials[ptr_sphere_material(&s.spheres, i)];
         CHECK_NEAR(s.spheres.radius[i], x->radius, 1e-4 * x->radius);
         PtrMaterialKind kind = !pbr && x->kind == PTR_MATERIAL_DIELECTRIC ? PTR_MATERIAL_DIFFUSE : x->kind;
         CHECK_INT(m->kind, kind);

@@ -9,7 +9,7 @@
 
 static const PtrMaterial *material_of(const PtrScene *s, size_t sphere)
 {
-    return &s->materials[s->spheres.material[sphere]];
+    return &s->materials[ptr_sphere_material(&s->spheres, sphere)];
 }
 
 static int has_warning(const PtrStrings *w, const char *needle)
@@ -37,7 +37,7 @@ static void test_hierarchy(void)
     check_sphere(&s, 6, 3, 3, 3, 1, 1e-5);
 
     CHECK_INT(s.material_count, 5); /* Red is shared by spheres 0, 3 and 4 */
-    CHECK_INT(s.spheres.material[0], s.spheres.material[3]);
+    CHECK_INT(ptr_sphere_material(&s.spheres, 0), ptr_sphere_material(&s.spheres, 3));
     const PtrMaterial *red = material_of(&s, 0), *gold = material_of(&s, 1),
                       *grey = material_of(&s, 2), *lamp = material_of(&s, 5),
                       *glass = material_of(&s, 6);

@@ -10,7 +10,7 @@
 
 static const PtrMaterial *material(const PtrScene *s, size_t sphere)
 {
-    return &s->materials[s->spheres.material[sphere]];
+    return &s->materials[ptr_sphere_material(&s->spheres, sphere)];
 }
 
 static void test_materials(void)

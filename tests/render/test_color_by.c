@@ -170,9 +170,9 @@ static void test_materials(void)
     CHECK(isnan(s.spheres.value[1]));
     CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find("magma"), 1.0, 2.0), PTR_OK);
     CHECK_INT((int)s.material_count, 2);
-    CHECK_INT((int)s.spheres.material[1], 0);
-    CHECK_INT((int)s.spheres.material[0], 1);
-    CHECK_INT((int)s.spheres.material[2], 1);
+    CHECK_INT((int)ptr_sphere_material(&s.spheres, 1), 0);
+    CHECK_INT((int)ptr_sphere_material(&s.spheres, 0), 1);
+    CHECK_INT((int)ptr_sphere_material(&s.spheres, 2), 1);
     const PtrMaterial *white = &s.materials[1];
     CHECK(white->kind == PTR_MATERIAL_METAL && white->fuzz == 0.25f);
     CHECK(white->albedo.x == 1.0f && white->albedo.y == 1.0f && white->albedo.z == 1.0f);

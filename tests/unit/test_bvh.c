@@ -325,7 +325,7 @@ static void test_renders_hard(void)
             float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
             PtrSpheres *sp = &s[k].spheres;
             for (size_t i = 0; i < sp->count; i++) {
-                sp->material[i] = (uint32_t)(i % 3);
+                ptr_sphere_set_material(sp, i, (uint32_t)(i % 3));
                 if (i % 4 == 0)
                     CHECK_INT(ptr_scene_set_sphere_color(&s[k], i, v3((float)(i % 5) / 4.0f, 0.5f,
                                                                       (float)(i % 7) / 6.0f)),

@@ -2,7 +2,8 @@
  * scene's arrays): exactly the pages the contract names leave the process
  * (mincore says which pages are resident), every byte the caller has not
  * finished with keeps its value, and releasing a range in steps, each from
- * where the last ended, leaves no page of it behind. */
+ * where the last ended, leaves no page of it behind; and the material
+ * array's entries, 1 byte a sphere until the materials need more. */
 #define _DEFAULT_SOURCE /* mincore */
 #include "test.h"
 
@@ -134,7 +135,7 @@ static void test_spheres_release(void)
     for (size_t i = 0; i < count + kept; i++) {
         s->cx[i] = s->cy[i] = s->cz[i] = (float)i;
         s->radius[i] = 1.0f;
-        s->material[i] = 7;
+        ptr_sphere_set_material(s, i, 7);
         s->id[i] = (uint32_t)i;
         failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f) != PTR_OK;
     }
@@ -145,7 +146,7 @@ static void test_spheres_release(void)
     for (size_t i = 0; i < count; i++)
         zeroed += s->cx[i] == 0.0f && s->radius[i] == 0.0f && s->id[i] == 0;
     for (size_t i = count; i < count + kept; i++)
-        changed_after += s->cx[i] != (float)i || s->radius[i] != 1.0f || s->material[i] != 7 ||
+        changed_after += s->cx[i] != (float)i || s->radius[i] != 1.0f || ptr_sphere_material(s, i) != 7 ||
                          s->id[i] != i;
     for (size_t i = 0; i < count + kept; i++)
         values_changed += s->value[i] != 2.0f;
@@ -158,10 +159,49 @@ static void test_spheres_release(void)
     ptr_scene_free(&scene);
 }
 
+/* Adds materials until the scene has count. */
+static void add_materials(PtrScene *scene, size_t count)
+{
+    const PtrMaterial m = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
+    uint32_t index;
+    while (scene->material_count < count)
+        CHECK_INT(ptr_scene_add_material(scene, &m, &index), PTR_OK);
+}
+
+/* 1 byte a sphere up to 256 materials, 2 up to 65,536, then 4; widening
+ * keeps every index, and padding entries stay 0. */
+static void test_material_widths(void)
+{
+    PtrScene scene;
+    ptr_scene_init(&scene);
+    add_materials(&scene, 256);
+    const size_t count = 1000;
+    for (size_t i = 0; i < count; i++)
+        CHECK_INT(ptr_scene_add_sphere(&scene, v3(0, 0, (float)i), 1.0f, (uint32_t)(i % 256)),
+                  PTR_OK);
+    PtrSpheres *s = &scene.spheres;
+    CHECK_INT(s->material_size, 1);
+    const size_t sizes[2] = { 2, 4 }, counts[2] = { 257, 65537 };
+    for (int w = 0; w < 2; w++) {
+        add_materials(&scene, counts[w]);
+        CHECK_INT(s->material_size, sizes[w]);
+        ptr_sphere_set_material(s, count - 1, (uint32_t)(counts[w] - 1));
+        size_t kept = 0;
+        for (size_t i = 0; i + 1 < count; i++)
+            kept += ptr_sphere_material(s, i) == i % 256;
+        CHECK_INT(kept, count - 1);
+        CHECK_INT(ptr_sphere_material(s, count - 1), counts[w] - 1);
+        for (size_t i = count; i < s->capacity; i++)
+            CHECK_INT(ptr_sphere_material(s, i), 0);
+    }
+    ptr_scene_free(&scene);
+}
+
 int main(void)
 {
     test_release_whole_pages_only();
     test_release_in_steps();
     test_spheres_release();
+    test_material_widths();
     return test_report();
 }
