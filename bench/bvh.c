@@ -134,9 +134,11 @@ int main(int argc, char **argv)
             fprintf(stderr, "bvh: out of memory building the tree over %zu spheres\n", n);
             return 1;
         }
-        /* The renderer's arrays (centre, radius, material) and nodes. */
-        double bytes = (double)(scene.spheres.capacity * (4 * sizeof(float) + scene.spheres.material_size) +
-                                tree.bvh.node_count * sizeof(PtrBvhNode)) / (double)scene.spheres.count;
+        /* The renderer's arrays (centre, radius, material) and nodes, not
+         * counting the room the arrays grew into. */
+        const PtrSpheres *s = &scene.spheres;
+        double bytes = (double)(s->count * (4 * sizeof(float) + s->material_size) +
+                                tree.bvh.node_count * sizeof(PtrBvhNode)) / (double)s->count;
         rate[2] = mrays(&scene, &tree, &setup, &seconds[2]);
         tree.isect = fastest;
         rate[3] = mrays(&scene, &tree, &setup, &seconds[3]);

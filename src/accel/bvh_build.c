@@ -14,8 +14,8 @@
  * that many unsplit: it becomes a node of its own, whose leaves then fill
  * most of its lanes. Split there too, it would be cut into eighths that
  * each took a node for two or three leaves: so, with leaves of up to 8,
- * bench/bvh's 10^6-sphere cloud took 10.6 bytes a sphere in nodes; with
- * leaves of 16 and this rule, 6.4, at the same rays per second
+ * bench/bvh's 10^6-sphere cloud took 9.6 bytes a sphere in nodes; with
+ * leaves of 16 and this rule, 5.4, at the same rays per second
  * (docs/intersectors.md, "Full nodes at the bottom").
  *
  * Threads: the top of the tree is built on the calling thread, with the
