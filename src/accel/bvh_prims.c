@@ -90,7 +90,8 @@ static float unbounded_radius(const PtrSpheres *s)
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i), ptr_sphere_material(s, i),
+    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i),
+                  ptr_sphere_material(s, i),
                   { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
     if (s->color)
         memcpy(p.color, &s->color[4 * i], sizeof p.color);

@@ -36,9 +36,9 @@ static uint32_t file_position(const PtrSpheres *s, size_t i, FileOrder order)
 /* Walks the tree: every sphere in the tree is in exactly one leaf, every
  * box contains its spheres and its subtree's boxes, leaves hold 1 to
  * PTR_BVH_LEAF_MAX spheres in ascending order, and the depth is as stated. */
-static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, uint32_t index, int level,
-                       const float parent_lo[3], const float parent_hi[3], unsigned char *seen,
-                       int *ok)
+static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, uint32_t index,
+                       int level, const float parent_lo[3], const float parent_hi[3],
+                       unsigned char *seen, int *ok)
 {
     const PtrBvhNode *n = &bvh->nodes[index];
     const float *lo[3] = { n->lower_x, n->lower_y, n->lower_z };
@@ -139,7 +139,8 @@ static void check_rays(const PtrScene *file_order, const PtrScene *built, const 
             brute.sphere != tree.sphere || file_found != tree_found ||
             memcmp(&file.t, &tree.t, sizeof file.t)) {
             if (differences++ < 5)
-                fprintf(stderr, "%s: ray %d: brute t %a sphere %u, tree t %a sphere %u, file order t %a\n",
+                fprintf(stderr,
+                        "%s: ray %d: brute t %a sphere %u, tree t %a sphere %u, file order t %a\n",
                         name, i, brute.t, brute.sphere, tree.t, tree.sphere, file.t);
         }
     }

@@ -146,8 +146,8 @@ static void test_spheres_release(void)
     for (size_t i = 0; i < count; i++)
         zeroed += s->cx[i] == 0.0f && s->radius[i] == 0.0f && s->id[i] == 0;
     for (size_t i = count; i < count + kept; i++)
-        changed_after += s->cx[i] != (float)i || s->radius[i] != 1.0f || ptr_sphere_material(s, i) != 7 ||
-                         s->id[i] != i;
+        changed_after += s->cx[i] != (float)i || s->radius[i] != 1.0f ||
+                         ptr_sphere_material(s, i) != 7 || s->id[i] != i;
     for (size_t i = 0; i < count + kept; i++)
         values_changed += s->value[i] != 2.0f;
     /* All but the first and the last page of each array below count, which
