@@ -368,9 +368,55 @@ static void test_auto(void)
     }
 }
 
+/* Coincident spheres, which a ray meets at the same t, show the first in
+ * the file, through the tree and through brute force alike: they share a
+ * leaf, which keeps the file's order. A grid of 1000 spheres apart from
+ * each other; ten of them repeated at the end of the file in another
+ * material. */
+static void test_coincident(void)
+{
+    PtrIsectTable c;
+    ptr_isect_init_level(&c, PTR_CPU_NONE);
+    for (int choice = PTR_ACCEL_BRUTE; choice <= PTR_ACCEL_BVH; choice++) {
+        PtrScene s;
+        ptr_scene_init(&s);
+        const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
+        uint32_t m;
+        for (int k = 0; k < 3; k++)
+            CHECK_INT(ptr_scene_add_material(&s, &grey, &m), PTR_OK);
+        for (int i = 0; i < 1000; i++) {
+            PtrVec3 at = v3(3.0f * (float)(i % 10), 3.0f * (float)(i / 10 % 10),
+                            -3.0f * (float)(i / 100) - 10.0f);
+            CHECK_INT(ptr_scene_add_sphere(&s, at, 1.0f, i % 100 == 7 ? 1 : 0), PTR_OK);
+        }
+        for (int i = 7; i < 1000; i += 100)
+            CHECK_INT(ptr_scene_add_sphere(&s, ptr_sphere_centre(&s.spheres, (size_t)i), 1.0f, 2),
+                      PTR_OK);
+        PtrVec3 centres[10];
+        for (int k = 0; k < 10; k++)
+            centres[k] = ptr_sphere_centre(&s.spheres, (size_t)(100 * k + 7));
+        PtrAccel accel;
+        CHECK_INT(ptr_accel_init(&accel, (PtrAccelChoice)choice, &c, 0, &s, 0), PTR_OK);
+        CHECK_STR(ptr_accel_name(&accel), choice == PTR_ACCEL_BVH ? "bvh" : "brute");
+        int first = 0;
+        for (int k = 0; k < 10; k++) {
+            /* From between the grid's spheres, straight at one of the pair. */
+            PtrRay ray = { { centres[k].x, centres[k].y, centres[k].z + 1.5f }, 0.0f,
+                           { 0, 0, -1 }, INFINITY };
+            PtrHit hit;
+            first += ptr_trace(&accel, &ray, &hit) && hit.t == 0.5f &&
+                     ptr_sphere_material(&s.spheres, hit.sphere) == 1;
+        }
+        CHECK_INT(first, 10);
+        ptr_accel_free(&accel);
+        ptr_scene_free(&s);
+    }
+}
+
 int main(void)
 {
     test_small();
+    test_coincident();
     test_unbounded();
     test_scenes();
     test_threads();
