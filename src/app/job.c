@@ -137,8 +137,8 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
     return res;
 }
 
-/* Chooses the structure for the imported scene (the tree reorders its
- * spheres), renders and writes the image. */
+/* Chooses the structure for the imported scene (the tree's build reorders
+ * its spheres, for either), renders and writes the image. */
 static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const PtrColor *color,
                                   PtrJobReport *report, PtrError *err)
 {
@@ -147,8 +147,8 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
     PtrIntegrator integrator = ptr_integrator_resolve(o->integrator);
     snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
-    /* Before the tree reorders the spheres: the hash does not depend on
-     * their order, but there is no need to find the file order again. */
+    /* Before the build, which reorders the spheres and frees the ids that
+     * give the file's order, which the hash takes. */
     uint64_t scene_hash = ptr_scene_hash(scene);
     PtrAccel accel;
     PtrResult built = ptr_accel_init(&accel, o->accel, &isect,
