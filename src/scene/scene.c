@@ -332,8 +332,8 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     /* In the file's order, through the ids where the importer put the huge
      * spheres last (out of memory, as they are: the renderer hashes before
      * the build, while nothing else holds memory). */
-    size_t reordered = 0;
-    while (reordered < s->count && ptr_sphere_id(s, reordered) == reordered)
+    size_t reordered = s->id ? 0 : s->count; /* no ids: in the file's order */
+    while (reordered < s->count && s->id[reordered] == reordered)
         reordered++;
     uint32_t *by_id = reordered < s->count ? malloc(s->count * sizeof *by_id) : NULL;
     for (size_t j = 0; by_id && j < s->count; j++)
