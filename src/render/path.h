@@ -10,8 +10,9 @@
 #include "accel/accel.h"
 #include "base/trig.h"
 #include "render/camera.h"
+#include "render/film.h"
 #include "render/lights.h"
-#include "render/render.h"
+#include "render/settings.h"
 #include "sampling/sampler.h"
 
 typedef struct PtrPathJob {
