@@ -17,9 +17,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "accel/huge.h"
 #include "accel/spawn.h"
-#include "render/material.h"
 #include "render/path.h"
 
 enum { LANES = PTR_PACKET_LANES, FREE = -1 };
@@ -251,7 +249,7 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
     }
     if (scene->huge.count)
         for (int l = 0; l < LANES; l++)
-            if (lanes->slot[l] != FREE && v->hit[l] && ptr_is_huge(scene, v->sphere[l])) {
+            if (lanes->slot[l] != FREE && v->hit[l] && ptr_path_in_double(job, v->sphere[l])) {
                 PtrRay ray = lane_ray(lanes, l);
                 PtrHit hit = { lanes->hit.t[l], lanes->hit.sphere[l] };
                 PtrVec3 point, normal;
@@ -265,17 +263,13 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
 STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes,
                             const Vertex *restrict v, float weight[LANES])
 {
-    for (int l = 0; l < LANES; l++) {
-        weight[l] = 1.0f;
-        if (job->sample_lights && lanes->slot[l] != FREE && v->hit[l] && lanes->lit[l].sampled &&
-            v3_max_comp(lane_v3(v->emission, l)) > 0.0f) {
-            PtrVec3 point = lane_v3(v->point, l);
-            weight[l] = ptr_path_emission_weight(job, &lanes->lit[l], v->sphere[l],
-                                                 lane_v3(lanes->ray.dir, l),
-                                                 v3_length(v3_sub(point, lanes->lit[l].point)),
-                                                 lane_v3(v->normal, l));
-        }
-    }
+    for (int l = 0; l < LANES; l++)
+        weight[l] = lanes->slot[l] != FREE && v->hit[l]
+                        ? ptr_path_emission_weight(job, &lanes->lit[l], v->sphere[l],
+                                                   lane_v3(v->emission, l),
+                                                   lane_v3(lanes->ray.dir, l),
+                                                   lane_v3(v->point, l), lane_v3(v->normal, l))
+                        : 1.0f;
 }
 
 /* The loop of add_sky_and_emission under one sky: inlined where the sky's
@@ -285,15 +279,11 @@ static inline __attribute__((always_inline)) void add_found(Lanes *restrict lane
                                                             const Vertex *restrict v,
                                                             const float weight[LANES], PtrSky sky)
 {
-    for (int l = 0; l < LANES; l++) {
-        PtrVec3 throughput = lane_v3(lanes->throughput, l), emission = lane_v3(v->emission, l);
-        PtrVec3 sky_l = ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l));
-        PtrVec3 found = v->hit[l] ? v3_scale(v3_mul(throughput, emission), weight[l])
-                                  : v3_mul(throughput, sky_l);
-        int adds = !v->hit[l] | (v3_max_comp(emission) > 0.0f);
-        PtrVec3 radiance = lane_v3(lanes->radiance, l);
-        set_lane_v3(lanes->radiance, l, adds ? v3_add(radiance, found) : radiance);
-    }
+    for (int l = 0; l < LANES; l++)
+        set_lane_v3(lanes->radiance, l,
+                    ptr_path_add_found(lane_v3(lanes->radiance, l), lane_v3(lanes->throughput, l),
+                                       v->hit[l], ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l)),
+                                       lane_v3(v->emission, l), weight[l]));
 }
 
 /* What the lanes found: the sky where they missed, emission where they hit
@@ -362,10 +352,12 @@ STAGE void bounce_numbers(const PtrPathJob *job, const Lanes *restrict lanes, in
 STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restrict v)
 {
     const PtrScene *scene = job->scene;
+    const PtrMaterial *materials = scene->materials;
     float u[3][LANES], unused[LANES];
     int third = 0;
     for (int l = 0; l < LANES; l++)
-        third |= lanes->slot[l] != FREE && v->hit[l] && v->kind[l] != PTR_MATERIAL_DIFFUSE;
+        third |= lanes->slot[l] != FREE && v->hit[l] &&
+                 ptr_scatter_reads_third((PtrMaterialKind)v->kind[l]);
     bounce_numbers(job, lanes, PTR_SLOT_BSDF, u[0], u[1]);
     if (third)
         bounce_numbers(job, lanes, PTR_SLOT_BSDF_EXTRA, u[2], unused);
@@ -373,29 +365,28 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
         for (int l = 0; l < LANES; l++)
             u[2][l] = 0.0f;
     for (int l = 0; l < LANES; l++) {
-        PtrVec3 d = lane_v3(lanes->ray.dir, l), normal = lane_v3(v->normal, l);
         const float ul[3] = { u[0][l], u[1][l], u[2][l] };
         set_lane_v3(v->out, l,
-                    ptr_scatter_direction((PtrMaterialKind)v->kind[l], v->ior[l], d,
-                                          ptr_facing_normal(d, normal), v3_dot(d, normal) < 0.0f,
-                                          ul, &v->scattered[l]));
+                    ptr_scatter_direction((PtrMaterialKind)v->kind[l], v->ior[l],
+                                          lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l), ul,
+                                          &v->scattered[l]));
     }
     for (int l = 0; l < LANES; l++) {
-        if (lanes->slot[l] == FREE || !v->hit[l] || v->kind[l] != PTR_MATERIAL_METAL)
+        if (lanes->slot[l] == FREE || !v->hit[l])
             continue;
-        float fuzz = scene->materials[ptr_sphere_material(&scene->spheres, v->sphere[l])].fuzz;
-        if (!(fuzz > 0.0f))
+        const PtrMaterial *m = &materials[ptr_sphere_material(&scene->spheres, v->sphere[l])];
+        if (!ptr_scatter_is_fuzzy(m->kind, m->fuzz))
             continue;
         const float ul[3] = { u[0][l], u[1][l], u[2][l] };
-        PtrVec3 d = lane_v3(lanes->ray.dir, l);
         set_lane_v3(v->out, l,
-                    ptr_scatter_fuzzy_metal(fuzz, d, ptr_facing_normal(d, lane_v3(v->normal, l)),
-                                            ul, &v->scattered[l]));
+                    ptr_scatter_fuzzy_metal(m->fuzz, lane_v3(lanes->ray.dir, l),
+                                            lane_v3(v->normal, l), ul, &v->scattered[l]));
     }
     if (job->sample_lights)
         for (int l = 0; l < LANES; l++)
             if (lanes->slot[l] != FREE && v->hit[l] && lanes->lit[l].sampled)
-                lanes->lit[l].scatter_pdf = ptr_diffuse_pdf(
+                lanes->lit[l].scatter_pdf = ptr_material_pdf(
+                    &materials[ptr_sphere_material(&scene->spheres, v->sphere[l])],
                     ptr_facing_normal(lane_v3(lanes->ray.dir, l), lane_v3(v->normal, l)),
                     lane_v3(v->out, l));
 }
@@ -408,15 +399,16 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
 {
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
-    int max_depth = job->settings->max_depth;
     int go_on[LANES];
     if (spheres->count) {
         const float *restrict cx = spheres->cx, *restrict cy = spheres->cy,
                     *restrict cz = spheres->cz, *restrict radius = spheres->radius;
         for (int l = 0; l < LANES; l++) {
-            PtrVec3 throughput = v3_mul(lane_v3(lanes->throughput, l), lane_v3(v->albedo, l));
-            go_on[l] = v->hit[l] & v->scattered[l] & !(v3_max_comp(throughput) <= 0.0f) &
-                       (lanes->depth[l] + 1 < max_depth);
+            PtrVec3 throughput =
+                v3_mul(lane_v3(lanes->throughput, l),
+                       ptr_scatter_attenuation((PtrMaterialKind)v->kind[l], lane_v3(v->albedo, l)));
+            go_on[l] = v->hit[l] & ptr_path_goes_on(job->settings, lanes->depth[l],
+                                                    v->scattered[l], throughput);
             set_lane_v3(lanes->throughput, l, throughput);
             uint32_t s = v->sphere[l];
             PtrRay next = ptr_spawn_ray(v3(cx[s], cy[s], cz[s]), radius[s], lane_v3(v->normal, l),
@@ -440,7 +432,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
             lanes->slot[l] = FREE;
             continue;
         }
-        if (scene->huge.count && ptr_is_huge(scene, v->sphere[l]))
+        if (scene->huge.count && ptr_path_in_double(job, v->sphere[l]))
             set_lane_ray(lanes, l, ptr_path_leave(job, v->sphere[l], lane_v3(v->point, l),
                                                   lane_v3(v->normal, l), lane_v3(v->out, l)));
         lanes->depth[l]++;
@@ -508,7 +500,7 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
                 round.sums[round.pixels++] = acc;
             }
         round.items = (uint32_t)round.pixels * round.span;
-        if (s->max_depth > 0)
+        if (ptr_path_may_trace(s, 0))
             render_round(job, &round, results, covered, rays);
         else
             for (uint32_t i = 0; i < round.items; i++) {

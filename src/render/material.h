@@ -5,8 +5,9 @@
  * The pieces are inline and branch-free where they can be: the path tracer
  * calls them one path at a time, and its bundles (render/bundle.c) call them
  * lane by lane in loops the compiler vectorises; both compute the same bits.
- * A new material is a case of ptr_scatter_direction (and, if it has a
- * density, of the light sampling in path.c). */
+ * Everything a path asks of a material is here, so a new material is a case
+ * of each ptr_scatter_* and ptr_material_* function below that names kinds,
+ * and of nothing else in the render. */
 #ifndef PTR_MATERIAL_H
 #define PTR_MATERIAL_H
 
@@ -91,34 +92,62 @@ static inline PtrVec3 ptr_facing_normal(PtrVec3 dir, PtrVec3 outward_normal)
     return v3_dot(dir, outward_normal) < 0.0f ? outward_normal : v3_neg(outward_normal);
 }
 
-/* The direction a ray along d leaves a surface of this kind and index of
- * refraction in, n the normal on the side it arrives from, u as for
- * ptr_scatter: every material's direction computed and the kind's kept,
+/* The direction a ray along unit d leaves a surface of this kind and index
+ * of refraction in (outward_normal: the surface's outward unit normal), u as
+ * for ptr_scatter: every material's direction computed and the kind's kept,
  * without branches, so that the bundles' loops over lanes vectorise (where
  * the kind is a constant, the compiler drops the others). Fuzzy metal takes
  * ptr_scatter_fuzzy_metal instead. *scattered is 0 where the ray is
  * absorbed. */
 static inline PtrVec3 ptr_scatter_direction(PtrMaterialKind kind, float ior, PtrVec3 d,
-                                            PtrVec3 n, int entering, const float u[3],
+                                            PtrVec3 outward_normal, const float u[3],
                                             int *scattered)
 {
+    PtrVec3 n = ptr_facing_normal(d, outward_normal);
     PtrVec3 diffuse = ptr_scatter_diffuse(n, u[0], u[1]);
     PtrVec3 mirror = ptr_reflect(d, n);
-    PtrVec3 glass = ptr_scatter_dielectric(ior, d, n, entering, u[2]);
+    PtrVec3 glass = ptr_scatter_dielectric(ior, d, n, v3_dot(d, outward_normal) < 0.0f, u[2]);
     *scattered = (kind != PTR_MATERIAL_METAL) | (v3_dot(mirror, n) > 0.0f);
     return kind == PTR_MATERIAL_DIFFUSE ? diffuse
            : kind == PTR_MATERIAL_METAL ? v3_normalize(mirror)
                                         : glass;
 }
 
+/* Whether a material of this kind and fuzz scatters by
+ * ptr_scatter_fuzzy_metal rather than ptr_scatter_direction. */
+static inline int ptr_scatter_is_fuzzy(PtrMaterialKind kind, float fuzz)
+{
+    return kind == PTR_MATERIAL_METAL && fuzz > 0.0f;
+}
+
 /* Metal with fuzz: the mirror direction plus ptr_fuzz_offset, absorbed
  * (*scattered 0) where that points into the surface. */
-static inline PtrVec3 ptr_scatter_fuzzy_metal(float fuzz, PtrVec3 d, PtrVec3 n, const float u[3],
-                                              int *scattered)
+static inline PtrVec3 ptr_scatter_fuzzy_metal(float fuzz, PtrVec3 d, PtrVec3 outward_normal,
+                                              const float u[3], int *scattered)
 {
+    PtrVec3 n = ptr_facing_normal(d, outward_normal);
     PtrVec3 dir = v3_add(ptr_reflect(d, n), ptr_fuzz_offset(fuzz, u));
     *scattered = v3_dot(dir, n) > 0.0f;
     return v3_normalize(dir);
+}
+
+/* Whether scattering off a material of this kind may read the third
+ * number u[2] (the Fresnel coin, the fuzz radius): where no lane's does,
+ * the bundles do not draw it. */
+static inline int ptr_scatter_reads_third(PtrMaterialKind kind)
+{
+    return kind != PTR_MATERIAL_DIFFUSE;
+}
+
+/* The factor a path's throughput takes where it scatters off a material of
+ * this kind and albedo: the BSDF times the cosine over the density of the
+ * direction taken. Every kind here draws its direction in proportion to
+ * BSDF times cosine, so the factor is the albedo (for diffuse,
+ * ptr_material_eval over ptr_material_pdf). */
+static inline PtrVec3 ptr_scatter_attenuation(PtrMaterialKind kind, PtrVec3 albedo)
+{
+    (void)kind;
+    return albedo;
 }
 
 /* For diffuse materials, with n the unit normal on the side the light
@@ -134,6 +163,30 @@ static inline float ptr_diffuse_pdf(PtrVec3 n, PtrVec3 out_dir)
 static inline PtrVec3 ptr_diffuse_eval(const PtrMaterial *material, PtrVec3 n, PtrVec3 out_dir)
 {
     return v3_scale(material->albedo, ptr_diffuse_pdf(n, out_dir));
+}
+
+/* Whether scattering off a material of this kind has a density that light
+ * sampling can weigh its directions against (ptr_material_pdf): where it
+ * has none (a mirror's or glass's single direction, metal's fuzz), light
+ * sampling skips the vertex and the emission scattering finds counts fully. */
+static inline int ptr_material_has_density(PtrMaterialKind kind)
+{
+    return kind == PTR_MATERIAL_DIFFUSE;
+}
+
+/* The density with which scattering off material picks out_dir, n the
+ * unit normal on the side the light arrives from, and the BSDF times the
+ * cosine there: what multiple importance sampling weighs light samples by.
+ * Both are 0 for a material without a density. */
+static inline float ptr_material_pdf(const PtrMaterial *material, PtrVec3 n, PtrVec3 out_dir)
+{
+    return material->kind == PTR_MATERIAL_DIFFUSE ? ptr_diffuse_pdf(n, out_dir) : 0.0f;
+}
+
+static inline PtrVec3 ptr_material_eval(const PtrMaterial *material, PtrVec3 n, PtrVec3 out_dir)
+{
+    return material->kind == PTR_MATERIAL_DIFFUSE ? ptr_diffuse_eval(material, n, out_dir)
+                                                  : v3_splat(0.0f);
 }
 
 #endif /* PTR_MATERIAL_H */

@@ -2,9 +2,7 @@
 
 #include <math.h>
 
-#include "accel/huge.h"
 #include "accel/spawn.h"
-#include "render/material.h"
 
 void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hit,
                       PtrVec3 *point, PtrVec3 *normal)
@@ -12,7 +10,7 @@ void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hi
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
     float fixed_tmin = job->settings->fixed_tmin;
-    if (ptr_is_huge(scene, hit->sphere) && fixed_tmin == 0.0f) {
+    if (ptr_path_in_double(job, hit->sphere)) {
         ptr_huge_surface(scene, ray, hit, point, normal);
         return;
     }
@@ -29,10 +27,10 @@ PtrRay ptr_path_leave(const PtrPathJob *job, uint32_t sphere, PtrVec3 point,
 {
     const PtrSpheres *spheres = &job->scene->spheres;
     float tmin = job->settings->fixed_tmin;
+    if (ptr_path_in_double(job, sphere))
+        return ptr_huge_spawn_ray(job->scene, sphere, point, dir);
     if (tmin > 0.0f)
         return (PtrRay){ { point.x, point.y, point.z }, tmin, { dir.x, dir.y, dir.z }, INFINITY };
-    if (ptr_is_huge(job->scene, sphere))
-        return ptr_huge_spawn_ray(job->scene, sphere, point, dir);
     return ptr_spawn_ray(ptr_sphere_centre(spheres, sphere), spheres->radius[sphere],
                          outward_normal, dir);
 }
@@ -81,7 +79,7 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
                           &distance, &pdf))
         return v3_splat(0.0f);
     pdf *= ptr_lights_pick_pdf(&job->lights, scene, emitter);
-    float scatter_pdf = ptr_diffuse_pdf(n, dir);
+    float scatter_pdf = ptr_material_pdf(m, n, dir);
     if (!(scatter_pdf > 0.0f) || !(pdf > 0.0f))
         return v3_splat(0.0f);
     PtrRay shadow = ptr_path_leave(job, at->sphere, at->point, outward_normal, dir);
@@ -90,16 +88,16 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
         return v3_splat(0.0f);
     PtrVec3 emission = scene->materials[ptr_sphere_material(spheres, emitter)].emission;
     float weight = power_heuristic(pdf, scatter_pdf) / pdf;
-    return v3_scale(v3_mul(ptr_diffuse_eval(m, n, dir), emission), weight);
+    return v3_scale(v3_mul(ptr_material_eval(m, n, dir), emission), weight);
 }
 
-float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
-                               PtrVec3 dir, float t, PtrVec3 normal)
+float ptr_path_mis_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
+                          PtrVec3 dir, PtrVec3 point, PtrVec3 normal)
 {
     const PtrSpheres *spheres = &job->scene->spheres;
     float light_pdf = ptr_light_pdf(view_from(from, spheres, emitter), from->point,
                                     ptr_sphere_centre(spheres, emitter), spheres->radius[emitter],
-                                    dir, t, normal);
+                                    dir, v3_length(v3_sub(point, from->point)), normal);
     if (!(light_pdf > 0.0f))
         return 1.0f;
     light_pdf *= ptr_lights_pick_pdf(&job->lights, job->scene, emitter);

@@ -8,10 +8,12 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
+#include "accel/huge.h"
 #include "base/trig.h"
 #include "render/camera.h"
 #include "render/film.h"
 #include "render/lights.h"
+#include "render/material.h"
 #include "render/settings.h"
 #include "sampling/sampler.h"
 
@@ -36,15 +38,32 @@ enum { PTR_TILE_SIZE = 16, PTR_TILE_PIXELS = PTR_TILE_SIZE * PTR_TILE_SIZE };
  * are complete nets at these counts. */
 enum { PTR_ADAPTIVE_STEP = 16 };
 
-/* A diffuse vertex where an emitter was sampled: what the next vertex needs
- * to weigh the emission the scattered ray finds against that sample. */
+/* A vertex where an emitter was sampled: what the next vertex needs to
+ * weigh the emission the scattered ray finds against that sample. */
 typedef struct PtrLitVertex {
     int sampled;       /* 0: the emission found next counts fully */
     PtrVec3 point;
     uint32_t sphere;   /* the sphere it lies on */
     int side;          /* 1 on its outside, -1 on its inside */
-    float scatter_pdf; /* of the direction taken */
+    float scatter_pdf; /* of the direction taken (ptr_material_pdf) */
 } PtrLitVertex;
+
+/* Whether a path may trace its ray number depth, counting from 0 (the
+ * camera's): max_depth rays at most. */
+static inline int ptr_path_may_trace(const PtrRenderSettings *settings, int depth)
+{
+    return depth < settings->max_depth;
+}
+
+/* Whether a path whose ray number depth hit a surface goes on from there:
+ * the surface scattered it (did not absorb it), the throughput after the
+ * scattering is not zero, and the path may trace another ray. Written with
+ * & and !(<= 0), as the bundles' vector loops need it. */
+static inline int ptr_path_goes_on(const PtrRenderSettings *settings, int depth, int scattered,
+                                   PtrVec3 throughput)
+{
+    return scattered & !(v3_max_comp(throughput) <= 0.0f) & ptr_path_may_trace(settings, depth + 1);
+}
 
 /* The albedo of material at sphere: tinted by the sphere's own colour where
  * the scene gives spheres colours. */
@@ -55,14 +74,36 @@ static inline PtrVec3 ptr_path_albedo(const PtrSpheres *spheres, uint32_t sphere
 
 /* The vertex a path makes at point on sphere with a material of this kind,
  * at this depth, arriving from outside the sphere (entering) or inside: an
- * emitter is sampled there if light sampling is on, the surface diffuse and
- * the path may take another ray. */
+ * emitter is sampled there if light sampling is on, the material has a
+ * density to weigh the sample against (ptr_material_has_density) and the
+ * path may take another ray. */
 static inline PtrLitVertex ptr_path_vertex(const PtrPathJob *job, PtrMaterialKind kind, int depth,
                                            PtrVec3 point, uint32_t sphere, int entering)
 {
-    return (PtrLitVertex){ .sampled = job->sample_lights && kind == PTR_MATERIAL_DIFFUSE &&
-                                      depth + 1 < job->settings->max_depth,
+    return (PtrLitVertex){ .sampled = job->sample_lights && ptr_material_has_density(kind) &&
+                                      ptr_path_may_trace(job->settings, depth + 1),
                            .point = point, .sphere = sphere, .side = entering ? 1 : -1 };
+}
+
+/* What a ray adds to its path's radiance where it ends: where it met
+ * nothing (hit 0), the sky's radiance along it; where it met a surface, the
+ * surface's emission weighed by weight (ptr_path_emission_weight), or
+ * nothing if the surface emits none (adding a zero would turn a -0 into
+ * +0). Both sides are computed and one kept, so a vector loop can take it. */
+static inline PtrVec3 ptr_path_add_found(PtrVec3 radiance, PtrVec3 throughput, int hit,
+                                         PtrVec3 sky, PtrVec3 emission, float weight)
+{
+    PtrVec3 found = hit ? v3_scale(v3_mul(throughput, emission), weight) : v3_mul(throughput, sky);
+    int adds = !hit | (v3_max_comp(emission) > 0.0f);
+    return adds ? v3_add(radiance, found) : radiance;
+}
+
+/* Whether a path meets and leaves sphere in double precision
+ * (ptr_huge_surface, ptr_huge_spawn_ray) rather than float: where the
+ * sphere is huge, unless rays leave surfaces with a fixed t_min. */
+static inline int ptr_path_in_double(const PtrPathJob *job, uint32_t sphere)
+{
+    return ptr_is_huge(job->scene, sphere) && job->settings->fixed_tmin == 0.0f;
 }
 
 static inline double *ptr_path_pixel_sums(const PtrPathJob *job, int x, int y)
@@ -97,28 +138,43 @@ static inline void ptr_path_camera_ray(const PtrPathJob *job, uint64_t pixel_key
 }
 
 /* Where ray met the sphere hit names: the point on its surface and the
- * outward normal there (for the stability suite's fixed t_min, the point
- * along the ray, as the seed renderer took it). */
+ * outward normal there, in double where ptr_path_in_double says (for the
+ * stability suite's fixed t_min, the point along the ray, as the seed
+ * renderer took it). */
 void ptr_path_surface(const PtrPathJob *job, const PtrRay *ray, const PtrHit *hit,
                       PtrVec3 *point, PtrVec3 *normal);
 
 /* A ray leaving the surface of sphere at point (outward normal there) along
- * dir, by the settings' method. */
+ * dir, by the settings' method, in double where ptr_path_in_double says. */
 PtrRay ptr_path_leave(const PtrPathJob *job, uint32_t sphere, PtrVec3 point,
                       PtrVec3 outward_normal, PtrVec3 dir);
 
-/* Light sampling at diffuse vertex at of material m (n: the normal on the
- * side the path arrives from): one emitter picked by power, one direction
+/* Light sampling at vertex at of material m (n: the normal on the side
+ * the path arrives from): one emitter picked by power, one direction
  * towards it, one shadow ray (counted in *rays), weighed against
- * scattering. */
+ * scattering by the material's own density and BSDF (ptr_material_pdf,
+ * ptr_material_eval). */
 PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler, int bounce,
                                 const PtrMaterial *m, const PtrLitVertex *at, PtrVec3 n,
                                 PtrVec3 outward_normal, uint64_t *rays);
 
-/* The weight of emission a scattered ray found on emitter (at distance t
- * along dir, outward normal there) after light sampling at vertex from. */
-float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
-                               PtrVec3 dir, float t, PtrVec3 normal);
+/* The weight against light sampling at vertex from of the emission a
+ * scattered ray found on emitter (along dir, at point, outward normal
+ * there), out of line. */
+float ptr_path_mis_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
+                          PtrVec3 dir, PtrVec3 point, PtrVec3 normal);
+
+/* The weight of the emission a ray found on sphere (at point along dir,
+ * outward normal there): 1 unless an emitter was sampled at the vertex it
+ * left (from) and the sphere emits, else ptr_path_mis_weight. */
+static inline float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from,
+                                             uint32_t sphere, PtrVec3 emission, PtrVec3 dir,
+                                             PtrVec3 point, PtrVec3 normal)
+{
+    if (!from->sampled || !(v3_max_comp(emission) > 0.0f))
+        return 1.0f;
+    return ptr_path_mis_weight(job, from, sphere, dir, point, normal);
+}
 
 /* Adds radiance as sample index of the pixel whose sums acc are, covered
  * or not (whether its camera ray hit a sphere), and decides whether

@@ -10,7 +10,6 @@
 #include "base/cpu.h"
 #include "base/threads.h"
 #include "render/camera.h"
-#include "render/material.h"
 #include "render/path.h"
 #include "sampling/sampler.h"
 
@@ -30,12 +29,14 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
     PtrLitVertex lit = { 0 };
     *covered = 0;
 
-    for (int depth = 0; depth < settings->max_depth; depth++) {
+    for (int depth = 0; ptr_path_may_trace(settings, depth); depth++) {
         PtrHit hit;
         PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
         ++*rays;
         if (!ptr_trace(job->accel, &ray, &hit)) {
-            radiance = v3_add(radiance, v3_mul(throughput, ptr_sky_radiance(&scene->sky, dir)));
+            radiance = ptr_path_add_found(radiance, throughput, 0,
+                                          ptr_sky_radiance(&scene->sky, dir), v3_splat(0.0f),
+                                          1.0f);
             break;
         }
         *covered = 1;
@@ -43,13 +44,9 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
         m.albedo = ptr_path_albedo(spheres, hit.sphere, m.albedo);
         PtrVec3 normal, point;
         ptr_path_surface(job, &ray, &hit, &point, &normal);
-        if (v3_max_comp(m.emission) > 0.0f) {
-            float weight = lit.sampled ? ptr_path_emission_weight(job, &lit, hit.sphere, dir,
-                                                                  v3_length(v3_sub(point, lit.point)),
-                                                                  normal)
-                                       : 1.0f;
-            radiance = v3_add(radiance, v3_scale(v3_mul(throughput, m.emission), weight));
-        }
+        float weight = ptr_path_emission_weight(job, &lit, hit.sphere, m.emission, dir, point,
+                                                normal);
+        radiance = ptr_path_add_found(radiance, throughput, 1, v3_splat(0.0f), m.emission, weight);
 
         lit = ptr_path_vertex(job, m.kind, depth, point, hit.sphere,
                               v3_dot(dir, normal) < 0.0f);
@@ -63,12 +60,11 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF), u);
         ptr_sampler_2d(sampler, ptr_bounce_dim(depth, PTR_SLOT_BSDF_EXTRA), u + 2);
         PtrVec3 out_dir, attenuation;
-        if (!ptr_scatter(&m, dir, normal, u, &out_dir, &attenuation))
-            break;
+        int scattered = ptr_scatter(&m, dir, normal, u, &out_dir, &attenuation);
         if (lit.sampled)
-            lit.scatter_pdf = ptr_diffuse_pdf(n, out_dir);
+            lit.scatter_pdf = ptr_material_pdf(&m, n, out_dir);
         throughput = v3_mul(throughput, attenuation);
-        if (v3_max_comp(throughput) <= 0.0f)
+        if (!ptr_path_goes_on(settings, depth, scattered, throughput))
             break;
         ray = ptr_path_leave(job, hit.sphere, point, normal, out_dir);
     }

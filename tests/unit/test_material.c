@@ -144,9 +144,47 @@ static void test_diffuse_density(void)
     CHECK_NEAR(under_half / count, 0.25, 5 * sqrt(0.25 * 0.75 / count));
 }
 
+/* What light sampling asks of a material: the density and BSDF of a
+ * diffuse surface are the diffuse formulas, and a mirror's, fuzzy metal's
+ * and glass's are 0 (they scatter without a density light sampling could
+ * weigh), as ptr_material_has_density says of each kind. */
+static void test_material_density(void)
+{
+    PtrRng rng = ptr_rng_for_sample(7, 0, 0);
+    const PtrMaterial materials[] = {
+        { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.9f, 0.5f, 0.1f) },
+        { .kind = PTR_MATERIAL_METAL, .albedo = v3(1, 0.8f, 0.6f) },
+        { .kind = PTR_MATERIAL_METAL, .albedo = v3(1, 0.8f, 0.6f), .fuzz = 0.3f },
+        { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1), .ior = 1.5f },
+    };
+    enum { KINDS = sizeof materials / sizeof materials[0] };
+    PtrVec3 n = v3_normalize(v3(0.3f, 1, -0.2f));
+    int cases = 0, wrong = 0, with_density[KINDS] = { 0 };
+    for (int i = 0; i < 1000; i++) {
+        PtrVec3 out = ptr_uniform_sphere(ptr_rng_float(&rng), ptr_rng_float(&rng));
+        for (int k = 0; k < KINDS; k++) {
+            const PtrMaterial *m = &materials[k];
+            float pdf = ptr_material_pdf(m, n, out);
+            PtrVec3 eval = ptr_material_eval(m, n, out);
+            int diffuse = m->kind == PTR_MATERIAL_DIFFUSE;
+            float want_pdf = diffuse ? ptr_diffuse_pdf(n, out) : 0.0f;
+            PtrVec3 want_eval = diffuse ? ptr_diffuse_eval(m, n, out) : v3_splat(0.0f);
+            wrong += pdf != want_pdf || eval.x != want_eval.x || eval.y != want_eval.y ||
+                     eval.z != want_eval.z;
+            with_density[k] += pdf > 0.0f;
+            cases++;
+        }
+    }
+    CHECK_INT(cases, 4000);
+    CHECK_INT(wrong, 0);
+    for (int k = 0; k < KINDS; k++)
+        CHECK_INT(with_density[k] > 0, ptr_material_has_density(materials[k].kind));
+}
+
 int main(void)
 {
     test_diffuse_density();
+    test_material_density();
     test_schlick();
     test_energy_and_directions();
     test_mirror();
