@@ -45,7 +45,7 @@ typedef struct Vertex {
     int hit[LANES];
     uint32_t sphere[LANES]; /* 0 for a miss */
     uint32_t kind[LANES];
-    float albedo[3][LANES], emission[3][LANES], ior[LANES];
+    float albedo[3][LANES], emission[3][LANES], ior[LANES], fuzz[LANES];
     float point[3][LANES], normal[3][LANES];
     float out[3][LANES]; /* the scattered direction */
     int scattered[LANES];
@@ -235,6 +235,7 @@ STAGE void find_surfaces(const PtrPathJob *job, Lanes *restrict lanes, Vertex *r
             v->sphere[l] = s;
             v->kind[l] = materials[m].kind;
             v->ior[l] = materials[m].ior;
+            v->fuzz[l] = materials[m].fuzz;
             set_lane_v3(v->albedo, l, materials[m].albedo);
             set_lane_v3(v->emission, l, materials[m].emission);
             PtrVec3 point, normal;
@@ -264,12 +265,17 @@ STAGE void emission_weights(const PtrPathJob *job, const Lanes *restrict lanes,
                             const Vertex *restrict v, float weight[LANES])
 {
     for (int l = 0; l < LANES; l++)
-        weight[l] = lanes->slot[l] != FREE && v->hit[l]
-                        ? ptr_path_emission_weight(job, &lanes->lit[l], v->sphere[l],
-                                                   lane_v3(v->emission, l),
-                                                   lane_v3(lanes->ray.dir, l),
-                                                   lane_v3(v->point, l), lane_v3(v->normal, l))
-                        : 1.0f;
+        weight[l] = 1.0f;
+    /* Without light sampling no vertex is lit and every weight stays 1:
+     * skipped here, not found lane by lane below. */
+    if (!job->sample_lights)
+        return;
+    for (int l = 0; l < LANES; l++)
+        if (lanes->slot[l] != FREE && v->hit[l] &&
+            ptr_path_weighs_emission(&lanes->lit[l], lane_v3(v->emission, l)))
+            weight[l] = ptr_path_emission_weight(job, &lanes->lit[l], v->sphere[l],
+                                                 lane_v3(lanes->ray.dir, l), lane_v3(v->point, l),
+                                                 lane_v3(v->normal, l));
 }
 
 /* The loop of add_sky_and_emission under one sky: inlined where the sky's
@@ -372,14 +378,12 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
                                           &v->scattered[l]));
     }
     for (int l = 0; l < LANES; l++) {
-        if (lanes->slot[l] == FREE || !v->hit[l])
-            continue;
-        const PtrMaterial *m = &materials[ptr_sphere_material(&scene->spheres, v->sphere[l])];
-        if (!ptr_scatter_is_fuzzy(m->kind, m->fuzz))
+        if (lanes->slot[l] == FREE || !v->hit[l] ||
+            !ptr_scatter_is_fuzzy((PtrMaterialKind)v->kind[l], v->fuzz[l]))
             continue;
         const float ul[3] = { u[0][l], u[1][l], u[2][l] };
         set_lane_v3(v->out, l,
-                    ptr_scatter_fuzzy_metal(m->fuzz, lane_v3(lanes->ray.dir, l),
+                    ptr_scatter_fuzzy_metal(v->fuzz[l], lane_v3(lanes->ray.dir, l),
                                             lane_v3(v->normal, l), ul, &v->scattered[l]));
     }
     if (job->sample_lights)

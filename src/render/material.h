@@ -96,12 +96,13 @@ static inline PtrVec3 ptr_facing_normal(PtrVec3 dir, PtrVec3 outward_normal)
  * of refraction in (outward_normal: the surface's outward unit normal), u as
  * for ptr_scatter: every material's direction computed and the kind's kept,
  * without branches, so that the bundles' loops over lanes vectorise (where
- * the kind is a constant, the compiler drops the others). Fuzzy metal takes
- * ptr_scatter_fuzzy_metal instead. *scattered is 0 where the ray is
- * absorbed. */
-static inline PtrVec3 ptr_scatter_direction(PtrMaterialKind kind, float ior, PtrVec3 d,
-                                            PtrVec3 outward_normal, const float u[3],
-                                            int *scattered)
+ * the kind is a constant, the compiler drops the others: always inlined, as
+ * gcc would not for ptr_scatter's four cases, which then computed all three
+ * for every kind). Fuzzy metal takes ptr_scatter_fuzzy_metal instead.
+ * *scattered is 0 where the ray is absorbed. */
+static inline __attribute__((always_inline)) PtrVec3
+ptr_scatter_direction(PtrMaterialKind kind, float ior, PtrVec3 d, PtrVec3 outward_normal,
+                      const float u[3], int *scattered)
 {
     PtrVec3 n = ptr_facing_normal(d, outward_normal);
     PtrVec3 diffuse = ptr_scatter_diffuse(n, u[0], u[1]);

@@ -91,8 +91,8 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
     return v3_scale(v3_mul(ptr_material_eval(m, n, dir), emission), weight);
 }
 
-float ptr_path_mis_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
-                          PtrVec3 dir, PtrVec3 point, PtrVec3 normal)
+float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
+                               PtrVec3 dir, PtrVec3 point, PtrVec3 normal)
 {
     const PtrSpheres *spheres = &job->scene->spheres;
     float light_pdf = ptr_light_pdf(view_from(from, spheres, emitter), from->point,

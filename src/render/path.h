@@ -87,7 +87,7 @@ static inline PtrLitVertex ptr_path_vertex(const PtrPathJob *job, PtrMaterialKin
 
 /* What a ray adds to its path's radiance where it ends: where it met
  * nothing (hit 0), the sky's radiance along it; where it met a surface, the
- * surface's emission weighed by weight (ptr_path_emission_weight), or
+ * surface's emission weighed by weight (ptr_path_weighs_emission), or
  * nothing if the surface emits none (adding a zero would turn a -0 into
  * +0). Both sides are computed and one kept, so a vector loop can take it. */
 static inline PtrVec3 ptr_path_add_found(PtrVec3 radiance, PtrVec3 throughput, int hit,
@@ -158,23 +158,19 @@ PtrVec3 ptr_path_sample_emitter(const PtrPathJob *job, const PtrSampler *sampler
                                 const PtrMaterial *m, const PtrLitVertex *at, PtrVec3 n,
                                 PtrVec3 outward_normal, uint64_t *rays);
 
-/* The weight against light sampling at vertex from of the emission a
- * scattered ray found on emitter (along dir, at point, outward normal
- * there), out of line. */
-float ptr_path_mis_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
-                          PtrVec3 dir, PtrVec3 point, PtrVec3 normal);
-
-/* The weight of the emission a ray found on sphere (at point along dir,
- * outward normal there): 1 unless an emitter was sampled at the vertex it
- * left (from) and the sphere emits, else ptr_path_mis_weight. */
-static inline float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from,
-                                             uint32_t sphere, PtrVec3 emission, PtrVec3 dir,
-                                             PtrVec3 point, PtrVec3 normal)
+/* Whether the emission a ray found on a surface emitting this is weighed
+ * against light sampling at the vertex it left (from), by
+ * ptr_path_emission_weight: where an emitter was sampled there and the
+ * surface emits. Otherwise it counts fully (weight 1). */
+static inline int ptr_path_weighs_emission(const PtrLitVertex *from, PtrVec3 emission)
 {
-    if (!from->sampled || !(v3_max_comp(emission) > 0.0f))
-        return 1.0f;
-    return ptr_path_mis_weight(job, from, sphere, dir, point, normal);
+    return from->sampled && v3_max_comp(emission) > 0.0f;
 }
+
+/* The weight of the emission a scattered ray found on emitter (along dir,
+ * at point, outward normal there) after light sampling at vertex from. */
+float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
+                               PtrVec3 dir, PtrVec3 point, PtrVec3 normal);
 
 /* Adds radiance as sample index of the pixel whose sums acc are, covered
  * or not (whether its camera ray hit a sphere), and decides whether

@@ -44,8 +44,9 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
         m.albedo = ptr_path_albedo(spheres, hit.sphere, m.albedo);
         PtrVec3 normal, point;
         ptr_path_surface(job, &ray, &hit, &point, &normal);
-        float weight = ptr_path_emission_weight(job, &lit, hit.sphere, m.emission, dir, point,
-                                                normal);
+        float weight = ptr_path_weighs_emission(&lit, m.emission)
+                           ? ptr_path_emission_weight(job, &lit, hit.sphere, dir, point, normal)
+                           : 1.0f;
         radiance = ptr_path_add_found(radiance, throughput, 1, v3_splat(0.0f), m.emission, weight);
 
         lit = ptr_path_vertex(job, m.kind, depth, point, hit.sphere,
