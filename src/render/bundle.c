@@ -285,11 +285,12 @@ static inline __attribute__((always_inline)) void add_found(Lanes *restrict lane
                                                             const Vertex *restrict v,
                                                             const float weight[LANES], PtrSky sky)
 {
-    for (int l = 0; l < LANES; l++)
+    for (int l = 0; l < LANES; l++) {
+        PtrVec3 sky_l = ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l));
         set_lane_v3(lanes->radiance, l,
                     ptr_path_add_found(lane_v3(lanes->radiance, l), lane_v3(lanes->throughput, l),
-                                       v->hit[l], ptr_sky_radiance(&sky, lane_v3(lanes->ray.dir, l)),
-                                       lane_v3(v->emission, l), weight[l]));
+                                       v->hit[l], sky_l, lane_v3(v->emission, l), weight[l]));
+    }
 }
 
 /* What the lanes found: the sky where they missed, emission where they hit
