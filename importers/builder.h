@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #include "base/result.h"
-#include "importer.h"
+#include "import_options.h"
 #include "scene/scene.h"
 
 typedef struct PtrSceneBuilder {
