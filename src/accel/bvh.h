@@ -68,8 +68,9 @@ typedef struct PtrBvh {
  * CPU. The tree's bytes depend only on
  * the spheres, never on the thread count. On failure (out of memory) *bvh
  * is empty and the spheres may be part reordered: the scene can only be
- * freed. */
-PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads);
+ * freed; err (which may be NULL) says so. */
+PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
+                        PtrError *err);
 
 void ptr_bvh_free(PtrBvh *bvh);
 

@@ -113,16 +113,16 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
  * float array. */
 enum { RELEASE_STEP = 1 << 20 };
 
-int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhPrim *prims,
-                  size_t *prim_count, float *magnitude_out)
+PtrResult ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhPrim *prims,
+                        size_t *prim_count, float *magnitude_out, PtrError *err)
 {
     *kept_out_count = *prim_count = 0;
     *magnitude_out = 0.0f;
     if (s->count == 0)
-        return 1;
+        return PTR_OK;
     float limit = unbounded_radius(s);
     if (isnan(limit))
-        return 0;
+        return bvh_out_of_memory(err);
     uint32_t order[BVH_UNBOUNDED_MAX];
     size_t u = 0;
     for (size_t i = 0; i < s->count; i++)
@@ -160,7 +160,7 @@ int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhP
     *kept_out_count = u;
     *prim_count = n;
     *magnitude_out = magnitude;
-    return 1;
+    return PTR_OK;
 }
 
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)

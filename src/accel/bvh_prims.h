@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/result.h"
 #include "scene/scene.h"
 
 enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
@@ -50,9 +51,18 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
  * start on spheres) and so scales the boxes' padding. Gives back the
  * spheres' memory as it goes (ptr_spheres_release): on success the prims
  * and kept_out hold the only copy of spheres 0 .. count - 1 but their
- * values. Returns 0 if out of memory (the spheres untouched). */
-int ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
-                  BvhPrim *prims, size_t *prim_count, float *magnitude);
+ * values. Fails only for memory (the spheres untouched). */
+PtrResult ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
+                        BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
+
+/* Fails for memory the tree's build cannot have: every failure of the
+ * build's functions is this one. (The code returned as a constant, so the
+ * compiler sees that no output is used after a failure.) */
+static inline PtrResult bvh_out_of_memory(PtrError *err)
+{
+    ptr_error_set(err, PTR_ERR_NOMEM, "out of memory building the tree");
+    return PTR_ERR_NOMEM;
+}
 
 /* Sphere i of s as a prim, and back. */
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);

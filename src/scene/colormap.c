@@ -55,12 +55,12 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         if (white[m] == UINT32_MAX) {
             PtrMaterial copy = scene->materials[m];
             copy.albedo = v3_splat(1.0f);
-            res = ptr_scene_add_material(scene, &copy, &white[m]);
+            res = ptr_scene_add_material(scene, &copy, &white[m], NULL);
         }
         if (res == PTR_OK) {
             ptr_sphere_set_material(s, i, white[m]);
             res = ptr_scene_set_sphere_color(scene, i,
-                                             ptr_colormap_linear(map, value, lo, hi));
+                                             ptr_colormap_linear(map, value, lo, hi), NULL);
         }
     }
     free(white);

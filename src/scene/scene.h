@@ -128,17 +128,18 @@ typedef struct PtrScene {
 void ptr_scene_init(PtrScene *scene);
 void ptr_scene_free(PtrScene *scene);
 
-/* Appends a sphere; returns PTR_ERR_NOMEM if the arrays cannot grow. */
+/* Appends a sphere; PTR_ERR_NOMEM if the arrays cannot grow. These
+ * functions fail only for memory, and say so in err (which may be NULL). */
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
-                               uint32_t material);
+                               uint32_t material, PtrError *err);
 
 /* Sets the sphere count, making room as needed, for an importer that knows
  * how many spheres it has: the arrays are allocated once (not doubled as
  * they fill), and memory is only used as they are written. Entries from the
  * old count on hold no sphere until the caller writes every array's entry
- * (colour and value through their functions). Returns PTR_ERR_NOMEM (arrays
+ * (colour and value through their functions). PTR_ERR_NOMEM (arrays
  * unchanged) if they cannot grow. */
-PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
+PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count, PtrError *err);
 
 /* Gives back the memory of the entries of spheres begin .. end - 1 in every
  * array but value, page by page, for a caller that has copied them and
@@ -150,30 +151,31 @@ void ptr_spheres_release(PtrSpheres *spheres, size_t begin, size_t end);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
-PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
+                                     PtrError *err);
 
 /* The same with the colour as PtrSpheres.color stores it. */
-PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4]);
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
+                                       PtrError *err);
 
 /* Creates the colour array, if absent, for a caller that writes every
  * sphere's colour: only the padding is set, so at 10^8 spheres memory is
- * used as the colours are written, not 800 MB at once. Returns
- * PTR_ERR_NOMEM if out of memory. */
-PtrResult ptr_spheres_make_colors(PtrSpheres *spheres);
+ * used as the colours are written, not 800 MB at once. */
+PtrResult ptr_spheres_make_colors(PtrSpheres *spheres, PtrError *err);
 
 /* The same for the values (PtrSpheres.value). */
-PtrResult ptr_spheres_make_values(PtrSpheres *spheres);
+PtrResult ptr_spheres_make_values(PtrSpheres *spheres, PtrError *err);
 
 /* The same for the ids (PtrSpheres.id), for an importer that puts spheres
  * out of the file's order. */
-PtrResult ptr_spheres_make_ids(PtrSpheres *spheres);
+PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
 
 /* Gives the sphere of id i a value (see PtrSpheres.value); the first call
  * creates the array, NaN for every other sphere. */
-PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
+PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value, PtrError *err);
 
 static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
 {
@@ -204,7 +206,7 @@ static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 /* Appends a material and stores its index in *index; the spheres' material
  * array widens if the count needs it (PtrSpheres.material). */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
-                                 uint32_t *index);
+                                 uint32_t *index, PtrError *err);
 
 /* The position in the file of sphere i (see PtrSpheres.id). */
 static inline uint32_t ptr_sphere_id(const PtrSpheres *s, size_t i)
@@ -217,12 +219,13 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
     return v3(s->cx[i], s->cy[i], s->cz[i]);
 }
 
-/* A 64-bit fingerprint of everything in the scene that shapes an image
- * (spheres, materials, camera, sky, origin), the spheres taken in the file's
- * order: parts of one render match, parts of different scenes almost surely
- * do not. Taken before the tree's build (as the renderer does), whose order
- * it does not know. */
-uint64_t ptr_scene_hash(const PtrScene *scene);
+/* In *hash, a 64-bit fingerprint of everything in the scene that shapes an
+ * image (spheres, materials, camera, sky, origin), the spheres taken in the
+ * file's order: parts of one render match, parts of different scenes almost
+ * surely do not. Taken before the tree's build (as the renderer does), whose
+ * order it does not know. PTR_ERR_NOMEM if the file's order, where the
+ * arrays are not in it, cannot be held: never another fingerprint. */
+PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err);
 
 /* The gradient sky's radiance along a unit direction. */
 static inline PtrVec3 ptr_sky_gradient(PtrVec3 unit_dir)

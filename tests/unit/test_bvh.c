@@ -17,7 +17,7 @@ static void tag_file_order(PtrScene *s)
 {
     for (size_t i = 0; i < s->spheres.count; i++) {
         const uint16_t tag[4] = { (uint16_t)i, (uint16_t)(i >> 16), 0, 0 };
-        CHECK_INT(ptr_scene_set_sphere_color16(s, i, tag), PTR_OK);
+        CHECK_INT(ptr_scene_set_sphere_color16(s, i, tag, NULL), PTR_OK);
     }
 }
 
@@ -163,12 +163,12 @@ static void test_scenes(void)
              * keeps: reversed here, for the larger sets. */
             FileOrder order = { .reversed = size };
             if (order.reversed) {
-                CHECK_INT(ptr_spheres_make_ids(&b.spheres), PTR_OK);
+                CHECK_INT(ptr_spheres_make_ids(&b.spheres, NULL), PTR_OK);
                 for (size_t i = 0; i < b.spheres.count; i++)
                     b.spheres.id[i] = (uint32_t)(b.spheres.count - 1 - i);
             }
             PtrBvh bvh;
-            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0), PTR_OK);
+            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0, NULL), PTR_OK);
             check_structure(&bvh, &b.spheres, order, bvh_scene_names[kind]);
             check_rays(&a, &b, &bvh, size ? 10000 : 20000, bvh_scene_names[kind]);
             ptr_bvh_free(&bvh);
@@ -187,7 +187,7 @@ static void test_unbounded(void)
         CHECK(bvh_scene_make(&s, kinds[k], 500, 2));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1), PTR_OK);
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1, NULL), PTR_OK);
         CHECK_INT(bvh.unbounded_count, k < 2 ? 1 : 0);
         if (k < 2)
             CHECK_INT(file_position(&s.spheres, 0, (FileOrder){ 0 }), 0);
@@ -209,7 +209,7 @@ static void test_threads(void)
         CHECK(bvh_scene_make(&s, BVH_SCENE_CLUSTERS, 150000, 3));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t]), PTR_OK);
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t], NULL), PTR_OK);
         if (t == 0) {
             first = bvh;
             first_scene = s;
@@ -236,15 +236,15 @@ static void test_small(void)
     PtrScene s;
     ptr_scene_init(&s);
     PtrBvh bvh;
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
     CHECK(bvh.nodes == NULL);
     PtrRay ray = { { 0, 0, 0 }, 0.0f, { 0, 0, -1 }, INFINITY };
     PtrHit hit;
     CHECK(!ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
     CHECK_INT(hit.sphere, PTR_NO_HIT);
     CHECK_FLOAT_EQ(hit.t, INFINITY);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0), PTR_OK);
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0, NULL), PTR_OK);
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
     CHECK(ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
     CHECK_FLOAT_EQ(hit.t, 4.0f);
     CHECK_INT(hit.sphere, 0);
@@ -260,7 +260,7 @@ static float *render_with(PtrScene *scene, PtrAccelChoice choice, int width, int
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     PtrAccel accel;
-    CHECK_INT(ptr_accel_init(&accel, choice, &c, 0, scene, 3), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, choice, &c, 0, scene, 3, NULL), PTR_OK);
     *used = ptr_accel_name(&accel);
     PtrRenderSettings settings = { .width = width, .height = height, .samples = 3, .seed = 9,
                                    .max_depth = 12, .threads = 2 };
@@ -320,7 +320,7 @@ static void test_renders_hard(void)
             ptr_scene_init(&s[k]);
             for (int m = 0; m < 3; m++) {
                 uint32_t index;
-                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index), PTR_OK);
+                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index, NULL), PTR_OK);
             }
             CHECK(bvh_scene_make(&s[k], (BvhSceneKind)kind, 600, 4));
             float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
@@ -329,7 +329,7 @@ static void test_renders_hard(void)
                 ptr_sphere_set_material(sp, i, (uint32_t)(i % 3));
                 if (i % 4 == 0)
                     CHECK_INT(ptr_scene_set_sphere_color(&s[k], i, v3((float)(i % 5) / 4.0f, 0.5f,
-                                                                      (float)(i % 7) / 6.0f)),
+                                                                      (float)(i % 7) / 6.0f), NULL),
                               PTR_OK);
                 if (sp->radius[i] > 100.0f) /* a ground: look at what stands on it */
                     continue;
@@ -361,7 +361,7 @@ static void test_auto(void)
         ptr_scene_init(&s);
         CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
         PtrAccel accel;
-        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, 0, &s, 0), PTR_OK);
+        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, 0, &s, 0, NULL), PTR_OK);
         CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER_C ? "brute" : "bvh");
         ptr_accel_free(&accel);
         ptr_scene_free(&s);
@@ -383,20 +383,20 @@ static void test_coincident(void)
         const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
         uint32_t m;
         for (int k = 0; k < 3; k++)
-            CHECK_INT(ptr_scene_add_material(&s, &grey, &m), PTR_OK);
+            CHECK_INT(ptr_scene_add_material(&s, &grey, &m, NULL), PTR_OK);
         for (int i = 0; i < 1000; i++) {
             PtrVec3 at = v3(3.0f * (float)(i % 10), 3.0f * (float)(i / 10 % 10),
                             -3.0f * (float)(i / 100) - 10.0f);
-            CHECK_INT(ptr_scene_add_sphere(&s, at, 1.0f, i % 100 == 7 ? 1 : 0), PTR_OK);
+            CHECK_INT(ptr_scene_add_sphere(&s, at, 1.0f, i % 100 == 7 ? 1 : 0, NULL), PTR_OK);
         }
         for (int i = 7; i < 1000; i += 100)
-            CHECK_INT(ptr_scene_add_sphere(&s, ptr_sphere_centre(&s.spheres, (size_t)i), 1.0f, 2),
+            CHECK_INT(ptr_scene_add_sphere(&s, ptr_sphere_centre(&s.spheres, (size_t)i), 1.0f, 2, NULL),
                       PTR_OK);
         PtrVec3 centres[10];
         for (int k = 0; k < 10; k++)
             centres[k] = ptr_sphere_centre(&s.spheres, (size_t)(100 * k + 7));
         PtrAccel accel;
-        CHECK_INT(ptr_accel_init(&accel, (PtrAccelChoice)choice, &c, 0, &s, 0), PTR_OK);
+        CHECK_INT(ptr_accel_init(&accel, (PtrAccelChoice)choice, &c, 0, &s, 0, NULL), PTR_OK);
         CHECK_STR(ptr_accel_name(&accel), choice == PTR_ACCEL_BVH ? "bvh" : "brute");
         int first = 0;
         for (int k = 0; k < 10; k++) {

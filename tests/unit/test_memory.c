@@ -128,16 +128,16 @@ static void test_spheres_release(void)
     PtrScene scene;
     ptr_scene_init(&scene);
     const size_t count = 300000, kept = 1000;
-    CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept), PTR_OK);
+    CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept, NULL), PTR_OK);
     PtrSpheres *s = &scene.spheres;
-    CHECK_INT(ptr_spheres_make_ids(s), PTR_OK);
+    CHECK_INT(ptr_spheres_make_ids(s, NULL), PTR_OK);
     size_t failed_values = 0;
     for (size_t i = 0; i < count + kept; i++) {
         s->cx[i] = s->cy[i] = s->cz[i] = (float)i;
         s->radius[i] = 1.0f;
         ptr_sphere_set_material(s, i, 7);
         s->id[i] = (uint32_t)i;
-        failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f) != PTR_OK;
+        failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f, NULL) != PTR_OK;
     }
     CHECK_INT(failed_values, 0);
     ptr_spheres_release(s, 0, count / 2);
@@ -165,7 +165,7 @@ static void add_materials(PtrScene *scene, size_t count)
     const PtrMaterial m = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
     uint32_t index;
     while (scene->material_count < count)
-        CHECK_INT(ptr_scene_add_material(scene, &m, &index), PTR_OK);
+        CHECK_INT(ptr_scene_add_material(scene, &m, &index, NULL), PTR_OK);
 }
 
 /* 1 byte a sphere up to 256 materials, 2 up to 65,536, then 4; widening
@@ -177,7 +177,7 @@ static void test_material_widths(void)
     add_materials(&scene, 256);
     const size_t count = 1000;
     for (size_t i = 0; i < count; i++)
-        CHECK_INT(ptr_scene_add_sphere(&scene, v3(0, 0, (float)i), 1.0f, (uint32_t)(i % 256)),
+        CHECK_INT(ptr_scene_add_sphere(&scene, v3(0, 0, (float)i), 1.0f, (uint32_t)(i % 256), NULL),
                   PTR_OK);
     PtrSpheres *s = &scene.spheres;
     CHECK_INT(s->material_size, 1);
