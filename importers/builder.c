@@ -373,17 +373,17 @@ static PtrVec3 relative(const double p[3], const double origin[3])
     return v3((float)(p[0] - origin[0]), (float)(p[1] - origin[1]), (float)(p[2] - origin[2]));
 }
 
-/* Which spheres are huge (see accel/huge.h): those whose radius is more than
- * HUGE_RATIO times the extent E of the region the rays live in, taken as the
- * box around the camera and every sphere of a radius within SMALL_RATIO of
- * the smallest. In float, rays leave a sphere of radius r lifted by about
+/* The huge spheres (scene.h's rule) kept in double (accel/huge.h says why):
+ * the limit is HUGE_RATIO times the extent E of the region the rays live
+ * in, taken as the box around the camera and every sphere of a radius within
+ * SMALL_RATIO of the smallest. In float, rays leave a sphere of radius r lifted by about
  * 2^-20 r; below 256 E that is under 2^-12 E, less than a pixel of a 4K
  * image of the whole region, and the double test would only cost time (a
  * quarter of the rays per second on a four-sphere scene). A radius-1e5
  * ground under a scene a few units (or a room 100) across is huge; the
  * radius-100 and radius-1000 grounds of seed.gltf and final.gltf are not;
- * a cloud of like spheres has none. At most PTR_HUGE_MAX, the largest (every
- * ray tests them all). Puts their indices in huge[], ascending, and returns
+ * a cloud of like spheres has none (the tree's limit takes those grounds
+ * out of its boxes). Puts their indices in huge[], ascending, and returns
  * how many. */
 #define HUGE_RATIO 256.0
 
@@ -402,26 +402,13 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
     double extent = 0;
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
-    /* The largest candidates, largest first (the earliest on equal radii). */
-    size_t top[PTR_HUGE_MAX], count = 0;
-    for (size_t i = 0; i < b->count; i++) {
-        double r = b->spheres[4 * i + 3];
-        if (!(r > HUGE_RATIO * extent))
-            continue;
-        size_t at = count < PTR_HUGE_MAX ? count++ : PTR_HUGE_MAX;
-        for (; at > 0 && b->spheres[4 * top[at - 1] + 3] < r; at--)
-            if (at < PTR_HUGE_MAX)
-                top[at] = top[at - 1];
-        if (at < PTR_HUGE_MAX)
-            top[at] = i;
-    }
-    for (size_t k = 0; k < count; k++) {
-        size_t at = k;
-        for (; at > 0 && huge[at - 1] > top[k]; at--)
-            huge[at] = huge[at - 1];
-        huge[at] = top[k];
-    }
-    return count;
+    PtrHugeChoice choice = { .limit = HUGE_RATIO * extent };
+    for (size_t i = 0; i < b->count; i++)
+        ptr_huge_offer(&choice, i, i, b->spheres[4 * i + 3]);
+    ptr_huge_file_order(&choice);
+    for (size_t k = 0; k < choice.count; k++)
+        huge[k] = choice.sphere[k].index;
+    return choice.count;
 }
 
 /* Puts sphere i of the builder (already relative to the scene's origin) at

@@ -1,5 +1,5 @@
 /* Building the tree: binned SAH splits, eight children a node, leaves of
- * contiguous spheres, the few huge spheres kept out.
+ * contiguous spheres, the few huge spheres kept out of the boxes.
  *
  * A node is grown Embree's way: its range is split in two by the binned
  * surface area heuristic, then the child with the largest box is split
@@ -327,9 +327,9 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
     Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
-    /* The prims and kept_out take the tree's spheres, whose memory the
+    /* The prims and huge take the tree's spheres, whose memory the
      * scene's arrays give back meanwhile; the spheres after them stay. */
-    BvhPrim kept_out[BVH_UNBOUNDED_MAX];
+    BvhPrim huge[PTR_HUGE_MAX];
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
     size_t prim_count = 0;
@@ -337,10 +337,10 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        r = ptr_bvh_prims(&tree_part, kept_out, &bvh->unbounded_count, build.set.prims,
+        r = ptr_bvh_prims(&tree_part, huge, &bvh->huge_count, build.set.prims,
                           &prim_count, &build.set.magnitude, err);
     }
-    build.first_sphere = bvh->unbounded_count;
+    build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
     if (r == PTR_OK && prim_count > 0) {
@@ -353,11 +353,11 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             r = run_tasks(&build, err);
     }
     if (r == PTR_OK) {
-        write_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
+        write_back(spheres, build.set.prims, prim_count, bvh->huge_count,
                    build.set.threads);
         build.set.prims = NULL;
-        SphereWrite kept = { spheres, kept_out, 0 };
-        write_spheres(&kept, 0, bvh->unbounded_count);
+        SphereWrite first = { spheres, huge, 0 };
+        write_spheres(&first, 0, bvh->huge_count);
         /* The ids have done their work (the leaves' order): from here on a
          * sphere's position decides a tie (see PtrSpheres). */
         free(spheres->id);

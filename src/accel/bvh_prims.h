@@ -1,5 +1,5 @@
 /* What the tree is built from: a padded box per sphere, and the choice of
- * the spheres kept out of the tree. */
+ * the huge spheres it keeps out of its boxes. */
 #ifndef PTR_BVH_PRIMS_H
 #define PTR_BVH_PRIMS_H
 
@@ -9,7 +9,6 @@
 #include "base/result.h"
 #include "scene/scene.h"
 
-enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
 
 /* A sphere as the build moves it, whole: 32 bytes. At 10^8 spheres the
  * prims are the build's largest array, and the scene's arrays give their
@@ -43,16 +42,17 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
     }
 }
 
-/* Puts the spheres kept out of the tree in kept_out[0 .. *kept_out_count -
- * 1] (by ascending id; room for BVH_UNBOUNDED_MAX), a prim for each of the
+/* Puts the huge spheres (scene.h's rule, with the tree's limit) in
+ * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX), a
+ * prim for each of the
  * others in prims (their count in *prim_count, in the arrays' order), and
  * in *magnitude the largest coordinate magnitude in the tree, which bounds
  * both the spheres' and the rays' origins (the camera sits at 0, other rays
  * start on spheres) and so scales the boxes' padding. Gives back the
  * spheres' memory as it goes (ptr_spheres_release): on success the prims
- * and kept_out hold the only copy of spheres 0 .. count - 1 but their
+ * and huge hold the only copy of spheres 0 .. count - 1 but their
  * values. Fails only for memory (the spheres untouched). */
-PtrResult ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
+PtrResult ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *huge, size_t *huge_count,
                         BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
 
 /* Fails for memory the tree's build cannot have: every failure of the

@@ -301,6 +301,35 @@ PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
     return PTR_OK;
 }
 
+/* Whether a comes before b among the huge: larger, or as large and first
+ * in the file. */
+static int huge_before(double radius_a, size_t file_a, double radius_b, size_t file_b)
+{
+    return radius_a != radius_b ? radius_a > radius_b : file_a < file_b;
+}
+
+void ptr_huge_insert(PtrHugeChoice *c, size_t index, size_t file_position, double radius)
+{
+    size_t at = c->count < PTR_HUGE_MAX ? c->count++ : PTR_HUGE_MAX;
+    for (; at > 0 && huge_before(radius, file_position, c->sphere[at - 1].radius,
+                                 c->sphere[at - 1].file_position); at--)
+        if (at < PTR_HUGE_MAX)
+            c->sphere[at] = c->sphere[at - 1];
+    if (at < PTR_HUGE_MAX)
+        c->sphere[at] = (PtrHugeCandidate){ radius, index, file_position };
+}
+
+void ptr_huge_file_order(PtrHugeChoice *c)
+{
+    for (size_t k = 1; k < c->count; k++) {
+        const PtrHugeCandidate chosen = c->sphere[k];
+        size_t at = k;
+        for (; at > 0 && c->sphere[at - 1].file_position > chosen.file_position; at--)
+            c->sphere[at] = c->sphere[at - 1];
+        c->sphere[at] = chosen;
+    }
+}
+
 /* FNV-1a over the bytes of the values, field by field (never over structure
  * padding). */
 static uint64_t hash_bytes(uint64_t h, const void *data, size_t size)

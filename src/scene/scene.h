@@ -110,6 +110,39 @@ typedef struct PtrHugeSpheres {
 
 enum { PTR_HUGE_MAX = 16 };
 
+/* The one rule for spheres much larger than the rest, "huge": of the
+ * spheres whose radius exceeds a limit, the PTR_HUGE_MAX largest (every ray
+ * tests them all), on equal radii the first in the file. Its two users set
+ * the limit their question asks for: the builder, which keeps the huge
+ * spheres in double (PtrHugeSpheres; importers/builder.c says why its limit
+ * decides pixels), and the tree's build, which keeps the huge ones among
+ * the rest out of its boxes (accel/bvh_prims.c; speed only). Offer every
+ * sphere, then put the choice in the file's order. */
+typedef struct PtrHugeCandidate {
+    double radius;
+    size_t index;         /* in the caller's arrays */
+    size_t file_position; /* decides between equal radii, and the final order */
+} PtrHugeCandidate;
+
+typedef struct PtrHugeChoice {
+    double limit;
+    size_t count;
+    PtrHugeCandidate sphere[PTR_HUGE_MAX];
+} PtrHugeChoice;
+
+/* Adds a sphere above the limit to the choice if among the largest. */
+void ptr_huge_insert(PtrHugeChoice *choice, size_t index, size_t file_position, double radius);
+
+static inline void ptr_huge_offer(PtrHugeChoice *choice, size_t index, size_t file_position,
+                                  double radius)
+{
+    if (radius > choice->limit)
+        ptr_huge_insert(choice, index, file_position, radius);
+}
+
+/* Sorts the choice by file position. */
+void ptr_huge_file_order(PtrHugeChoice *choice);
+
 typedef struct PtrScene {
     /* World position of the point every coordinate below is relative to:
      * importers put it at the camera (see importers/builder.h). */

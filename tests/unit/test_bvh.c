@@ -70,7 +70,7 @@ static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, 
             continue;
         }
         uint32_t first = n->child[k];
-        if (count > PTR_BVH_LEAF_MAX || first < bvh->unbounded_count || first + count > s->count) {
+        if (count > PTR_BVH_LEAF_MAX || first < bvh->huge_count || first + count > s->count) {
             *ok = 0;
             continue;
         }
@@ -91,7 +91,7 @@ static void check_structure(const PtrBvh *bvh, const PtrSpheres *s, FileOrder or
 {
     unsigned char *seen = calloc(s->count + 1, 1);
     int ok = seen != NULL && s->id == NULL; /* the build frees the ids */
-    for (size_t i = 0; ok && i < bvh->unbounded_count; i++) {
+    for (size_t i = 0; ok && i < bvh->huge_count; i++) {
         seen[i]++;
         if (i > 0 && file_position(s, i, order) <= file_position(s, i - 1, order))
             ok = 0;
@@ -178,7 +178,7 @@ static void test_scenes(void)
 }
 
 /* The huge grounds stay out of the tree; ordinary spheres do not. */
-static void test_unbounded(void)
+static void test_huge(void)
 {
     const BvhSceneKind kinds[] = { BVH_SCENE_GROUND, BVH_SCENE_BIG_GROUND, BVH_SCENE_RANDOM };
     for (int k = 0; k < 3; k++) {
@@ -188,7 +188,7 @@ static void test_unbounded(void)
         tag_file_order(&s);
         PtrBvh bvh;
         CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1, NULL), PTR_OK);
-        CHECK_INT(bvh.unbounded_count, k < 2 ? 1 : 0);
+        CHECK_INT(bvh.huge_count, k < 2 ? 1 : 0);
         if (k < 2)
             CHECK_INT(file_position(&s.spheres, 0, (FileOrder){ 0 }), 0);
         ptr_bvh_free(&bvh);
@@ -218,7 +218,7 @@ static void test_threads(void)
         }
         CHECK_INT(bvh.node_count, first.node_count);
         CHECK_INT(bvh.depth, first.depth);
-        CHECK_INT(bvh.unbounded_count, first.unbounded_count);
+        CHECK_INT(bvh.huge_count, first.huge_count);
         CHECK(bvh.node_count == first.node_count &&
               !memcmp(bvh.nodes, first.nodes, bvh.node_count * sizeof *bvh.nodes));
         CHECK(!memcmp(s.spheres.color, first_scene.spheres.color,
@@ -417,7 +417,7 @@ int main(void)
 {
     test_small();
     test_coincident();
-    test_unbounded();
+    test_huge();
     test_scenes();
     test_threads();
     test_auto();
