@@ -22,36 +22,47 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
     }
 }
 
-void ptr_builder_free(PtrSceneBuilder *builder)
-{
-    free(builder->spheres);
-    free(builder->materials);
-    free(builder->colors);
-    free(builder->values);
-    builder->spheres = NULL;
-    builder->materials = NULL;
-    builder->colors = NULL;
-    builder->values = NULL;
-    builder->count = builder->capacity = 0;
-}
-
 /* The optional per-sphere arrays (words 4-byte words a sphere, and the bits
  * of each word of a sphere that has none): they exist from the first sphere
- * that has one. */
-enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
+ * that has one. The attributes' entries are the scene's (colours: 8 bytes,
+ * not 12 floats'). */
+enum {
+#define OPTIONAL_INDEX(name, type, per_sphere, none) OPTIONAL_##name,
+    PTR_SPHERE_ATTRIBUTES(OPTIONAL_INDEX)
+#undef OPTIONAL_INDEX
+    OPTIONAL_VALUES
+};
 static const struct {
     size_t offset;
     size_t words;
     uint32_t none;
 } optional_arrays[] = {
-    /* As the scene stores them (PtrSpheres.color): 8 bytes, not 12 floats' */
-    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 2, UINT32_MAX }, /* white */
+#define OPTIONAL_ENTRY(name, type, per_sphere, none)                                       \
+    [OPTIONAL_##name] = { offsetof(PtrSceneBuilder, name),                                 \
+                          (per_sphere) * sizeof(type) / sizeof(uint32_t), (none) },
+    PTR_SPHERE_ATTRIBUTES(OPTIONAL_ENTRY)
+#undef OPTIONAL_ENTRY
     [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, 0x7fc00000u }, /* NaN */
 };
+
+enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
 
 static uint32_t **optional_array(PtrSceneBuilder *b, size_t k)
 {
     return (uint32_t **)((char *)b + optional_arrays[k].offset);
+}
+
+void ptr_builder_free(PtrSceneBuilder *builder)
+{
+    free(builder->spheres);
+    free(builder->materials);
+    builder->spheres = NULL;
+    builder->materials = NULL;
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
+        free(*optional_array(builder, k));
+        *optional_array(builder, k) = NULL;
+    }
+    builder->count = builder->capacity = 0;
 }
 
 /* Entries from .. to - 1 of optional array k get its value for none. */
@@ -61,8 +72,6 @@ static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
     for (size_t i = from * words; i < to * words; i++)
         (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
-
-enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
 
 static PtrResult no_room(size_t count, PtrError *err)
 {
@@ -130,17 +139,17 @@ PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_col
         if (r != PTR_OK)
             return r;
     }
-    uint32_t **colors = optional_array(b, OPTIONAL_COLORS);
+    uint32_t **colors = optional_array(b, OPTIONAL_color);
     if (with_colors && !*colors) {
-        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_COLORS].words * sizeof **colors);
+        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_color].words * sizeof **colors);
         if (!*colors)
             return no_room(b->capacity, err);
         /* The earlier spheres only: the caller writes the new ones' (at
          * 10^8 spheres, 800 MB), and each later one fills its own. */
-        fill_none(b, OPTIONAL_COLORS, 0, b->count);
+        fill_none(b, OPTIONAL_color, 0, b->count);
     }
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
-        if (*optional_array(b, k) && !(k == OPTIONAL_COLORS && with_colors))
+        if (*optional_array(b, k) && !(k == OPTIONAL_color && with_colors))
             fill_none(b, k, b->count, b->count + count);
     *first = b->count;
     b->count += count;
@@ -160,7 +169,7 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3
     out[3] = radius;
     b->materials[n] = material;
     if (rgb)
-        quantize_color(rgb, &b->colors[4 * n]);
+        quantize_color(rgb, &b->color[4 * n]);
 }
 
 /* Optional array k's entry for the sphere added last, the array created if
@@ -180,7 +189,7 @@ static void *last_entry(PtrSceneBuilder *b, size_t k)
 
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3], PtrError *err)
 {
-    uint16_t *entry = last_entry(b, OPTIONAL_COLORS);
+    uint16_t *entry = last_entry(b, OPTIONAL_color);
     if (!entry)
         return no_room(b->capacity, err);
     quantize_color(rgb, entry);
@@ -413,7 +422,7 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
 
 /* Puts sphere i of the builder (already relative to the scene's origin) at
  * entry at of the scene's arrays (its value at entry i: see PtrSpheres),
- * whose colours and values exist if the builder's do. */
+ * whose attributes and values exist if the builder's do. */
 static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, PtrError *err)
 {
     const double *d = &b->spheres[4 * i];
@@ -430,8 +439,12 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, PtrError *e
     ptr_sphere_set_material(s, at, b->materials[i]);
     if (s->id)
         s->id[at] = (uint32_t)i;
-    if (b->colors)
-        memcpy(&s->color[4 * at], &b->colors[4 * i], 4 * sizeof *s->color);
+#define COPY_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (b->name)                                                                           \
+        memcpy(&s->name[(per_sphere) * at], &b->name[(per_sphere) * i],                    \
+               (per_sphere) * sizeof(type));
+    PTR_SPHERE_ATTRIBUTES(COPY_ATTRIBUTE)
+#undef COPY_ATTRIBUTE
     if (b->values)
         s->value[i] = b->values[i];
     return PTR_OK;
@@ -484,10 +497,13 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
-    if (res == PTR_OK && b->colors)
-        res = ptr_spheres_make_colors(&scene->spheres, err);
+#define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (res == PTR_OK && b->name)                                                          \
+        res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.name, err);
+    PTR_SPHERE_ATTRIBUTES(MAKE_ATTRIBUTE)
+#undef MAKE_ATTRIBUTE
     if (res == PTR_OK && b->values)
-        res = ptr_spheres_make_values(&scene->spheres, err);
+        res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.value, err);
     if (res == PTR_OK && huge_count)
         res = ptr_spheres_make_ids(&scene->spheres, err);
     if (res == PTR_OK && huge_count) {

@@ -23,7 +23,11 @@ typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
-    uint16_t *colors; /* as PtrSpheres.color; NULL while no sphere has its own */
+    /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
+     * each NULL while no sphere has one. */
+#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+    PTR_SPHERE_ATTRIBUTES(PTR_BUILDER_ATTRIBUTE_ARRAY)
+#undef PTR_BUILDER_ATTRIBUTE_ARRAY
     float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
     size_t count, capacity;
     int has_camera;
@@ -52,7 +56,7 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 /* Adds count spheres at once for an importer that fills them itself, on as
  * many threads as it likes: for each sphere first + i, the centre and radius
  * at spheres[4 * (first + i)], the material, and with with_colors the
- * colour at colors[4 * (first + i)] (see ptr_color_quantize). */
+ * colour at color[4 * (first + i)] (see ptr_color_quantize). */
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
                                   size_t *first, PtrError *err);
 

@@ -60,11 +60,13 @@ static float huge_radius(const PtrSpheres *s)
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i),
-                  ptr_sphere_material(s, i),
-                  { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
-    if (s->color)
-        memcpy(p.color, &s->color[4 * i], sizeof p.color);
+    BvhPrim p = { .centre = { s->cx[i], s->cy[i], s->cz[i] }, .radius = s->radius[i],
+                  .id = ptr_sphere_id(s, i), .material = ptr_sphere_material(s, i) };
+#define COPY_IN(name, type, per_sphere, none)                                              \
+    if (s->name)                                                                           \
+        memcpy(p.name, &s->name[(per_sphere) * i], sizeof p.name);
+    PTR_SPHERE_ATTRIBUTES(COPY_IN)
+#undef COPY_IN
     return p;
 }
 
@@ -75,8 +77,11 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
     s->cz[i] = p->centre[2];
     s->radius[i] = p->radius;
     ptr_sphere_set_material(s, i, p->material);
-    if (s->color)
-        memcpy(&s->color[4 * i], p->color, sizeof p->color);
+#define COPY_OUT(name, type, per_sphere, none)                                             \
+    if (s->name)                                                                           \
+        memcpy(&s->name[(per_sphere) * i], p->name, sizeof p->name);
+    PTR_SPHERE_ATTRIBUTES(COPY_OUT)
+#undef COPY_OUT
 }
 
 /* Spheres copied between two releases of the arrays' memory: 4 MB of each

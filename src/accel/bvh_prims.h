@@ -10,15 +10,18 @@
 #include "scene/scene.h"
 
 
-/* A sphere as the build moves it, whole: 32 bytes. At 10^8 spheres the
- * prims are the build's largest array, and the scene's arrays give their
- * memory back as the prims are filled; the tree's leaves are written back
- * to them from the prims, in their final order. */
+/* A sphere as the build moves it, whole: 32 bytes with its colour. At 10^8
+ * spheres the prims are the build's largest array, and the scene's arrays
+ * give their memory back as the prims are filled; the tree's leaves are
+ * written back to them from the prims, in their final order. */
 typedef struct BvhPrim {
     float centre[3], radius;
     uint32_t id; /* the sphere's in the file (ptr_sphere_id), which orders a leaf */
     uint32_t material;
-    uint16_t color[4]; /* white where the scene has no colours */
+    /* Those of PTR_SPHERE_ATTRIBUTES, unset where the scene has none. */
+#define BVH_PRIM_ATTRIBUTE(name, type, per_sphere, none) type name[per_sphere];
+    PTR_SPHERE_ATTRIBUTES(BVH_PRIM_ATTRIBUTE)
+#undef BVH_PRIM_ATTRIBUTE
 } BvhPrim;
 
 /* Box padding, relative to the magnitude of the numbers involved: see the

@@ -31,6 +31,12 @@ typedef struct SphereArray {
 
 enum { SPHERE_ARRAYS_MAX = 16 };
 
+#define WHOLE_WORDS(name, type, per_sphere, none)                                          \
+    static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0,                     \
+                  #name ": an attribute's entry is whole 4-byte words (see pad_array)");
+PTR_SPHERE_ATTRIBUTES(WHOLE_WORDS)
+#undef WHOLE_WORDS
+
 /* Fills a with s's arrays; returns how many there are. */
 static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
@@ -44,8 +50,11 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
         { (void **)&s->material, s->material_size, 0, 0, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1 },
-        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 1 }, /* white */
-        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
+#define ATTRIBUTE_ARRAY(name, type, per_sphere, none)                                      \
+    { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1 },
+        PTR_SPHERE_ATTRIBUTES(ATTRIBUTE_ARRAY)
+#undef ATTRIBUTE_ARRAY
+        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 }, /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -220,19 +229,14 @@ static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from, Pt
     return PTR_OK;
 }
 
-PtrResult ptr_spheres_make_colors(PtrSpheres *s, PtrError *err)
+PtrResult ptr_spheres_make(PtrSpheres *s, void **array, PtrError *err)
 {
-    return create_optional(s, (void **)&s->color, s->count, err);
-}
-
-PtrResult ptr_spheres_make_values(PtrSpheres *s, PtrError *err)
-{
-    return create_optional(s, (void **)&s->value, s->count, err);
+    return create_optional(s, array, s->count, err);
 }
 
 PtrResult ptr_spheres_make_ids(PtrSpheres *s, PtrError *err)
 {
-    return create_optional(s, (void **)&s->id, s->count, err);
+    return ptr_spheres_make(s, (void **)&s->id, err);
 }
 
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
@@ -389,8 +393,11 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
         const uint32_t m = ptr_sphere_material(s, by_id ? by_id[k] : k);
         h = hash_bytes(h, &m, sizeof m);
     }
-    if (s->color)
-        h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
+#define HASH_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (s->name)                                                                           \
+        h = hash_in_file_order(h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
+    PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)
+#undef HASH_ATTRIBUTE
     free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {

@@ -24,6 +24,22 @@
 
 enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 
+/* The attributes a sphere may have besides its centre, radius and
+ * material: the one list of them, from which the scene's arrays, the
+ * builder's (importers/builder.h), the tree's prims (accel/bvh_prims.h) and
+ * the hash are all made, so that a new attribute is a line here (and a way
+ * for importers to set it). Each is an array of PtrSpheres, NULL while no
+ * sphere has one, that moves with its sphere:
+ *
+ *   X(name, type of an element, elements a sphere, bits of each 4-byte
+ *     word of the entry of a sphere that has none)
+ *
+ * color: the sphere's own colour, multiplying its material's base colour
+ * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
+ * entry, 8 bytes a sphere; none is white. So a million colours are a
+ * million of these, never a million materials. */
+#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX)
+
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
@@ -39,11 +55,10 @@ typedef struct PtrSpheres {
      * file) and frees the array: the renderer needs no ids. NULL: the arrays
      * are in the file's order. */
     uint32_t *id;
-    /* Each sphere's own colour, multiplying its material's base colour
-     * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
-     * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
-     * a million colours are a million of these, never a million materials. */
-    uint16_t *color;
+    /* Those of PTR_SPHERE_ATTRIBUTES, in its order. */
+#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+    PTR_SPHERE_ATTRIBUTES(PTR_SPHERE_ATTRIBUTE_ARRAY)
+#undef PTR_SPHERE_ATTRIBUTE_ARRAY
     /* The value of the quantity --color-by names of the sphere of id i (NaN:
      * none) at entry i, in the file's order whatever the order of the other
      * arrays; 4 bytes a sphere, NULL unless asked for (see scene/colormap.h),
@@ -191,16 +206,14 @@ PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
                                        PtrError *err);
 
-/* Creates the colour array, if absent, for a caller that writes every
- * sphere's colour: only the padding is set, so at 10^8 spheres memory is
- * used as the colours are written, not 800 MB at once. */
-PtrResult ptr_spheres_make_colors(PtrSpheres *spheres, PtrError *err);
+/* Creates array, one of the optional arrays of spheres (an attribute's, the
+ * values or the ids), if absent, for a caller that writes every sphere's
+ * entry: only the padding is set, so at 10^8 spheres memory is used as the
+ * entries are written (800 MB of colours), not at once. */
+PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
 
-/* The same for the values (PtrSpheres.value). */
-PtrResult ptr_spheres_make_values(PtrSpheres *spheres, PtrError *err);
-
-/* The same for the ids (PtrSpheres.id), for an importer that puts spheres
- * out of the file's order. */
+/* ptr_spheres_make for the ids (PtrSpheres.id), for an importer that puts
+ * spheres out of the file's order. */
 PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
