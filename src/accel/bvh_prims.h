@@ -9,7 +9,6 @@
 #include "base/result.h"
 #include "scene/scene.h"
 
-
 /* A sphere as the build moves it, whole: 32 bytes with its colour. At 10^8
  * spheres the prims are the build's largest array, and the scene's arrays
  * give their memory back as the prims are filled; the tree's leaves are
@@ -47,14 +46,13 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
 
 /* Puts the huge spheres (scene.h's rule, with the tree's limit) in
  * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX), a
- * prim for each of the
- * others in prims (their count in *prim_count, in the arrays' order), and
- * in *magnitude the largest coordinate magnitude in the tree, which bounds
- * both the spheres' and the rays' origins (the camera sits at 0, other rays
- * start on spheres) and so scales the boxes' padding. Gives back the
- * spheres' memory as it goes (ptr_spheres_release): on success the prims
- * and huge hold the only copy of spheres 0 .. count - 1 but their
- * values. Fails only for memory (the spheres untouched). */
+ * prim for each of the others in prims (their count in *prim_count, in the
+ * arrays' order), and in *magnitude the largest coordinate magnitude in the
+ * tree, which bounds both the spheres' and the rays' origins (the camera
+ * sits at 0, other rays start on spheres) and so scales the boxes' padding.
+ * Gives back the spheres' memory as it goes (ptr_spheres_release): on
+ * success the prims and huge hold the only copy of spheres 0 .. count - 1
+ * but their values. Fails only for memory (the spheres untouched). */
 PtrResult ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *huge, size_t *huge_count,
                         BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
 
