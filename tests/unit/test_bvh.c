@@ -177,6 +177,33 @@ static void test_scenes(void)
         }
 }
 
+/* The rule itself (scene.h), as the builder and the tree apply it: of the
+ * spheres above the limit, the PTR_HUGE_MAX largest, on equal radii the
+ * first in the file, handed back in the file's order. 40 spheres offered in
+ * the arrays' order, whose file positions run backwards: radius 1 (below
+ * the limit of 2) for even positions, else 10 for the positions of 30 and
+ * over and 5 below. */
+static void test_huge_rule(void)
+{
+    PtrHugeChoice choice = { .limit = 2.0 };
+    for (size_t i = 0; i < 40; i++) {
+        const size_t file = 39 - i;
+        ptr_huge_offer(&choice, i, file, file % 2 == 0 ? 1.0 : file >= 30 ? 10.0 : 5.0);
+    }
+    ptr_huge_file_order(&choice);
+    CHECK_INT(choice.count, PTR_HUGE_MAX);
+    /* Odd positions: the five of radius 10 (31 .. 39), then of the fifteen
+     * of radius 5 the first eleven in the file (1 .. 21). */
+    size_t wrong = 0;
+    for (size_t k = 0; k < choice.count; k++) {
+        const size_t file = choice.sphere[k].file_position;
+        const size_t expected = k < 11 ? 2 * k + 1 : 31 + 2 * (k - 11);
+        wrong += file != expected || choice.sphere[k].index != 39 - file ||
+                 choice.sphere[k].radius != (file >= 30 ? 10.0 : 5.0);
+    }
+    CHECK_INT(wrong, 0);
+}
+
 /* The huge grounds stay out of the tree; ordinary spheres do not. */
 static void test_huge(void)
 {
@@ -417,6 +444,7 @@ int main(void)
 {
     test_small();
     test_coincident();
+    test_huge_rule();
     test_huge();
     test_scenes();
     test_threads();
