@@ -27,7 +27,7 @@ section .text
 ; reciprocal direction broadcast to 8 lanes, the children's entry distances,
 ; best * PTR_BVH_SLACK broadcast, then the traversal stack of 16-byte
 ; entries (child, leaf count, entry distance, unused); also the count of the
-; spheres kept out of the tree, which are tested last (the tree's first node
+; huge spheres left out of the tree, which are tested last (the tree's first node
 ; test need not wait on their square roots), and the rsp to return with.
 ORG_X   equ 0
 ORG_Y   equ 32
@@ -125,7 +125,7 @@ FUNCTION ptr_bvh_closest_hit_avx2
 
 .tree:
     test        r13, r13
-    jz          .kept_out
+    jz          .huge
     ; Per ray: origin, and 1 / dir clamped to +-FLT_MAX (finite or zero
     ; products, never NaN), each in 8 lanes.
     vbroadcastss ymm8, [rdi + RAY_ORG_X]
@@ -158,7 +158,7 @@ FUNCTION ptr_bvh_closest_hit_avx2
 .pop:
     lea         rax, [rbp + STACK]
     cmp         r14, rax
-    je          .kept_out
+    je          .huge
     sub         r14, 16
     vmovss      xmm8, [r14 + 8]
     vucomiss    xmm8, [rbp + BEST_UP]
@@ -238,9 +238,9 @@ FUNCTION ptr_bvh_closest_hit_avx2
     call        test_leaf
     jmp         .pop
 
-    ; The spheres kept out of the tree, eight at a time, once the tree has
+    ; The huge spheres left out of the tree, eight at a time, once the tree has
     ; found its best: the tree's first node test need not wait for them.
-.kept_out:
+.huge:
     TEST_KEPT_OUT [rbp + KEPT_OUT]
 .finish:
     TREE_LEAVE_FRAME FRAME

@@ -6,7 +6,7 @@
 ; without a round trip through the stack, and the others are compressed
 ; (vcompressps, vpcompressd) onto three stacks, of entry distances, children
 ; and leaf counts, with one store each instead of a loop over the lanes; and
-; the spheres kept out of the tree tested last, so that the first node test
+; the huge spheres left out of the tree tested last, so that the first node test
 ; does not wait on their square roots (on the recorded rays of a 10^5-sphere
 ; cloud, 1.1x as fast; bench/query).
 ;
@@ -101,7 +101,7 @@ TEST_LEAF_BY_EIGHT
 ; rdi ray, rsi bvh (then the node being tested), rdx spheres (then scratch),
 ; rcx hit (pushed; then scratch)
 ; r8-r11 cx, cy, cz, radius   r13 nodes   r14 entries on the stacks
-; r15d best sphere (PTR_NO_HIT)   rbx spheres kept out of the tree   rbp the frame
+; r15d best sphere (PTR_NO_HIT)   rbx huge spheres left out of the tree   rbp the frame
 ; ymm0-2 dx, dy, dz   ymm3 tmin   ymm4 best t   ymm6 lane indices
 ; ymm7 sign mask   ymm8-15 scratch   ymm16-18 ox, oy, oz
 ; ymm19-21 1 / d clamped   ymm22 slack   ymm23 +inf   ymm24 best * slack
@@ -127,7 +127,7 @@ FUNCTION ptr_bvh_closest_hit_avx512
 
 .tree:
     test        r13, r13
-    jz          .kept_out
+    jz          .huge
     RECIPROCALS_AVX512
     xor         r14d, r14d
     xor         eax, eax                        ; the root
@@ -177,7 +177,7 @@ FUNCTION ptr_bvh_closest_hit_avx512
 
 .pop:
     test        r14, r14
-    jz          .kept_out
+    jz          .huge
     dec         r14
     vmovss      xmm8, [rbp + STACK_ENTRY + r14*4]
     vucomiss    xmm8, xmm24
@@ -189,9 +189,9 @@ FUNCTION ptr_bvh_closest_hit_avx512
     call        test_leaf
     jmp         .pop
 
-    ; The spheres kept out of the tree, eight at a time, once the tree has
+    ; The huge spheres left out of the tree, eight at a time, once the tree has
     ; found its best: the tree's first node test need not wait for them.
-.kept_out:
+.huge:
     TEST_KEPT_OUT rbx
 .finish:
     TREE_LEAVE_FRAME FRAME

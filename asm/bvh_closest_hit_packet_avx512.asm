@@ -107,7 +107,7 @@ FUNCTION ptr_bvh_closest_hit_packet_avx512
     mov         eax, 0xff
     kmovw       k1, eax                         ; every ray
 
-    ; The spheres kept out of the tree, by every ray.
+    ; The huge spheres left out of the tree, by every ray.
     test        rbx, rbx
     jz          .tree
     xor         eax, eax

@@ -50,8 +50,8 @@ static int make_cloud(PtrScene *scene, size_t n, uint64_t seed)
     float r = cbrtf(0.08f * box[0] * box[1] * box[2] / (float)n * 3.0f / (4.0f * PTR_PI));
     uint32_t ground;
     PtrMaterial m = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3(0.5f, 0.5f, 0.5f) };
-    int ok = ptr_scene_add_material(scene, &m, &ground) == PTR_OK &&
-             ptr_scene_add_sphere(scene, v3_sub(v3(0, -1000, 0), eye), 1000.0f, ground) == PTR_OK;
+    int ok = ptr_scene_add_material(scene, &m, &ground, NULL) == PTR_OK &&
+             ptr_scene_add_sphere(scene, v3_sub(v3(0, -1000, 0), eye), 1000.0f, ground, NULL) == PTR_OK;
     for (size_t i = 0; ok && i < n; i++) {
         PtrVec3 c = v3(uniform(&rng, -10, 10), uniform(&rng, r, box[1]), uniform(&rng, -10, 10));
         float kind = ptr_rng_float(&rng);
@@ -68,8 +68,8 @@ static int make_cloud(PtrScene *scene, size_t n, uint64_t seed)
         else
             m = (PtrMaterial){ .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3(1, 1, 1), .ior = 1.5f };
         uint32_t material;
-        ok = ptr_scene_add_material(scene, &m, &material) == PTR_OK &&
-             ptr_scene_add_sphere(scene, v3_sub(c, eye), r, material) == PTR_OK;
+        ok = ptr_scene_add_material(scene, &m, &material, NULL) == PTR_OK &&
+             ptr_scene_add_sphere(scene, v3_sub(c, eye), r, material, NULL) == PTR_OK;
     }
     return ok;
 }
@@ -130,7 +130,7 @@ int main(int argc, char **argv)
             rate[1] = mrays(&scene, &brute_asm, &setup, &seconds[1]);
         }
         PtrAccel tree;
-        if (ptr_accel_init(&tree, PTR_ACCEL_BVH, &c, 0, &scene, 0) != PTR_OK) {
+        if (ptr_accel_init(&tree, PTR_ACCEL_BVH, &c, 0, &scene, 0, NULL) != PTR_OK) {
             fprintf(stderr, "bvh: out of memory building the tree over %zu spheres\n", n);
             return 1;
         }

@@ -47,7 +47,7 @@ static double render(PtrScene *scene, const Config *c, PtrRenderSettings setting
     PtrError err = { 0 };
     ptr_isect_init(&isect, c->kernel, scene->spheres.count);
     if (ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, c->integrator == PTR_INTEGRATOR_BUNDLES,
-                       scene, 0) != PTR_OK ||
+                       scene, 0, NULL) != PTR_OK ||
         ptr_render(scene, &accel, &settings, rgb, &stats, &err) != PTR_OK) {
         fprintf(stderr, "paths: %s\n", err.message[0] ? err.message : "out of memory");
         exit(2);

@@ -305,7 +305,7 @@ int main(int argc, char **argv)
     PtrAccel accel;
     recorded = malloc(RAYS_MAX * sizeof *recorded);
     packet_start = malloc(RAYS_MAX);
-    if (!recorded || !packet_start || ptr_accel_init(&accel, PTR_ACCEL_BVH, &c, 0, &scene, 0) != PTR_OK) {
+    if (!recorded || !packet_start || ptr_accel_init(&accel, PTR_ACCEL_BVH, &c, 0, &scene, 0, NULL) != PTR_OK) {
         fprintf(stderr, "query: out of memory\n");
         return 6;
     }

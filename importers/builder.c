@@ -22,36 +22,47 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
     }
 }
 
-void ptr_builder_free(PtrSceneBuilder *builder)
-{
-    free(builder->spheres);
-    free(builder->materials);
-    free(builder->colors);
-    free(builder->values);
-    builder->spheres = NULL;
-    builder->materials = NULL;
-    builder->colors = NULL;
-    builder->values = NULL;
-    builder->count = builder->capacity = 0;
-}
-
 /* The optional per-sphere arrays (words 4-byte words a sphere, and the bits
  * of each word of a sphere that has none): they exist from the first sphere
- * that has one. */
-enum { OPTIONAL_COLORS, OPTIONAL_VALUES };
+ * that has one. The attributes' entries are the scene's (colours: 8 bytes,
+ * not 12 floats'). */
+enum {
+#define OPTIONAL_INDEX(name, type, per_sphere, none) OPTIONAL_##name,
+    PTR_SPHERE_ATTRIBUTES(OPTIONAL_INDEX)
+#undef OPTIONAL_INDEX
+    OPTIONAL_VALUES
+};
 static const struct {
     size_t offset;
     size_t words;
     uint32_t none;
 } optional_arrays[] = {
-    /* As the scene stores them (PtrSpheres.color): 8 bytes, not 12 floats' */
-    [OPTIONAL_COLORS] = { offsetof(PtrSceneBuilder, colors), 2, UINT32_MAX }, /* white */
+#define OPTIONAL_ENTRY(name, type, per_sphere, none)                                       \
+    [OPTIONAL_##name] = { offsetof(PtrSceneBuilder, name),                                 \
+                          (per_sphere) * sizeof(type) / sizeof(uint32_t), (none) },
+    PTR_SPHERE_ATTRIBUTES(OPTIONAL_ENTRY)
+#undef OPTIONAL_ENTRY
     [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, 0x7fc00000u }, /* NaN */
 };
+
+enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
 
 static uint32_t **optional_array(PtrSceneBuilder *b, size_t k)
 {
     return (uint32_t **)((char *)b + optional_arrays[k].offset);
+}
+
+void ptr_builder_free(PtrSceneBuilder *builder)
+{
+    free(builder->spheres);
+    free(builder->materials);
+    builder->spheres = NULL;
+    builder->materials = NULL;
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
+        free(*optional_array(builder, k));
+        *optional_array(builder, k) = NULL;
+    }
+    builder->count = builder->capacity = 0;
 }
 
 /* Entries from .. to - 1 of optional array k get its value for none. */
@@ -62,22 +73,25 @@ static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
         (*optional_array(b, k))[i] = optional_arrays[k].none;
 }
 
-enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
+static PtrResult no_room(size_t count, PtrError *err)
+{
+    return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu spheres", count);
+}
 
 /* Resizes every array to capacity spheres (while they fill, count stays
  * below it; add_spheres shrinks them below count as it empties them). */
-static PtrResult resize(PtrSceneBuilder *b, size_t capacity)
+static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
 {
     if (capacity > SIZE_MAX / (4 * sizeof *b->spheres))
-        return PTR_ERR_NOMEM;
+        return no_room(capacity, err);
     const size_t entries = capacity ? capacity : 1;
     double *spheres = realloc(b->spheres, entries * 4 * sizeof *spheres);
     if (!spheres)
-        return PTR_ERR_NOMEM;
+        return no_room(capacity, err);
     b->spheres = spheres;
     uint32_t *materials = realloc(b->materials, entries * sizeof *materials);
     if (!materials)
-        return PTR_ERR_NOMEM;
+        return no_room(capacity, err);
     b->materials = materials;
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
         uint32_t **array = optional_array(b, k);
@@ -85,23 +99,23 @@ static PtrResult resize(PtrSceneBuilder *b, size_t capacity)
             continue;
         uint32_t *resized = realloc(*array, entries * optional_arrays[k].words * sizeof *resized);
         if (!resized)
-            return PTR_ERR_NOMEM;
+            return no_room(capacity, err);
         *array = resized;
     }
     b->capacity = capacity;
     return PTR_OK;
 }
 
-PtrResult ptr_builder_reserve(PtrSceneBuilder *b, size_t count)
+PtrResult ptr_builder_reserve(PtrSceneBuilder *b, size_t count, PtrError *err)
 {
-    return count > b->capacity ? resize(b, count) : PTR_OK;
+    return count > b->capacity ? resize(b, count, err) : PTR_OK;
 }
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
-                                 uint32_t material)
+                                 uint32_t material, PtrError *err)
 {
     if (b->count == b->capacity) {
-        PtrResult r = resize(b, b->capacity ? 2 * b->capacity : 64);
+        PtrResult r = resize(b, b->capacity ? 2 * b->capacity : 64, err);
         if (r != PTR_OK)
             return r;
     }
@@ -118,24 +132,24 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
 }
 
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_colors,
-                                  size_t *first)
+                                  size_t *first, PtrError *err)
 {
     if (b->count + count > b->capacity) {
-        PtrResult r = resize(b, b->count + count);
+        PtrResult r = resize(b, b->count + count, err);
         if (r != PTR_OK)
             return r;
     }
-    uint32_t **colors = optional_array(b, OPTIONAL_COLORS);
+    uint32_t **colors = optional_array(b, OPTIONAL_color);
     if (with_colors && !*colors) {
-        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_COLORS].words * sizeof **colors);
+        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_color].words * sizeof **colors);
         if (!*colors)
-            return PTR_ERR_NOMEM;
+            return no_room(b->capacity, err);
         /* The earlier spheres only: the caller writes the new ones' (at
          * 10^8 spheres, 800 MB), and each later one fills its own. */
-        fill_none(b, OPTIONAL_COLORS, 0, b->count);
+        fill_none(b, OPTIONAL_color, 0, b->count);
     }
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
-        if (*optional_array(b, k) && !(k == OPTIONAL_COLORS && with_colors))
+        if (*optional_array(b, k) && !(k == OPTIONAL_color && with_colors))
             fill_none(b, k, b->count, b->count + count);
     *first = b->count;
     b->count += count;
@@ -155,7 +169,7 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3
     out[3] = radius;
     b->materials[n] = material;
     if (rgb)
-        quantize_color(rgb, &b->colors[4 * n]);
+        quantize_color(rgb, &b->color[4 * n]);
 }
 
 /* Optional array k's entry for the sphere added last, the array created if
@@ -173,20 +187,20 @@ static void *last_entry(PtrSceneBuilder *b, size_t k)
     return &(*array)[(b->count - 1) * words];
 }
 
-PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3])
+PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3], PtrError *err)
 {
-    uint16_t *entry = last_entry(b, OPTIONAL_COLORS);
+    uint16_t *entry = last_entry(b, OPTIONAL_color);
     if (!entry)
-        return PTR_ERR_NOMEM;
+        return no_room(b->capacity, err);
     quantize_color(rgb, entry);
     return PTR_OK;
 }
 
-PtrResult ptr_builder_set_value(PtrSceneBuilder *b, double value)
+PtrResult ptr_builder_set_value(PtrSceneBuilder *b, double value, PtrError *err)
 {
     float *entry = last_entry(b, OPTIONAL_VALUES);
     if (!entry)
-        return PTR_ERR_NOMEM;
+        return no_room(b->capacity, err);
     *entry = (float)value;
     return PTR_OK;
 }
@@ -368,17 +382,17 @@ static PtrVec3 relative(const double p[3], const double origin[3])
     return v3((float)(p[0] - origin[0]), (float)(p[1] - origin[1]), (float)(p[2] - origin[2]));
 }
 
-/* Which spheres are huge (see accel/huge.h): those whose radius is more than
- * HUGE_RATIO times the extent E of the region the rays live in, taken as the
- * box around the camera and every sphere of a radius within SMALL_RATIO of
- * the smallest. In float, rays leave a sphere of radius r lifted by about
+/* The huge spheres (scene.h's rule) kept in double (accel/huge.h says why):
+ * the limit is HUGE_RATIO times the extent E of the region the rays live
+ * in, taken as the box around the camera and every sphere of a radius within
+ * SMALL_RATIO of the smallest. In float, rays leave a sphere of radius r lifted by about
  * 2^-20 r; below 256 E that is under 2^-12 E, less than a pixel of a 4K
  * image of the whole region, and the double test would only cost time (a
  * quarter of the rays per second on a four-sphere scene). A radius-1e5
  * ground under a scene a few units (or a room 100) across is huge; the
  * radius-100 and radius-1000 grounds of seed.gltf and final.gltf are not;
- * a cloud of like spheres has none. At most PTR_HUGE_MAX, the largest (every
- * ray tests them all). Puts their indices in huge[], ascending, and returns
+ * a cloud of like spheres has none (the tree's limit takes those grounds
+ * out of its boxes). Puts their indices in huge[], ascending, and returns
  * how many. */
 #define HUGE_RATIO 256.0
 
@@ -397,39 +411,27 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
     double extent = 0;
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
-    /* The largest candidates, largest first (the earliest on equal radii). */
-    size_t top[PTR_HUGE_MAX], count = 0;
-    for (size_t i = 0; i < b->count; i++) {
-        double r = b->spheres[4 * i + 3];
-        if (!(r > HUGE_RATIO * extent))
-            continue;
-        size_t at = count < PTR_HUGE_MAX ? count++ : PTR_HUGE_MAX;
-        for (; at > 0 && b->spheres[4 * top[at - 1] + 3] < r; at--)
-            if (at < PTR_HUGE_MAX)
-                top[at] = top[at - 1];
-        if (at < PTR_HUGE_MAX)
-            top[at] = i;
-    }
-    for (size_t k = 0; k < count; k++) {
-        size_t at = k;
-        for (; at > 0 && huge[at - 1] > top[k]; at--)
-            huge[at] = huge[at - 1];
-        huge[at] = top[k];
-    }
-    return count;
+    PtrHugeChoice choice = { .limit = HUGE_RATIO * extent };
+    for (size_t i = 0; i < b->count; i++)
+        ptr_huge_offer(&choice, i, i, b->spheres[4 * i + 3]);
+    ptr_huge_file_order(&choice);
+    for (size_t k = 0; k < choice.count; k++)
+        huge[k] = choice.sphere[k].index;
+    return choice.count;
 }
 
 /* Puts sphere i of the builder (already relative to the scene's origin) at
- * entry at of the scene's arrays (its value at entry i: see PtrSpheres). */
-static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
+ * entry at of the scene's arrays (its value at entry i: see PtrSpheres),
+ * whose attributes and values exist if the builder's do. */
+static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, PtrError *err)
 {
     const double *d = &b->spheres[4 * i];
     PtrVec3 c = v3((float)d[0], (float)d[1], (float)d[2]);
     float r = (float)d[3];
     if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
-        return PTR_ERR_SCENE_INVALID;
-    PtrScene *scene = b->scene;
-    PtrSpheres *s = &scene->spheres;
+        return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                             "a sphere lies too far from the camera for single precision");
+    PtrSpheres *s = &b->scene->spheres;
     s->cx[at] = c.x;
     s->cy[at] = c.y;
     s->cz[at] = c.z;
@@ -437,12 +439,15 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at)
     ptr_sphere_set_material(s, at, b->materials[i]);
     if (s->id)
         s->id[at] = (uint32_t)i;
-    PtrResult res = PTR_OK;
-    if (b->colors)
-        res = ptr_scene_set_sphere_color16(scene, at, &b->colors[4 * i]);
-    if (res == PTR_OK && b->values)
-        res = ptr_scene_set_sphere_value(scene, i, b->values[i]);
-    return res;
+#define COPY_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (b->name)                                                                           \
+        memcpy(&s->name[(per_sphere) * at], &b->name[(per_sphere) * i],                    \
+               (per_sphere) * sizeof(type));
+    PTR_SPHERE_ATTRIBUTES(COPY_ATTRIBUTE)
+#undef COPY_ATTRIBUTE
+    if (b->values)
+        s->value[i] = b->values[i];
+    return PTR_OK;
 }
 
 /* The builder's arrays give back this many spheres' memory at a time as
@@ -469,7 +474,7 @@ static void move_spheres(void *arg, size_t begin, size_t end)
         if (huge_before < m->huge_count && m->huge[huge_before] == i)
             huge_before++;
         else
-            invalid |= add_sphere(m->builder, i, i - huge_before) != PTR_OK;
+            invalid |= add_sphere(m->builder, i, i - huge_before, NULL) != PTR_OK;
     }
     if (invalid)
         atomic_store(&m->invalid, 1);
@@ -479,7 +484,8 @@ static void move_spheres(void *arg, size_t begin, size_t end)
  * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
  * all cores from the last back, the builder's arrays shrinking behind, so
  * that 10^8 spheres are never in memory twice. */
-static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double)
+static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double,
+                             PtrError *err)
 {
     PtrScene *scene = b->scene;
     const size_t count = b->count;
@@ -489,22 +495,25 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
             b->spheres[4 * i + k] -= origin[k];
     size_t huge[PTR_HUGE_MAX];
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
-    PtrResult res = ptr_spheres_resize(&scene->spheres, count);
+    PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
-    if (res == PTR_OK && b->colors)
-        res = ptr_spheres_make_colors(&scene->spheres);
+#define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (res == PTR_OK && b->name)                                                          \
+        res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.name, err);
+    PTR_SPHERE_ATTRIBUTES(MAKE_ATTRIBUTE)
+#undef MAKE_ATTRIBUTE
     if (res == PTR_OK && b->values)
-        res = ptr_spheres_make_values(&scene->spheres);
+        res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.value, err);
     if (res == PTR_OK && huge_count)
-        res = ptr_spheres_make_ids(&scene->spheres);
+        res = ptr_spheres_make_ids(&scene->spheres, err);
     if (res == PTR_OK && huge_count) {
         scene->huge.centre_radius = malloc(huge_count * 4 * sizeof(double));
         if (!scene->huge.centre_radius)
-            res = PTR_ERR_NOMEM;
+            res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the huge spheres");
     }
     for (size_t k = 0; k < huge_count && res == PTR_OK; k++) {
         memcpy(&scene->huge.centre_radius[4 * k], &b->spheres[4 * huge[k]], 4 * sizeof(double));
-        res = add_sphere(b, huge[k], count - huge_count + k);
+        res = add_sphere(b, huge[k], count - huge_count + k, err);
     }
     SphereMove move = { .builder = b, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
@@ -513,8 +522,9 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
         const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
         ptr_parallel_ranges(threads, begin, end, move_spheres, &move);
         if (atomic_load(&move.invalid))
-            res = PTR_ERR_SCENE_INVALID;
-        (void)resize(b, begin); /* spheres begin and on are moved; failing keeps more */
+            res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                                "a sphere lies too far from the camera for single precision");
+        (void)resize(b, begin, NULL); /* spheres begin and on are moved; failing keeps more */
         end = begin;
     }
     if (res == PTR_OK)
@@ -522,7 +532,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
     return res;
 }
 
-PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags)
+PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
 {
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
@@ -535,7 +545,7 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags)
     const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : zero;
     memcpy(scene->origin, origin, sizeof scene->origin);
 
-    res = add_spheres(b, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE);
+    res = add_spheres(b, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
     scene->camera = b->lens;
     scene->camera.lookfrom = relative(b->eye, origin);
     scene->camera.lookat = relative(b->target, origin);

@@ -16,14 +16,18 @@
 #include <stdint.h>
 
 #include "base/result.h"
-#include "importer.h"
+#include "import_options.h"
 #include "scene/scene.h"
 
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
     uint32_t *materials;
-    uint16_t *colors; /* as PtrSpheres.color; NULL while no sphere has its own */
+    /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
+     * each NULL while no sphere has one. */
+#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+    PTR_SPHERE_ATTRIBUTES(PTR_BUILDER_ATTRIBUTE_ARRAY)
+#undef PTR_BUILDER_ATTRIBUTE_ARRAY
     float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
     size_t count, capacity;
     int has_camera;
@@ -41,18 +45,20 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
 void ptr_builder_free(PtrSceneBuilder *builder);
 
 /* Makes room for count spheres, for an importer that knows how many it will
- * add: its arrays are then allocated once, not doubled as they fill. */
-PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count);
+ * add: its arrays are then allocated once, not doubled as they fill. This
+ * and the functions below that add to the builder fail only for memory
+ * (PTR_ERR_NOMEM, said in err, which may be NULL). */
+PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count, PtrError *err);
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
-                                 double radius, uint32_t material);
+                                 double radius, uint32_t material, PtrError *err);
 
 /* Adds count spheres at once for an importer that fills them itself, on as
  * many threads as it likes: for each sphere first + i, the centre and radius
  * at spheres[4 * (first + i)], the material, and with with_colors the
- * colour at colors[4 * (first + i)] (see ptr_color_quantize). */
+ * colour at color[4 * (first + i)] (see ptr_color_quantize). */
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
-                                  size_t *first);
+                                  size_t *first, PtrError *err);
 
 /* Fills sphere n of those ptr_builder_add_spheres added, from any thread:
  * centre, radius, material and, where rgb is not NULL (only if they were
@@ -61,10 +67,10 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *builder, size_t n, const double ce
                              double radius, uint32_t material, const double *rgb);
 
 /* Gives the sphere added last its own colour (see PtrSpheres.color). */
-PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3]);
+PtrResult ptr_builder_set_color(PtrSceneBuilder *builder, const double rgb[3], PtrError *err);
 
 /* Gives the sphere added last its value (see PtrSpheres.value). */
-PtrResult ptr_builder_set_value(PtrSceneBuilder *builder, double value);
+PtrResult ptr_builder_set_value(PtrSceneBuilder *builder, double value, PtrError *err);
 
 /* lens gives everything but the position and orientation. Ignored when the
  * builder has an override. */
@@ -83,9 +89,9 @@ typedef enum PtrBuildFlags {
 
 /* Fills the scene's spheres and camera: the camera given, or one that frames
  * the spheres from +Z, looking down -Z (see frame_spheres), then turned by
- * the orbit. Frees the builder's memory. Returns
+ * the orbit. Frees the builder's memory. Fails with
  * PTR_ERR_SCENE_INVALID if a sphere is too far from the camera for single
  * precision, PTR_ERR_NOMEM if memory runs out. */
-PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags);
+PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags, PtrError *err);
 
 #endif /* PTR_BUILDER_H */

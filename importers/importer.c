@@ -60,18 +60,9 @@ void ptr_strings_free(PtrStrings *warnings)
 
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err)
 {
-    PtrResult res = ptr_builder_finish(builder, PTR_BUILD_DEFAULT);
-    switch (res) {
-    case PTR_OK:
-        return res;
-    case PTR_ERR_NOMEM:
-        return ptr_error_set(err, res, "%s: out of memory", path);
-    case PTR_ERR_SCENE_INVALID:
-        return ptr_error_set(err, res, "%s: a sphere lies too far from the camera for single "
-                                       "precision", path);
-    default:
-        return ptr_error_set(err, res, "%s: %s", path, ptr_result_description(res));
-    }
+    PtrError problem;
+    PtrResult res = ptr_builder_finish(builder, PTR_BUILD_DEFAULT, &problem);
+    return res == PTR_OK ? res : ptr_error_set(err, res, "%s: %s", path, problem.message);
 }
 
 PtrResult ptr_import_check_memory(const char *path, uint64_t spheres, PtrError *err)

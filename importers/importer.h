@@ -4,47 +4,9 @@
 #ifndef PTR_IMPORTER_H
 #define PTR_IMPORTER_H
 
-#include <stddef.h>
-
 #include "base/result.h"
+#include "import_options.h"
 #include "scene/scene.h"
-
-/* A list of lines of text (warnings, file names). */
-typedef struct PtrStrings {
-    char **lines;
-    size_t count;
-} PtrStrings;
-
-/* A camera given on the command line, in world coordinates: it replaces the
- * scene's. */
-typedef struct PtrCameraSpec {
-    double lookfrom[3], lookat[3], up[3];
-    double vfov_deg;
-    double ortho_height;   /* above 0: orthographic, the view this high; vfov_deg unused */
-    double aperture;       /* lens diameter; 0: a pinhole */
-    double focus_distance; /* 0: the distance from lookfrom to lookat */
-} PtrCameraSpec;
-
-typedef struct PtrImportOptions {
-    const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
-    const PtrCameraSpec *camera; /* if set, the camera, whatever the file says */
-    int fit_all_objects;     /* OBJ: fit every object, not only those named *sphere* */
-    /* glTF: read each sphere's value of this instance or point attribute
-     * (--color-by) into PtrSpheres.value; NULL: none. A scene where no
-     * sphere has it is refused. */
-    const char *value_attribute;
-    /* The automatic camera of a scene that has none: its projection, and the
-     * width / height of the image it frames the spheres in (0: the scene's
-     * resolution, else 16:9). */
-    PtrProjection auto_projection;
-    double auto_aspect;
-    /* Degrees the camera, whichever it is, turns about the vertical axis
-     * (+Y) through the spheres' centre: a frame of a turntable. */
-    double orbit_degrees;
-    /* If set, receives the other files the scene was read from (a glTF's
-     * external buffers): what --watch must watch besides the scene file. */
-    PtrStrings *dependencies;
-} PtrImportOptions;
 
 /* Reads path into scene (which the call initialises). On failure the scene
  * is left empty and err holds one line naming the file and the problem:

@@ -11,8 +11,7 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options,
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                           PtrScene *scene, PtrStrings *warnings, PtrError *err);
 
-/* ptr_builder_finish with ptr's own flags, its failure told as what it is:
- * out of memory, or a sphere too far from the camera. */
+/* ptr_builder_finish with ptr's own flags, its message naming the file. */
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err);
 
 /* Bytes a sphere takes at the peak of its import and the tree's build

@@ -148,7 +148,7 @@ static PtrResult map_material(Importer *im, int gltf_index, uint32_t *out)
             m.fuzz = (float)g.roughness;
         }
     }
-    if (ptr_scene_add_material(im->scene, &m, slot) != PTR_OK)
+    if (ptr_scene_add_material(im->scene, &m, slot, NULL) != PTR_OK)
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     *out = *slot;
     return PTR_OK;
@@ -229,9 +229,9 @@ static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3
 {
     if (sphere_fault(centre, radius))
         return part_error(im, o, sphere_fault_text);
-    if (ptr_builder_add_sphere(&im->builder, centre, radius, material) != PTR_OK ||
-        (color && ptr_builder_set_color(&im->builder, color) != PTR_OK) ||
-        (value && ptr_builder_set_value(&im->builder, *value) != PTR_OK))
+    if (ptr_builder_add_sphere(&im->builder, centre, radius, material, NULL) != PTR_OK ||
+        (color && ptr_builder_set_color(&im->builder, color, NULL) != PTR_OK) ||
+        (value && ptr_builder_set_value(&im->builder, *value, NULL) != PTR_OK))
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return PTR_OK;
 }
@@ -531,7 +531,7 @@ static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfN
                          .col = prim->color >= 0 ? &col : NULL, .world = world, .color = color,
                          .radius = node->radius, .scale = scale, .material = material };
         atomic_init(&run.failed, SIZE_MAX);
-        if (ptr_builder_add_spheres(&im->builder, count, run.col || color, &run.first) != PTR_OK)
+        if (ptr_builder_add_spheres(&im->builder, count, run.col || color, &run.first, NULL) != PTR_OK)
             return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
         convert_in_blocks(im, count, convert_points, &run, &run.failed, read, release);
         o.part_index = atomic_load(&run.failed);
@@ -667,7 +667,7 @@ static PtrResult add_instances_parallel(Importer *im, const Origin *instance,
     atomic_init(&run.nonuniform, 0);
     PtrResult res = map_material(im, mesh->material, &run.material);
     if (res == PTR_OK &&
-        ptr_builder_add_spheres(&im->builder, count, run.c != NULL, &run.first) != PTR_OK)
+        ptr_builder_add_spheres(&im->builder, count, run.c != NULL, &run.first, NULL) != PTR_OK)
         res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     if (res != PTR_OK)
         return res;
@@ -1045,7 +1045,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
             res = walk_nodes(&im, &gs, count_spheres, &spheres);
         if (res == PTR_OK)
             res = ptr_import_check_memory(path, spheres, err);
-        if (res == PTR_OK && ptr_builder_reserve(&im.builder, (size_t)spheres) != PTR_OK)
+        if (res == PTR_OK && ptr_builder_reserve(&im.builder, (size_t)spheres, NULL) != PTR_OK)
             res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
         if (res == PTR_OK)
             res = walk_nodes(&im, &gs, import_node, NULL);

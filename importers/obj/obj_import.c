@@ -363,7 +363,7 @@ static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint
                      r->path, name);
         if (*grey == UINT32_MAX) {
             const PtrMaterial g = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.8f), .ior = 1.5f };
-            if (ptr_scene_add_material(scene, &g, grey) != PTR_OK)
+            if (ptr_scene_add_material(scene, &g, grey, NULL) != PTR_OK)
                 return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         }
         *index = *grey;
@@ -386,7 +386,7 @@ static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint
         return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
                              "%s: material '%s' has a value out of range (Ni > 0, Ke >= 0)", r->path,
                              m->name);
-    if (ptr_scene_add_material(scene, &out, index) != PTR_OK)
+    if (ptr_scene_add_material(scene, &out, index, NULL) != PTR_OK)
         return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     m->scene_index = *index;
     return PTR_OK;
@@ -425,7 +425,7 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
         }
         uint32_t material;
         res = material_for(r, p->material, scene, &material, &grey);
-        if (res == PTR_OK && ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material))
+        if (res == PTR_OK && ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         fitted++;
     }

@@ -12,13 +12,13 @@ PtrAccel ptr_accel_brute(const PtrIsectTable *isect, const PtrScene *scene)
 }
 
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
-                         int packets, PtrScene *scene, int threads)
+                         int packets, PtrScene *scene, int threads, PtrError *err)
 {
     *accel = ptr_accel_brute(isect, scene);
     /* Built for brute force too, for its order: on equal t the sphere first
      * in the arrays wins, so both must search the same arrays (PtrSpheres). */
     double start = ptr_now_seconds();
-    PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads);
+    PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads, err);
     if (r != PTR_OK)
         return r;
     accel->build_seconds = ptr_now_seconds() - start;

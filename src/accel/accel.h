@@ -50,9 +50,9 @@ typedef struct PtrAccel {
  * kernels of isect; the tree's build reorders the spheres (all arrays
  * together; see bvh.h), for brute force too, which then searches them in
  * that order; packets as for ptr_accel_crossover. threads: for the build, 0 for
- * one per CPU. Only PTR_ERR_NOMEM can fail. */
+ * one per CPU. Fails only with PTR_ERR_NOMEM, said in err (which may be NULL). */
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
-                         int packets, PtrScene *scene, int threads);
+                         int packets, PtrScene *scene, int threads, PtrError *err);
 
 /* Brute force over the scene's spheres as they are: nothing to build or
  * free. (A render's brute force, ptr_accel_init's, searches them in the

@@ -1,6 +1,6 @@
 /* The reference traversal of the tree (bvh_build.c builds it).
  *
- * Every ray first tests the spheres kept out of the tree, then walks the
+ * Every ray first tests the huge spheres left out of the tree, then walks the
  * tree front to back: of a node's children it visits the nearest entry
  * first and stacks the others, and it skips any child whose box it enters
  * beyond the best hit so far. Skipping never changes the answer: a box
@@ -48,7 +48,7 @@
 #include "accel/sphere_hit.h"
 
 /* The assembly traversal reads these at fixed offsets (asm/layout.inc). */
-static_assert(offsetof(PtrBvh, nodes) == 0 && offsetof(PtrBvh, unbounded_count) == 16,
+static_assert(offsetof(PtrBvh, nodes) == 0 && offsetof(PtrBvh, huge_count) == 16,
               "PtrBvh layout");
 static_assert(offsetof(PtrBvhNode, lower_x) == 0 && offsetof(PtrBvhNode, upper_x) == 32 &&
               offsetof(PtrBvhNode, lower_y) == 64 && offsetof(PtrBvhNode, lower_z) == 128 &&
@@ -78,7 +78,7 @@ PTR_DECL_BVH_CLOSEST_HIT(ptr_bvh_closest_hit_c)
     uint32_t best_index = PTR_NO_HIT;
     uint32_t tie = 0; /* the best's position; 0 before a first hit: no tie with tmax wins */
 
-    for (size_t i = 0; i < bvh->unbounded_count; i++) {
+    for (size_t i = 0; i < bvh->huge_count; i++) {
         const float t = ptr_sphere_hit(ray, spheres, i);
         if (better(t, (uint32_t)i, tmin, best, tie)) {
             best = t;

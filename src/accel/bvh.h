@@ -4,9 +4,10 @@
  * so the leaf test is the brute-force kernel's arithmetic on a few lanes.
  *
  * The build reorders the scene's spheres (every per-sphere array but the
- * --color-by values, see PtrSpheres) so that every leaf is contiguous, and keeps the
- * few spheres much larger than the rest out of the tree: they come first in
- * the arrays and every ray tests them, as the brute-force kernel would.
+ * --color-by values, see PtrSpheres) so that every leaf is contiguous, and
+ * keeps the few huge ones (much larger than the rest: scene.h's rule) out of
+ * the tree: they come first in the arrays and every ray tests them, as the
+ * brute-force kernel would.
  *
  * The result contract is the brute-force kernel's over the reordered
  * arrays: the closest hit with its t bit for bit, and on equal t the sphere
@@ -55,10 +56,10 @@ typedef struct PtrBvhNode {
 typedef struct PtrBvh {
     PtrBvhNode *nodes; /* nodes[0] is the root; NULL if the tree is empty */
     size_t node_count;
-    /* Spheres 0 .. unbounded_count - 1 of the reordered arrays are not in
-     * the tree (they would ruin it: a huge ground under tiny spheres); every
-     * ray tests them first. */
-    size_t unbounded_count;
+    /* Spheres 0 .. huge_count - 1 of the reordered arrays, the huge ones
+     * among the tree's (scene.h's rule), are not in it (they would ruin it:
+     * a huge ground under tiny spheres); every ray tests them first. */
+    size_t huge_count;
     int depth; /* levels below the root at most, for the traversal stack */
 } PtrBvh;
 
@@ -68,8 +69,9 @@ typedef struct PtrBvh {
  * CPU. The tree's bytes depend only on
  * the spheres, never on the thread count. On failure (out of memory) *bvh
  * is empty and the spheres may be part reordered: the scene can only be
- * freed. */
-PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads);
+ * freed; err (which may be NULL) says so. */
+PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
+                        PtrError *err);
 
 void ptr_bvh_free(PtrBvh *bvh);
 

@@ -1,5 +1,5 @@
 /* Building the tree: binned SAH splits, eight children a node, leaves of
- * contiguous spheres, the few huge spheres kept out.
+ * contiguous spheres, the few huge spheres kept out of the boxes.
  *
  * A node is grown Embree's way: its range is split in two by the binned
  * surface area heuristic, then the child with the largest box is split
@@ -72,13 +72,13 @@ typedef struct Build {
     atomic_size_t next_task;
 } Build;
 
-static int node_array_add(NodeArray *a, size_t *index)
+static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 {
     if (a->count == a->capacity) {
         size_t capacity = a->capacity ? a->capacity * 2 : 64;
         PtrBvhNode *grown = aligned_alloc(64, capacity * sizeof *grown);
         if (!grown)
-            return 0;
+            return bvh_out_of_memory(err);
         if (a->count)
             memcpy(grown, a->nodes, a->count * sizeof *grown);
         free(a->nodes);
@@ -86,31 +86,34 @@ static int node_array_add(NodeArray *a, size_t *index)
         a->capacity = capacity;
     }
     *index = a->count++;
-    return 1;
+    return PTR_OK;
 }
 
-static int add_task(Build *build, size_t begin, size_t end, int level, uint32_t *task)
+static PtrResult add_task(Build *build, size_t begin, size_t end, int level, uint32_t *task,
+                          PtrError *err)
 {
     if (build->task_count == build->task_capacity) {
         size_t capacity = build->task_capacity ? build->task_capacity * 2 : 64;
         Task *grown = realloc(build->tasks, capacity * sizeof *grown);
         if (!grown)
-            return 0;
+            return bvh_out_of_memory(err);
         build->tasks = grown;
         build->task_capacity = capacity;
     }
     *task = (uint32_t)build->task_count;
     build->tasks[build->task_count++] = (Task){ .begin = begin, .end = end, .level = level };
-    return 1;
+    return PTR_OK;
 }
 
 /* Builds the node at this level over c's range into nodes (its index in
  * *index), and its inner children below it; depth: levels below the node. In
  * the top level (top set), inner children of at most task_spheres spheres
  * become tasks. scratch: see bvh_split (tasks have it, the top level not). */
-static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
-                      const BvhCandidate *range, int top, int level, size_t *index, int *depth)
+static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
+                            const BvhCandidate *range, int top, int level, size_t *index,
+                            int *depth, PtrError *err)
 {
+    PtrResult r;
     BvhCandidate child[PTR_BVH_WIDTH];
     int n = 1;
     child[0] = *range;
@@ -130,13 +133,14 @@ static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         }
         if (pick < 0)
             break;
-        if (!bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch,
-                       &child[pick], &child[n]))
-            return 0;
+        r = bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch,
+                      &child[pick], &child[n], err);
+        if (r != PTR_OK)
+            return r;
     }
 
-    if (!node_array_add(nodes, index))
-        return 0;
+    if ((r = node_array_add(nodes, index, err)) != PTR_OK)
+        return r;
     size_t self = *index;
     PtrBvhNode node;
     *depth = 0;
@@ -165,21 +169,22 @@ static int build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         node.leaf_count[k] = 0;
         if (top && count <= build->task_spheres) {
             uint32_t task;
-            if (!add_task(build, c->begin, c->end, level + 1, &task))
-                return 0;
+            if ((r = add_task(build, c->begin, c->end, level + 1, &task, err)) != PTR_OK)
+                return r;
             node.child[k] = TASK_FLAG | task;
             continue;
         }
         size_t below;
         int below_depth;
-        if (!build_node(build, nodes, scratch, c, top, level + 1, &below, &below_depth))
-            return 0;
+        r = build_node(build, nodes, scratch, c, top, level + 1, &below, &below_depth, err);
+        if (r != PTR_OK)
+            return r;
         node.child[k] = (uint32_t)below;
         if (below_depth + 1 > *depth)
             *depth = below_depth + 1;
     }
     nodes->nodes[self] = node; /* after the children: the array may have moved */
-    return 1;
+    return PTR_OK;
 }
 
 static void *task_worker(void *arg)
@@ -198,20 +203,21 @@ static void *task_worker(void *arg)
         if (!scratch)
             scratch = malloc(build->task_spheres * sizeof *scratch);
         t->failed = !scratch ||
-                    !bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL) ||
-                    !build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
-                                &t->nodes.depth);
+                    bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL,
+                                       NULL) != PTR_OK ||
+                    build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
+                               &t->nodes.depth, NULL) != PTR_OK;
     }
     free(scratch);
     return NULL;
 }
 
-static int run_tasks(Build *build)
+static PtrResult run_tasks(Build *build, PtrError *err)
 {
     int threads = build->set.threads;
     PtrThread **ids = malloc((size_t)threads * sizeof *ids);
     if (!ids)
-        return 0;
+        return bvh_out_of_memory(err);
     atomic_init(&build->next_task, 0);
     int started = 0;
     while (started < threads - 1 && (ids[started] = ptr_thread_start(task_worker, build)))
@@ -222,25 +228,25 @@ static int run_tasks(Build *build)
     free(ids);
     for (size_t i = 0; i < build->task_count; i++)
         if (build->tasks[i].failed)
-            return 0;
-    return 1;
+            return bvh_out_of_memory(err);
+    return PTR_OK;
 }
 
 /* One node array: the top level's first, then each task's, with every task
  * reference and every inner child index moved to its final place. */
-static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
+static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *err)
 {
     size_t total = top->count;
     for (size_t i = 0; i < build->task_count; i++)
         total += build->tasks[i].nodes.count;
     PtrBvhNode *nodes = aligned_alloc(64, total * sizeof *nodes);
     if (!nodes)
-        return 0;
+        return bvh_out_of_memory(err);
     memcpy(nodes, top->nodes, top->count * sizeof *nodes);
     size_t *start = malloc((build->task_count + 1) * sizeof *start);
     if (!start) {
         free(nodes);
-        return 0;
+        return bvh_out_of_memory(err);
     }
     size_t at = top->count;
     for (size_t i = 0; i < build->task_count; i++) {
@@ -273,7 +279,7 @@ static int lay_out(Build *build, NodeArray *top, PtrBvh *bvh)
     bvh->nodes = nodes;
     bvh->node_count = total;
     bvh->depth = top->depth + 1 + depth;
-    return 1;
+    return PTR_OK;
 }
 
 typedef struct SphereWrite {
@@ -314,41 +320,44 @@ static void write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t 
     free(prims);
 }
 
-PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads)
+PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
+                        PtrError *err)
 {
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
-        return PTR_ERR_NOMEM;
+        return bvh_out_of_memory(err);
     Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
-    /* The prims and kept_out take the tree's spheres, whose memory the
+    /* The prims and huge take the tree's spheres, whose memory the
      * scene's arrays give back meanwhile; the spheres after them stay. */
-    BvhPrim kept_out[BVH_UNBOUNDED_MAX];
+    BvhPrim huge[PTR_HUGE_MAX];
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
     size_t prim_count = 0;
-    int ok = build.set.prims != NULL;
-    if (ok) {
+    PtrResult r = build.set.prims ? PTR_OK : bvh_out_of_memory(err);
+    if (r == PTR_OK) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        ok = ptr_bvh_prims(&tree_part, kept_out, &bvh->unbounded_count, build.set.prims,
-                           &prim_count, &build.set.magnitude);
+        r = ptr_bvh_prims(&tree_part, huge, &bvh->huge_count, build.set.prims,
+                          &prim_count, &build.set.magnitude, err);
     }
-    build.first_sphere = bvh->unbounded_count;
+    build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
-    if (ok && prim_count > 0) {
+    if (r == PTR_OK && prim_count > 0) {
         BvhCandidate root;
         size_t index;
-        ok = bvh_candidate_init(&build.set, &root, 0, prim_count, NULL, NULL) &&
-             build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth) &&
-             run_tasks(&build);
+        r = bvh_candidate_init(&build.set, &root, 0, prim_count, NULL, NULL, err);
+        if (r == PTR_OK)
+            r = build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth, err);
+        if (r == PTR_OK)
+            r = run_tasks(&build, err);
     }
-    if (ok) {
-        write_back(spheres, build.set.prims, prim_count, bvh->unbounded_count,
+    if (r == PTR_OK) {
+        write_back(spheres, build.set.prims, prim_count, bvh->huge_count,
                    build.set.threads);
         build.set.prims = NULL;
-        SphereWrite kept = { spheres, kept_out, 0 };
-        write_spheres(&kept, 0, bvh->unbounded_count);
+        SphereWrite first = { spheres, huge, 0 };
+        write_spheres(&first, 0, bvh->huge_count);
         /* The ids have done their work (the leaves' order): from here on a
          * sphere's position decides a tie (see PtrSpheres). */
         free(spheres->id);
@@ -357,16 +366,15 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     free(build.set.prims);
     /* Laying the tree out in one array needs memory of its own: it comes
      * once the prims are gone. */
-    ok = ok && (prim_count == 0 || lay_out(&build, &top, bvh));
+    if (r == PTR_OK && prim_count > 0)
+        r = lay_out(&build, &top, bvh, err);
     for (size_t i = 0; i < build.task_count; i++)
         free(build.tasks[i].nodes.nodes);
     free(build.tasks);
     free(top.nodes);
-    if (!ok) {
+    if (r != PTR_OK)
         ptr_bvh_free(bvh);
-        return PTR_ERR_NOMEM;
-    }
-    return PTR_OK;
+    return r;
 }
 
 void ptr_bvh_free(PtrBvh *bvh)

@@ -4,13 +4,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A sphere is kept out of the tree if its radius is more than UNBOUNDED_RATIO
- * times the median radius: a ground of radius 1000 under spheres of 0.2, or
- * 1e5 under 1, would otherwise make one box span the scene and every ray
- * visit much of the tree. At most BVH_UNBOUNDED_MAX of them (the largest), as
- * every ray tests them all. */
-enum { UNBOUNDED_RATIO = 100 };
-
+/* The tree keeps the huge spheres among its own (scene.h's rule) out of its
+ * boxes, with a limit of HUGE_RATIO times the median radius: a ground of
+ * radius 1000 under spheres of 0.2, or 1e5 under 1, would otherwise make
+ * one box span the scene and every ray visit much of the tree. (Spheres the
+ * builder chose, against another limit, are tested in double and never
+ * reach the tree.) */
+enum { HUGE_RATIO = 100 };
 
 /* The k-th smallest of values[0 .. n - 1] (reorders values). */
 static float select_kth(float *values, size_t n, size_t k)
@@ -45,39 +45,9 @@ static float select_kth(float *values, size_t n, size_t k)
     return values[k];
 }
 
-/* Whether sphere i comes before sphere j among those kept out: larger
- * first, then lower id. */
-static int larger(const PtrSpheres *s, uint32_t i, uint32_t j)
-{
-    return s->radius[i] != s->radius[j] ? s->radius[i] > s->radius[j]
-                                        : ptr_sphere_id(s, i) < ptr_sphere_id(s, j);
-}
-
-/* Offers sphere i to list[0 .. *n - 1], the largest so far, largest first:
- * it is kept if among the BVH_UNBOUNDED_MAX largest. */
-static void offer_largest(uint32_t *list, size_t *n, uint32_t i, const PtrSpheres *s)
-{
-    size_t at = *n < BVH_UNBOUNDED_MAX ? (*n)++ : BVH_UNBOUNDED_MAX;
-    for (; at > 0 && larger(s, i, list[at - 1]); at--)
-        if (at < BVH_UNBOUNDED_MAX)
-            list[at] = list[at - 1];
-    if (at < BVH_UNBOUNDED_MAX)
-        list[at] = i;
-}
-
-static void sort_by_id(uint32_t *list, size_t n, const PtrSpheres *s)
-{
-    for (size_t i = 1; i < n; i++) {
-        uint32_t v = list[i];
-        size_t j = i;
-        for (; j > 0 && ptr_sphere_id(s, list[j - 1]) > ptr_sphere_id(s, v); j--)
-            list[j] = list[j - 1];
-        list[j] = v;
-    }
-}
-
-/* The threshold above which a radius is kept out of the tree. */
-static float unbounded_radius(const PtrSpheres *s)
+/* The limit above which a radius is huge for the tree; NaN if out of
+ * memory. */
+static float huge_radius(const PtrSpheres *s)
 {
     float *radii = malloc(s->count * sizeof *radii);
     if (!radii)
@@ -85,16 +55,18 @@ static float unbounded_radius(const PtrSpheres *s)
     memcpy(radii, s->radius, s->count * sizeof *radii);
     float median = select_kth(radii, s->count, s->count / 2);
     free(radii);
-    return median * UNBOUNDED_RATIO;
+    return median * HUGE_RATIO;
 }
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { { s->cx[i], s->cy[i], s->cz[i] }, s->radius[i], ptr_sphere_id(s, i),
-                  ptr_sphere_material(s, i),
-                  { UINT16_MAX, UINT16_MAX, UINT16_MAX, UINT16_MAX } };
-    if (s->color)
-        memcpy(p.color, &s->color[4 * i], sizeof p.color);
+    BvhPrim p = { .centre = { s->cx[i], s->cy[i], s->cz[i] }, .radius = s->radius[i],
+                  .id = ptr_sphere_id(s, i), .material = ptr_sphere_material(s, i) };
+#define COPY_IN(name, type, per_sphere, none)                                              \
+    if (s->name)                                                                           \
+        memcpy(p.name, &s->name[(per_sphere) * i], sizeof p.name);
+    PTR_SPHERE_ATTRIBUTES(COPY_IN)
+#undef COPY_IN
     return p;
 }
 
@@ -105,42 +77,40 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
     s->cz[i] = p->centre[2];
     s->radius[i] = p->radius;
     ptr_sphere_set_material(s, i, p->material);
-    if (s->color)
-        memcpy(&s->color[4 * i], p->color, sizeof p->color);
+#define COPY_OUT(name, type, per_sphere, none)                                             \
+    if (s->name)                                                                           \
+        memcpy(&s->name[(per_sphere) * i], p->name, sizeof p->name);
+    PTR_SPHERE_ATTRIBUTES(COPY_OUT)
+#undef COPY_OUT
 }
 
 /* Spheres copied between two releases of the arrays' memory: 4 MB of each
  * float array. */
 enum { RELEASE_STEP = 1 << 20 };
 
-int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhPrim *prims,
-                  size_t *prim_count, float *magnitude_out)
+PtrResult ptr_bvh_prims(PtrSpheres *s, BvhPrim *huge, size_t *huge_count, BvhPrim *prims,
+                        size_t *prim_count, float *magnitude_out, PtrError *err)
 {
-    *kept_out_count = *prim_count = 0;
+    *huge_count = *prim_count = 0;
     *magnitude_out = 0.0f;
     if (s->count == 0)
-        return 1;
-    float limit = unbounded_radius(s);
-    if (isnan(limit))
-        return 0;
-    uint32_t order[BVH_UNBOUNDED_MAX];
-    size_t u = 0;
+        return PTR_OK;
+    PtrHugeChoice choice = { .limit = huge_radius(s) };
+    if (isnan(choice.limit))
+        return bvh_out_of_memory(err);
     for (size_t i = 0; i < s->count; i++)
-        if (s->radius[i] > limit)
-            offer_largest(order, &u, (uint32_t)i, s);
-    /* By index, to skip them below; then by id, their order in the arrays. */
-    uint32_t out[BVH_UNBOUNDED_MAX + 1];
-    memcpy(out, order, u * sizeof *out);
-    for (size_t i = 1; i < u; i++)
-        for (size_t j = i; j > 0 && out[j - 1] > out[j]; j--) {
-            uint32_t t = out[j];
-            out[j] = out[j - 1];
-            out[j - 1] = t;
-        }
-    out[u] = UINT32_MAX;
-    sort_by_id(order, u, s);
-    for (size_t k = 0; k < u; k++)
-        kept_out[k] = bvh_prim_of(s, order[k]);
+        ptr_huge_offer(&choice, i, ptr_sphere_id(s, i), s->radius[i]);
+    ptr_huge_file_order(&choice);
+    /* By index, to skip them below. */
+    size_t out[PTR_HUGE_MAX + 1];
+    for (size_t k = 0; k < choice.count; k++) {
+        huge[k] = bvh_prim_of(s, choice.sphere[k].index);
+        size_t at = k;
+        for (; at > 0 && out[at - 1] > choice.sphere[k].index; at--)
+            out[at] = out[at - 1];
+        out[at] = choice.sphere[k].index;
+    }
+    out[choice.count] = SIZE_MAX;
     float magnitude = 0.0f;
     size_t n = 0, k = 0;
     for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
@@ -157,10 +127,10 @@ int ptr_bvh_prims(PtrSpheres *s, BvhPrim *kept_out, size_t *kept_out_count, BvhP
         }
         ptr_spheres_release(s, begin, end);
     }
-    *kept_out_count = u;
+    *huge_count = choice.count;
     *prim_count = n;
     *magnitude_out = magnitude;
-    return 1;
+    return PTR_OK;
 }
 
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)

@@ -1,24 +1,26 @@
 /* What the tree is built from: a padded box per sphere, and the choice of
- * the spheres kept out of the tree. */
+ * the huge spheres it keeps out of its boxes. */
 #ifndef PTR_BVH_PRIMS_H
 #define PTR_BVH_PRIMS_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/result.h"
 #include "scene/scene.h"
 
-enum { BVH_UNBOUNDED_MAX = 16 }; /* spheres kept out of the tree, at most */
-
-/* A sphere as the build moves it, whole: 32 bytes. At 10^8 spheres the
- * prims are the build's largest array, and the scene's arrays give their
- * memory back as the prims are filled; the tree's leaves are written back
- * to them from the prims, in their final order. */
+/* A sphere as the build moves it, whole: 32 bytes with its colour. At 10^8
+ * spheres the prims are the build's largest array, and the scene's arrays
+ * give their memory back as the prims are filled; the tree's leaves are
+ * written back to them from the prims, in their final order. */
 typedef struct BvhPrim {
     float centre[3], radius;
     uint32_t id; /* the sphere's in the file (ptr_sphere_id), which orders a leaf */
     uint32_t material;
-    uint16_t color[4]; /* white where the scene has no colours */
+    /* Those of PTR_SPHERE_ATTRIBUTES, unset where the scene has none. */
+#define BVH_PRIM_ATTRIBUTE(name, type, per_sphere, none) type name[per_sphere];
+    PTR_SPHERE_ATTRIBUTES(BVH_PRIM_ATTRIBUTE)
+#undef BVH_PRIM_ATTRIBUTE
 } BvhPrim;
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
@@ -42,17 +44,26 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
     }
 }
 
-/* Puts the spheres kept out of the tree in kept_out[0 .. *kept_out_count -
- * 1] (by ascending id; room for BVH_UNBOUNDED_MAX), a prim for each of the
- * others in prims (their count in *prim_count, in the arrays' order), and
- * in *magnitude the largest coordinate magnitude in the tree, which bounds
- * both the spheres' and the rays' origins (the camera sits at 0, other rays
- * start on spheres) and so scales the boxes' padding. Gives back the
- * spheres' memory as it goes (ptr_spheres_release): on success the prims
- * and kept_out hold the only copy of spheres 0 .. count - 1 but their
- * values. Returns 0 if out of memory (the spheres untouched). */
-int ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *kept_out, size_t *kept_out_count,
-                  BvhPrim *prims, size_t *prim_count, float *magnitude);
+/* Puts the huge spheres (scene.h's rule, with the tree's limit) in
+ * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX), a
+ * prim for each of the others in prims (their count in *prim_count, in the
+ * arrays' order), and in *magnitude the largest coordinate magnitude in the
+ * tree, which bounds both the spheres' and the rays' origins (the camera
+ * sits at 0, other rays start on spheres) and so scales the boxes' padding.
+ * Gives back the spheres' memory as it goes (ptr_spheres_release): on
+ * success the prims and huge hold the only copy of spheres 0 .. count - 1
+ * but their values. Fails only for memory (the spheres untouched). */
+PtrResult ptr_bvh_prims(PtrSpheres *spheres, BvhPrim *huge, size_t *huge_count,
+                        BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
+
+/* Fails for memory the tree's build cannot have: every failure of the
+ * build's functions is this one. (The code returned as a constant, so the
+ * compiler sees that no output is used after a failure.) */
+static inline PtrResult bvh_out_of_memory(PtrError *err)
+{
+    ptr_error_set(err, PTR_ERR_NOMEM, "out of memory building the tree");
+    return PTR_ERR_NOMEM;
+}
 
 /* Sphere i of s as a prim, and back. */
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);

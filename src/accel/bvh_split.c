@@ -135,8 +135,9 @@ static void *parallel_bin_worker(void *arg)
 
 /* Bins (or, with c NULL, only bounds) prims begin .. end - 1 into *out.
  * Counts add and boxes take minima and maxima, so the result does not depend
- * on how the run is shared between threads. Returns 0 if out of memory. */
-static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhCandidate *c, Bins *out)
+ * on how the run is shared between threads. */
+static PtrResult bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhCandidate *c,
+                           Bins *out, PtrError *err)
 {
     int threads = end - begin >= PARALLEL_PRIMS ? set->threads : 1;
     int bins = c ? c->bins : 0;
@@ -146,7 +147,7 @@ static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhC
             bin_run(set, begin, end, 1, c, out);
         else
             bound_run(set, begin, end, out);
-        return 1;
+        return PTR_OK;
     }
     Bins *per_thread = malloc((size_t)threads * sizeof *per_thread);
     ParallelRun *runs = malloc((size_t)threads * sizeof *runs);
@@ -155,7 +156,7 @@ static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhC
         free(per_thread);
         free(runs);
         free(ids);
-        return 0;
+        return bvh_out_of_memory(err);
     }
     int started = 1; /* threads 1 .. started - 1 run; the rest are done here */
     for (int t = 0; t < threads; t++)
@@ -173,11 +174,11 @@ static int bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhC
     free(per_thread);
     free(runs);
     free(ids);
-    return 1;
+    return PTR_OK;
 }
 
-int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
-                          const float lower[3], const float upper[3])
+PtrResult bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
+                             const float lower[3], const float upper[3], PtrError *err)
 {
     Bins bins;
     c->begin = begin;
@@ -185,15 +186,16 @@ int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, siz
     c->axis = -1;
     c->sampled = 0;
     if (!lower) {
-        if (!bin_range(set, begin, end, NULL, &bins))
-            return 0;
+        PtrResult r = bin_range(set, begin, end, NULL, &bins, err);
+        if (r != PTR_OK)
+            return r;
         lower = bins.box_lo;
         upper = bins.box_hi;
     }
     memcpy(c->lower, lower, sizeof c->lower);
     memcpy(c->upper, upper, sizeof c->upper);
     if (end - begin <= PTR_BVH_LEAF_MAX)
-        return 1;
+        return PTR_OK;
     /* Embree's rule: few bins for few prims, where more would mostly be
      * empty and only cost time. */
     c->bins = 4 + (int)((end - begin) / 20);
@@ -208,13 +210,15 @@ int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, siz
         spread |= extent > 0.0f;
     }
     if (!spread)
-        return 1;
+        return PTR_OK;
     c->sampled = end - begin > SAMPLED_ABOVE;
     if (c->sampled) {
         bins_clear(&bins, c->bins);
         bin_run(set, begin, end, (end - begin) / SAMPLES, c, &bins);
-    } else if (!bin_range(set, begin, end, c, &bins)) {
-        return 0;
+    } else {
+        PtrResult r = bin_range(set, begin, end, c, &bins, err);
+        if (r != PTR_OK)
+            return r;
     }
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
@@ -255,7 +259,7 @@ int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, siz
             }
         }
     }
-    return 1;
+    return PTR_OK;
 }
 
 /* The boxes of the prims a partition sends left ([0]) and right ([1]): a
@@ -440,23 +444,26 @@ static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *s
     return half[0].first_right + left_b;
 }
 
-int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
-              BvhCandidate *left, BvhCandidate *right)
+PtrResult bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
+                    BvhCandidate *left, BvhCandidate *right, PtrError *err)
 {
     const size_t begin = c->begin, end = c->end;
-    if (middle || c->axis < 0) {
-        const size_t mid = begin + (end - begin) / 2;
-        return bvh_candidate_init(set, left, begin, mid, NULL, NULL) &&
-               bvh_candidate_init(set, right, mid, end, NULL, NULL);
-    }
-    /* A split chosen from samples knows its halves' boxes only once they
-     * are moved; the bins of one from every prim know them already. */
+    size_t mid = begin + (end - begin) / 2;
+    /* The halves' boxes: unknown (NULL) for a split in the middle or one
+     * chosen from samples, which knows them only once its prims are moved;
+     * the bins of one from every prim know them already. */
+    const float *box[2][2] = { { NULL, NULL }, { NULL, NULL } };
     SideBoxes sides;
     const BvhCandidate whole = *c;
-    const size_t mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
-    if (whole.sampled)
-        return bvh_candidate_init(set, left, begin, mid, sides.lower[0], sides.upper[0]) &&
-               bvh_candidate_init(set, right, mid, end, sides.lower[1], sides.upper[1]);
-    return bvh_candidate_init(set, left, begin, mid, whole.left_lower, whole.left_upper) &&
-           bvh_candidate_init(set, right, mid, end, whole.right_lower, whole.right_upper);
+    if (!middle && whole.axis >= 0) {
+        mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
+        for (int side = 0; side < 2; side++) {
+            box[side][0] = whole.sampled ? sides.lower[side]
+                                         : side ? whole.right_lower : whole.left_lower;
+            box[side][1] = whole.sampled ? sides.upper[side]
+                                         : side ? whole.right_upper : whole.left_upper;
+        }
+    }
+    PtrResult r = bvh_candidate_init(set, left, begin, mid, box[0][0], box[0][1], err);
+    return r != PTR_OK ? r : bvh_candidate_init(set, right, mid, end, box[1][0], box[1][1], err);
 }

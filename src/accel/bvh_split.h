@@ -40,15 +40,14 @@ static inline float bvh_half_area(const float lo[3], const float hi[3])
 
 /* Sets c to the range begin .. end - 1 with box lower, upper (NULL: find
  * it) and, if it has more prims than a leaf holds, finds its best split.
- * Returns 0 if out of memory. */
-int bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
-                       const float lower[3], const float upper[3]);
+ * Fails only for memory (see bvh_out_of_memory), as bvh_split does. */
+PtrResult bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
+                             const float lower[3], const float upper[3], PtrError *err);
 
 /* Splits c in two (into *left and *right, which may be c): by its best split,
  * or in the middle of its order if it has none or middle is set. scratch
- * (room for c's prims, or NULL) makes the partition faster. Returns 0 if out
- * of memory. */
-int bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
-              BvhCandidate *left, BvhCandidate *right);
+ * (room for c's prims, or NULL) makes the partition faster. */
+PtrResult bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
+                    BvhCandidate *left, BvhCandidate *right, PtrError *err);
 
 #endif /* PTR_BVH_SPLIT_H */

@@ -62,7 +62,9 @@ PtrResult ptr_color_by_apply(const PtrOptions *o, const char *scene_path, PtrSce
         fprintf(stderr, "ptr: %s: --color-by %s: %zu spheres, values %.9g to %.9g, mapped from "
                         "%.9g to %.9g through %s\n", scene_path, o->color_by, valued, lo, hi,
                 from, to, map->name);
-    if (ptr_scene_color_by_value(scene, map, from, to) != PTR_OK)
-        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", scene_path);
+    PtrError problem;
+    PtrResult res = ptr_scene_color_by_value(scene, map, from, to, &problem);
+    if (res != PTR_OK)
+        return ptr_error_set(err, res, "%s: --color-by: %s", scene_path, problem.message);
     return o->color_bar && color ? write_bar(o, map, scene_path, color, err) : PTR_OK;
 }

@@ -149,13 +149,18 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
     /* Before the build, which reorders the spheres and frees the ids that
      * give the file's order, which the hash takes. */
-    uint64_t scene_hash = ptr_scene_hash(scene);
+    uint64_t scene_hash;
+    PtrError problem;
+    PtrResult hashed = ptr_scene_hash(scene, &scene_hash, &problem);
+    if (hashed != PTR_OK)
+        return ptr_error_set(err, hashed, "%s: %s", report->scene, problem.message);
     PtrAccel accel;
     PtrResult built = ptr_accel_init(&accel, o->accel, &isect,
-                                     integrator == PTR_INTEGRATOR_BUNDLES, scene, o->threads);
+                                     integrator == PTR_INTEGRATOR_BUNDLES, scene, o->threads,
+                                     &problem);
     if (built != PTR_OK)
         return ptr_error_set(err, built, "%s: cannot build the tree over %zu spheres: %s",
-                             report->scene, scene->spheres.count, ptr_result_description(built));
+                             report->scene, scene->spheres.count, problem.message);
     snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&accel));
     report->spheres = scene->spheres.count;
     report->build_seconds = accel.build_seconds;

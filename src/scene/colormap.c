@@ -34,7 +34,7 @@ PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, dou
 }
 
 PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,
-                                   double hi)
+                                   double hi, PtrError *err)
 {
     PtrSpheres *s = &scene->spheres;
     const size_t materials = scene->material_count;
@@ -43,7 +43,7 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
     /* The white copy of each material, made when a sphere first needs it. */
     uint32_t *white = malloc((materials ? materials : 1) * sizeof *white);
     if (!white)
-        return PTR_ERR_NOMEM;
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu materials", materials);
     for (size_t m = 0; m < materials; m++)
         white[m] = UINT32_MAX;
     PtrResult res = PTR_OK;
@@ -55,12 +55,12 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
         if (white[m] == UINT32_MAX) {
             PtrMaterial copy = scene->materials[m];
             copy.albedo = v3_splat(1.0f);
-            res = ptr_scene_add_material(scene, &copy, &white[m]);
+            res = ptr_scene_add_material(scene, &copy, &white[m], err);
         }
         if (res == PTR_OK) {
             ptr_sphere_set_material(s, i, white[m]);
             res = ptr_scene_set_sphere_color(scene, i,
-                                             ptr_colormap_linear(map, value, lo, hi));
+                                             ptr_colormap_linear(map, value, lo, hi), err);
         }
     }
     free(white);

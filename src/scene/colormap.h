@@ -33,8 +33,9 @@ PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, dou
  * value as its own colour, and a copy of its material whose base colour is
  * white, so the mapped colour replaces the base colour instead of
  * multiplying it; emission, fuzz and ior are kept. Other spheres are left as
- * they are. Returns PTR_ERR_NOMEM if memory runs out. */
+ * they are. Fails only for memory (PTR_ERR_NOMEM, said in err, which may
+ * be NULL). */
 PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,
-                                   double hi);
+                                   double hi, PtrError *err);
 
 #endif /* PTR_COLORMAP_H */

@@ -31,6 +31,12 @@ typedef struct SphereArray {
 
 enum { SPHERE_ARRAYS_MAX = 16 };
 
+#define WHOLE_WORDS(name, type, per_sphere, none)                                          \
+    static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0,                     \
+                  #name ": an attribute's entry is whole 4-byte words (see pad_array)");
+PTR_SPHERE_ATTRIBUTES(WHOLE_WORDS)
+#undef WHOLE_WORDS
+
 /* Fills a with s's arrays; returns how many there are. */
 static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
@@ -44,8 +50,11 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
         { (void **)&s->material, s->material_size, 0, 0, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1 },
-        { (void **)&s->color, 4 * sizeof *s->color, UINT32_MAX, 1, 1 }, /* white */
-        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 },      /* none */
+#define ATTRIBUTE_ARRAY(name, type, per_sphere, none)                                      \
+    { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1 },
+        PTR_SPHERE_ATTRIBUTES(ATTRIBUTE_ARRAY)
+#undef ATTRIBUTE_ARRAY
+        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 }, /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -93,12 +102,18 @@ static void pad_array(const SphereArray *a, size_t from, size_t to)
         words[i] = a->padding;
 }
 
+/* Fails for the memory of count spheres. */
+static PtrResult no_room(size_t count, PtrError *err)
+{
+    return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu spheres", count);
+}
+
 /* Arrays like s's with room for capacity entries, the first s->count copied
  * from s and those from pad_from on padding (those between are left for the
  * caller to write). An optional array s does not have (the colour) stays
  * absent. */
 static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, size_t pad_from,
-                              PtrSpheres *out)
+                              PtrSpheres *out, PtrError *err)
 {
     PtrSpheres copy = { .count = s->count, .capacity = capacity,
                         .material_size = s->material_size };
@@ -111,7 +126,7 @@ static PtrResult spheres_copy(const PtrSpheres *s, size_t capacity, size_t pad_f
         *to[k].data = array_alloc(capacity, to[k].size);
         if (!*to[k].data) {
             spheres_free(&copy);
-            return PTR_ERR_NOMEM;
+            return no_room(capacity, err);
         }
         if (s->count)
             memcpy(*to[k].data, *from[k].data, s->count * to[k].size);
@@ -129,12 +144,12 @@ static size_t capacity_for(size_t count)
 }
 
 /* Gives s room for count spheres, entries from pad_from on padding. */
-static PtrResult spheres_grow(PtrSpheres *s, size_t count, size_t pad_from)
+static PtrResult spheres_grow(PtrSpheres *s, size_t count, size_t pad_from, PtrError *err)
 {
     if (count > SIZE_MAX / 128)
-        return PTR_ERR_NOMEM;
+        return no_room(count, err);
     PtrSpheres grown;
-    PtrResult r = spheres_copy(s, capacity_for(count), pad_from, &grown);
+    PtrResult r = spheres_copy(s, capacity_for(count), pad_from, &grown, err);
     if (r != PTR_OK)
         return r;
     spheres_free(s);
@@ -142,10 +157,10 @@ static PtrResult spheres_grow(PtrSpheres *s, size_t count, size_t pad_from)
     return PTR_OK;
 }
 
-PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count)
+PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count, PtrError *err)
 {
     if (capacity_for(count) > s->capacity) {
-        PtrResult r = spheres_grow(s, count, count);
+        PtrResult r = spheres_grow(s, count, count, err);
         if (r != PTR_OK)
             return r;
     } else if (count < s->count) {
@@ -169,11 +184,11 @@ void ptr_spheres_release(PtrSpheres *s, size_t begin, size_t end)
 }
 
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
-                               uint32_t material)
+                               uint32_t material, PtrError *err)
 {
     PtrSpheres *s = &scene->spheres;
     if (capacity_for(s->count) > s->capacity) {
-        PtrResult r = spheres_grow(s, 2 * s->count, s->count);
+        PtrResult r = spheres_grow(s, 2 * s->count, s->count, err);
         if (r != PTR_OK)
             return r;
     }
@@ -198,7 +213,7 @@ void ptr_color_quantize(PtrVec3 color, uint16_t out[4])
 
 /* Creates the optional array at data (one of s's) if absent, entries from
  * pad_from on holding its value for none. */
-static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from)
+static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from, PtrError *err)
 {
     if (*data)
         return PTR_OK;
@@ -209,46 +224,42 @@ static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from)
         k++;
     *data = array_alloc(s->capacity, a[k].size);
     if (!*data)
-        return PTR_ERR_NOMEM;
+        return no_room(s->capacity, err);
     pad_array(&a[k], pad_from, s->capacity);
     return PTR_OK;
 }
 
-PtrResult ptr_spheres_make_colors(PtrSpheres *s)
+PtrResult ptr_spheres_make(PtrSpheres *s, void **array, PtrError *err)
 {
-    return create_optional(s, (void **)&s->color, s->count);
+    return create_optional(s, array, s->count, err);
 }
 
-PtrResult ptr_spheres_make_values(PtrSpheres *s)
+PtrResult ptr_spheres_make_ids(PtrSpheres *s, PtrError *err)
 {
-    return create_optional(s, (void **)&s->value, s->count);
+    return ptr_spheres_make(s, (void **)&s->id, err);
 }
 
-PtrResult ptr_spheres_make_ids(PtrSpheres *s)
-{
-    return create_optional(s, (void **)&s->id, s->count);
-}
-
-PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4])
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
+                                       PtrError *err)
 {
     PtrSpheres *s = &scene->spheres;
-    PtrResult res = create_optional(s, (void **)&s->color, 0);
+    PtrResult res = create_optional(s, (void **)&s->color, 0, err);
     if (res == PTR_OK)
         memcpy(&s->color[4 * i], color, 4 * sizeof *color);
     return res;
 }
 
-PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color)
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color, PtrError *err)
 {
     uint16_t quantized[4];
     ptr_color_quantize(color, quantized);
-    return ptr_scene_set_sphere_color16(scene, i, quantized);
+    return ptr_scene_set_sphere_color16(scene, i, quantized, err);
 }
 
-PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)
+PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value, PtrError *err)
 {
     PtrSpheres *s = &scene->spheres;
-    PtrResult res = create_optional(s, (void **)&s->value, 0);
+    PtrResult res = create_optional(s, (void **)&s->value, 0, err);
     if (res == PTR_OK)
         s->value[i] = value;
     return res;
@@ -256,13 +267,13 @@ PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value)
 
 /* Gives the spheres' material array entries of size bytes, the indices
  * kept. */
-static PtrResult widen_materials(PtrSpheres *s, size_t size)
+static PtrResult widen_materials(PtrSpheres *s, size_t size, PtrError *err)
 {
     void *wide = NULL;
     if (s->material) {
         wide = array_alloc(s->capacity, size);
         if (!wide)
-            return PTR_ERR_NOMEM;
+            return no_room(s->capacity, err);
         PtrSpheres to = { .material = wide, .material_size = size };
         for (size_t i = 0; i < s->capacity; i++)
             ptr_sphere_set_material(&to, i, ptr_sphere_material(s, i));
@@ -274,25 +285,53 @@ static PtrResult widen_materials(PtrSpheres *s, size_t size)
 }
 
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
-                                 uint32_t *index)
+                                 uint32_t *index, PtrError *err)
 {
-    if (scene->material_count >= UINT32_MAX)
-        return PTR_ERR_NOMEM;
     const size_t count = scene->material_count + 1;
+    if (scene->material_count >= UINT32_MAX)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu materials", count);
     const size_t size = count > 65536 ? 4 : count > 256 ? 2 : 1;
     if (size > scene->spheres.material_size) {
-        PtrResult r = widen_materials(&scene->spheres, size);
+        PtrResult r = widen_materials(&scene->spheres, size, err);
         if (r != PTR_OK)
             return r;
     }
-    PtrMaterial *grown = realloc(scene->materials,
-                                 (scene->material_count + 1) * sizeof *grown);
+    PtrMaterial *grown = realloc(scene->materials, count * sizeof *grown);
     if (!grown)
-        return PTR_ERR_NOMEM;
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu materials", count);
     scene->materials = grown;
     grown[scene->material_count] = *material;
     *index = (uint32_t)scene->material_count++;
     return PTR_OK;
+}
+
+/* Whether a comes before b among the huge: larger, or as large and first
+ * in the file. */
+static int huge_before(double radius_a, size_t file_a, double radius_b, size_t file_b)
+{
+    return radius_a != radius_b ? radius_a > radius_b : file_a < file_b;
+}
+
+void ptr_huge_insert(PtrHugeChoice *c, size_t index, size_t file_position, double radius)
+{
+    size_t at = c->count < PTR_HUGE_MAX ? c->count++ : PTR_HUGE_MAX;
+    for (; at > 0 && huge_before(radius, file_position, c->sphere[at - 1].radius,
+                                 c->sphere[at - 1].file_position); at--)
+        if (at < PTR_HUGE_MAX)
+            c->sphere[at] = c->sphere[at - 1];
+    if (at < PTR_HUGE_MAX)
+        c->sphere[at] = (PtrHugeCandidate){ radius, index, file_position };
+}
+
+void ptr_huge_file_order(PtrHugeChoice *c)
+{
+    for (size_t k = 1; k < c->count; k++) {
+        const PtrHugeCandidate chosen = c->sphere[k];
+        size_t at = k;
+        for (; at > 0 && c->sphere[at - 1].file_position > chosen.file_position; at--)
+            c->sphere[at] = c->sphere[at - 1];
+        c->sphere[at] = chosen;
+    }
 }
 
 /* FNV-1a over the bytes of the values, field by field (never over structure
@@ -325,17 +364,23 @@ static uint64_t hash_in_file_order(uint64_t h, const void *array, size_t size,
     return h;
 }
 
-uint64_t ptr_scene_hash(const PtrScene *scene)
+PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
 {
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
     /* In the file's order, through the ids where the importer put the huge
-     * spheres last (out of memory, as they are: the renderer hashes before
-     * the build, while nothing else holds memory). */
+     * spheres last (the renderer hashes before the build, while nothing
+     * else holds memory). */
     size_t reordered = s->id ? 0 : s->count; /* no ids: in the file's order */
     while (reordered < s->count && s->id[reordered] == reordered)
         reordered++;
-    uint32_t *by_id = reordered < s->count ? malloc(s->count * sizeof *by_id) : NULL;
+    uint32_t *by_id = NULL;
+    if (reordered < s->count) {
+        by_id = malloc(s->count * sizeof *by_id);
+        if (!by_id)
+            return ptr_error_set(err, PTR_ERR_NOMEM,
+                                 "out of memory for the file's order of %zu spheres", s->count);
+    }
     for (size_t j = 0; by_id && j < s->count; j++)
         by_id[s->id[j]] = (uint32_t)j;
     h = hash_bytes(h, scene->origin, sizeof scene->origin);
@@ -348,8 +393,11 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
         const uint32_t m = ptr_sphere_material(s, by_id ? by_id[k] : k);
         h = hash_bytes(h, &m, sizeof m);
     }
-    if (s->color)
-        h = hash_in_file_order(h, s->color, 4 * sizeof *s->color, by_id, s->count);
+#define HASH_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    if (s->name)                                                                           \
+        h = hash_in_file_order(h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
+    PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)
+#undef HASH_ATTRIBUTE
     free(by_id);
     h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {
@@ -373,7 +421,8 @@ uint64_t ptr_scene_hash(const PtrScene *scene)
     }
     const int sky = scene->sky.kind;
     h = hash_bytes(h, &sky, sizeof sky);
-    return hash_vec(h, scene->sky.radiance);
+    *hash = hash_vec(h, scene->sky.radiance);
+    return PTR_OK;
 }
 
 int ptr_sky_parse(const char *text, PtrSky *sky)

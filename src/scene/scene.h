@@ -24,6 +24,22 @@
 
 enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
 
+/* The attributes a sphere may have besides its centre, radius and
+ * material: the one list of them, from which the scene's arrays, the
+ * builder's (importers/builder.h), the tree's prims (accel/bvh_prims.h) and
+ * the hash are all made, so that a new attribute is a line here (and a way
+ * for importers to set it). Each is an array of PtrSpheres, NULL while no
+ * sphere has one, that moves with its sphere:
+ *
+ *   X(name, type of an element, elements a sphere, bits of each 4-byte
+ *     word of the entry of a sphere that has none)
+ *
+ * color: the sphere's own colour, multiplying its material's base colour
+ * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
+ * entry, 8 bytes a sphere; none is white. So a million colours are a
+ * million of these, never a million materials. */
+#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX)
+
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
     float *cx, *cy, *cz, *radius;
@@ -39,11 +55,10 @@ typedef struct PtrSpheres {
      * file) and frees the array: the renderer needs no ids. NULL: the arrays
      * are in the file's order. */
     uint32_t *id;
-    /* Each sphere's own colour, multiplying its material's base colour
-     * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
-     * entry, 8 bytes a sphere. NULL while no sphere has one (then white), so
-     * a million colours are a million of these, never a million materials. */
-    uint16_t *color;
+    /* Those of PTR_SPHERE_ATTRIBUTES, in its order. */
+#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+    PTR_SPHERE_ATTRIBUTES(PTR_SPHERE_ATTRIBUTE_ARRAY)
+#undef PTR_SPHERE_ATTRIBUTE_ARRAY
     /* The value of the quantity --color-by names of the sphere of id i (NaN:
      * none) at entry i, in the file's order whatever the order of the other
      * arrays; 4 bytes a sphere, NULL unless asked for (see scene/colormap.h),
@@ -110,6 +125,39 @@ typedef struct PtrHugeSpheres {
 
 enum { PTR_HUGE_MAX = 16 };
 
+/* The one rule for spheres much larger than the rest, "huge": of the
+ * spheres whose radius exceeds a limit, the PTR_HUGE_MAX largest (every ray
+ * tests them all), on equal radii the first in the file. Its two users set
+ * the limit their question asks for: the builder, which keeps the huge
+ * spheres in double (PtrHugeSpheres; importers/builder.c says why its limit
+ * decides pixels), and the tree's build, which keeps the huge ones among
+ * the rest out of its boxes (accel/bvh_prims.c; speed only). Offer every
+ * sphere, then put the choice in the file's order. */
+typedef struct PtrHugeCandidate {
+    double radius;
+    size_t index;         /* in the caller's arrays */
+    size_t file_position; /* decides between equal radii, and the final order */
+} PtrHugeCandidate;
+
+typedef struct PtrHugeChoice {
+    double limit;
+    size_t count;
+    PtrHugeCandidate sphere[PTR_HUGE_MAX];
+} PtrHugeChoice;
+
+/* Adds a sphere above the limit to the choice if among the largest. */
+void ptr_huge_insert(PtrHugeChoice *choice, size_t index, size_t file_position, double radius);
+
+static inline void ptr_huge_offer(PtrHugeChoice *choice, size_t index, size_t file_position,
+                                  double radius)
+{
+    if (radius > choice->limit)
+        ptr_huge_insert(choice, index, file_position, radius);
+}
+
+/* Sorts the choice by file position. */
+void ptr_huge_file_order(PtrHugeChoice *choice);
+
 typedef struct PtrScene {
     /* World position of the point every coordinate below is relative to:
      * importers put it at the camera (see importers/builder.h). */
@@ -128,17 +176,18 @@ typedef struct PtrScene {
 void ptr_scene_init(PtrScene *scene);
 void ptr_scene_free(PtrScene *scene);
 
-/* Appends a sphere; returns PTR_ERR_NOMEM if the arrays cannot grow. */
+/* Appends a sphere; PTR_ERR_NOMEM if the arrays cannot grow. These
+ * functions fail only for memory, and say so in err (which may be NULL). */
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
-                               uint32_t material);
+                               uint32_t material, PtrError *err);
 
 /* Sets the sphere count, making room as needed, for an importer that knows
  * how many spheres it has: the arrays are allocated once (not doubled as
  * they fill), and memory is only used as they are written. Entries from the
  * old count on hold no sphere until the caller writes every array's entry
- * (colour and value through their functions). Returns PTR_ERR_NOMEM (arrays
+ * (colour and value through their functions). PTR_ERR_NOMEM (arrays
  * unchanged) if they cannot grow. */
-PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count);
+PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count, PtrError *err);
 
 /* Gives back the memory of the entries of spheres begin .. end - 1 in every
  * array but value, page by page, for a caller that has copied them and
@@ -150,30 +199,29 @@ void ptr_spheres_release(PtrSpheres *spheres, size_t begin, size_t end);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
-PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color);
+PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
+                                     PtrError *err);
 
 /* The same with the colour as PtrSpheres.color stores it. */
-PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4]);
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
+                                       PtrError *err);
 
-/* Creates the colour array, if absent, for a caller that writes every
- * sphere's colour: only the padding is set, so at 10^8 spheres memory is
- * used as the colours are written, not 800 MB at once. Returns
- * PTR_ERR_NOMEM if out of memory. */
-PtrResult ptr_spheres_make_colors(PtrSpheres *spheres);
+/* Creates array, one of the optional arrays of spheres (an attribute's, the
+ * values or the ids), if absent, for a caller that writes every sphere's
+ * entry: only the padding is set, so at 10^8 spheres memory is used as the
+ * entries are written (800 MB of colours), not at once. */
+PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
 
-/* The same for the values (PtrSpheres.value). */
-PtrResult ptr_spheres_make_values(PtrSpheres *spheres);
-
-/* The same for the ids (PtrSpheres.id), for an importer that puts spheres
- * out of the file's order. */
-PtrResult ptr_spheres_make_ids(PtrSpheres *spheres);
+/* ptr_spheres_make for the ids (PtrSpheres.id), for an importer that puts
+ * spheres out of the file's order. */
+PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
 void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
 
 /* Gives the sphere of id i a value (see PtrSpheres.value); the first call
  * creates the array, NaN for every other sphere. */
-PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value);
+PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value, PtrError *err);
 
 static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
 {
@@ -204,7 +252,7 @@ static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 /* Appends a material and stores its index in *index; the spheres' material
  * array widens if the count needs it (PtrSpheres.material). */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
-                                 uint32_t *index);
+                                 uint32_t *index, PtrError *err);
 
 /* The position in the file of sphere i (see PtrSpheres.id). */
 static inline uint32_t ptr_sphere_id(const PtrSpheres *s, size_t i)
@@ -217,12 +265,13 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
     return v3(s->cx[i], s->cy[i], s->cz[i]);
 }
 
-/* A 64-bit fingerprint of everything in the scene that shapes an image
- * (spheres, materials, camera, sky, origin), the spheres taken in the file's
- * order: parts of one render match, parts of different scenes almost surely
- * do not. Taken before the tree's build (as the renderer does), whose order
- * it does not know. */
-uint64_t ptr_scene_hash(const PtrScene *scene);
+/* In *hash, a 64-bit fingerprint of everything in the scene that shapes an
+ * image (spheres, materials, camera, sky, origin), the spheres taken in the
+ * file's order: parts of one render match, parts of different scenes almost
+ * surely do not. Taken before the tree's build (as the renderer does), whose
+ * order it does not know. PTR_ERR_NOMEM if the file's order, where the
+ * arrays are not in it, cannot be held: never another fingerprint. */
+PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err);
 
 /* The gradient sky's radiance along a unit direction. */
 static inline PtrVec3 ptr_sky_gradient(PtrVec3 unit_dir)

@@ -72,7 +72,7 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                 ptr_scene_free(&tree_scene);
                 continue;
             }
-            if (ptr_bvh_build(&bvh, &tree_scene.spheres, tree_scene.spheres.count, 0) != PTR_OK) {
+            if (ptr_bvh_build(&bvh, &tree_scene.spheres, tree_scene.spheres.count, 0, NULL) != PTR_OK) {
                 fprintf(stderr, "check_bvh: cannot build %s %d\n", bvh_scene_names[kind], sizes[z]);
                 return 1;
             }
@@ -183,9 +183,9 @@ void bench_bvh_closest_hit(void)
         const float r = cbrtf(0.08f * 2400.0f / (float)n * 3.0f / (4.0f * PTR_PI));
         for (int i = 0; i < n; i++)
             ptr_scene_add_sphere(&scene, v3(bvh_uniform(&rng, -10, 10), bvh_uniform(&rng, r, 6),
-                                            bvh_uniform(&rng, -10, 10)), r, 0);
+                                            bvh_uniform(&rng, -10, 10)), r, 0, NULL);
         PtrBvh bvh;
-        if (ptr_bvh_build(&bvh, &scene.spheres, scene.spheres.count, 0) != PTR_OK)
+        if (ptr_bvh_build(&bvh, &scene.spheres, scene.spheres.count, 0, NULL) != PTR_OK)
             return;
         for (int i = 0; i < RAYS; i++) {
             PtrVec3 o = v3(0, 9, 26);

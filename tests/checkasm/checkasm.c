@@ -66,7 +66,7 @@ static void random_case(Case *c, PtrRng *rng, int extreme)
     for (size_t i = 0; i < n; i++) {
         PtrVec3 p = v3_add(base, v3_scale(random_unit(rng), scale * ptr_rng_float(rng) * 4));
         float r = scale * (extreme ? log_uniform(rng, -20, 1) : log_uniform(rng, -3, 0));
-        ptr_scene_add_sphere(&c->scene, p, r, 0);
+        ptr_scene_add_sphere(&c->scene, p, r, 0, NULL);
     }
     PtrVec3 o = v3_add(base, v3_scale(random_unit(rng), scale * ptr_rng_float(rng) * 6));
     PtrVec3 d = random_unit(rng);
@@ -93,7 +93,7 @@ static void tangent_case(Case *c, PtrRng *rng)
     float nudge = ptr_rng_float(rng) < 0.5f ? 1.0f : ptr_rng_float(rng) < 0.5f ? 1.0f - 0x1p-23f
                                                                                 : 1.0f + 0x1p-23f;
     for (int i = 0; i < 5; i++)
-        ptr_scene_add_sphere(&c->scene, v3(r * nudge, 0, -d - 3.0f * (float)i), r, 0);
+        ptr_scene_add_sphere(&c->scene, v3(r * nudge, 0, -d - 3.0f * (float)i), r, 0, NULL);
     set_ray(c, v3(0, 0, 0), v3(0, 0, -1), rng);
     c->ray.tmin = 0.0f;
     c->ray.tmax = INFINITY;
@@ -108,7 +108,7 @@ static void tie_case(Case *c, PtrRng *rng)
     for (size_t i = 0; i < n; i++) {
         int copy = ptr_rng_float(rng) < 0.4f;
         PtrVec3 p = copy ? centre : v3(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -30, -11));
-        ptr_scene_add_sphere(&c->scene, p, copy ? 1.0f : 0.5f, 0);
+        ptr_scene_add_sphere(&c->scene, p, copy ? 1.0f : 0.5f, 0, NULL);
     }
     set_ray(c, v3(0, 0, 0), v3_add(centre, v3(uniform(rng, -.5f, .5f), uniform(rng, -.5f, .5f), 0)),
             rng);

@@ -82,7 +82,7 @@ void bench_closest_hit(void)
         for (size_t i = 0; i < sizes[s]; i++)
             ptr_scene_add_sphere(&scene, v3(uniform(&rng, -10, 10), uniform(&rng, -1, 1),
                                             uniform(&rng, -10, 10)),
-                                 uniform(&rng, 0.2f, 0.5f), 0);
+                                 uniform(&rng, 0.2f, 0.5f), 0, NULL);
         for (int i = 0; i < RAYS; i++) {
             PtrVec3 o = v3(uniform(&rng, -15, 15), uniform(&rng, 0, 3), 15);
             PtrVec3 d = v3_normalize(v3_sub(v3(uniform(&rng, -10, 10), 0, uniform(&rng, -10, 10)), o));

@@ -25,7 +25,7 @@ static const char *const scene_names[] = { "cluster", "cluster, orthographic", "
 static uint32_t add(PtrScene *s, PtrMaterial m)
 {
     uint32_t index = 0;
-    CHECK_INT(ptr_scene_add_material(s, &m, &index), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(s, &m, &index, NULL), PTR_OK);
     return index;
 }
 
@@ -60,18 +60,18 @@ static PtrScene make_scene(SceneKind kind)
         double c[3] = { spread * (ptr_rng_float(&rng) - 0.5), 1.5 * ptr_rng_float(&rng),
                         spread * (ptr_rng_float(&rng) - 0.5) };
         double r = (kind == CLOUD ? 0.08 : 0.2) + 0.4 * ptr_rng_float(&rng);
-        CHECK_INT(ptr_builder_add_sphere(&b, c, r, materials[i % 6]), PTR_OK);
+        CHECK_INT(ptr_builder_add_sphere(&b, c, r, materials[i % 6], NULL), PTR_OK);
         if (i % 5 == 1) {
             const double rgb[3] = { ptr_rng_float(&rng), ptr_rng_float(&rng), ptr_rng_float(&rng) };
-            CHECK_INT(ptr_builder_set_color(&b, rgb), PTR_OK);
+            CHECK_INT(ptr_builder_set_color(&b, rgb, NULL), PTR_OK);
         }
         if (i % 9 == 3) /* glass inside glass */
-            CHECK_INT(ptr_builder_add_sphere(&b, c, 0.5 * r, materials[3]), PTR_OK);
+            CHECK_INT(ptr_builder_add_sphere(&b, c, 0.5 * r, materials[3], NULL), PTR_OK);
     }
     if (kind != EMPTY) {
         double radius = kind == HUGE_GROUND ? 1e5 : 100.0;
         const double ground[3] = { 0, -radius, 0 };
-        CHECK_INT(ptr_builder_add_sphere(&b, ground, radius, materials[0]), PTR_OK);
+        CHECK_INT(ptr_builder_add_sphere(&b, ground, radius, materials[0], NULL), PTR_OK);
     }
     const double eye[3] = { 0, 2, 7 }, target[3] = { 0, 0.5, 0 }, up[3] = { 0, 1, 0 };
     const PtrCamera lens = kind == ORTHOGRAPHIC
@@ -80,7 +80,7 @@ static PtrScene make_scene(SceneKind kind)
                                : (PtrCamera){ .vfov_deg = 50.0f, .aperture = 0.1f,
                                               .focus_distance = 7.0f };
     ptr_builder_set_camera(&b, eye, target, up, &lens);
-    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT), PTR_OK);
+    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
     s.sky = kind == HUGE_GROUND ? (PtrSky){ PTR_SKY_CONSTANT, v3(0.3f, 0.4f, 0.5f) }
                                 : (PtrSky){ PTR_SKY_GRADIENT, v3_splat(0.0f) };
     return s;
@@ -104,7 +104,7 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
     CHECK(ptr_isect_init(&isect, kernel, scene->spheres.count));
     CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, integrator == PTR_INTEGRATOR_BUNDLES,
-                             scene, 0),
+                             scene, 0, NULL),
               PTR_OK);
     for (uint32_t done = 0; done < count; done += pass) {
         PtrRenderStats stats;

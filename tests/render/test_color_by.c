@@ -84,10 +84,10 @@ static PtrScene valued_sphere(PtrMaterial material, float value, float sky)
     PtrScene s;
     uint32_t m;
     ptr_scene_init(&s);
-    CHECK_INT(ptr_scene_add_material(&s, &material, &m), PTR_OK);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, 0), 1.0f, m), PTR_OK);
-    CHECK_INT(ptr_scene_set_sphere_color(&s, 0, v3_splat(0.5f)), PTR_OK);
-    CHECK_INT(ptr_scene_set_sphere_value(&s, 0, value), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &material, &m, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, 0), 1.0f, m, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_set_sphere_color(&s, 0, v3_splat(0.5f), NULL), PTR_OK);
+    CHECK_INT(ptr_scene_set_sphere_value(&s, 0, value, NULL), PTR_OK);
     s.sky = (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(sky) };
     s.camera = (PtrCamera){ .lookfrom = v3(0, 0, 5), .lookat = v3(0, 0, 0),
                             .up = v3(0, 1, 0), .vfov_deg = 20.0f, .focus_distance = 5.0f };
@@ -130,7 +130,8 @@ static void test_furnace_shows_the_map(void)
     const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.3f) };
     for (size_t i = 0; i < sizeof published / sizeof published[0]; i++) {
         PtrScene s = valued_sphere(grey, (float)value_of(published[i].index), 0.8f);
-        CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find(published[i].map), 0.0, 256.0),
+        CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find(published[i].map), 0.0, 256.0,
+                                           NULL),
                   PTR_OK);
         double expected[3];
         for (int c = 0; c < 3; c++)
@@ -145,7 +146,7 @@ static void test_furnace_clamps(void)
 {
     const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.3f) };
     PtrScene s = valued_sphere(grey, 500.0f, 1.0f);
-    CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find("viridis"), 0.0, 256.0), PTR_OK);
+    CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find("viridis"), 0.0, 256.0, NULL), PTR_OK);
     double expected[3];
     for (int c = 0; c < 3; c++)
         expected[c] = srgb_decode(published[2].srgb[c]); /* viridis[255] */
@@ -162,13 +163,13 @@ static void test_materials(void)
     const PtrMaterial gold = { .kind = PTR_MATERIAL_METAL, .albedo = v3(0.9f, 0.7f, 0.2f),
                                .fuzz = 0.25f, .emission = v3_splat(0.5f) };
     uint32_t m;
-    CHECK_INT(ptr_scene_add_material(&s, &gold, &m), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &gold, &m, NULL), PTR_OK);
     for (int i = 0; i < 3; i++)
-        CHECK_INT(ptr_scene_add_sphere(&s, v3((float)i, 0, 0), 0.4f, m), PTR_OK);
-    CHECK_INT(ptr_scene_set_sphere_value(&s, 0, 1.0f), PTR_OK);
-    CHECK_INT(ptr_scene_set_sphere_value(&s, 2, 2.0f), PTR_OK);
+        CHECK_INT(ptr_scene_add_sphere(&s, v3((float)i, 0, 0), 0.4f, m, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_set_sphere_value(&s, 0, 1.0f, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_set_sphere_value(&s, 2, 2.0f, NULL), PTR_OK);
     CHECK(isnan(s.spheres.value[1]));
-    CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find("magma"), 1.0, 2.0), PTR_OK);
+    CHECK_INT(ptr_scene_color_by_value(&s, ptr_colormap_find("magma"), 1.0, 2.0, NULL), PTR_OK);
     CHECK_INT((int)s.material_count, 2);
     CHECK_INT((int)ptr_sphere_material(&s.spheres, 1), 0);
     CHECK_INT((int)ptr_sphere_material(&s.spheres, 0), 1);

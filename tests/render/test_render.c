@@ -31,8 +31,8 @@ static PtrScene furnace(PtrMaterial material)
     PtrScene s;
     uint32_t m;
     ptr_scene_init(&s);
-    CHECK_INT(ptr_scene_add_material(&s, &material, &m), PTR_OK);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, 0), 1.0f, m), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &material, &m, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, 0), 1.0f, m, NULL), PTR_OK);
     s.sky = (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(1.0f) };
     s.camera = (PtrCamera){ .lookfrom = v3(0, 0, 5), .lookat = v3(0, 0, 0),
                             .up = v3(0, 1, 0), .vfov_deg = 20.0f, .focus_distance = 5.0f };
@@ -187,9 +187,9 @@ static void test_orthographic_disc(void)
     uint32_t m;
     ptr_scene_init(&s);
     const PtrMaterial lamp = { .kind = PTR_MATERIAL_DIFFUSE, .emission = v3_splat(1.0f) };
-    CHECK_INT(ptr_scene_add_material(&s, &lamp, &m), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &lamp, &m, NULL), PTR_OK);
     const double r = 1.5, cx = 0.25, cy = -0.125;
-    CHECK_INT(ptr_scene_add_sphere(&s, v3((float)cx, (float)cy, -3), (float)r, m), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3((float)cx, (float)cy, -3), (float)r, m, NULL), PTR_OK);
     s.sky.kind = PTR_SKY_BLACK;
     s.camera = orthographic(2.0f);
     const PtrRenderSettings settings = { .width = 64, .height = 64, .samples = 64, .seed = 1,

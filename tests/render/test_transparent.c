@@ -172,14 +172,14 @@ static void test_adaptive(void)
     ptr_scene_init(&scene);
     uint32_t black;
     const PtrMaterial m = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.0f) };
-    CHECK_INT(ptr_scene_add_material(&scene, &m, &black), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&scene, &m, &black, NULL), PTR_OK);
     PtrSceneBuilder b;
     ptr_builder_init(&b, &scene, NULL);
     const double centre[3] = { 0, 0, 0 }, eye[3] = { 0, 0, 5 }, up[3] = { 0, 1, 0 };
-    CHECK_INT(ptr_builder_add_sphere(&b, centre, 1.0, black), PTR_OK);
+    CHECK_INT(ptr_builder_add_sphere(&b, centre, 1.0, black, NULL), PTR_OK);
     const PtrCamera lens = { .vfov_deg = 40.0f, .focus_distance = 5.0f };
     ptr_builder_set_camera(&b, eye, centre, up, &lens);
-    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT), PTR_OK);
+    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
     scene.sky.kind = PTR_SKY_BLACK;
     PtrIsectTable isect;
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);

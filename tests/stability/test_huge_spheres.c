@@ -28,8 +28,8 @@ static PtrScene room(unsigned build_flags, PtrSky sky)
     PtrScene s;
     uint32_t w, l;
     ptr_scene_init(&s);
-    CHECK_INT(ptr_scene_add_material(&s, &wall, &w), PTR_OK);
-    CHECK_INT(ptr_scene_add_material(&s, &light, &l), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &wall, &w, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &light, &l, NULL), PTR_OK);
     PtrSceneBuilder b;
     ptr_builder_init(&b, &s, NULL);
     const double big = 1e5;
@@ -38,13 +38,13 @@ static PtrScene room(unsigned build_flags, PtrSky sky)
         { 50, 80 + big, 85 }, { 50, 40, -big }, { 50, 40, 170 + big },
     };
     for (int i = 0; i < 6; i++)
-        CHECK_INT(ptr_builder_add_sphere(&b, walls[i], big, w), PTR_OK);
+        CHECK_INT(ptr_builder_add_sphere(&b, walls[i], big, w, NULL), PTR_OK);
     const double lamp[3] = { 50, 75, 85 };
-    CHECK_INT(ptr_builder_add_sphere(&b, lamp, 4.0, l), PTR_OK);
+    CHECK_INT(ptr_builder_add_sphere(&b, lamp, 4.0, l, NULL), PTR_OK);
     const double eye[3] = { 70, 50, 160 }, corner[3] = { 0, 0, 0 }, up[3] = { 0, 1, 0 };
     const PtrCamera lens = { .vfov_deg = 50.0f, .focus_distance = 1.0f };
     ptr_builder_set_camera(&b, eye, corner, up, &lens);
-    CHECK_INT(ptr_builder_finish(&b, build_flags), PTR_OK);
+    CHECK_INT(ptr_builder_finish(&b, build_flags, NULL), PTR_OK);
     s.sky = sky;
     return s;
 }
@@ -57,7 +57,7 @@ static float *render(const Method *m, PtrSky sky, PtrAccelChoice choice)
     float *rgb = malloc(SIZE * SIZE * 3 * sizeof *rgb);
     PtrError err = { 0 };
     PtrAccel accel;
-    CHECK_INT(ptr_accel_init(&accel, choice, &m->isect, 0, &s, 0), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, choice, &m->isect, 0, &s, 0, NULL), PTR_OK);
     CHECK_INT(ptr_render(&s, &accel, &settings, rgb, NULL, &err), PTR_OK);
     ptr_accel_free(&accel);
     ptr_scene_free(&s);

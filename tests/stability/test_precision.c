@@ -62,7 +62,7 @@ static void reference_rays(const Method *methods, int n)
         PtrVec3 aim = v3_add(c, v3_scale(side, (float)(radius * 0.9 * ptr_rng_float(&rng))));
         PtrScene s;
         ptr_scene_init(&s);
-        ptr_scene_add_sphere(&s, c, (float)radius, 0);
+        ptr_scene_add_sphere(&s, c, (float)radius, 0, NULL);
         PtrVec3 d = v3_normalize(v3_sub(aim, o));
         PtrRay ray = { { o.x, o.y, o.z }, 0, { d.x, d.y, d.z }, INFINITY };
 
@@ -132,7 +132,7 @@ static int leave_surfaces(const PtrIsectTable *isect, int cases, uint64_t seed, 
         PtrVec3 target = v3_add(c, v3_scale(random_unit(&rng), (float)radius));
         PtrScene s;
         ptr_scene_init(&s);
-        ptr_scene_add_sphere(&s, c, (float)radius, 0);
+        ptr_scene_add_sphere(&s, c, (float)radius, 0, NULL);
         PtrVec3 d = v3_normalize(v3_sub(target, o));
         PtrRay ray = { { o.x, o.y, o.z }, 0, { d.x, d.y, d.z }, INFINITY };
         PtrHit hit;

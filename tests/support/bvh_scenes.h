@@ -43,7 +43,7 @@ static inline int bvh_scene_make(PtrScene *scene, BvhSceneKind kind, int n, uint
 {
     PtrRng rng = ptr_rng_for_sample(seed, (uint64_t)kind, 0);
     int ok = 1;
-#define ADD(x, y, z, r) (ok &= ptr_scene_add_sphere(scene, v3((x), (y), (z)), (r), 0) == PTR_OK)
+#define ADD(x, y, z, r) (ok &= ptr_scene_add_sphere(scene, v3((x), (y), (z)), (r), 0, NULL) == PTR_OK)
     switch (kind) {
     case BVH_SCENE_RANDOM:
         for (int i = 0; i < n; i++)

@@ -33,16 +33,16 @@ static inline LitGroundErrors lit_ground_errors(double ground_radius, unsigned b
     uint32_t g, l;
     const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat((float)a) };
     const PtrMaterial lamp = { .kind = PTR_MATERIAL_DIFFUSE, .emission = v3_splat((float)L) };
-    CHECK_INT(ptr_scene_add_material(&s, &diffuse, &g), PTR_OK);
-    CHECK_INT(ptr_scene_add_material(&s, &lamp, &l), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &diffuse, &g, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(&s, &lamp, &l, NULL), PTR_OK);
     PtrSceneBuilder b;
     ptr_builder_init(&b, &s, NULL);
-    CHECK_INT(ptr_builder_add_sphere(&b, ground, big, g), PTR_OK);
-    CHECK_INT(ptr_builder_add_sphere(&b, emitter, r, l), PTR_OK);
+    CHECK_INT(ptr_builder_add_sphere(&b, ground, big, g, NULL), PTR_OK);
+    CHECK_INT(ptr_builder_add_sphere(&b, emitter, r, l, NULL), PTR_OK);
     const double eye[3] = { 0, 10, 0 }, target[3] = { 0, 0, 0 }, up[3] = { 0, 0, -1 };
     const PtrCamera lens = { .vfov_deg = 30, .focus_distance = 10 };
     ptr_builder_set_camera(&b, eye, target, up, &lens);
-    CHECK_INT(ptr_builder_finish(&b, build_flags), PTR_OK);
+    CHECK_INT(ptr_builder_finish(&b, build_flags, NULL), PTR_OK);
     s.sky.kind = PTR_SKY_BLACK;
 
     const int size = LIT_GROUND_SIZE;

@@ -17,7 +17,7 @@ static void tag_file_order(PtrScene *s)
 {
     for (size_t i = 0; i < s->spheres.count; i++) {
         const uint16_t tag[4] = { (uint16_t)i, (uint16_t)(i >> 16), 0, 0 };
-        CHECK_INT(ptr_scene_set_sphere_color16(s, i, tag), PTR_OK);
+        CHECK_INT(ptr_scene_set_sphere_color16(s, i, tag, NULL), PTR_OK);
     }
 }
 
@@ -70,7 +70,7 @@ static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, 
             continue;
         }
         uint32_t first = n->child[k];
-        if (count > PTR_BVH_LEAF_MAX || first < bvh->unbounded_count || first + count > s->count) {
+        if (count > PTR_BVH_LEAF_MAX || first < bvh->huge_count || first + count > s->count) {
             *ok = 0;
             continue;
         }
@@ -91,7 +91,7 @@ static void check_structure(const PtrBvh *bvh, const PtrSpheres *s, FileOrder or
 {
     unsigned char *seen = calloc(s->count + 1, 1);
     int ok = seen != NULL && s->id == NULL; /* the build frees the ids */
-    for (size_t i = 0; ok && i < bvh->unbounded_count; i++) {
+    for (size_t i = 0; ok && i < bvh->huge_count; i++) {
         seen[i]++;
         if (i > 0 && file_position(s, i, order) <= file_position(s, i - 1, order))
             ok = 0;
@@ -163,12 +163,12 @@ static void test_scenes(void)
              * keeps: reversed here, for the larger sets. */
             FileOrder order = { .reversed = size };
             if (order.reversed) {
-                CHECK_INT(ptr_spheres_make_ids(&b.spheres), PTR_OK);
+                CHECK_INT(ptr_spheres_make_ids(&b.spheres, NULL), PTR_OK);
                 for (size_t i = 0; i < b.spheres.count; i++)
                     b.spheres.id[i] = (uint32_t)(b.spheres.count - 1 - i);
             }
             PtrBvh bvh;
-            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0), PTR_OK);
+            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0, NULL), PTR_OK);
             check_structure(&bvh, &b.spheres, order, bvh_scene_names[kind]);
             check_rays(&a, &b, &bvh, size ? 10000 : 20000, bvh_scene_names[kind]);
             ptr_bvh_free(&bvh);
@@ -177,8 +177,35 @@ static void test_scenes(void)
         }
 }
 
+/* The rule itself (scene.h), as the builder and the tree apply it: of the
+ * spheres above the limit, the PTR_HUGE_MAX largest, on equal radii the
+ * first in the file, handed back in the file's order. 40 spheres offered in
+ * the arrays' order, whose file positions run backwards: radius 1 (below
+ * the limit of 2) for even positions, else 10 for the positions of 30 and
+ * over and 5 below. */
+static void test_huge_rule(void)
+{
+    PtrHugeChoice choice = { .limit = 2.0 };
+    for (size_t i = 0; i < 40; i++) {
+        const size_t file = 39 - i;
+        ptr_huge_offer(&choice, i, file, file % 2 == 0 ? 1.0 : file >= 30 ? 10.0 : 5.0);
+    }
+    ptr_huge_file_order(&choice);
+    CHECK_INT(choice.count, PTR_HUGE_MAX);
+    /* Odd positions: the five of radius 10 (31 .. 39), then of the fifteen
+     * of radius 5 the first eleven in the file (1 .. 21). */
+    size_t wrong = 0;
+    for (size_t k = 0; k < choice.count; k++) {
+        const size_t file = choice.sphere[k].file_position;
+        const size_t expected = k < 11 ? 2 * k + 1 : 31 + 2 * (k - 11);
+        wrong += file != expected || choice.sphere[k].index != 39 - file ||
+                 choice.sphere[k].radius != (file >= 30 ? 10.0 : 5.0);
+    }
+    CHECK_INT(wrong, 0);
+}
+
 /* The huge grounds stay out of the tree; ordinary spheres do not. */
-static void test_unbounded(void)
+static void test_huge(void)
 {
     const BvhSceneKind kinds[] = { BVH_SCENE_GROUND, BVH_SCENE_BIG_GROUND, BVH_SCENE_RANDOM };
     for (int k = 0; k < 3; k++) {
@@ -187,8 +214,8 @@ static void test_unbounded(void)
         CHECK(bvh_scene_make(&s, kinds[k], 500, 2));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1), PTR_OK);
-        CHECK_INT(bvh.unbounded_count, k < 2 ? 1 : 0);
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1, NULL), PTR_OK);
+        CHECK_INT(bvh.huge_count, k < 2 ? 1 : 0);
         if (k < 2)
             CHECK_INT(file_position(&s.spheres, 0, (FileOrder){ 0 }), 0);
         ptr_bvh_free(&bvh);
@@ -209,7 +236,7 @@ static void test_threads(void)
         CHECK(bvh_scene_make(&s, BVH_SCENE_CLUSTERS, 150000, 3));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t]), PTR_OK);
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t], NULL), PTR_OK);
         if (t == 0) {
             first = bvh;
             first_scene = s;
@@ -218,7 +245,7 @@ static void test_threads(void)
         }
         CHECK_INT(bvh.node_count, first.node_count);
         CHECK_INT(bvh.depth, first.depth);
-        CHECK_INT(bvh.unbounded_count, first.unbounded_count);
+        CHECK_INT(bvh.huge_count, first.huge_count);
         CHECK(bvh.node_count == first.node_count &&
               !memcmp(bvh.nodes, first.nodes, bvh.node_count * sizeof *bvh.nodes));
         CHECK(!memcmp(s.spheres.color, first_scene.spheres.color,
@@ -236,15 +263,15 @@ static void test_small(void)
     PtrScene s;
     ptr_scene_init(&s);
     PtrBvh bvh;
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
     CHECK(bvh.nodes == NULL);
     PtrRay ray = { { 0, 0, 0 }, 0.0f, { 0, 0, -1 }, INFINITY };
     PtrHit hit;
     CHECK(!ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
     CHECK_INT(hit.sphere, PTR_NO_HIT);
     CHECK_FLOAT_EQ(hit.t, INFINITY);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0), PTR_OK);
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0, NULL), PTR_OK);
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
     CHECK(ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
     CHECK_FLOAT_EQ(hit.t, 4.0f);
     CHECK_INT(hit.sphere, 0);
@@ -260,7 +287,7 @@ static float *render_with(PtrScene *scene, PtrAccelChoice choice, int width, int
     PtrIsectTable c;
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     PtrAccel accel;
-    CHECK_INT(ptr_accel_init(&accel, choice, &c, 0, scene, 3), PTR_OK);
+    CHECK_INT(ptr_accel_init(&accel, choice, &c, 0, scene, 3, NULL), PTR_OK);
     *used = ptr_accel_name(&accel);
     PtrRenderSettings settings = { .width = width, .height = height, .samples = 3, .seed = 9,
                                    .max_depth = 12, .threads = 2 };
@@ -320,7 +347,7 @@ static void test_renders_hard(void)
             ptr_scene_init(&s[k]);
             for (int m = 0; m < 3; m++) {
                 uint32_t index;
-                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index), PTR_OK);
+                CHECK_INT(ptr_scene_add_material(&s[k], &materials[m], &index, NULL), PTR_OK);
             }
             CHECK(bvh_scene_make(&s[k], (BvhSceneKind)kind, 600, 4));
             float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
@@ -329,7 +356,7 @@ static void test_renders_hard(void)
                 ptr_sphere_set_material(sp, i, (uint32_t)(i % 3));
                 if (i % 4 == 0)
                     CHECK_INT(ptr_scene_set_sphere_color(&s[k], i, v3((float)(i % 5) / 4.0f, 0.5f,
-                                                                      (float)(i % 7) / 6.0f)),
+                                                                      (float)(i % 7) / 6.0f), NULL),
                               PTR_OK);
                 if (sp->radius[i] > 100.0f) /* a ground: look at what stands on it */
                     continue;
@@ -361,7 +388,7 @@ static void test_auto(void)
         ptr_scene_init(&s);
         CHECK(bvh_scene_make(&s, BVH_SCENE_RANDOM, n, 1));
         PtrAccel accel;
-        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, 0, &s, 0), PTR_OK);
+        CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &c, 0, &s, 0, NULL), PTR_OK);
         CHECK_STR(ptr_accel_name(&accel), n < PTR_ACCEL_CROSSOVER_C ? "brute" : "bvh");
         ptr_accel_free(&accel);
         ptr_scene_free(&s);
@@ -383,20 +410,20 @@ static void test_coincident(void)
         const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
         uint32_t m;
         for (int k = 0; k < 3; k++)
-            CHECK_INT(ptr_scene_add_material(&s, &grey, &m), PTR_OK);
+            CHECK_INT(ptr_scene_add_material(&s, &grey, &m, NULL), PTR_OK);
         for (int i = 0; i < 1000; i++) {
             PtrVec3 at = v3(3.0f * (float)(i % 10), 3.0f * (float)(i / 10 % 10),
                             -3.0f * (float)(i / 100) - 10.0f);
-            CHECK_INT(ptr_scene_add_sphere(&s, at, 1.0f, i % 100 == 7 ? 1 : 0), PTR_OK);
+            CHECK_INT(ptr_scene_add_sphere(&s, at, 1.0f, i % 100 == 7 ? 1 : 0, NULL), PTR_OK);
         }
         for (int i = 7; i < 1000; i += 100)
-            CHECK_INT(ptr_scene_add_sphere(&s, ptr_sphere_centre(&s.spheres, (size_t)i), 1.0f, 2),
+            CHECK_INT(ptr_scene_add_sphere(&s, ptr_sphere_centre(&s.spheres, (size_t)i), 1.0f, 2, NULL),
                       PTR_OK);
         PtrVec3 centres[10];
         for (int k = 0; k < 10; k++)
             centres[k] = ptr_sphere_centre(&s.spheres, (size_t)(100 * k + 7));
         PtrAccel accel;
-        CHECK_INT(ptr_accel_init(&accel, (PtrAccelChoice)choice, &c, 0, &s, 0), PTR_OK);
+        CHECK_INT(ptr_accel_init(&accel, (PtrAccelChoice)choice, &c, 0, &s, 0, NULL), PTR_OK);
         CHECK_STR(ptr_accel_name(&accel), choice == PTR_ACCEL_BVH ? "bvh" : "brute");
         int first = 0;
         for (int k = 0; k < 10; k++) {
@@ -417,7 +444,8 @@ int main(void)
 {
     test_small();
     test_coincident();
-    test_unbounded();
+    test_huge_rule();
+    test_huge();
     test_scenes();
     test_threads();
     test_auto();

@@ -15,7 +15,7 @@ static PtrRay make_ray(PtrVec3 o, PtrVec3 d)
 static void one_sphere(PtrScene *s, PtrVec3 c, float r)
 {
     ptr_scene_init(s);
-    CHECK_INT(ptr_scene_add_sphere(s, c, r, 0), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(s, c, r, 0, NULL), PTR_OK);
 }
 
 static PtrHit closest(const PtrScene *s, PtrRay ray, int *found)
@@ -81,8 +81,8 @@ static void test_many_spheres(void)
     /* Spheres along -Z at distances 10, 9, ..., 1 (so the last is nearest),
      * and a duplicate of the nearest with a higher index. */
     for (int i = 0; i < 10; i++)
-        CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -(float)(10 - i) - 0.25f), 0.25f, 0), PTR_OK);
-    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -1.25f), 0.25f, 0), PTR_OK);
+        CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -(float)(10 - i) - 0.25f), 0.25f, 0, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -1.25f), 0.25f, 0, NULL), PTR_OK);
     CHECK_INT(s.spheres.capacity % PTR_SPHERE_BLOCK, 0);
     CHECK((uintptr_t)s.spheres.cx % PTR_SPHERE_ALIGN == 0);
 

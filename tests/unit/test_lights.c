@@ -24,7 +24,7 @@
 static uint32_t add_material(PtrScene *s, PtrMaterial m)
 {
     uint32_t index;
-    CHECK_INT(ptr_scene_add_material(s, &m, &index), PTR_OK);
+    CHECK_INT(ptr_scene_add_material(s, &m, &index, NULL), PTR_OK);
     return index;
 }
 
@@ -40,7 +40,7 @@ static void test_alias_table(void)
                                                   .emission = v3(strengths[i], 0, 1) });
     for (int i = 0; i < 40; i++)
         CHECK_INT(ptr_scene_add_sphere(&s, v3((float)i, 0, 0), 0.1f + 0.05f * (float)(i % 5),
-                                       i % 3 ? mats[i % 6] : dull), PTR_OK);
+                                       i % 3 ? mats[i % 6] : dull, NULL), PTR_OK);
     PtrLights l;
     PtrError err = { 0 };
     CHECK_INT(ptr_lights_init(&l, &s, &err), PTR_OK);
@@ -155,7 +155,7 @@ static PtrScene mixed_scene(void)
     };
     for (size_t i = 0; i < sizeof spheres / sizeof spheres[0]; i++)
         CHECK_INT(ptr_scene_add_sphere(&s, v3(spheres[i].x, spheres[i].y, spheres[i].z),
-                                       spheres[i].r, add_material(&s, spheres[i].m)), PTR_OK);
+                                       spheres[i].r, add_material(&s, spheres[i].m), NULL), PTR_OK);
     s.sky.kind = PTR_SKY_BLACK;
     s.camera = (PtrCamera){ .lookfrom = v3(0, 2.5f, 7), .lookat = v3(0, 1, 0), .up = v3(0, 1, 0),
                             .vfov_deg = 50, .focus_distance = 7 };

@@ -2,13 +2,16 @@
  * scene's arrays): exactly the pages the contract names leave the process
  * (mincore says which pages are resident), every byte the caller has not
  * finished with keeps its value, and releasing a range in steps, each from
- * where the last ended, leaves no page of it behind; and the material
- * array's entries, 1 byte a sphere until the materials need more. */
+ * where the last ended, leaves no page of it behind; the material array's
+ * entries, 1 byte a sphere until the materials need more; and the hash,
+ * which needs memory for the file's order, failing without it. */
 #define _DEFAULT_SOURCE /* mincore */
 #include "test.h"
 
 #include <stdint.h>
+#include <stdio.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "base/memory.h"
@@ -128,16 +131,16 @@ static void test_spheres_release(void)
     PtrScene scene;
     ptr_scene_init(&scene);
     const size_t count = 300000, kept = 1000;
-    CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept), PTR_OK);
+    CHECK_INT(ptr_spheres_resize(&scene.spheres, count + kept, NULL), PTR_OK);
     PtrSpheres *s = &scene.spheres;
-    CHECK_INT(ptr_spheres_make_ids(s), PTR_OK);
+    CHECK_INT(ptr_spheres_make_ids(s, NULL), PTR_OK);
     size_t failed_values = 0;
     for (size_t i = 0; i < count + kept; i++) {
         s->cx[i] = s->cy[i] = s->cz[i] = (float)i;
         s->radius[i] = 1.0f;
         ptr_sphere_set_material(s, i, 7);
         s->id[i] = (uint32_t)i;
-        failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f) != PTR_OK;
+        failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f, NULL) != PTR_OK;
     }
     CHECK_INT(failed_values, 0);
     ptr_spheres_release(s, 0, count / 2);
@@ -165,7 +168,7 @@ static void add_materials(PtrScene *scene, size_t count)
     const PtrMaterial m = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
     uint32_t index;
     while (scene->material_count < count)
-        CHECK_INT(ptr_scene_add_material(scene, &m, &index), PTR_OK);
+        CHECK_INT(ptr_scene_add_material(scene, &m, &index, NULL), PTR_OK);
 }
 
 /* 1 byte a sphere up to 256 materials, 2 up to 65,536, then 4; widening
@@ -177,7 +180,7 @@ static void test_material_widths(void)
     add_materials(&scene, 256);
     const size_t count = 1000;
     for (size_t i = 0; i < count; i++)
-        CHECK_INT(ptr_scene_add_sphere(&scene, v3(0, 0, (float)i), 1.0f, (uint32_t)(i % 256)),
+        CHECK_INT(ptr_scene_add_sphere(&scene, v3(0, 0, (float)i), 1.0f, (uint32_t)(i % 256), NULL),
                   PTR_OK);
     PtrSpheres *s = &scene.spheres;
     CHECK_INT(s->material_size, 1);
@@ -197,11 +200,82 @@ static void test_material_widths(void)
     ptr_scene_free(&scene);
 }
 
+/* The address space the process has mapped, in bytes. */
+static size_t mapped_bytes(void)
+{
+    unsigned long pages = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        CHECK_INT(fscanf(f, "%lu", &pages), 1);
+        fclose(f);
+    }
+    return pages * page_size();
+}
+
+/* Sanitizers reserve terabytes of address space: a limit means nothing
+ * there. */
+#if defined(__SANITIZE_ADDRESS__)
+#define ADDRESS_LIMITS 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ADDRESS_LIMITS 0
+#endif
+#endif
+#ifndef ADDRESS_LIMITS
+#define ADDRESS_LIMITS 1
+#endif
+
+/* The hash takes the spheres in the file's order: a scene whose first
+ * sphere the importer put last (its id saying so) hashes as the same scene
+ * in order; and where that order cannot be allocated, the hash fails with
+ * PTR_ERR_NOMEM instead of giving a fingerprint of the arrays' order. */
+static void test_hash_in_file_order(void)
+{
+    enum { COUNT = 1 << 22 }; /* 16 MB of order: more than the limit leaves */
+    PtrScene in_order, reordered;
+    ptr_scene_init(&in_order);
+    ptr_scene_init(&reordered);
+    CHECK_INT(ptr_spheres_resize(&in_order.spheres, COUNT, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_resize(&reordered.spheres, COUNT, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_make_ids(&reordered.spheres, NULL), PTR_OK);
+    for (size_t i = 0; i < COUNT; i++) {
+        const size_t file = (i + 1) % COUNT; /* sphere 0 of the file last */
+        PtrSpheres *a = &in_order.spheres, *b = &reordered.spheres;
+        a->cx[i] = a->cy[i] = a->cz[i] = (float)i;
+        a->radius[i] = i ? 1.0f : 1000.0f;
+        ptr_sphere_set_material(a, i, 0);
+        b->cx[i] = b->cy[i] = b->cz[i] = (float)file;
+        b->radius[i] = file ? 1.0f : 1000.0f;
+        ptr_sphere_set_material(b, i, 0);
+        b->id[i] = (uint32_t)file;
+    }
+    uint64_t expected = 0, hash = 1;
+    CHECK_INT(ptr_scene_hash(&in_order, &expected, NULL), PTR_OK);
+    CHECK_INT(ptr_scene_hash(&reordered, &hash, NULL), PTR_OK);
+    CHECK(hash == expected);
+    if (ADDRESS_LIMITS) {
+        struct rlimit old, tight;
+        CHECK_INT(getrlimit(RLIMIT_AS, &old), 0);
+        tight = old;
+        tight.rlim_cur = mapped_bytes() + ((size_t)1 << 20);
+        CHECK_INT(setrlimit(RLIMIT_AS, &tight), 0);
+        PtrError err = { 0 };
+        hash = 1;
+        const PtrResult r = ptr_scene_hash(&reordered, &hash, &err);
+        CHECK_INT(setrlimit(RLIMIT_AS, &old), 0);
+        CHECK_INT(r, PTR_ERR_NOMEM);
+        CHECK(hash == 1 && err.code == PTR_ERR_NOMEM && err.message[0]);
+    }
+    ptr_scene_free(&in_order);
+    ptr_scene_free(&reordered);
+}
+
 int main(void)
 {
     test_release_whole_pages_only();
     test_release_in_steps();
     test_spheres_release();
     test_material_widths();
+    test_hash_in_file_order();
     return test_report();
 }
