@@ -5,6 +5,7 @@
 
 #include "app/batch.h"
 #include "app/claim.h"
+#include "app/cli_help.h"
 #include "app/cli_options.h"
 #include "app/color_by.h"
 #include "app/job.h"
@@ -169,15 +170,19 @@ static int watch_scene(const PtrOptions *o, const PtrColor *color)
 int ptr_cli_main(int argc, char **argv)
 {
     PtrOptions o;
-    int code = ptr_options_parse(argc, argv, &o);
-    if (code >= 0)
-        return code;
+    PtrError err = { 0 };
+    if (ptr_options_parse(argc, argv, &o, &err) != PTR_OK)
+        return fail(&err);
+    if (o.print != PTR_PRINT_NOTHING) {
+        ptr_print_requested(&o);
+        return 0;
+    }
     ptr_signals_install();
 
     if (o.dump_scene)
         return dump_scenes(&o);
 
-    PtrError err = { 0 };
+    int code = 0;
     /* Renders and merges write images. For any format but EXR, OpenImageIO
      * loads on a thread of its own while the colour config, the scenes and
      * the render proceed. The tree's and the render's threads start first:
@@ -199,8 +204,8 @@ int ptr_cli_main(int argc, char **argv)
         if (output && ptr_image_preload(output, &err) != PTR_OK)
             return fail(&err);
     }
-    PtrColor *color = ptr_color_open(o.ocio_config, &err);
-    if (!color)
+    PtrColor *color;
+    if (ptr_color_open(o.ocio_config, &color, &err) != PTR_OK)
         return fail(&err);
     if (ptr_color_select(color, o.display, o.view, o.look, o.exposure, &err) != PTR_OK) {
         code = fail(&err);
@@ -214,17 +219,15 @@ int ptr_cli_main(int argc, char **argv)
     } else {
         /* Refuse an unavailable kernel or integrator before reading any scene. */
         PtrIsectTable isect;
-        if (!ptr_isect_init(&isect, o.kernel, SIZE_MAX)) {
-            ptr_error_set(&err, PTR_ERR_USAGE,
-                          "--asm: no assembly intersector at CPU level '%s' (this build %s)",
-                          ptr_cpu_level_name(ptr_cpu_level()),
-                          ptr_isect_has_asm() ? "has them" : "was built without them");
+        PtrError kernel_err;
+        if (ptr_isect_init(&isect, o.kernel, o.cpu_level, SIZE_MAX, &kernel_err) != PTR_OK) {
+            ptr_error_set(&err, kernel_err.code, "--asm: %s", kernel_err.message);
             code = fail(&err);
-        } else if (!ptr_integrator_available(o.integrator)) {
+        } else if (!ptr_integrator_available(o.integrator, o.cpu_level)) {
             int built = ptr_integrator_for_level(PTR_CPU_LEVEL_COUNT - 1) == PTR_INTEGRATOR_BUNDLES;
             ptr_error_set(&err, PTR_ERR_USAGE,
                           "--integrator %s: not at CPU level '%s' (this build %s)",
-                          ptr_integrator_name(o.integrator), ptr_cpu_level_name(ptr_cpu_level()),
+                          ptr_integrator_name(o.integrator), ptr_cpu_level_name(o.cpu_level),
                           built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
         } else if (ptr_live_view_open(&o, color, &err) != PTR_OK) {

@@ -27,9 +27,9 @@ static const char *required(const Part *p, const char *name, PtrError *err)
 
 static PtrResult read_part(Part *p, PtrError *err)
 {
-    p->image = ptr_image_read(p->path, err);
-    if (!p->image)
-        return err->code;
+    PtrResult res = ptr_image_read(p->path, &p->image, err);
+    if (res != PTR_OK)
+        return res;
     p->layout = ptr_image_layout(p->image);
     const char *first, *samples, *depth, *space;
     if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||

@@ -45,14 +45,14 @@ static const Format *find_format(const char *path)
 
 static const char *const depth_names[] = { "default", "8", "16", "half", "float" };
 
-int ptr_depth_parse(const char *text, PtrDepth *depth)
+PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err)
 {
     for (int d = PTR_DEPTH_8; d <= PTR_DEPTH_FLOAT; d++)
         if (!strcmp(text, depth_names[d])) {
             *depth = (PtrDepth)d;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not 8, 16, half or float", text);
 }
 
 /* The depth a file gets, or PTR_DEPTH_DEFAULT if its format cannot store the
@@ -80,8 +80,9 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError
                              "%s: a transparent image (--transparent) needs a format with "
                              "alpha: .exr, .png or .tif",
                              path);
-    if (!known && ptr_image_ready(err) != PTR_OK)
-        return err->code;
+    PtrResult ready = known ? PTR_OK : ptr_image_ready(err);
+    if (ready != PTR_OK)
+        return ready;
     if (!known && !ptr_image_can_write(path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);

@@ -47,8 +47,8 @@ typedef struct PtrOutputInfo {
     int dither;            /* 8-bit: dither before rounding */
 } PtrOutputInfo;
 
-/* Parses "8", "16", "half" or "float". */
-int ptr_depth_parse(const char *text, PtrDepth *depth);
+/* Parses "8", "16", "half" or "float"; PTR_ERR_USAGE for anything else. */
+PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err);
 
 /* Fails early, before any rendering, if no writer exists for the output's
  * extension or it cannot store that depth, or an alpha channel if alpha is

@@ -87,10 +87,11 @@ void ptr_image_discard_partial(void);
  * if it has one; other channels are dropped. */
 typedef struct PtrImage PtrImage;
 
-/* NULL on failure, with err filled: PTR_ERR_USAGE for a file that is not an
- * image the module can read (images are read only as files the command line
- * names), PTR_ERR_NOMEM, or what ptr_image_ready says. */
-PtrImage *ptr_image_read(const char *path, PtrError *err);
+/* The image into *out (for ptr_image_free): PTR_OK, else PTR_ERR_USAGE for a
+ * file that is not an image the module can read (images are read only as
+ * files the command line names), PTR_ERR_NOMEM, or what ptr_image_ready
+ * says. */
+PtrResult ptr_image_read(const char *path, PtrImage **out, PtrError *err);
 void ptr_image_free(PtrImage *image);
 int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);

@@ -86,8 +86,9 @@ PtrResult ptr_image_preload(const char *output, PtrError *err)
     if (ptr_image_is_exr(output))
         return PTR_OK;
     char path[PATH_SIZE];
-    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, err) != PTR_OK)
-        return err->code;
+    PtrResult found = ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, err);
+    if (found != PTR_OK)
+        return found;
     if (access(path, R_OK))
         return ptr_error_set(err, PTR_ERR_INSTALL, "%s: ptr's image module is missing: %s", path,
                              strerror(errno));
@@ -102,7 +103,7 @@ PtrResult ptr_image_preload(const char *output, PtrError *err)
     return PTR_OK;
 }
 
-const PtrImageModule *ptr_oiio_module(PtrError *err)
+PtrResult ptr_oiio_module(const PtrImageModule **out, PtrError *err)
 {
     pthread_mutex_lock(&lock);
     join_loader_locked();
@@ -110,7 +111,6 @@ const PtrImageModule *ptr_oiio_module(PtrError *err)
         load();
     const PtrImageModule *m = module;
     pthread_mutex_unlock(&lock);
-    if (!m && err)
-        *err = load_error;
-    return m;
+    *out = m;
+    return m ? PTR_OK : ptr_error_set(err, load_error.code, "%s", load_error.message);
 }

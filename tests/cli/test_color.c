@@ -37,8 +37,8 @@ static PtrOutputInfo info_for(const PtrColor *color)
 static PtrImage *read_image(const char *path)
 {
     PtrError err;
-    PtrImage *img = ptr_image_read(path, &err);
-    if (!img)
+    PtrImage *img = NULL;
+    if (ptr_image_read(path, &img, &err) != PTR_OK)
         TEST_FAIL_("%s", err.message);
     return img;
 }
@@ -52,8 +52,8 @@ static void oracle(const char *config, const char *display, const char *view)
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
     CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, NULL, PTR_PIXEL_FLOAT, NULL, 0, &err), 0);
 
-    PtrColor *color = ptr_color_open(config, &err);
-    CHECK(color != NULL);
+    PtrColor *color = NULL;
+    CHECK_INT(ptr_color_open(config, &color, &err), PTR_OK);
     if (!color)
         return;
     CHECK_INT(ptr_color_select(color, display, view, NULL, 0, &err), 0);
@@ -93,7 +93,8 @@ static void test_oracle(void)
     const char *ptr_views[] = { "Standard", "ACES 1.0 SDR-video", "Raw" };
     for (int v = 0; v < 3; v++) {
         PtrError err;
-        PtrColor *embedded = ptr_color_open(NULL, &err);
+        PtrColor *embedded = NULL;
+        CHECK_INT(ptr_color_open(NULL, &embedded, &err), PTR_OK);
         CHECK_STR(ptr_color_source(embedded), "embedded");
         ptr_color_close(embedded);
         oracle(PTR_CONFIG, "sRGB", ptr_views[v]);
@@ -119,24 +120,25 @@ static void test_lookup_order(void)
 {
     PtrError err;
     unsetenv("OCIO");
-    PtrColor *c = ptr_color_open(NULL, &err);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_STR(ptr_color_source(c), "embedded");
     ptr_color_close(c);
 
     setenv("OCIO", SECOND_CONFIG, 1);
-    c = ptr_color_open(NULL, &err);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_STR(ptr_color_source(c), SECOND_CONFIG);
     CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0, &err), 0);
     CHECK_STR(ptr_color_view(c), "Gamma"); /* that config's default */
     ptr_color_close(c);
 
-    c = ptr_color_open(PTR_CONFIG, &err); /* --ocio-config beats $OCIO */
+    CHECK_INT(ptr_color_open(PTR_CONFIG, &c, &err), PTR_OK); /* --ocio-config beats $OCIO */
     CHECK_STR(ptr_color_source(c), PTR_CONFIG);
     ptr_color_close(c);
 
     /* A broken $OCIO is an error, not a fallback to the embedded config. */
     setenv("OCIO", BROKEN_CONFIG, 1);
-    CHECK(ptr_color_open(NULL, &err) == NULL);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_ERR_COLOR);
     CHECK(strstr(err.message, BROKEN_CONFIG) != NULL && strstr(err.message, "$OCIO") != NULL);
     unsetenv("OCIO");
 }
@@ -144,12 +146,13 @@ static void test_lookup_order(void)
 static void test_errors(void)
 {
     PtrError err;
-    CHECK(ptr_color_open(BROKEN_CONFIG, &err) == NULL);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(BROKEN_CONFIG, &c, &err), PTR_ERR_COLOR);
     CHECK(strstr(err.message, BROKEN_CONFIG) != NULL);
-    CHECK(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", &err) == NULL);
+    CHECK_INT(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", &c, &err), PTR_ERR_COLOR);
     CHECK_INT(err.code, PTR_ERR_COLOR);
 
-    PtrColor *c = ptr_color_open(NULL, &err);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_INT(ptr_color_select(c, NULL, "Filmic", NULL, 0, &err), PTR_ERR_USAGE);
     CHECK(strstr(err.message, "'Filmic'") && strstr(err.message, "'Standard'") &&
           strstr(err.message, "'Raw'"));
@@ -177,7 +180,8 @@ static void test_errors(void)
 static void test_output_path(void)
 {
     PtrError err;
-    PtrColor *c = ptr_color_open(NULL, &err);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     const float grey[3] = { 0.18f, 0.18f, 0.18f }, doubled[3] = { 0.36f, 0.36f, 0.36f };
     const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
 

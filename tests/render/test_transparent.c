@@ -30,8 +30,8 @@ static PtrImage *render(const char *name, ...)
     argv[argc] = NULL;
     CHECK_INT(ptr_cli_main(argc, argv), 0);
     PtrError err;
-    PtrImage *image = ptr_image_read(out, &err);
-    CHECK(image != NULL);
+    PtrImage *image = NULL;
+    CHECK_INT(ptr_image_read(out, &image, &err), PTR_OK);
     return image;
 }
 
@@ -95,7 +95,7 @@ static void test_same_bytes(void)
 {
     PtrImage *a = render("a.exr", "--transparent", "--threads", "1", "--integrator", "paths",
                          "--accel", "brute", NULL);
-    const char *integrator = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES) ? "bundles" : "paths";
+    const char *integrator = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level()) ? "bundles" : "paths";
     PtrImage *b = render("b.exr", "--transparent", "--threads", "2", "--integrator", integrator,
                          "--accel", "bvh", NULL);
     PtrImage *c = render("c.exr", "--transparent", "--threads", "2", "--cpumask", "none",
@@ -119,7 +119,8 @@ static void test_regions_merge(void)
                        test_path("merged.exr"), "--quiet", NULL),
               0);
     PtrError err;
-    PtrImage *merged = ptr_image_read(test_path("merged.exr"), &err);
+    PtrImage *merged = NULL;
+    CHECK_INT(ptr_image_read(test_path("merged.exr"), &merged, &err), PTR_OK);
     CHECK(merged && ptr_image_alpha(merged));
     if (whole && merged)
         CHECK(same_pixels(whole, merged));
@@ -182,7 +183,7 @@ static void test_adaptive(void)
     CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT), PTR_OK);
     scene.sky.kind = PTR_SKY_BLACK;
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
     const PtrAccel accel = ptr_accel_brute(&isect, &scene);
     PtrRenderSettings s = { .width = 32, .height = 32, .seed = 3, .max_depth = 8, .threads = 2,
                             .noise_threshold = 0.01f, .min_samples = 16 };
@@ -225,7 +226,8 @@ static void test_framing(const char *projection)
                        "--auto-camera", projection, "--quiet", NULL),
               0);
     PtrError err;
-    PtrImage *image = ptr_image_read(out, &err);
+    PtrImage *image = NULL;
+    CHECK_INT(ptr_image_read(out, &image, &err), PTR_OK);
     const float *alpha = image ? ptr_image_alpha(image) : NULL;
     CHECK(alpha != NULL);
     if (!alpha) {
