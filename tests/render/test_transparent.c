@@ -89,10 +89,13 @@ static void test_alpha_and_composite(void)
 }
 
 /* The same bytes with one thread and the one-path integrator over brute
- * force, two threads and bundles over the tree, and (last: the cap stays)
- * the C reference with the CPU capped at no vector extension. */
+ * force, two threads and bundles over the tree, the C reference with the CPU
+ * capped at no vector extension, and then, where the build and the CPU have
+ * them, the assembly kernels: the cap was that render's alone (a cap kept
+ * by the process would refuse --asm, and cap every case after this one). */
 static void test_same_bytes(void)
 {
+    const int have_asm = ptr_isect_has_asm() && ptr_cpu_level() >= PTR_CPU_SSE41;
     PtrImage *a = render("a.exr", "--transparent", "--threads", "1", "--integrator", "paths",
                          "--accel", "brute", NULL);
     const char *integrator = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level()) ? "bundles" : "paths";
@@ -100,13 +103,17 @@ static void test_same_bytes(void)
                          "--accel", "bvh", NULL);
     PtrImage *c = render("c.exr", "--transparent", "--threads", "2", "--cpumask", "none",
                          "--integrator", "paths", "--c", NULL);
+    PtrImage *d = have_asm ? render("d.exr", "--transparent", "--asm", NULL) : NULL;
     if (a && b && c) {
         CHECK(same_pixels(a, b));
         CHECK(same_pixels(a, c));
     }
+    if (a && d)
+        CHECK(same_pixels(a, d));
     ptr_image_free(a);
     ptr_image_free(b);
     ptr_image_free(c);
+    ptr_image_free(d);
 }
 
 /* Two regions merged: the whole render's bytes, alpha included. */
@@ -254,13 +261,13 @@ int main(void)
 {
     if (!test_dir_create("transparent"))
         return 1;
+    test_same_bytes(); /* first: its CPU cap must not reach the cases after it */
     test_alpha_and_composite();
     test_regions_merge();
     test_png();
     test_adaptive();
     test_framing("perspective");
     test_framing("orthographic");
-    test_same_bytes(); /* last: it caps the CPU level */
     test_dir_remove();
     return test_report();
 }
