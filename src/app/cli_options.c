@@ -285,7 +285,8 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     case OPT_colormap:
         o->colormap = ptr_colormap_find(value);
         if (!o->colormap)
-            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm", err);
+            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm",
+                             err);
         break;
     case OPT_color_range: {
         char tail;

@@ -72,8 +72,9 @@ typedef struct PtrLiveModule {
     void (*stop)(PtrLiveSession *session);
 } PtrLiveModule;
 
-/* The module into *out, loaded now (live_loader.c): PTR_OK, else
- * PTR_ERR_INSTALL or PTR_ERR_NOMEM. */
+/* The module into *out, loaded now (live_loader.c), for the caller to keep
+ * (it stays loaded for the process): PTR_OK, else PTR_ERR_INSTALL or
+ * PTR_ERR_NOMEM. */
 PtrResult ptr_live_module(const PtrLiveModule **out, PtrError *err);
 
 #ifdef __cplusplus

@@ -98,7 +98,8 @@ static void test_same_bytes(void)
     const int have_asm = ptr_isect_has_asm() && ptr_cpu_level() >= PTR_CPU_SSE41;
     PtrImage *a = render("a.exr", "--transparent", "--threads", "1", "--integrator", "paths",
                          "--accel", "brute", NULL);
-    const char *integrator = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level()) ? "bundles" : "paths";
+    const char *integrator =
+        ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level()) ? "bundles" : "paths";
     PtrImage *b = render("b.exr", "--transparent", "--threads", "2", "--integrator", integrator,
                          "--accel", "bvh", NULL);
     PtrImage *c = render("c.exr", "--transparent", "--threads", "2", "--cpumask", "none",
