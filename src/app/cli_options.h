@@ -85,6 +85,9 @@ typedef struct PtrOptions {
     int dump_scene;
     int list_views;
     PtrPrintRequest print;  /* --help, --version, --print-dispatch: options after it are not read */
+    /* Not an option: the image module's loader of the run, which
+     * ptr_cli_main owns (NULL from ptr_options_parse). */
+    PtrImageLoader *images;
 } PtrOptions;
 
 /* What the importers need of the options. */

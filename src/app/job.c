@@ -119,7 +119,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         /* A frame of a sequence that --skip-existing resumes is written
          * whole or not at all: an output that exists is never rendered again. */
         if (!(done.stopped && o->skip_existing))
-            res = ptr_output_write(report->output, &layout, rgb, &info, err);
+            res = ptr_output_write(o->images, report->output, &layout, rgb, &info, err);
     }
     free(rgb);
     free(counts);

@@ -28,16 +28,17 @@ PtrResult ptr_image_set_threads(int threads, PtrError *err)
     return ptr_exr_set_threads(threads, err);
 }
 
-PtrResult ptr_image_ready(PtrError *err)
+PtrResult ptr_image_ready(PtrImageLoader *loader, PtrError *err)
 {
     const PtrImageModule *m;
-    return ptr_oiio_module(&m, err);
+    return ptr_oiio_module(loader, "the image module", &m, err);
 }
 
-int ptr_image_can_write(const char *path)
+int ptr_image_can_write(PtrImageLoader *loader, const char *path)
 {
     const PtrImageModule *m;
-    return ptr_image_is_exr(path) || (ptr_oiio_module(&m, NULL) == PTR_OK && m->can_write(path));
+    return ptr_image_is_exr(path) ||
+           (ptr_oiio_module(loader, path, &m, NULL) == PTR_OK && m->can_write(path));
 }
 
 /* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
@@ -54,13 +55,14 @@ static int temporary_name(const char *path, char *tmp, size_t size)
     return n > 0 && (size_t)n < size;
 }
 
-PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                          const float *alpha, const float *sample_counts, PtrPixelFormat format,
-                          const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
+PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrImageLayout *layout,
+                          const float *rgb, const float *alpha, const float *sample_counts,
+                          PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
+                          PtrError *err)
 {
     const int exr = ptr_image_is_exr(path);
     const PtrImageModule *m = NULL;
-    PtrResult loaded = exr ? PTR_OK : ptr_oiio_module(&m, err);
+    PtrResult loaded = exr ? PTR_OK : ptr_oiio_module(loader, path, &m, err);
     if (loaded != PTR_OK)
         return loaded;
     char tmp[PATH_SIZE];
@@ -86,12 +88,13 @@ void ptr_image_discard_partial(void)
         unlink(partial_path);
 }
 
-PtrResult ptr_image_read(const char *path, PtrImage **out, PtrError *err)
+PtrResult ptr_image_read(PtrImageLoader *loader, const char *path, PtrImage **out,
+                         PtrError *err)
 {
     if (ptr_image_is_exr(path))
         return ptr_exr_read(path, out, err);
     const PtrImageModule *m;
-    PtrResult loaded = ptr_oiio_module(&m, err);
+    PtrResult loaded = ptr_oiio_module(loader, path, &m, err);
     return loaded == PTR_OK ? m->read(path, out, err) : loaded;
 }
 

@@ -106,9 +106,11 @@ typedef struct PtrImageModule {
     PtrResult (*read)(const char *path, PtrImage **out, PtrError *err);
 } PtrImageModule;
 
-/* The module into *out, loaded now if oiio_loader.c's thread has not (see
- * ptr_image_preload): PTR_OK, else what ptr_image_ready says. */
-PtrResult ptr_oiio_module(const PtrImageModule **out, PtrError *err);
+/* The loader's module into *out, loaded now if its thread has not (see
+ * ptr_image_preload): PTR_OK, else what ptr_image_ready says, or
+ * PTR_ERR_USAGE naming path without a loader. */
+PtrResult ptr_oiio_module(PtrImageLoader *loader, const char *path, const PtrImageModule **out,
+                          PtrError *err);
 
 #ifdef __cplusplus
 }

@@ -48,7 +48,7 @@ static void test_render_seed_exr(void)
                   "--quiet", "--c", NULL), 0);
     PtrError err;
     PtrImage *img = NULL;
-    CHECK_INT(ptr_image_read(out, &img, &err), PTR_OK);
+    CHECK_INT(test_image_read(out, &img, &err), PTR_OK);
     if (!img)
         return;
     /* The scene's camera is square: the height follows the width. */
@@ -91,7 +91,7 @@ static void test_png_and_options(void)
                   "--sky", "black", "--threads", "1", "--max-depth", "5", "--quiet", NULL), 0);
     PtrError err;
     PtrImage *img = NULL;
-    CHECK_INT(ptr_image_read(png, &img, &err), PTR_OK);
+    CHECK_INT(test_image_read(png, &img, &err), PTR_OK);
     if (!img)
         return;
     CHECK_INT(ptr_image_width(img), 40);
@@ -106,7 +106,7 @@ static void test_png_and_options(void)
     /* A constant sky of 0.5 seen directly encodes to sRGB 0.735 -> code 188. */
     CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
                   "--camera", "Camera", "--quiet", NULL), 0);
-    CHECK_INT(ptr_image_read(png, &img, &err), PTR_OK);
+    CHECK_INT(test_image_read(png, &img, &err), PTR_OK);
     CHECK_NEAR(ptr_image_pixels(img)[0] * 255.0f, 188.0, 1e-3);
     ptr_image_free(img);
 }
@@ -124,7 +124,7 @@ static void test_orthographic_option(void)
               0);
     PtrError err;
     PtrImage *img = NULL;
-    CHECK_INT(ptr_image_read(out, &img, &err), PTR_OK);
+    CHECK_INT(test_image_read(out, &img, &err), PTR_OK);
     if (!img)
         return;
     const float *px = ptr_image_pixels(img);

@@ -102,8 +102,8 @@ static void test_same_image(void)
                        cam[5], "--quiet", NULL), 0);
     PtrError err;
     PtrImage *a = NULL, *b = NULL;
-    CHECK_INT(ptr_image_read(test_path("gltf.exr"), &a, &err), PTR_OK);
-    CHECK_INT(ptr_image_read(test_path("obj.exr"), &b, &err), PTR_OK);
+    CHECK_INT(test_image_read(test_path("gltf.exr"), &a, &err), PTR_OK);
+    CHECK_INT(test_image_read(test_path("obj.exr"), &b, &err), PTR_OK);
     if (!a || !b)
         return;
     double worst = 0, mean = 0;

@@ -56,7 +56,7 @@ static PtrImage *render_file(const char *scene, const char *out, const char *ker
     CHECK_INT(ptr_cli_main(10, argv), 0);
     PtrError err;
     PtrImage *img = NULL;
-    CHECK_INT(ptr_image_read(out, &img, &err), PTR_OK);
+    CHECK_INT(ptr_image_read(NULL, out, &img, &err), PTR_OK);
     return img;
 }
 

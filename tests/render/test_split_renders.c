@@ -21,7 +21,7 @@ static PtrImage *load(const char *path)
 {
     PtrError err;
     PtrImage *img = NULL;
-    if (ptr_image_read(path, &img, &err) != PTR_OK)
+    if (test_image_read(path, &img, &err) != PTR_OK)
         TEST_FAIL_("%s", err.message);
     return img;
 }

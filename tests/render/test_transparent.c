@@ -31,7 +31,7 @@ static PtrImage *render(const char *name, ...)
     CHECK_INT(ptr_cli_main(argc, argv), 0);
     PtrError err;
     PtrImage *image = NULL;
-    CHECK_INT(ptr_image_read(out, &image, &err), PTR_OK);
+    CHECK_INT(test_image_read(out, &image, &err), PTR_OK);
     return image;
 }
 
@@ -128,7 +128,7 @@ static void test_regions_merge(void)
               0);
     PtrError err;
     PtrImage *merged = NULL;
-    CHECK_INT(ptr_image_read(test_path("merged.exr"), &merged, &err), PTR_OK);
+    CHECK_INT(test_image_read(test_path("merged.exr"), &merged, &err), PTR_OK);
     CHECK(merged && ptr_image_alpha(merged));
     if (whole && merged)
         CHECK(same_pixels(whole, merged));
@@ -235,7 +235,7 @@ static void test_framing(const char *projection)
               0);
     PtrError err;
     PtrImage *image = NULL;
-    CHECK_INT(ptr_image_read(out, &image, &err), PTR_OK);
+    CHECK_INT(test_image_read(out, &image, &err), PTR_OK);
     const float *alpha = image ? ptr_image_alpha(image) : NULL;
     CHECK(alpha != NULL);
     if (!alpha) {
