@@ -181,10 +181,8 @@ static int run(const PtrOptions *o)
     if (!o->list_views) {
         int threads = o->threads > 0 ? o->threads : ptr_online_cpus();
         ptr_threads_keep(threads);
-        if (o->skip_existing && !ptr_claim_keeper_start()) {
-            ptr_error_set(&err, PTR_ERR_NOMEM, "cannot start the thread that keeps claims fresh");
+        if (o->skip_existing && ptr_claim_keeper_start(&err) != PTR_OK)
             return fail(&err);
-        }
         if (ptr_image_set_threads(threads, &err) != PTR_OK)
             return fail(&err);
         const char *output = o->merge ? o->output
