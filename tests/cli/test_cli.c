@@ -207,6 +207,30 @@ static void test_bad_input(void)
     CHECK_INT(file_count(), ok_files);
 }
 
+/* Image module loaders are their owners' alone: one freed leaves another
+ * working, and a caller without one reads EXR only, whatever another has
+ * loaded in the same process. */
+static void test_image_loaders(void)
+{
+    const char *png = test_path("loaders.png");
+    const float grey[3] = { 0.5f, 0.5f, 0.5f };
+    const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
+    PtrImageLoader *first = NULL, *second = NULL;
+    PtrError err;
+    CHECK_INT(ptr_image_loader_new(&first, &err), PTR_OK);
+    CHECK_INT(ptr_image_loader_new(&second, &err), PTR_OK);
+    CHECK_INT(ptr_image_write(first, png, &one, grey, NULL, NULL, PTR_PIXEL_UINT8, NULL, 0, &err),
+              PTR_OK);
+    ptr_image_loader_free(first);
+    PtrImage *img = NULL;
+    CHECK_INT(ptr_image_read(NULL, png, &img, &err), PTR_ERR_USAGE);
+    CHECK(img == NULL);
+    CHECK_INT(ptr_image_read(second, png, &img, &err), PTR_OK);
+    CHECK(img && ptr_image_width(img) == 1);
+    ptr_image_free(img);
+    ptr_image_loader_free(second);
+}
+
 int main(void)
 {
     if (!test_dir_create("test-cli"))
@@ -215,6 +239,7 @@ int main(void)
     test_png_and_options();
     test_orthographic_option();
     test_bad_input();
+    test_image_loaders();
     test_dir_remove();
     return test_report();
 }
