@@ -178,7 +178,7 @@ int main(int argc, char **argv)
         size_t n = (size_t)bench->width * bench->height * 3;
         float *ref = malloc(n * sizeof *ref), *img = malloc(n * sizeof *img);
         PtrIsectTable fastest;
-        ptr_isect_init(&fastest, PTR_KERNEL_AUTO, scene.spheres.count);
+        ptr_isect_init(&fastest, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
         PtrRenderSettings settings = { .width = bench->width, .height = bench->height,
                                        .samples = ref_spp, .seed = 1000 };
         double seconds;

@@ -60,7 +60,7 @@ int main(int argc, char **argv)
         }
         ptr_strings_free(&warnings);
         PtrIsectTable isect;
-        ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
+        ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
         PtrRenderSettings s = { .width = WIDTH, .height = HEIGHT, .samples = ref_spp, .seed = 1000,
                                 .max_depth = 50, .min_samples = 32 };
         double t = 0, ref_sum = 0;

@@ -39,13 +39,12 @@ enum { CONFIGS = sizeof configs / sizeof configs[0], MAX_THREADS = 2 };
 
 static double render(PtrScene *scene, const Config *c, PtrRenderSettings settings, float *rgb)
 {
-    ptr_cpu_set_cap(c->cap);
     settings.integrator = c->integrator;
     PtrIsectTable isect;
     PtrAccel accel;
     PtrRenderStats stats;
     PtrError err = { 0 };
-    ptr_isect_init(&isect, c->kernel, scene->spheres.count);
+    ptr_isect_init(&isect, c->kernel, c->cap, scene->spheres.count, NULL);
     if (ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, c->integrator == PTR_INTEGRATOR_BUNDLES,
                        scene, 0, NULL) != PTR_OK ||
         ptr_render(scene, &accel, &settings, rgb, &stats, &err) != PTR_OK) {

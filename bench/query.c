@@ -311,7 +311,7 @@ int main(int argc, char **argv)
     }
 
     /* Record with the table of this CPU, as a render would trace. */
-    ptr_isect_init(&recorded_table, PTR_KERNEL_AUTO, SIZE_MAX);
+    ptr_isect_init(&recorded_table, PTR_KERNEL_AUTO, ptr_cpu_level(), SIZE_MAX, NULL);
     accel.isect = recorded_table;
     accel.isect.bvh_closest_hit = record_ray;
     accel.isect.bvh_closest_hit_packet = record_packet;

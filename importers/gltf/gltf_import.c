@@ -987,7 +987,8 @@ done:
 static PtrResult read_scene_extras(Importer *im, const GltfScene *gs)
 {
     PtrScene *scene = im->scene;
-    if (gs->sky_invalid || (gs->sky_name && !ptr_sky_parse(gs->sky_name, &scene->sky)) ||
+    if (gs->sky_invalid ||
+        (gs->sky_name && ptr_sky_parse(gs->sky_name, &scene->sky, NULL) != PTR_OK) ||
         (gs->sky_name && scene->sky.kind == PTR_SKY_CONSTANT))
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: scene extras.sky must be \"gradient\", \"black\" or [r, g, b]",

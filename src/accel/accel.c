@@ -62,13 +62,13 @@ const char *ptr_accel_name(const PtrAccel *accel)
     return accel->kind == PTR_ACCEL_BVH ? "bvh" : "brute";
 }
 
-int ptr_accel_parse(const char *text, PtrAccelChoice *choice)
+PtrResult ptr_accel_parse(const char *text, PtrAccelChoice *choice, PtrError *err)
 {
     static const char *const names[] = { "auto", "brute", "bvh" };
     for (int i = 0; i < 3; i++)
         if (!strcmp(text, names[i])) {
             *choice = (PtrAccelChoice)i;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not auto, brute or bvh", text);
 }

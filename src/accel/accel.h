@@ -64,8 +64,8 @@ void ptr_accel_free(PtrAccel *accel);
 /* "brute" or "bvh". */
 const char *ptr_accel_name(const PtrAccel *accel);
 
-/* Parses "auto", "brute" or "bvh"; returns 0 if it is none of them. */
-int ptr_accel_parse(const char *text, PtrAccelChoice *choice);
+/* Parses "auto", "brute" or "bvh"; PTR_ERR_USAGE for anything else. */
+PtrResult ptr_accel_parse(const char *text, PtrAccelChoice *choice, PtrError *err);
 
 /* The closest hit along ray, as PTR_DECL_CLOSEST_HIT describes it; on equal
  * distances the sphere first in the arrays wins, whichever structure. */

@@ -131,9 +131,9 @@ static PtrCpuLevel widest_useful_level(size_t sphere_count)
 
 /* The one-ray brute-force kernel no wider than the scene; everything else
  * (packets, the tree) at the CPU's level. */
-static void init_for_scene(PtrIsectTable *table, size_t sphere_count)
+static void init_for_scene(PtrIsectTable *table, PtrCpuLevel level, size_t sphere_count)
 {
-    PtrCpuLevel level = ptr_cpu_level(), useful = widest_useful_level(sphere_count);
+    PtrCpuLevel useful = widest_useful_level(sphere_count);
     ptr_isect_init_level(table, level);
     if (level > useful) {
         PtrIsectTable narrow;
@@ -143,18 +143,18 @@ static void init_for_scene(PtrIsectTable *table, size_t sphere_count)
     }
 }
 
-int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, size_t sphere_count)
+PtrResult ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, PtrCpuLevel level,
+                         size_t sphere_count, PtrError *err)
 {
-    switch (kernel) {
-    case PTR_KERNEL_C:
+    if (kernel == PTR_KERNEL_C) {
         ptr_isect_init_level(table, PTR_CPU_NONE);
-        return 1;
-    case PTR_KERNEL_AUTO:
-        init_for_scene(table, sphere_count);
-        return 1;
-    case PTR_KERNEL_ASM:
-        init_for_scene(table, sphere_count);
-        return table->closest_hit != ptr_closest_hit_c;
+        return PTR_OK;
     }
-    return 0;
+    init_for_scene(table, level, sphere_count);
+    if (kernel == PTR_KERNEL_ASM && table->closest_hit == ptr_closest_hit_c)
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "no assembly intersector at CPU level '%s' (this build %s)",
+                             ptr_cpu_level_name(level),
+                             ptr_isect_has_asm() ? "has them" : "was built without them");
+    return PTR_OK;
 }

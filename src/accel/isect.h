@@ -14,6 +14,7 @@
 #include "accel/bvh.h"
 #include "accel/ray.h"
 #include "base/cpu.h"
+#include "base/result.h"
 #include "scene/scene.h"
 
 /* One signature for the pointer type, the C reference and every assembly
@@ -79,11 +80,13 @@ typedef struct PtrIsectTable {
                         * narrower: see ptr_isect_init) */
 } PtrIsectTable;
 
-/* Fills the table for the requested kernel at the CPU level in force
- * (ptr_cpu_level), for scenes of sphere_count spheres: a vector wider than
- * the scene only tests padding, so the widest kernel is the one the scene
- * fills. Returns 0 if the requested kernel is not available. */
-int ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, size_t sphere_count);
+/* Fills the table for the requested kernel at the given CPU level (the
+ * caller's: ptr_cpu_level, or lower), for scenes of sphere_count spheres: a
+ * vector wider than the scene only tests padding, so the widest kernel is the
+ * one the scene fills. PTR_ERR_USAGE if the requested kernel is not
+ * available. */
+PtrResult ptr_isect_init(PtrIsectTable *table, PtrKernel kernel, PtrCpuLevel level,
+                         size_t sphere_count, PtrError *err);
 
 /* Fills the table as a CPU of exactly this level would (for the checker and
  * for --print-dispatch). */

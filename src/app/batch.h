@@ -15,9 +15,6 @@ typedef struct PtrBatchItem {
     double orbit_degrees; /* the turntable's turn of the camera for this frame */
 } PtrBatchItem;
 
-/* At most this many frames in one sequence. */
-enum { PTR_MAX_FRAMES = 1000000 };
-
 /* The output for one scene: -o with {name} replaced by the scene's name; a
  * folder (existing, or written with a trailing /) gets NAME.exr; a plain
  * file name serves one scene only. */

@@ -167,17 +167,19 @@ static void *keep_claims(void *unused)
     return NULL;
 }
 
-int ptr_claim_keeper_start(void)
+PtrResult ptr_claim_keeper_start(PtrError *err)
 {
     if (held.running)
-        return 1;
+        return PTR_OK;
     /* The keeper takes no signals: the render's stop stays the main thread's. */
     sigset_t all, old;
     sigfillset(&all);
     pthread_sigmask(SIG_SETMASK, &all, &old);
     held.running = pthread_create(&held.thread, NULL, keep_claims, NULL) == 0;
     pthread_sigmask(SIG_SETMASK, &old, NULL);
-    return held.running;
+    return held.running ? PTR_OK
+                        : ptr_error_set(err, PTR_ERR_NOMEM,
+                                        "cannot start the thread that keeps claims fresh");
 }
 
 void ptr_claim_keeper_stop(void)

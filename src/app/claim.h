@@ -41,8 +41,9 @@ PtrClaimState ptr_claim_take(const char *output, char *holder, size_t size, PtrE
 void ptr_claim_release(const char *output);
 
 /* Starts the thread that keeps this process's claim fresh; call it before
- * other threads load libraries (see base/threads.h). 0 if it cannot start. */
-int ptr_claim_keeper_start(void);
+ * other threads load libraries (see base/threads.h). PTR_ERR_NOMEM if it
+ * cannot start. */
+PtrResult ptr_claim_keeper_start(PtrError *err);
 
 /* Stops that thread, if it runs. */
 void ptr_claim_keeper_stop(void);

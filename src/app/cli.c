@@ -5,6 +5,7 @@
 
 #include "app/batch.h"
 #include "app/claim.h"
+#include "app/cli_help.h"
 #include "app/cli_options.h"
 #include "app/color_by.h"
 #include "app/job.h"
@@ -139,7 +140,7 @@ static int watch_scene(const PtrOptions *o, const PtrColor *color)
     char output[PTR_PATH_SIZE];
     PtrError err = { 0 };
     if (ptr_batch_output(o, o->inputs[0], output, &err) != PTR_OK ||
-        ptr_output_check(output, o->depth, o->transparent, &err) != PTR_OK)
+        ptr_output_check(o->images, output, o->depth, o->transparent, &err) != PTR_OK)
         return fail(&err);
     PtrWatch watch = { 0 };
     int code = 0;
@@ -166,75 +167,83 @@ static int watch_scene(const PtrOptions *o, const PtrColor *color)
     return code == ptr_result_exit_code(PTR_ERR_INTERRUPTED) ? code : 0;
 }
 
-int ptr_cli_main(int argc, char **argv)
+/* What the command line asks for once parsed: renders, a merge or the list of
+ * views. */
+static int run(const PtrOptions *o)
 {
-    PtrOptions o;
-    int code = ptr_options_parse(argc, argv, &o);
-    if (code >= 0)
-        return code;
-    ptr_signals_install();
-
-    if (o.dump_scene)
-        return dump_scenes(&o);
-
     PtrError err = { 0 };
+    int code = 0;
     /* Renders and merges write images. For any format but EXR, OpenImageIO
      * loads on a thread of its own while the colour config, the scenes and
      * the render proceed. The tree's and the render's threads start first:
      * no thread can start while the load runs. */
     char first_output[PTR_PATH_SIZE];
-    if (!o.list_views) {
-        int threads = o.threads > 0 ? o.threads : ptr_online_cpus();
+    if (!o->list_views) {
+        int threads = o->threads > 0 ? o->threads : ptr_online_cpus();
         ptr_threads_keep(threads);
-        if (o.skip_existing && !ptr_claim_keeper_start()) {
-            ptr_error_set(&err, PTR_ERR_NOMEM, "cannot start the thread that keeps claims fresh");
+        if (o->skip_existing && ptr_claim_keeper_start(&err) != PTR_OK)
             return fail(&err);
-        }
         if (ptr_image_set_threads(threads, &err) != PTR_OK)
             return fail(&err);
-        const char *output = o.merge ? o.output
-                             : ptr_batch_output(&o, o.inputs[0], first_output, &err) == PTR_OK
+        const char *output = o->merge ? o->output
+                             : ptr_batch_output(o, o->inputs[0], first_output, &err) == PTR_OK
                                  ? first_output
                                  : NULL;
-        if (output && ptr_image_preload(output, &err) != PTR_OK)
+        if (output && ptr_image_preload(o->images, output, &err) != PTR_OK)
             return fail(&err);
     }
-    PtrColor *color = ptr_color_open(o.ocio_config, &err);
-    if (!color)
+    PtrColor *color;
+    if (ptr_color_open(o->ocio_config, &color, &err) != PTR_OK)
         return fail(&err);
-    if (ptr_color_select(color, o.display, o.view, o.look, o.exposure, &err) != PTR_OK) {
+    if (ptr_color_select(color, o->display, o->view, o->look, o->exposure, &err) != PTR_OK) {
         code = fail(&err);
-    } else if (o.list_views) {
+    } else if (o->list_views) {
         code = ptr_color_list(color, stdout, &err) == PTR_OK ? 0 : fail(&err);
-    } else if (o.merge) {
+    } else if (o->merge) {
         PtrJobReport report;
-        ptr_merge(o.inputs, o.input_count, o.output, &o, color, &report);
-        code = finish_job(&o, &report);
+        ptr_merge(o->inputs, o->input_count, o->output, o, color, &report);
+        code = finish_job(o, &report);
         ptr_job_report_free(&report);
     } else {
         /* Refuse an unavailable kernel or integrator before reading any scene. */
         PtrIsectTable isect;
-        if (!ptr_isect_init(&isect, o.kernel, SIZE_MAX)) {
-            ptr_error_set(&err, PTR_ERR_USAGE,
-                          "--asm: no assembly intersector at CPU level '%s' (this build %s)",
-                          ptr_cpu_level_name(ptr_cpu_level()),
-                          ptr_isect_has_asm() ? "has them" : "was built without them");
+        PtrError kernel_err;
+        if (ptr_isect_init(&isect, o->kernel, o->cpu_level, SIZE_MAX, &kernel_err) != PTR_OK) {
+            ptr_error_set(&err, kernel_err.code, "--asm: %s", kernel_err.message);
             code = fail(&err);
-        } else if (!ptr_integrator_available(o.integrator)) {
+        } else if (!ptr_integrator_available(o->integrator, o->cpu_level)) {
             int built = ptr_integrator_for_level(PTR_CPU_LEVEL_COUNT - 1) == PTR_INTEGRATOR_BUNDLES;
             ptr_error_set(&err, PTR_ERR_USAGE,
                           "--integrator %s: not at CPU level '%s' (this build %s)",
-                          ptr_integrator_name(o.integrator), ptr_cpu_level_name(ptr_cpu_level()),
+                          ptr_integrator_name(o->integrator), ptr_cpu_level_name(o->cpu_level),
                           built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
-        } else if (ptr_live_view_open(&o, color, &err) != PTR_OK) {
+        } else if (ptr_live_view_open(o, color, &err) != PTR_OK) {
             code = fail(&err);
         } else {
-            code = o.watch ? watch_scene(&o, color) : render_all(&o, color);
+            code = o->watch ? watch_scene(o, color) : render_all(o, color);
         }
         ptr_live_view_close();
     }
     ptr_color_close(color);
     ptr_claim_keeper_stop();
+    return code;
+}
+
+int ptr_cli_main(int argc, char **argv)
+{
+    PtrOptions o;
+    PtrError err = { 0 };
+    if (ptr_options_parse(argc, argv, &o, &err) != PTR_OK)
+        return fail(&err);
+    if (o.print != PTR_PRINT_NOTHING) {
+        ptr_print_requested(&o);
+        return 0;
+    }
+    ptr_signals_install();
+    if (ptr_image_loader_new(&o.images, &err) != PTR_OK)
+        return fail(&err);
+    int code = o.dump_scene ? dump_scenes(&o) : run(&o);
+    ptr_image_loader_free(o.images);
     return code;
 }

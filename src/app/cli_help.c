@@ -51,7 +51,7 @@ static void print_option(const char *name, char short_name, const char *metavar,
     putchar('\n');
 }
 
-void ptr_print_help(void)
+static void print_help(void)
 {
     fputs("Usage: ptr SCENE... -o OUTPUT [options]\n"
           "       ptr merge PART.exr... -o OUTPUT [output options]\n"
@@ -88,16 +88,16 @@ void ptr_print_help(void)
                ptr_result_description((PtrResult)r));
 }
 
-void ptr_print_version(void)
+static void print_version(PtrCpuLevel level)
 {
     PtrIsectTable table;
-    ptr_isect_init_level(&table, ptr_cpu_level());
+    ptr_isect_init_level(&table, level);
     printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
 }
 
-void ptr_print_dispatch(void)
+static void print_dispatch(PtrCpuLevel level)
 {
-    PtrCpuLevel detected = ptr_cpu_detected(), level = ptr_cpu_level();
+    PtrCpuLevel detected = ptr_cpu_detected();
     for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
         PtrIsectTable table;
         ptr_isect_init_level(&table, (PtrCpuLevel)l);
@@ -105,5 +105,15 @@ void ptr_print_dispatch(void)
                ptr_integrator_name(ptr_integrator_for_level((PtrCpuLevel)l)),
                l > (int)detected ? "  (not on this CPU)" : "",
                l == (int)level ? "  <- in use" : "");
+    }
+}
+
+void ptr_print_requested(const PtrOptions *o)
+{
+    switch (o->print) {
+    case PTR_PRINT_NOTHING: break;
+    case PTR_PRINT_HELP: print_help(); break;
+    case PTR_PRINT_VERSION: print_version(o->cpu_level); break;
+    case PTR_PRINT_DISPATCH: print_dispatch(o->cpu_level); break;
     }
 }

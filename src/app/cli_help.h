@@ -3,8 +3,9 @@
 #ifndef PTR_CLI_HELP_H
 #define PTR_CLI_HELP_H
 
-void ptr_print_help(void);
-void ptr_print_version(void);
-void ptr_print_dispatch(void);
+#include "app/cli_options.h"
+
+/* Prints what options->print asks for, the CPU level being options'. */
+void ptr_print_requested(const PtrOptions *options);
 
 #endif /* PTR_CLI_HELP_H */

@@ -7,14 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "app/batch.h"
-#include "app/cli_help.h"
-#include "base/cpu.h"
-
-enum {
-    GO_ON = -1, /* what ptr_options_parse returns to go on rendering */
-    MAX_THREADS = 1024,
-};
+enum { MAX_THREADS = 1024 };
 
 /* Which of --lookfrom, --lookat, --vfov and --ortho were given: a camera
  * needs the first two and one of the others. */
@@ -87,24 +80,26 @@ static int option_id(int c)
     return -1;
 }
 
-static int usage_error(const char *option, const char *value, const char *expected)
+/* A value's problem as the command line reports it, naming where the value
+ * came from: an option or a variable of the environment. */
+static PtrResult value_error(const char *source, const PtrError *problem, PtrError *err)
 {
-    fprintf(stderr, "ptr: %s: '%s' is not %s (see ptr --help)\n", option, value, expected);
-    return ptr_result_exit_code(PTR_ERR_USAGE);
+    return ptr_error_set(err, problem->code, "%s: %s (see ptr --help)", source, problem->message);
 }
 
 /* Errors name an option by its long name, whichever name was typed. */
-static int bad_value(OptionId id, const char *value, const char *expected)
+static PtrResult option_error(OptionId id, const PtrError *problem, PtrError *err)
 {
     char option[64];
     snprintf(option, sizeof option, "--%s", long_options[id].name);
-    return usage_error(option, value, expected);
+    return value_error(option, problem, err);
 }
 
-static int usage_error_line(const char *problem)
+static PtrResult bad_value(OptionId id, const char *value, const char *expected, PtrError *err)
 {
-    fprintf(stderr, "ptr: %s (usage: ptr SCENE... -o OUTPUT [options]; see ptr --help)\n", problem);
-    return ptr_result_exit_code(PTR_ERR_USAGE);
+    PtrError problem;
+    ptr_error_set(&problem, PTR_ERR_USAGE, "'%s' is not %s", value, expected);
+    return option_error(id, &problem, err);
 }
 
 /* A whole decimal number in [lo, hi], nothing else. */
@@ -130,54 +125,54 @@ static int parse_number(const char *text, double *value)
     return !errno && end != text && !*end;
 }
 
-/* The set_ helpers take an option's value into o. They return GO_ON, else
- * the exit code of the usage error they reported. */
-static int set_int(OptionId id, const char *value, int lo, int hi, int *out)
+/* The set_ helpers take an option's value into o: PTR_OK, else
+ * PTR_ERR_USAGE with err saying what is wrong. */
+static PtrResult set_int(OptionId id, const char *value, int lo, int hi, int *out, PtrError *err)
 {
     uint64_t v;
     if (!parse_uint(value, (uint64_t)lo, (uint64_t)hi, &v)) {
         char expected[64];
         snprintf(expected, sizeof expected, "a whole number from %d to %d", lo, hi);
-        return bad_value(id, value, expected);
+        return bad_value(id, value, expected, err);
     }
     *out = (int)v;
-    return GO_ON;
+    return PTR_OK;
 }
 
-static int set_point(OptionId id, const char *value, double xyz[3])
+static PtrResult set_point(OptionId id, const char *value, double xyz[3], PtrError *err)
 {
     char tail;
     if (sscanf(value, "%lf,%lf,%lf%c", &xyz[0], &xyz[1], &xyz[2], &tail) != 3 ||
         !isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
-        return bad_value(id, value, "X,Y,Z (three finite numbers)");
-    return GO_ON;
+        return bad_value(id, value, "X,Y,Z (three finite numbers)", err);
+    return PTR_OK;
 }
 
-static int set_sample_range(OptionId id, const char *value, PtrOptions *o)
+static PtrResult set_sample_range(OptionId id, const char *value, PtrOptions *o, PtrError *err)
 {
     unsigned long long a, b;
     char tail;
     /* %llu alone would take spaces and a sign. */
     if (sscanf(value, "%llu:%llu%c", &a, &b, &tail) != 2 || b <= a || b > (1u << 30) ||
         value[0] < '0' || value[0] > '9')
-        return bad_value(id, value, "START:END with 0 <= START < END <= 2^30");
+        return bad_value(id, value, "START:END with 0 <= START < END <= 2^30", err);
     o->sample_first = (uint32_t)a;
     o->samples = (uint32_t)(b - a);
-    return GO_ON;
+    return PTR_OK;
 }
 
-static int set_region(OptionId id, const char *value, PtrOptions *o)
+static PtrResult set_region(OptionId id, const char *value, PtrOptions *o, PtrError *err)
 {
     int x0, y0, x1, y1;
     char tail;
     if (sscanf(value, "%d,%d,%d,%d%c", &x0, &y0, &x1, &y1, &tail) != 4 || x0 < 0 || y0 < 0 ||
         x1 <= x0 || y1 <= y0)
-        return bad_value(id, value, "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1");
+        return bad_value(id, value, "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1", err);
     o->region = (PtrRegion){ x0, y0, x1, y1 };
-    return GO_ON;
+    return PTR_OK;
 }
 
-static int set_frames(OptionId id, const char *value, PtrOptions *o)
+static PtrResult set_frames(OptionId id, const char *value, PtrOptions *o, PtrError *err)
 {
     long a, b, step = 1;
     int end = 0, with_step = 0;
@@ -187,141 +182,144 @@ static int set_frames(OptionId id, const char *value, PtrOptions *o)
         end = with_step;
     if (n < 2 || value[end] || value[0] < '0' || value[0] > '9' || a < 0 || b < a ||
         b > 1000000000L || step < 1)
-        return bad_value(id, value, "A:B or A:B:STEP with 0 <= A <= B <= 10^9, STEP >= 1");
+        return bad_value(id, value, "A:B or A:B:STEP with 0 <= A <= B <= 10^9, STEP >= 1", err);
     o->has_frames = 1;
     o->frame_first = a;
     o->frame_last = b;
     o->frame_step = step;
-    return GO_ON;
+    return PTR_OK;
 }
 
-/* Takes one option (and its value, if it has one) into o. Returns GO_ON,
- * else the exit code: 0 after printing what replaces the render, a usage
- * error after reporting it. The cases follow the table; the switch has no
- * default, so that the compiler names an option left without one. */
-static int apply_option(OptionId id, const char *value, PtrOptions *o)
+/* Takes one option (and its value, if it has one) into o: PTR_OK, else
+ * PTR_ERR_USAGE with err saying what is wrong. The cases follow the table;
+ * the switch has no default, so that the compiler names an option left
+ * without one. */
+static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, PtrError *err)
 {
     uint64_t v;
     double x;
+    PtrError problem; /* a parser's, which err then gets with the option's name */
     switch (id) {
     case OPT_output: o->output = value; break;
     case OPT_samples:
         if (!parse_uint(value, 1, 1u << 30, &v))
-            return bad_value(id, value, "a whole number from 1 to 2^30");
+            return bad_value(id, value, "a whole number from 1 to 2^30", err);
         o->samples = (uint32_t)v;
         o->sample_first = 0; /* the last of --samples and --sample-range counts */
         break;
-    case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width);
-    case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height);
+    case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width, err);
+    case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height, err);
     case OPT_transparent: o->transparent = 1; break;
-    case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads);
+    case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads, err);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))
-            return bad_value(id, value, "a whole number from 0 to 2^64-1");
+            return bad_value(id, value, "a whole number from 0 to 2^64-1", err);
         break;
-    case OPT_max_depth: return set_int(id, value, 1, 100000, &o->max_depth);
+    case OPT_max_depth: return set_int(id, value, 1, 100000, &o->max_depth, err);
     case OPT_sampler:
-        if (!ptr_sampler_parse(value, &o->sampler))
-            return bad_value(id, value, "sobol or independent");
+        if (ptr_sampler_parse(value, &o->sampler, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
         break;
     case OPT_direct_lighting:
         if (strcmp(value, "on") && strcmp(value, "off"))
-            return bad_value(id, value, "on or off");
+            return bad_value(id, value, "on or off", err);
         o->direct_lighting = strcmp(value, "on") ? PTR_OFF : PTR_ON;
         break;
     case OPT_noise_threshold:
         if (!parse_number(value, &x) || !(x > 0 && x <= 1e6))
-            return bad_value(id, value, "a number above 0");
+            return bad_value(id, value, "a number above 0", err);
         o->noise_threshold = (float)x;
         break;
     case OPT_min_samples:
         if (!parse_uint(value, 2, 1u << 30, &v))
-            return bad_value(id, value, "a whole number from 2 to 2^30");
+            return bad_value(id, value, "a whole number from 2 to 2^30", err);
         o->min_samples = (uint32_t)v;
         break;
     case OPT_sky:
-        if (!ptr_sky_parse(value, &o->sky))
-            return bad_value(id, value, "gradient, black or R,G,B (not negative)");
+        if (ptr_sky_parse(value, &o->sky, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
         o->has_sky = 1;
         break;
     case OPT_camera: o->camera_name = value; break;
     case OPT_lookfrom:
         o->has_camera |= CAMERA_LOOKFROM;
-        return set_point(id, value, o->camera.lookfrom);
+        return set_point(id, value, o->camera.lookfrom, err);
     case OPT_lookat:
         o->has_camera |= CAMERA_LOOKAT;
-        return set_point(id, value, o->camera.lookat);
+        return set_point(id, value, o->camera.lookat, err);
     case OPT_vfov:
         if (!parse_number(value, &x) || !(x > 0 && x < 180))
-            return bad_value(id, value, "an angle between 0 and 180 degrees");
+            return bad_value(id, value, "an angle between 0 and 180 degrees", err);
         o->camera.vfov_deg = x;
         o->has_camera |= CAMERA_VFOV;
         break;
     case OPT_ortho:
         if (!parse_number(value, &x) || !(isfinite(x) && x > 0))
-            return bad_value(id, value, "a height above 0");
+            return bad_value(id, value, "a height above 0", err);
         o->camera.ortho_height = x;
         o->has_camera |= CAMERA_ORTHO;
         break;
-    case OPT_up: return set_point(id, value, o->camera.up);
+    case OPT_up: return set_point(id, value, o->camera.up, err);
     case OPT_aperture:
         if (!parse_number(value, &x) || !(isfinite(x) && x >= 0))
-            return bad_value(id, value, "a diameter, 0 or more");
+            return bad_value(id, value, "a diameter, 0 or more", err);
         o->camera.aperture = x;
         break;
     case OPT_focus_distance:
         if (!parse_number(value, &x) || !(isfinite(x) && x > 0))
-            return bad_value(id, value, "a distance above 0");
+            return bad_value(id, value, "a distance above 0", err);
         o->camera.focus_distance = x;
         break;
     case OPT_auto_camera:
         if (strcmp(value, "perspective") && strcmp(value, "orthographic"))
-            return bad_value(id, value, "perspective or orthographic");
+            return bad_value(id, value, "perspective or orthographic", err);
         o->auto_camera = strcmp(value, "perspective") ? PTR_PROJECTION_ORTHOGRAPHIC
                                                       : PTR_PROJECTION_PERSPECTIVE;
         break;
     case OPT_fit_all_objects: o->fit_all_objects = 1; break;
     case OPT_color_by:
         if (!*value)
-            return bad_value(id, value, "an attribute name");
+            return bad_value(id, value, "an attribute name", err);
         o->color_by = value;
         break;
     case OPT_colormap:
         o->colormap = ptr_colormap_find(value);
         if (!o->colormap)
-            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm");
+            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm",
+                             err);
         break;
     case OPT_color_range: {
         char tail;
         double *r = o->color_range;
         if (sscanf(value, "%lf,%lf%c", &r[0], &r[1], &tail) != 2 || !isfinite(r[0]) ||
             !isfinite(r[1]) || !(r[0] < r[1]))
-            return bad_value(id, value, "MIN,MAX (finite numbers, MIN below MAX)");
+            return bad_value(id, value, "MIN,MAX (finite numbers, MIN below MAX)", err);
         o->has_color_range = 1;
         break;
     }
     case OPT_color_bar: o->color_bar = value; break;
     case OPT_accel:
-        if (!ptr_accel_parse(value, &o->accel))
-            return bad_value(id, value, "auto, brute or bvh");
+        if (ptr_accel_parse(value, &o->accel, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
         break;
     case OPT_c: o->kernel = PTR_KERNEL_C; break;
     case OPT_asm: o->kernel = PTR_KERNEL_ASM; break;
     case OPT_integrator:
-        if (!ptr_integrator_parse(value, &o->integrator))
-            return bad_value(id, value, "auto, paths or bundles");
+        if (ptr_integrator_parse(value, &o->integrator, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
         break;
     case OPT_cpumask: {
         PtrCpuLevel cap;
-        if (!ptr_cpu_parse_level(value, &cap))
-            return bad_value(id, value, "none, sse41, avx2 or avx512");
-        ptr_cpu_set_cap(cap);
+        if (ptr_cpu_parse_level(value, &cap, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
+        /* The last --cpumask counts, as the environment lets it. */
+        o->cpu_level = cap < ptr_cpu_level() ? cap : ptr_cpu_level();
         break;
     }
-    case OPT_print_dispatch: ptr_print_dispatch(); return 0;
+    case OPT_print_dispatch: o->print = PTR_PRINT_DISPATCH; break;
     case OPT_depth:
-        if (!ptr_depth_parse(value, &o->depth))
-            return bad_value(id, value, "8, 16, half or float");
+        if (ptr_depth_parse(value, &o->depth, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
         break;
     case OPT_dither: o->dither = 1; break;
     case OPT_ocio_config: o->ocio_config = value; break;
@@ -330,57 +328,55 @@ static int apply_option(OptionId id, const char *value, PtrOptions *o)
     case OPT_look: o->look = value; break;
     case OPT_exposure:
         if (!parse_number(value, &x) || !(fabs(x) <= 64))
-            return bad_value(id, value, "a number of stops from -64 to 64");
+            return bad_value(id, value, "a number of stops from -64 to 64", err);
         o->exposure = (float)x;
         break;
     case OPT_bake_view: o->bake_view = 1; break;
     case OPT_list_views: o->list_views = 1; break;
     case OPT_time:
         if (!parse_number(value, &x) || !(x > 0 && x <= 1e7))
-            return bad_value(id, value, "a number of seconds above 0");
+            return bad_value(id, value, "a number of seconds above 0", err);
         o->time_budget = x;
         break;
     case OPT_preview: o->preview = 1; break;
-    case OPT_sample_range: return set_sample_range(id, value, o);
-    case OPT_region: return set_region(id, value, o);
+    case OPT_sample_range: return set_sample_range(id, value, o, err);
+    case OPT_region: return set_region(id, value, o, err);
     case OPT_watch: o->watch = 1; break;
     case OPT_live: o->live = value; break;
     case OPT_tev: o->tev = value; break;
-    case OPT_frames: return set_frames(id, value, o);
-    case OPT_turntable: return set_int(id, value, 1, PTR_MAX_FRAMES, &o->turntable);
+    case OPT_frames: return set_frames(id, value, o, err);
+    case OPT_turntable: return set_int(id, value, 1, PTR_MAX_FRAMES, &o->turntable, err);
     case OPT_skip_existing: o->skip_existing = 1; break;
     case OPT_json: o->json = 1; break;
     case OPT_quiet: o->quiet = 1; break;
     case OPT_dump_scene: o->dump_scene = 1; break;
-    case OPT_help: ptr_print_help(); return 0;
-    case OPT_version: ptr_print_version(); return 0;
+    case OPT_help: o->print = PTR_PRINT_HELP; break;
+    case OPT_version: o->print = PTR_PRINT_VERSION; break;
     }
-    return GO_ON;
+    return PTR_OK;
 }
 
-/* Takes argv's options into o, leaving optind at the first operand. Returns
- * GO_ON, else the exit code. */
-static int read_options(int argc, char **argv, PtrOptions *o)
+/* Takes argv's options into o, leaving optind at the first operand, up to
+ * the first that asks for something printed instead of a render. */
+static PtrResult read_options(int argc, char **argv, PtrOptions *o, PtrError *err)
 {
     char shorts[2 * OPTION_COUNT + 2];
     short_options(shorts);
     optind = 0; /* glibc: restart scanning, so the parser can run more than once */
     opterr = 0;
     for (int c; (c = getopt_long(argc, argv, shorts, long_options, NULL)) != -1;) {
-        if (c == ':') {
-            fprintf(stderr, "ptr: %s needs a value (see ptr --help)\n", argv[optind - 1]);
-            return ptr_result_exit_code(PTR_ERR_USAGE);
-        }
+        if (c == ':')
+            return ptr_error_set(err, PTR_ERR_USAGE, "%s needs a value (see ptr --help)",
+                                 argv[optind - 1]);
         int id = option_id(c);
-        if (id < 0) {
-            fprintf(stderr, "ptr: unknown option '%s' (see ptr --help)\n", argv[optind - 1]);
-            return ptr_result_exit_code(PTR_ERR_USAGE);
-        }
-        int code = apply_option((OptionId)id, optarg, o);
-        if (code != GO_ON)
-            return code;
+        if (id < 0)
+            return ptr_error_set(err, PTR_ERR_USAGE, "unknown option '%s' (see ptr --help)",
+                                 argv[optind - 1]);
+        PtrResult res = apply_option((OptionId)id, optarg, o, err);
+        if (res != PTR_OK || o->print != PTR_PRINT_NOTHING)
+            return res;
     }
-    return GO_ON;
+    return PTR_OK;
 }
 
 /* What is wrong with the options taken together, or NULL. */
@@ -415,32 +411,36 @@ static const char *usage_problem(const PtrOptions *o)
     return NULL;
 }
 
-int ptr_options_parse(int argc, char **argv, PtrOptions *o)
+PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *o, PtrError *err)
 {
+    PtrError problem;
     const char *env_mask = getenv("PTR_CPUMASK");
     PtrCpuLevel env_cap;
-    if (env_mask && !ptr_cpu_parse_level(env_mask, &env_cap))
-        return usage_error("PTR_CPUMASK", env_mask, "none, sse41, avx2 or avx512");
+    if (env_mask && ptr_cpu_parse_level(env_mask, &env_cap, &problem) != PTR_OK)
+        return value_error("PTR_CPUMASK", &problem, err);
     *o = (PtrOptions){
         .samples = PTR_DEFAULT_SAMPLES, .seed = 1, .max_depth = PTR_DEFAULT_MAX_DEPTH,
         .min_samples = PTR_DEFAULT_MIN_SAMPLES,
-        .kernel = PTR_KERNEL_AUTO, .camera = { .up = { 0, 1, 0 } },
+        .kernel = PTR_KERNEL_AUTO, .cpu_level = ptr_cpu_level(), .camera = { .up = { 0, 1, 0 } },
     };
     const char *env_integrator = getenv("PTR_INTEGRATOR");
-    if (env_integrator && !ptr_integrator_parse(env_integrator, &o->integrator))
-        return usage_error("PTR_INTEGRATOR", env_integrator, "auto, paths or bundles");
+    if (env_integrator && ptr_integrator_parse(env_integrator, &o->integrator, &problem) != PTR_OK)
+        return value_error("PTR_INTEGRATOR", &problem, err);
     if (argc > 1 && !strcmp(argv[1], "merge")) {
         o->merge = 1;
         argv++;
         argc--;
     }
-    int code = read_options(argc, argv, o);
-    if (code != GO_ON || o->list_views)
-        return code;
+    PtrResult res = read_options(argc, argv, o, err);
+    if (res != PTR_OK || o->print != PTR_PRINT_NOTHING || o->list_views)
+        return res;
     o->inputs = argv + optind;
     o->input_count = argc - optind;
-    const char *problem = usage_problem(o);
-    return problem ? usage_error_line(problem) : GO_ON;
+    const char *wrong = usage_problem(o);
+    return wrong ? ptr_error_set(err, PTR_ERR_USAGE,
+                                 "%s (usage: ptr SCENE... -o OUTPUT [options]; see ptr --help)",
+                                 wrong)
+                 : PTR_OK;
 }
 
 PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencies)

@@ -7,6 +7,8 @@
 #include "accel/accel.h"
 #include "accel/isect.h"
 #include "app/output.h"
+#include "base/cpu.h"
+#include "base/result.h"
 #include "importer.h"
 #include "render/render.h"
 #include "scene/colormap.h"
@@ -19,6 +21,17 @@
 #define PTR_DEFAULT_MIN_SAMPLES 32
 
 enum { PTR_MAX_IMAGE_SIZE = 1 << 16 };
+
+/* At most this many frames in one sequence. */
+enum { PTR_MAX_FRAMES = 1000000 };
+
+/* What the command line asks printed instead of a render. */
+typedef enum PtrPrintRequest {
+    PTR_PRINT_NOTHING,
+    PTR_PRINT_HELP,
+    PTR_PRINT_VERSION,
+    PTR_PRINT_DISPATCH,
+} PtrPrintRequest;
 
 typedef struct PtrOptions {
     char **inputs;          /* scenes; for `ptr merge`, the parts */
@@ -50,6 +63,7 @@ typedef struct PtrOptions {
     int has_sky;
     PtrSky sky;
     PtrKernel kernel;
+    PtrCpuLevel cpu_level;  /* the CPU's, capped by $PTR_CPUMASK, then by --cpumask */
     PtrIntegrator integrator; /* --integrator, else $PTR_INTEGRATOR, else auto */
     PtrAccelChoice accel;
     PtrDepth depth;
@@ -70,14 +84,17 @@ typedef struct PtrOptions {
     int quiet;
     int dump_scene;
     int list_views;
+    PtrPrintRequest print;  /* --help, --version, --print-dispatch: options after it are not read */
+    /* Not an option: the image module's loader of the run, which
+     * ptr_cli_main owns (NULL from ptr_options_parse). */
+    PtrImageLoader *images;
 } PtrOptions;
 
 /* What the importers need of the options. */
 PtrImportOptions ptr_options_import(const PtrOptions *options, PtrStrings *dependencies);
 
-/* Parses argv. Returns -1 to go on, else the exit code to return at once
- * (after --help, --version, --print-dispatch, or a usage error, which it has
- * reported). */
-int ptr_options_parse(int argc, char **argv, PtrOptions *options);
+/* Parses argv: PTR_OK, with options->print saying whether to print something
+ * instead of rendering, else PTR_ERR_USAGE with err saying what is wrong. */
+PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *options, PtrError *err);
 
 #endif /* PTR_CLI_OPTIONS_H */

@@ -15,8 +15,9 @@ enum { BAR_WIDTH = 512, BAR_HEIGHT = 32 }; /* two columns an entry of 256 */
 static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const char *scene_path,
                            const PtrColor *color, PtrError *err)
 {
-    if (ptr_output_check(o->color_bar, PTR_DEPTH_DEFAULT, 0, err) != PTR_OK)
-        return err->code;
+    PtrResult usable = ptr_output_check(o->images, o->color_bar, PTR_DEPTH_DEFAULT, 0, err);
+    if (usable != PTR_OK)
+        return usable;
     float *rgb = malloc((size_t)BAR_WIDTH * BAR_HEIGHT * 3 * sizeof *rgb);
     if (!rgb)
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", o->color_bar);
@@ -35,7 +36,7 @@ static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const ch
         .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
         .dither = o->dither,
     };
-    PtrResult res = ptr_output_write(o->color_bar, &layout, rgb, &info, err);
+    PtrResult res = ptr_output_write(o->images, o->color_bar, &layout, rgb, &info, err);
     free(rgb);
     return res;
 }

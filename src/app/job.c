@@ -48,16 +48,16 @@ static PtrResult fail(PtrJobReport *report, const PtrError *err)
 }
 
 /* Renders with the structure chosen and writes the image. */
-static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const PtrAccel *accel,
-                              uint64_t scene_hash, const PtrColor *color, PtrJobReport *report,
-                              PtrError *err)
+static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, const PtrScene *scene,
+                              const PtrAccel *accel, uint64_t scene_hash, const PtrColor *color,
+                              PtrJobReport *report, PtrError *err)
 {
 
     PtrRenderSettings settings = {
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = o->integrator, .transparent = o->transparent,
+        .integrator = integrator, .transparent = o->transparent,
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -119,7 +119,7 @@ static PtrResult render_accel(const PtrOptions *o, const PtrScene *scene, const 
         /* A frame of a sequence that --skip-existing resumes is written
          * whole or not at all: an output that exists is never rendered again. */
         if (!(done.stopped && o->skip_existing))
-            res = ptr_output_write(report->output, &layout, rgb, &info, err);
+            res = ptr_output_write(o->images, report->output, &layout, rgb, &info, err);
     }
     free(rgb);
     free(counts);
@@ -143,9 +143,10 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
                                   PtrJobReport *report, PtrError *err)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, o->kernel, scene->spheres.count);
+    /* The kernel was checked before any scene was read: this cannot fail. */
+    ptr_isect_init(&isect, o->kernel, o->cpu_level, scene->spheres.count, NULL);
     snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
-    PtrIntegrator integrator = ptr_integrator_resolve(o->integrator);
+    PtrIntegrator integrator = ptr_integrator_resolve(o->integrator, o->cpu_level);
     snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
     /* Before the build, which reorders the spheres and frees the ids that
      * give the file's order, which the hash takes. */
@@ -164,7 +165,7 @@ static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const Pt
     snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&accel));
     report->spheres = scene->spheres.count;
     report->build_seconds = accel.build_seconds;
-    PtrResult res = render_accel(o, scene, &accel, scene_hash, color, report, err);
+    PtrResult res = render_accel(o, integrator, scene, &accel, scene_hash, color, report, err);
     ptr_accel_free(&accel);
     return res;
 }

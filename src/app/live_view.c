@@ -30,15 +30,15 @@ PtrResult ptr_live_view_open(const PtrOptions *o, const PtrColor *color, PtrErro
 {
     if (!o->live && !o->tev)
         return PTR_OK;
-    module = ptr_live_module(err);
-    if (!module)
-        return err->code;
+    PtrResult res = ptr_live_module(&module, err);
+    if (res != PTR_OK)
+        return res;
     PtrLiveOptions options = {
         .http = o->live, .tev = o->tev, .view = apply_view, .view_user = (void *)color,
     };
-    session = module->start(&options, err);
-    if (!session)
-        return err->code;
+    res = module->start(&options, &session, err);
+    if (res != PTR_OK)
+        return res;
     if (o->live)
         fprintf(stderr, "ptr: live view at %s\n", module->url(session));
     return PTR_OK;

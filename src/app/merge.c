@@ -25,11 +25,11 @@ static const char *required(const Part *p, const char *name, PtrError *err)
     return value;
 }
 
-static PtrResult read_part(Part *p, PtrError *err)
+static PtrResult read_part(PtrImageLoader *images, Part *p, PtrError *err)
 {
-    p->image = ptr_image_read(p->path, err);
-    if (!p->image)
-        return err->code;
+    PtrResult res = ptr_image_read(images, p->path, &p->image, err);
+    if (res != PTR_OK)
+        return res;
     p->layout = ptr_image_layout(p->image);
     const char *first, *samples, *depth, *space;
     if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||
@@ -191,7 +191,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .alpha = alpha, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
         .dither = o->dither,
     };
-    res = ptr_output_write(output, &full, rgb, &info, err);
+    res = ptr_output_write(o->images, output, &full, rgb, &info, err);
 done:
     free(sum);
     free(n);
@@ -210,10 +210,11 @@ PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOption
     PtrResult res = parts ? PTR_OK : ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
     for (int i = 0; res == PTR_OK && i < count; i++) {
         parts[i].path = paths[i];
-        res = read_part(&parts[i], &err);
+        res = read_part(o->images, &parts[i], &err);
     }
     if (res == PTR_OK)
-        res = ptr_output_check(output, o->depth, ptr_image_alpha(parts[0].image) != NULL, &err);
+        res = ptr_output_check(o->images, output, o->depth,
+                               ptr_image_alpha(parts[0].image) != NULL, &err);
     if (res == PTR_OK)
         res = check_parts(parts, count, &err);
     if (res == PTR_OK)

@@ -45,14 +45,14 @@ static const Format *find_format(const char *path)
 
 static const char *const depth_names[] = { "default", "8", "16", "half", "float" };
 
-int ptr_depth_parse(const char *text, PtrDepth *depth)
+PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err)
 {
     for (int d = PTR_DEPTH_8; d <= PTR_DEPTH_FLOAT; d++)
         if (!strcmp(text, depth_names[d])) {
             *depth = (PtrDepth)d;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not 8, 16, half or float", text);
 }
 
 /* The depth a file gets, or PTR_DEPTH_DEFAULT if its format cannot store the
@@ -71,7 +71,8 @@ static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
     return wanted == PTR_DEPTH_DEFAULT || wanted == PTR_DEPTH_8 ? PTR_DEPTH_8 : PTR_DEPTH_DEFAULT;
 }
 
-PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError *err)
+PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth depth, int alpha,
+                           PtrError *err)
 {
     const Format *format = find_format(path);
     int known = format != NULL;
@@ -80,9 +81,10 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError
                              "%s: a transparent image (--transparent) needs a format with "
                              "alpha: .exr, .png or .tif",
                              path);
-    if (!known && ptr_image_ready(err) != PTR_OK)
-        return err->code;
-    if (!known && !ptr_image_can_write(path))
+    PtrResult ready = known ? PTR_OK : ptr_image_ready(images, err);
+    if (ready != PTR_OK)
+        return ready;
+    if (!known && !ptr_image_can_write(images, path))
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: no image format for this extension (try .exr or .png)", path);
     if (resolve_depth(path, depth) == PTR_DEPTH_DEFAULT)
@@ -119,8 +121,8 @@ static void scale_by_alpha(float *rgb, const float *alpha, size_t pixels, int pr
             rgb[3 * p + c] = premultiply ? rgb[3 * p + c] * alpha[p] : rgb[3 * p + c] / alpha[p];
 }
 
-PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                           const PtrOutputInfo *info, PtrError *err)
+PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrImageLayout *layout,
+                           const float *rgb, const PtrOutputInfo *info, PtrError *err)
 {
     PtrDepth depth = resolve_depth(path, info->depth);
     int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
@@ -192,8 +194,9 @@ PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    PtrResult res = ptr_image_write(path, layout, viewed ? viewed : rgb, alpha, info->sample_counts,
-                                    pixel_formats[depth], attrs, sizeof attrs / sizeof attrs[0], err);
+    PtrResult res = ptr_image_write(images, path, layout, viewed ? viewed : rgb, alpha,
+                                    info->sample_counts, pixel_formats[depth], attrs,
+                                    sizeof attrs / sizeof attrs[0], err);
     free(viewed);
     return res;
 }

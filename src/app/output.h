@@ -47,13 +47,15 @@ typedef struct PtrOutputInfo {
     int dither;            /* 8-bit: dither before rounding */
 } PtrOutputInfo;
 
-/* Parses "8", "16", "half" or "float". */
-int ptr_depth_parse(const char *text, PtrDepth *depth);
+/* Parses "8", "16", "half" or "float"; PTR_ERR_USAGE for anything else. */
+PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err);
 
 /* Fails early, before any rendering, if no writer exists for the output's
  * extension or it cannot store that depth, or an alpha channel if alpha is
- * set (PTR_ERR_USAGE), or its folder cannot take the file (PTR_ERR_OUTPUT). */
-PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError *err);
+ * set (PTR_ERR_USAGE), or its folder cannot take the file (PTR_ERR_OUTPUT).
+ * images loads the module for formats other than EXR (ptr_image_read). */
+PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth depth, int alpha,
+                           PtrError *err);
 
 /* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
  * full image as layout says) as info says. The file is replaced atomically.
@@ -61,7 +63,7 @@ PtrResult ptr_output_check(const char *path, PtrDepth depth, int alpha, PtrError
  * defines it, and every other format straight (divided by alpha); the view
  * of an integer format is taken of the straight colour, as OpenColorIO's
  * transforms expect. */
-PtrResult ptr_output_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                           const PtrOutputInfo *info, PtrError *err);
+PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrImageLayout *layout,
+                           const float *rgb, const PtrOutputInfo *info, PtrError *err);
 
 #endif /* PTR_OUTPUT_H */

@@ -45,8 +45,6 @@ static const char *const level_names[PTR_CPU_LEVEL_COUNT] = {
     "none", "sse41", "avx2", "avx512",
 };
 
-static PtrCpuLevel user_cap = PTR_CPU_LEVEL_COUNT - 1;
-
 PtrCpuLevel ptr_cpu_detected(void)
 {
     return detect();
@@ -55,16 +53,11 @@ PtrCpuLevel ptr_cpu_detected(void)
 PtrCpuLevel ptr_cpu_level(void)
 {
     PtrCpuLevel level = detect();
-    PtrCpuLevel env_cap;
+    PtrCpuLevel env_cap = level;
     const char *env = getenv("PTR_CPUMASK");
-    if (env && ptr_cpu_parse_level(env, &env_cap) && env_cap < level)
+    if (env && ptr_cpu_parse_level(env, &env_cap, NULL) == PTR_OK && env_cap < level)
         level = env_cap;
-    return user_cap < level ? user_cap : level;
-}
-
-void ptr_cpu_set_cap(PtrCpuLevel cap)
-{
-    user_cap = cap;
+    return level;
 }
 
 const char *ptr_cpu_level_name(PtrCpuLevel level)
@@ -72,14 +65,14 @@ const char *ptr_cpu_level_name(PtrCpuLevel level)
     return level < PTR_CPU_LEVEL_COUNT ? level_names[level] : "unknown";
 }
 
-int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level)
+PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *err)
 {
     for (int i = 0; i < PTR_CPU_LEVEL_COUNT; i++)
         if (!strcmp(name, level_names[i])) {
             *level = (PtrCpuLevel)i;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not none, sse41, avx2 or avx512", name);
 }
 
 int ptr_online_cpus(void)

@@ -6,6 +6,8 @@
 #ifndef PTR_CPU_H
 #define PTR_CPU_H
 
+#include "base/result.h"
+
 typedef enum PtrCpuLevel {
     PTR_CPU_NONE,   /* portable C only */
     PTR_CPU_SSE41,
@@ -17,18 +19,17 @@ typedef enum PtrCpuLevel {
 /* The highest level this CPU and OS support, ignoring any cap. */
 PtrCpuLevel ptr_cpu_detected(void);
 
-/* The level in force: the detected one capped by PTR_CPUMASK in the
- * environment, then by ptr_cpu_set_cap. */
+/* The detected level capped by PTR_CPUMASK in the environment (a name
+ * ptr_cpu_parse_level does not know caps nothing). Callers cap it further
+ * for themselves (ptr's --cpumask) and pass the level on to what they call:
+ * the process keeps no level of its own. */
 PtrCpuLevel ptr_cpu_level(void);
-
-/* Caps the level (e.g. from --cpumask). */
-void ptr_cpu_set_cap(PtrCpuLevel cap);
 
 /* "none", "sse41", "avx2", "avx512". */
 const char *ptr_cpu_level_name(PtrCpuLevel level);
 
-/* Parses a level name; returns 0 if it is not one. */
-int ptr_cpu_parse_level(const char *name, PtrCpuLevel *level);
+/* Parses a level name; PTR_ERR_USAGE if it is not one. */
+PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *err);
 
 /* The number of online CPUs (at least 1, at most 1024): the default thread
  * count. */

@@ -31,7 +31,7 @@ std::string join(const std::string &label, int count, const std::function<const 
 
 } // namespace
 
-extern "C" PtrColor *ptr_color_open(const char *path, PtrError *err)
+extern "C" PtrResult ptr_color_open(const char *path, PtrColor **out, PtrError *err)
 {
     const char *env = std::getenv("OCIO");
     const bool from_env = !path && env && *env;
@@ -53,11 +53,11 @@ extern "C" PtrColor *ptr_color_open(const char *path, PtrError *err)
         if (color->config->getNumDisplays() < 1)
             throw OCIO::Exception("the config has no display");
         color->source = source;
-        return color.release();
+        *out = color.release();
+        return PTR_OK;
     } catch (...) {
-        ptr_shim_caught(err, PTR_ERR_COLOR, label);
+        return ptr_shim_caught(err, PTR_ERR_COLOR, label);
     }
-    return nullptr;
 }
 
 extern "C" void ptr_color_close(PtrColor *color) { delete color; }

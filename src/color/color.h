@@ -15,11 +15,12 @@ extern "C" {
 
 typedef struct PtrColor PtrColor;
 
-/* Loads a config: the file at path if given, else the one $OCIO names, else
- * ptr's embedded one. A config that cannot be loaded, fails validation or has
- * no scene_linear role is an error (NULL, err filled with PTR_ERR_COLOR and a
- * line naming the file): never a silent fallback to another config. */
-PtrColor *ptr_color_open(const char *path, PtrError *err);
+/* Loads a config into *out (for ptr_color_close): the file at path if given,
+ * else the one $OCIO names, else ptr's embedded one. A config that cannot be
+ * loaded, fails validation or has no scene_linear role is an error
+ * (PTR_ERR_COLOR, or PTR_ERR_NOMEM, with a line naming the file): never a
+ * silent fallback to another config. */
+PtrResult ptr_color_open(const char *path, PtrColor **out, PtrError *err);
 void ptr_color_close(PtrColor *color);
 
 /* Where the config came from: its path, or "embedded". */

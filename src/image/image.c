@@ -28,20 +28,17 @@ PtrResult ptr_image_set_threads(int threads, PtrError *err)
     return ptr_exr_set_threads(threads, err);
 }
 
-PtrResult ptr_image_ready(PtrError *err)
-{
-    PtrError why;
-    if (ptr_oiio_module(&why))
-        return PTR_OK;
-    if (err)
-        *err = why;
-    return why.code;
-}
-
-int ptr_image_can_write(const char *path)
+PtrResult ptr_image_ready(PtrImageLoader *loader, PtrError *err)
 {
     const PtrImageModule *m;
-    return ptr_image_is_exr(path) || ((m = ptr_oiio_module(NULL)) && m->can_write(path));
+    return ptr_oiio_module(loader, "the image module", &m, err);
+}
+
+int ptr_image_can_write(PtrImageLoader *loader, const char *path)
+{
+    const PtrImageModule *m;
+    return ptr_image_is_exr(path) ||
+           (ptr_oiio_module(loader, path, &m, NULL) == PTR_OK && m->can_write(path));
 }
 
 /* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
@@ -58,14 +55,16 @@ static int temporary_name(const char *path, char *tmp, size_t size)
     return n > 0 && (size_t)n < size;
 }
 
-PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                          const float *alpha, const float *sample_counts, PtrPixelFormat format,
-                          const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
+PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrImageLayout *layout,
+                          const float *rgb, const float *alpha, const float *sample_counts,
+                          PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
+                          PtrError *err)
 {
     const int exr = ptr_image_is_exr(path);
-    const PtrImageModule *m = exr ? NULL : ptr_oiio_module(err);
-    if (!exr && !m)
-        return err->code;
+    const PtrImageModule *m = NULL;
+    PtrResult loaded = exr ? PTR_OK : ptr_oiio_module(loader, path, &m, err);
+    if (loaded != PTR_OK)
+        return loaded;
     char tmp[PATH_SIZE];
     if (!temporary_name(path, tmp, sizeof tmp))
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
@@ -89,12 +88,14 @@ void ptr_image_discard_partial(void)
         unlink(partial_path);
 }
 
-PtrImage *ptr_image_read(const char *path, PtrError *err)
+PtrResult ptr_image_read(PtrImageLoader *loader, const char *path, PtrImage **out,
+                         PtrError *err)
 {
     if (ptr_image_is_exr(path))
-        return ptr_exr_read(path, err);
-    const PtrImageModule *m = ptr_oiio_module(err);
-    return m ? m->read(path, err) : NULL;
+        return ptr_exr_read(path, out, err);
+    const PtrImageModule *m;
+    PtrResult loaded = ptr_oiio_module(loader, path, &m, err);
+    return loaded == PTR_OK ? m->read(path, out, err) : loaded;
 }
 
 void ptr_image_free(PtrImage *image)

@@ -50,20 +50,33 @@ PtrResult ptr_image_set_threads(int threads, PtrError *err);
  * other format goes through the OpenImageIO module. */
 int ptr_image_is_exr(const char *path);
 
+/* The OpenImageIO module as one owner loads it, once, at first use or
+ * early (ptr_image_preload). The functions below that take a loader need it
+ * for formats other than EXR only, and take NULL from a caller that reads
+ * and writes EXR alone (any other format is then PTR_ERR_USAGE). */
+typedef struct PtrImageLoader PtrImageLoader;
+
+/* A loader that has loaded nothing yet, into *out: PTR_OK or PTR_ERR_NOMEM. */
+PtrResult ptr_image_loader_new(PtrImageLoader **out, PtrError *err);
+
+/* Waits for the loader's thread, if it runs (exiting while it runs the
+ * libraries' constructors would race their destructors), and frees the
+ * loader; the module stays loaded for the process. Takes NULL. */
+void ptr_image_loader_free(PtrImageLoader *loader);
+
 /* If writing output needs the module, starts loading it on a thread of its
  * own and returns at once: PTR_OK, or PTR_ERR_INSTALL with one line in err if
- * the module file is missing (a broken installation). Loading or not, the
- * process waits for that thread before it exits. */
-PtrResult ptr_image_preload(const char *output, PtrError *err);
+ * the module file is missing (a broken installation). */
+PtrResult ptr_image_preload(PtrImageLoader *loader, const char *output, PtrError *err);
 
 /* Loads the module, or waits for ptr_image_preload's thread: PTR_OK once it
  * works, else (and the formats it serves then fail alike) PTR_ERR_NOMEM if
  * the module or a library it needs could not be mapped for want of memory,
  * PTR_ERR_INSTALL if it cannot be loaded otherwise, with one line in err. */
-PtrResult ptr_image_ready(PtrError *err);
+PtrResult ptr_image_ready(PtrImageLoader *loader, PtrError *err);
 
 /* Whether a writer exists for the file's extension. */
-int ptr_image_can_write(const char *path);
+int ptr_image_can_write(PtrImageLoader *loader, const char *path);
 
 /* Writes RGB float pixels (rows top to bottom), stored in the file as format,
  * with an alpha channel (A) from alpha if it is not NULL, and for EXR, whose
@@ -75,9 +88,10 @@ int ptr_image_can_write(const char *path);
  * whole new one or not at all. Returns PTR_OK; otherwise fills err with one
  * line and returns its code: PTR_ERR_OUTPUT, PTR_ERR_NOMEM, or what
  * ptr_image_ready says. */
-PtrResult ptr_image_write(const char *path, const PtrImageLayout *layout, const float *rgb,
-                          const float *alpha, const float *sample_counts, PtrPixelFormat format,
-                          const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
+PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrImageLayout *layout,
+                          const float *rgb, const float *alpha, const float *sample_counts,
+                          PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
+                          PtrError *err);
 
 /* Removes the temporary file of a write under way, if any. Safe to call from
  * a signal handler: for a process that is about to _exit mid-write. */
@@ -87,10 +101,12 @@ void ptr_image_discard_partial(void);
  * if it has one; other channels are dropped. */
 typedef struct PtrImage PtrImage;
 
-/* NULL on failure, with err filled: PTR_ERR_USAGE for a file that is not an
- * image the module can read (images are read only as files the command line
- * names), PTR_ERR_NOMEM, or what ptr_image_ready says. */
-PtrImage *ptr_image_read(const char *path, PtrError *err);
+/* The image into *out (for ptr_image_free): PTR_OK, else PTR_ERR_USAGE for a
+ * file that is not an image the module can read (images are read only as
+ * files the command line names), PTR_ERR_NOMEM, or what ptr_image_ready
+ * says. */
+PtrResult ptr_image_read(PtrImageLoader *loader, const char *path, PtrImage **out,
+                         PtrError *err);
 void ptr_image_free(PtrImage *image);
 int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);

@@ -87,7 +87,7 @@ PtrResult ptr_exr_write(const char *file, const char *name, const PtrImageLayout
                         const float *rgb, const float *alpha, const float *sample_counts,
                         PtrPixelFormat format,
                         const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
-PtrImage *ptr_exr_read(const char *path, PtrError *err);
+PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *err);
 PtrResult ptr_exr_set_threads(int threads, PtrError *err);
 
 #define PTR_IMAGE_MODULE_SYMBOL "ptr_image_module"
@@ -103,12 +103,14 @@ typedef struct PtrImageModule {
     PtrResult (*write)(const char *file, const char *name, const PtrImageLayout *layout,
                        const float *rgb, const float *alpha, PtrPixelFormat format,
                        const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
-    PtrImage *(*read)(const char *path, PtrError *err);
+    PtrResult (*read)(const char *path, PtrImage **out, PtrError *err);
 } PtrImageModule;
 
-/* The module, loaded now if oiio_loader.c's thread has not (see
- * ptr_image_preload); NULL if it cannot be, with err saying why. */
-const PtrImageModule *ptr_oiio_module(PtrError *err);
+/* The loader's module into *out, loaded now if its thread has not (see
+ * ptr_image_preload): PTR_OK, else what ptr_image_ready says, or
+ * PTR_ERR_USAGE naming path without a loader. */
+PtrResult ptr_oiio_module(PtrImageLoader *loader, const char *path, const PtrImageModule **out,
+                          PtrError *err);
 
 #ifdef __cplusplus
 }

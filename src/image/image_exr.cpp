@@ -136,7 +136,7 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
     }
 }
 
-extern "C" PtrImage *ptr_exr_read(const char *path, PtrError *err)
+extern "C" PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *err)
 {
     PtrImage *image = nullptr;
     try {
@@ -146,10 +146,8 @@ extern "C" PtrImage *ptr_exr_read(const char *path, PtrError *err)
         const long long width = 1LL + data.max.x - data.min.x, height = 1LL + data.max.y - data.min.y;
         const long long full_width = 1LL + display.max.x - display.min.x,
                         full_height = 1LL + display.max.y - display.min.y;
-        if (width > INT_MAX || height > INT_MAX || full_width > INT_MAX || full_height > INT_MAX) {
-            ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": image too large");
-            return nullptr;
-        }
+        if (width > INT_MAX || height > INT_MAX || full_width > INT_MAX || full_height > INT_MAX)
+            return ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": image too large");
         PtrImageLayout layout = { int(width), int(height), data.min.x, data.min.y,
                                   int(full_width), int(full_height) };
         // Text, integer and float attributes, as text; the standard ones of
@@ -196,10 +194,10 @@ extern "C" PtrImage *ptr_exr_read(const char *path, PtrError *err)
         in.readPixels(data.min.y, data.max.y);
         for (size_t p = 0; grey && p < size_t(layout.width) * size_t(layout.height); p++)
             image->rgb[3 * p + 1] = image->rgb[3 * p + 2] = image->rgb[3 * p];
-        return image;
+        *out = image;
+        return PTR_OK;
     } catch (...) {
         ptr_image_release(image);
-        ptr_shim_caught(err, PTR_ERR_USAGE, path);
+        return ptr_shim_caught(err, PTR_ERR_USAGE, path);
     }
-    return nullptr;
 }

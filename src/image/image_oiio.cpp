@@ -78,7 +78,7 @@ PtrResult write_image(const char *file, const char *name, const PtrImageLayout *
     }
 }
 
-PtrImage *read_image(const char *path, PtrError *err)
+PtrResult read_image(const char *path, PtrImage **out, PtrError *err)
 {
     PtrImage *image = nullptr;
     try {
@@ -86,16 +86,12 @@ PtrImage *read_image(const char *path, PtrError *err)
         OIIO::ImageSpec config;
         config.attribute("oiio:UnassociatedAlpha", 1);
         auto in = OIIO::ImageInput::open(path, &config);
-        if (!in) {
-            ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + OIIO::geterror());
-            return nullptr;
-        }
+        if (!in)
+            return ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + OIIO::geterror());
         const OIIO::ImageSpec &spec = in->spec();
         std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
-            ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + in->geterror());
-            return nullptr;
-        }
+        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+            return ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + in->geterror());
         size_t pixels = size_t(spec.width) * size_t(spec.height);
         image = ptr_image_alloc(pixels, spec.extra_attribs.size());
         if (!image)
@@ -116,12 +112,12 @@ PtrImage *read_image(const char *path, PtrError *err)
             if (!ptr_image_set_attr(image, i++, param.name().c_str(), param.get_string().c_str()))
                 throw std::bad_alloc();
         in->close();
-        return image;
+        *out = image;
+        return PTR_OK;
     } catch (...) {
         ptr_image_release(image);
-        ptr_shim_caught(err, PTR_ERR_USAGE, path);
+        return ptr_shim_caught(err, PTR_ERR_USAGE, path);
     }
-    return nullptr;
 }
 
 } // namespace

@@ -1,6 +1,7 @@
-/* Finds the OpenImageIO module beside the executable and loads it: on a
- * thread of its own when asked early enough to overlap other work, else at
- * first use. */
+/* Finds the OpenImageIO module beside the executable and loads it for the
+ * loader's owner: on a thread of its own when asked early enough to overlap
+ * other work, else at first use. A second loader loads the same module
+ * (the dynamic linker counts it) and shares no state with the first. */
 #include "image/image_backend.h"
 
 #include <dlfcn.h>
@@ -16,19 +17,31 @@
 
 enum { PATH_SIZE = 4096 };
 
-static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
-static pthread_t loader;
-static int loader_running;  /* started by ptr_image_preload and not joined yet */
-static int load_tried;      /* load() ran: module, else load_error, says how it went */
-static int exit_waits;      /* join_loader is registered with atexit */
-static PtrError load_error; /* why the load failed */
-static const PtrImageModule *module; /* set once the module works */
+struct PtrImageLoader {
+    pthread_mutex_t lock;
+    pthread_t thread;
+    int thread_running;           /* started by ptr_image_preload and not joined yet */
+    int load_tried;               /* load() ran: module, else load_error, says how it went */
+    PtrError load_error;          /* why the load failed */
+    const PtrImageModule *module; /* set once the module works */
+};
 
-static void load(void)
+PtrResult ptr_image_loader_new(PtrImageLoader **out, PtrError *err)
+{
+    PtrImageLoader *loader = calloc(1, sizeof *loader);
+    if (!loader)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the image module's loader");
+    pthread_mutex_init(&loader->lock, NULL);
+    *out = loader;
+    return PTR_OK;
+}
+
+static void load(PtrImageLoader *loader)
 {
     char path[PATH_SIZE];
     const PtrImageModule *m = NULL;
-    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, &load_error) == PTR_OK) {
+    PtrError *load_error = &loader->load_error;
+    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, load_error) == PTR_OK) {
         /* Lazy binding, as when a program links the libraries: binding all of
          * their functions up front costs a tenth more. */
         void *handle = dlopen(path, RTLD_LAZY | RTLD_LOCAL);
@@ -39,78 +52,80 @@ static void load(void)
             if (!strncmp(why, path, len) && !strncmp(why + len, ": ", 2))
                 why += len + 2;
             if (ptr_dl_out_of_memory(why))
-                ptr_error_set(&load_error, PTR_ERR_NOMEM,
+                ptr_error_set(load_error, PTR_ERR_NOMEM,
                               "%s: out of memory: cannot load ptr's image module: %s", path, why);
             else
-                ptr_error_set(&load_error, PTR_ERR_INSTALL,
+                ptr_error_set(load_error, PTR_ERR_INSTALL,
                               "%s: cannot load ptr's image module: %s", path, why);
         } else if (!(m = dlsym(handle, PTR_IMAGE_MODULE_SYMBOL)) || m->size != sizeof *m ||
                    strcmp(m->version, PTR_VERSION)) {
-            ptr_error_set(&load_error, PTR_ERR_INSTALL, "%s: not the image module of ptr %s", path,
+            ptr_error_set(load_error, PTR_ERR_INSTALL, "%s: not the image module of ptr %s", path,
                           PTR_VERSION);
             m = NULL;
             dlclose(handle);
         }
     }
-    load_tried = 1;
-    module = m;
+    loader->load_tried = 1;
+    loader->module = m;
 }
 
-static void *load_on_thread(void *unused)
+static void *load_on_thread(void *loader)
 {
-    (void)unused;
-    load();
+    load(loader);
     return NULL;
 }
 
 /* With the lock held. */
-static void join_loader_locked(void)
+static void join_loader_locked(PtrImageLoader *loader)
 {
-    if (loader_running) {
-        pthread_join(loader, NULL);
-        loader_running = 0;
+    if (loader->thread_running) {
+        pthread_join(loader->thread, NULL);
+        loader->thread_running = 0;
     }
 }
 
-/* Exiting while the thread runs the libraries' constructors would race
- * their destructors. */
-static void join_loader(void)
+void ptr_image_loader_free(PtrImageLoader *loader)
 {
-    pthread_mutex_lock(&lock);
-    join_loader_locked();
-    pthread_mutex_unlock(&lock);
+    if (!loader)
+        return;
+    join_loader_locked(loader);
+    pthread_mutex_destroy(&loader->lock);
+    free(loader);
 }
 
-PtrResult ptr_image_preload(const char *output, PtrError *err)
+PtrResult ptr_image_preload(PtrImageLoader *loader, const char *output, PtrError *err)
 {
     if (ptr_image_is_exr(output))
         return PTR_OK;
     char path[PATH_SIZE];
-    if (ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, err) != PTR_OK)
-        return err->code;
+    PtrResult found = ptr_module_path(PTR_IMAGE_MODULE_PATH, "image", path, sizeof path, err);
+    if (found != PTR_OK)
+        return found;
     if (access(path, R_OK))
         return ptr_error_set(err, PTR_ERR_INSTALL, "%s: ptr's image module is missing: %s", path,
                              strerror(errno));
-    pthread_mutex_lock(&lock);
+    pthread_mutex_lock(&loader->lock);
     /* A thread that cannot start leaves the load to the first use. */
-    if (!loader_running && !load_tried && !pthread_create(&loader, NULL, load_on_thread, NULL)) {
-        loader_running = 1;
-        if (!exit_waits)
-            exit_waits = !atexit(join_loader);
-    }
-    pthread_mutex_unlock(&lock);
+    if (!loader->thread_running && !loader->load_tried &&
+        !pthread_create(&loader->thread, NULL, load_on_thread, loader))
+        loader->thread_running = 1;
+    pthread_mutex_unlock(&loader->lock);
     return PTR_OK;
 }
 
-const PtrImageModule *ptr_oiio_module(PtrError *err)
+PtrResult ptr_oiio_module(PtrImageLoader *loader, const char *path, const PtrImageModule **out,
+                          PtrError *err)
 {
-    pthread_mutex_lock(&lock);
-    join_loader_locked();
-    if (!load_tried)
-        load();
-    const PtrImageModule *m = module;
-    pthread_mutex_unlock(&lock);
-    if (!m && err)
-        *err = load_error;
-    return m;
+    if (!loader)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: only EXR can be read or written here",
+                             path);
+    pthread_mutex_lock(&loader->lock);
+    join_loader_locked(loader);
+    if (!loader->load_tried)
+        load(loader);
+    const PtrImageModule *m = loader->module;
+    pthread_mutex_unlock(&loader->lock);
+    *out = m;
+    return m ? PTR_OK
+             : ptr_error_set(err, loader->load_error.code, "%s", loader->load_error.message);
 }

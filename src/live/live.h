@@ -53,10 +53,10 @@ typedef struct PtrLiveModule {
     size_t size;
     const char *version;
 
-    /* Binds the server and starts the threads. NULL on failure, with err
-     * filled: PTR_ERR_USAGE for an address that cannot be used (a port in
-     * use, an unknown host), PTR_ERR_NOMEM, PTR_ERR_INTERNAL. */
-    PtrLiveSession *(*start)(const PtrLiveOptions *options, PtrError *err);
+    /* Binds the server, starts the threads, and hands the session over in
+     * *out: PTR_OK, else PTR_ERR_USAGE for an address that cannot be used (a
+     * port in use, an unknown host), PTR_ERR_NOMEM, PTR_ERR_INTERNAL. */
+    PtrResult (*start)(const PtrLiveOptions *options, PtrLiveSession **out, PtrError *err);
     /* The page's address, "http://HOST:PORT/" ("" without --live). */
     const char *(*url)(const PtrLiveSession *session);
     /* A render starts: the image it makes is width x height. */
@@ -72,9 +72,10 @@ typedef struct PtrLiveModule {
     void (*stop)(PtrLiveSession *session);
 } PtrLiveModule;
 
-/* The module, loaded now (live_loader.c); NULL if it cannot be, with err
- * saying why (PTR_ERR_INSTALL, PTR_ERR_NOMEM). */
-const PtrLiveModule *ptr_live_module(PtrError *err);
+/* The module into *out, loaded now (live_loader.c), for the caller to keep
+ * (it stays loaded for the process): PTR_OK, else PTR_ERR_INSTALL or
+ * PTR_ERR_NOMEM. */
+PtrResult ptr_live_module(const PtrLiveModule **out, PtrError *err);
 
 #ifdef __cplusplus
 }

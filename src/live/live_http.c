@@ -432,17 +432,16 @@ static int is_loopback(const struct sockaddr *a)
     return 0;
 }
 
-/* Binds and listens at the address given; the socket, else -1 with err. */
-static int bind_socket(const char *option, char *host, const char *port, int *family,
-                       char *url, size_t url_size, PtrError *err)
+/* Binds and listens at the address given, the socket into *out: PTR_OK,
+ * else PTR_ERR_USAGE. */
+static PtrResult bind_socket(const char *option, char *host, const char *port, int *family,
+                             char *url, size_t url_size, int *out, PtrError *err)
 {
     struct addrinfo hints = { .ai_socktype = SOCK_STREAM, .ai_flags = AI_NUMERICSERV }, *list;
     int gai = getaddrinfo(host, port, &hints, &list);
-    if (gai) {
-        ptr_live_error(err, PTR_ERR_USAGE, "%s: cannot use host '%s': %s", option, host,
-                       gai_strerror(gai));
-        return -1;
-    }
+    if (gai)
+        return ptr_live_error(err, PTR_ERR_USAGE, "%s: cannot use host '%s': %s", option, host,
+                              gai_strerror(gai));
     int fd = -1, why = 0;
     for (struct addrinfo *a = list; a && fd < 0; a = a->ai_next) {
         fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
@@ -464,12 +463,11 @@ static int bind_socket(const char *option, char *host, const char *port, int *fa
                             "can reach this machine can see the render\n", option, host, port);
     }
     freeaddrinfo(list);
-    if (fd < 0) {
-        ptr_live_error(err, PTR_ERR_USAGE, "%s %s:%s: %s%s", option, host, port, strerror(why),
-                       why == EADDRINUSE ? " (another program listens there; try another port, "
-                                           "or 0 for a free one)" : "");
-        return -1;
-    }
+    if (fd < 0)
+        return ptr_live_error(err, PTR_ERR_USAGE, "%s %s:%s: %s%s", option, host, port,
+                              strerror(why),
+                              why == EADDRINUSE ? " (another program listens there; try another "
+                                                  "port, or 0 for a free one)" : "");
     struct sockaddr_storage bound;
     socklen_t len = sizeof bound;
     char name[1025] = "", service[32] = "";
@@ -478,19 +476,21 @@ static int bind_socket(const char *option, char *host, const char *port, int *fa
                     NI_NUMERICHOST | NI_NUMERICSERV);
     snprintf(url, url_size, strchr(name, ':') ? "http://[%s]:%s/" : "http://%s:%s/", name,
              service);
-    return fd;
+    *out = fd;
+    return PTR_OK;
 }
 
 PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err)
 {
     char host[256], port[16];
     int family = AF_INET;
-    if (!ptr_live_parse_address("--live", s->options.http, host, sizeof host, port, sizeof port,
-                                err))
-        return err->code;
-    s->listen_fd = bind_socket("--live", host, port, &family, s->url, sizeof s->url, err);
-    if (s->listen_fd < 0)
-        return err->code;
+    PtrResult res = ptr_live_parse_address("--live", s->options.http, host, sizeof host, port,
+                                           sizeof port, err);
+    if (res != PTR_OK)
+        return res;
+    res = bind_socket("--live", host, port, &family, s->url, sizeof s->url, &s->listen_fd, err);
+    if (res != PTR_OK)
+        return res;
     s->http = http_new();
     if (!s->http) {
         close(s->listen_fd);

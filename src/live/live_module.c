@@ -25,6 +25,8 @@ static const double linger_seconds = 1.0;
 
 PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
 {
+    if (!err)
+        return code;
     err->code = code;
     va_list args;
     va_start(args, fmt);
@@ -57,8 +59,8 @@ void ptr_live_wait(PtrLiveSession *s, double seconds)
     pthread_cond_timedwait(&s->changed, &s->lock, &t);
 }
 
-int ptr_live_parse_address(const char *option, const char *text, char *host, size_t host_size,
-                           char *port, size_t port_size, PtrError *err)
+PtrResult ptr_live_parse_address(const char *option, const char *text, char *host,
+                                 size_t host_size, char *port, size_t port_size, PtrError *err)
 {
     const char *colon = strrchr(text, ':');
     const char *p = colon ? colon + 1 : text;
@@ -72,12 +74,10 @@ int ptr_live_parse_address(const char *option, const char *text, char *host, siz
     errno = 0;
     unsigned long n = strtoul(p, &end, 10);
     if (*p < '0' || *p > '9' || *end || errno || n > 65535 || (colon && host_len == 0) ||
-        host_len >= host_size || strlen(p) >= port_size) {
-        ptr_live_error(err, PTR_ERR_USAGE,
-                       "%s: '%s' is not [HOST:]PORT (a port from 0 to 65535) (see ptr --help)",
-                       option, text);
-        return 0;
-    }
+        host_len >= host_size || strlen(p) >= port_size)
+        return ptr_live_error(
+            err, PTR_ERR_USAGE,
+            "%s: '%s' is not [HOST:]PORT (a port from 0 to 65535) (see ptr --help)", option, text);
     if (colon) {
         memcpy(host, h, host_len);
         host[host_len] = '\0';
@@ -85,7 +85,7 @@ int ptr_live_parse_address(const char *option, const char *text, char *host, siz
         snprintf(host, host_size, "127.0.0.1");
     }
     snprintf(port, port_size, "%lu", n);
-    return 1;
+    return PTR_OK;
 }
 
 /* Scene-linear to the view, then to 8 bits as an 8-bit output is rounded. */
@@ -216,35 +216,36 @@ static void session_stop(PtrLiveSession *s)
     session_free(s);
 }
 
-static PtrLiveSession *session_start(const PtrLiveOptions *options, PtrError *err)
+static PtrResult session_start(const PtrLiveOptions *options, PtrLiveSession **out,
+                               PtrError *err)
 {
     PtrLiveSession *s = calloc(1, sizeof *s);
-    if (!s) {
-        ptr_live_error(err, PTR_ERR_NOMEM, "out of memory for the live view");
-        return NULL;
-    }
+    if (!s)
+        return ptr_live_error(err, PTR_ERR_NOMEM, "out of memory for the live view");
     s->options = *options;
     s->listen_fd = -1;
     s->status.remaining = -1;
     pthread_mutex_init(&s->lock, NULL);
     ptr_live_cond_init(&s->changed);
+    PtrResult res = options->http ? ptr_live_http_start(s, err) : PTR_OK;
+    if (res != PTR_OK) {
+        session_free(s);
+        return res;
+    }
     if (options->http) {
-        if (ptr_live_http_start(s, err) != PTR_OK) {
-            session_free(s);
-            return NULL;
-        }
         if (pthread_create(&s->encoder, NULL, encode_loop, s)) {
-            ptr_live_error(err, PTR_ERR_INTERNAL, "--live: cannot start a thread");
             session_stop(s);
-            return NULL;
+            return ptr_live_error(err, PTR_ERR_INTERNAL, "--live: cannot start a thread");
         }
         s->encoder_started = 1;
     }
-    if (options->tev && ptr_live_tev_start(s, err) != PTR_OK) {
+    res = options->tev ? ptr_live_tev_start(s, err) : PTR_OK;
+    if (res != PTR_OK) {
         session_stop(s);
-        return NULL;
+        return res;
     }
-    return s;
+    *out = s;
+    return PTR_OK;
 }
 
 static const char *session_url(const PtrLiveSession *s)

@@ -55,11 +55,13 @@ struct PtrLiveSession {
 };
 
 /* "[HOST:]PORT" ("[::1]:PORT" for IPv6) split into host (default
- * 127.0.0.1) and port: 0 and a message in err if the text is not that. */
-int ptr_live_parse_address(const char *option, const char *text, char *host, size_t host_size,
-                           char *port, size_t port_size, PtrError *err);
+ * 127.0.0.1) and port: PTR_ERR_USAGE, naming option, if the text is not
+ * that. */
+PtrResult ptr_live_parse_address(const char *option, const char *text, char *host,
+                                 size_t host_size, char *port, size_t port_size, PtrError *err);
 
-/* Fills err as ptr_error_set would (the module cannot call into ptr). */
+/* Fills err as ptr_error_set would, err NULL too (the module cannot call
+ * into ptr). */
 PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

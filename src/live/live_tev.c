@@ -315,10 +315,11 @@ PtrResult ptr_live_tev_start(PtrLiveSession *s, PtrError *err)
     if (!t)
         return ptr_live_error(err, PTR_ERR_NOMEM, "out of memory for --tev");
     t->fd = -1;
-    if (!ptr_live_parse_address("--tev", s->options.tev, t->host, sizeof t->host, t->port,
-                                sizeof t->port, err)) {
+    PtrResult res = ptr_live_parse_address("--tev", s->options.tev, t->host, sizeof t->host,
+                                           t->port, sizeof t->port, err);
+    if (res != PTR_OK) {
         free(t);
-        return err->code;
+        return res;
     }
     s->tev = t;
     if (pthread_create(&t->thread, NULL, send_loop, s)) {

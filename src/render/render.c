@@ -119,14 +119,14 @@ const char *ptr_integrator_name(PtrIntegrator integrator)
     return integrator_names[integrator];
 }
 
-int ptr_integrator_parse(const char *text, PtrIntegrator *integrator)
+PtrResult ptr_integrator_parse(const char *text, PtrIntegrator *integrator, PtrError *err)
 {
     for (int i = PTR_INTEGRATOR_AUTO; i <= PTR_INTEGRATOR_BUNDLES; i++)
         if (!strcmp(text, integrator_names[i])) {
             *integrator = (PtrIntegrator)i;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not auto, paths or bundles", text);
 }
 
 PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level)
@@ -140,21 +140,21 @@ PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level)
     return PTR_INTEGRATOR_PATHS;
 }
 
-int ptr_integrator_available(PtrIntegrator integrator)
+int ptr_integrator_available(PtrIntegrator integrator, PtrCpuLevel level)
 {
     return integrator != PTR_INTEGRATOR_BUNDLES ||
-           ptr_integrator_for_level(ptr_cpu_level()) == PTR_INTEGRATOR_BUNDLES;
+           ptr_integrator_for_level(level) == PTR_INTEGRATOR_BUNDLES;
 }
 
-PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator)
+PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator, PtrCpuLevel level)
 {
-    return integrator == PTR_INTEGRATOR_AUTO ? ptr_integrator_for_level(ptr_cpu_level())
-                                             : integrator;
+    return integrator == PTR_INTEGRATOR_AUTO ? ptr_integrator_for_level(level) : integrator;
 }
 
 PtrIntegrator ptr_render_integrator(const PtrRenderSettings *s)
 {
-    return s->fixed_tmin > 0.0f ? PTR_INTEGRATOR_PATHS : ptr_integrator_resolve(s->integrator);
+    return s->fixed_tmin > 0.0f ? PTR_INTEGRATOR_PATHS
+                                : ptr_integrator_resolve(s->integrator, ptr_cpu_level());
 }
 
 static PtrRenderTileFn render_tile_for(PtrIntegrator integrator)
@@ -220,7 +220,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
     if (settings->max_depth < 0 || !(settings->fixed_tmin >= 0.0f) || first + count < first)
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "max depth and fixed t_min must not be negative, samples must fit 32 bits");
-    if (!ptr_integrator_available(integrator))
+    if (!ptr_integrator_available(integrator, ptr_cpu_level()))
         return ptr_error_set(err, PTR_ERR_USAGE, "the %s integrator cannot run at CPU level %s",
                              ptr_integrator_name(integrator),
                              ptr_cpu_level_name(ptr_cpu_level()));

@@ -29,20 +29,22 @@ PtrRegion ptr_render_region(const PtrRenderSettings *settings);
  * where the build has them (they lose below: docs/bundles.md), else paths. */
 PtrIntegrator ptr_integrator_for_level(PtrCpuLevel level);
 
-/* Whether the integrator can run at the CPU level in force. */
-int ptr_integrator_available(PtrIntegrator integrator);
+/* Whether the integrator can run at the CPU level. */
+int ptr_integrator_available(PtrIntegrator integrator, PtrCpuLevel level);
 
 /* The integrator asked for, or for PTR_INTEGRATOR_AUTO the ladder's at the
- * CPU level in force. */
-PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator);
+ * CPU level. */
+PtrIntegrator ptr_integrator_resolve(PtrIntegrator integrator, PtrCpuLevel level);
 
-/* The integrator a render with these settings uses: theirs resolved, but
+/* The integrator a render with these settings uses: theirs resolved at
+ * ptr_cpu_level (a caller that caps the level lower resolves it itself), but
  * always paths with a fixed t_min, which the bundles do not take. */
 PtrIntegrator ptr_render_integrator(const PtrRenderSettings *settings);
 
-/* "paths" or "bundles", and back ("auto" too); parse returns 0 for neither. */
+/* "paths" or "bundles", and back ("auto" too); parse returns PTR_ERR_USAGE
+ * for anything else. */
 const char *ptr_integrator_name(PtrIntegrator integrator);
-int ptr_integrator_parse(const char *text, PtrIntegrator *integrator);
+PtrResult ptr_integrator_parse(const char *text, PtrIntegrator *integrator, PtrError *err);
 
 /* The renderer reads the spheres through accel (accel->spheres, which must
  * be scene->spheres) and finds every hit, shadow rays too, with ptr_trace.

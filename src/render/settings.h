@@ -15,7 +15,7 @@ typedef enum PtrSwitch { PTR_ON, PTR_OFF } PtrSwitch;
  * time (render.c, the reference), or in bundles of eight, one path a lane
  * (bundle.c, built for AVX2 on x86-64). */
 typedef enum PtrIntegrator {
-    PTR_INTEGRATOR_AUTO,    /* the dispatch ladder's, at the CPU level in force */
+    PTR_INTEGRATOR_AUTO,    /* the dispatch ladder's, at a CPU level */
     PTR_INTEGRATOR_PATHS,
     PTR_INTEGRATOR_BUNDLES,
 } PtrIntegrator;

@@ -12,14 +12,14 @@ PtrSampler ptr_sampler_for_sample(PtrSamplerKind kind, uint64_t seed, uint64_t p
 static const char *const names[] = { [PTR_SAMPLER_SOBOL] = "sobol",
                                      [PTR_SAMPLER_INDEPENDENT] = "independent" };
 
-int ptr_sampler_parse(const char *text, PtrSamplerKind *kind)
+PtrResult ptr_sampler_parse(const char *text, PtrSamplerKind *kind, PtrError *err)
 {
     for (int k = PTR_SAMPLER_SOBOL; k <= PTR_SAMPLER_INDEPENDENT; k++)
         if (!strcmp(text, names[k])) {
             *kind = (PtrSamplerKind)k;
-            return 1;
+            return PTR_OK;
         }
-    return 0;
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not sobol or independent", text);
 }
 
 const char *ptr_sampler_name(PtrSamplerKind kind)

@@ -13,6 +13,7 @@
 
 #include <stdint.h>
 
+#include "base/result.h"
 #include "sampling/rng.h"
 
 typedef enum PtrSamplerKind {
@@ -137,8 +138,8 @@ static inline void ptr_sampler_2d_bits(const PtrSampler *sampler, uint32_t dim, 
     ptr_sampler_pair_bits(sampler->kind, sampler->pixel_key, sampler->index, dim, out);
 }
 
-/* "sobol" or "independent". */
-int ptr_sampler_parse(const char *text, PtrSamplerKind *kind);
+/* "sobol" or "independent"; PTR_ERR_USAGE for anything else. */
+PtrResult ptr_sampler_parse(const char *text, PtrSamplerKind *kind, PtrError *err);
 const char *ptr_sampler_name(PtrSamplerKind kind);
 
 #endif /* PTR_SAMPLER_H */

@@ -425,22 +425,22 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     return PTR_OK;
 }
 
-int ptr_sky_parse(const char *text, PtrSky *sky)
+PtrResult ptr_sky_parse(const char *text, PtrSky *sky, PtrError *err)
 {
     if (!strcmp(text, "gradient")) {
         *sky = (PtrSky){ .kind = PTR_SKY_GRADIENT };
-        return 1;
+        return PTR_OK;
     }
     if (!strcmp(text, "black")) {
         *sky = (PtrSky){ .kind = PTR_SKY_BLACK };
-        return 1;
+        return PTR_OK;
     }
     float r, g, b;
     char tail;
-    if (sscanf(text, "%f,%f,%f%c", &r, &g, &b, &tail) != 3)
-        return 0;
-    if (!isfinite(r) || !isfinite(g) || !isfinite(b) || r < 0 || g < 0 || b < 0)
-        return 0;
+    if (sscanf(text, "%f,%f,%f%c", &r, &g, &b, &tail) != 3 || !isfinite(r) || !isfinite(g) ||
+        !isfinite(b) || r < 0 || g < 0 || b < 0)
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "'%s' is not gradient, black or R,G,B (not negative)", text);
     *sky = (PtrSky){ .kind = PTR_SKY_CONSTANT, .radiance = v3(r, g, b) };
-    return 1;
+    return PTR_OK;
 }

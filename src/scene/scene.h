@@ -294,7 +294,8 @@ static inline PtrVec3 ptr_sky_radiance(const PtrSky *sky, PtrVec3 unit_dir)
     return v3_splat(0.0f);
 }
 
-/* "gradient", "black" or "R,G,B" (as --sky takes it). */
-int ptr_sky_parse(const char *text, PtrSky *sky);
+/* "gradient", "black" or "R,G,B" (as --sky takes it); PTR_ERR_USAGE for
+ * anything else. */
+PtrResult ptr_sky_parse(const char *text, PtrSky *sky, PtrError *err);
 
 #endif /* PTR_SCENE_H */

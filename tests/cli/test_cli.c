@@ -47,8 +47,8 @@ static void test_render_seed_exr(void)
     CHECK_INT(test_ptr(SEED_SCENE, "-o", out, "--samples", "32", "--width", "60", "--seed", "42",
                   "--quiet", "--c", NULL), 0);
     PtrError err;
-    PtrImage *img = ptr_image_read(out, &err);
-    CHECK(img != NULL);
+    PtrImage *img = NULL;
+    CHECK_INT(test_image_read(out, &img, &err), PTR_OK);
     if (!img)
         return;
     /* The scene's camera is square: the height follows the width. */
@@ -90,8 +90,8 @@ static void test_png_and_options(void)
     CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "2", "--width", "40", "--height", "20",
                   "--sky", "black", "--threads", "1", "--max-depth", "5", "--quiet", NULL), 0);
     PtrError err;
-    PtrImage *img = ptr_image_read(png, &err);
-    CHECK(img != NULL);
+    PtrImage *img = NULL;
+    CHECK_INT(test_image_read(png, &img, &err), PTR_OK);
     if (!img)
         return;
     CHECK_INT(ptr_image_width(img), 40);
@@ -106,7 +106,7 @@ static void test_png_and_options(void)
     /* A constant sky of 0.5 seen directly encodes to sRGB 0.735 -> code 188. */
     CHECK_INT(test_ptr(SEED_SCENE, "-o", png, "--samples", "1", "--width", "8", "--sky", "0.5,0.5,0.5",
                   "--camera", "Camera", "--quiet", NULL), 0);
-    img = ptr_image_read(png, &err);
+    CHECK_INT(test_image_read(png, &img, &err), PTR_OK);
     CHECK_NEAR(ptr_image_pixels(img)[0] * 255.0f, 188.0, 1e-3);
     ptr_image_free(img);
 }
@@ -123,8 +123,8 @@ static void test_orthographic_option(void)
                        "4", "--quiet", NULL),
               0);
     PtrError err;
-    PtrImage *img = ptr_image_read(out, &err);
-    CHECK(img != NULL);
+    PtrImage *img = NULL;
+    CHECK_INT(test_image_read(out, &img, &err), PTR_OK);
     if (!img)
         return;
     const float *px = ptr_image_pixels(img);
@@ -207,6 +207,30 @@ static void test_bad_input(void)
     CHECK_INT(file_count(), ok_files);
 }
 
+/* Image module loaders are their owners' alone: one freed leaves another
+ * working, and a caller without one reads EXR only, whatever another has
+ * loaded in the same process. */
+static void test_image_loaders(void)
+{
+    const char *png = test_path("loaders.png");
+    const float grey[3] = { 0.5f, 0.5f, 0.5f };
+    const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
+    PtrImageLoader *first = NULL, *second = NULL;
+    PtrError err;
+    CHECK_INT(ptr_image_loader_new(&first, &err), PTR_OK);
+    CHECK_INT(ptr_image_loader_new(&second, &err), PTR_OK);
+    CHECK_INT(ptr_image_write(first, png, &one, grey, NULL, NULL, PTR_PIXEL_UINT8, NULL, 0, &err),
+              PTR_OK);
+    ptr_image_loader_free(first);
+    PtrImage *img = NULL;
+    CHECK_INT(ptr_image_read(NULL, png, &img, &err), PTR_ERR_USAGE);
+    CHECK(img == NULL);
+    CHECK_INT(ptr_image_read(second, png, &img, &err), PTR_OK);
+    CHECK(img && ptr_image_width(img) == 1);
+    ptr_image_free(img);
+    ptr_image_loader_free(second);
+}
+
 int main(void)
 {
     if (!test_dir_create("test-cli"))
@@ -215,6 +239,7 @@ int main(void)
     test_png_and_options();
     test_orthographic_option();
     test_bad_input();
+    test_image_loaders();
     test_dir_remove();
     return test_report();
 }

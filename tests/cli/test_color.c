@@ -28,6 +28,9 @@ static const float inputs[][3] = {
 };
 enum { N = sizeof inputs / sizeof inputs[0] };
 
+/* The image module's loader the outputs are written and read back through. */
+static PtrImageLoader *images;
+
 static PtrOutputInfo info_for(const PtrColor *color)
 {
     return (PtrOutputInfo){ .scene_path = "test", .kernel = "c", .samples = 1, .seed = 1,
@@ -37,8 +40,8 @@ static PtrOutputInfo info_for(const PtrColor *color)
 static PtrImage *read_image(const char *path)
 {
     PtrError err;
-    PtrImage *img = ptr_image_read(path, &err);
-    if (!img)
+    PtrImage *img = NULL;
+    if (ptr_image_read(images, path, &img, &err) != PTR_OK)
         TEST_FAIL_("%s", err.message);
     return img;
 }
@@ -50,16 +53,18 @@ static void oracle(const char *config, const char *display, const char *view)
     char cmd[1024];
     const char *in = test_path("in.exr"), *ours = test_path("ours.png"), *theirs = test_path("theirs.png");
     const PtrImageLayout row = { N, 1, 0, 0, N, 1 };
-    CHECK_INT(ptr_image_write(in, &row, &inputs[0][0], NULL, NULL, PTR_PIXEL_FLOAT, NULL, 0, &err), 0);
+    CHECK_INT(ptr_image_write(NULL, in, &row, &inputs[0][0], NULL, NULL, PTR_PIXEL_FLOAT, NULL, 0,
+                              &err),
+              0);
 
-    PtrColor *color = ptr_color_open(config, &err);
-    CHECK(color != NULL);
+    PtrColor *color = NULL;
+    CHECK_INT(ptr_color_open(config, &color, &err), PTR_OK);
     if (!color)
         return;
     CHECK_INT(ptr_color_select(color, display, view, NULL, 0, &err), 0);
     PtrOutputInfo info = info_for(color);
     PtrError perr = { 0 };
-    CHECK_INT(ptr_output_write(ours, &row, &inputs[0][0], &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(images, ours, &row, &inputs[0][0], &info, &perr), PTR_OK);
     ptr_color_close(color);
 
     snprintf(cmd, sizeof cmd, "'%s' --colorconfig '%s' '%s' --ociodisplay '%s' '%s' -d uint8 -o '%s'",
@@ -93,7 +98,8 @@ static void test_oracle(void)
     const char *ptr_views[] = { "Standard", "ACES 1.0 SDR-video", "Raw" };
     for (int v = 0; v < 3; v++) {
         PtrError err;
-        PtrColor *embedded = ptr_color_open(NULL, &err);
+        PtrColor *embedded = NULL;
+        CHECK_INT(ptr_color_open(NULL, &embedded, &err), PTR_OK);
         CHECK_STR(ptr_color_source(embedded), "embedded");
         ptr_color_close(embedded);
         oracle(PTR_CONFIG, "sRGB", ptr_views[v]);
@@ -119,24 +125,25 @@ static void test_lookup_order(void)
 {
     PtrError err;
     unsetenv("OCIO");
-    PtrColor *c = ptr_color_open(NULL, &err);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_STR(ptr_color_source(c), "embedded");
     ptr_color_close(c);
 
     setenv("OCIO", SECOND_CONFIG, 1);
-    c = ptr_color_open(NULL, &err);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_STR(ptr_color_source(c), SECOND_CONFIG);
     CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0, &err), 0);
     CHECK_STR(ptr_color_view(c), "Gamma"); /* that config's default */
     ptr_color_close(c);
 
-    c = ptr_color_open(PTR_CONFIG, &err); /* --ocio-config beats $OCIO */
+    CHECK_INT(ptr_color_open(PTR_CONFIG, &c, &err), PTR_OK); /* --ocio-config beats $OCIO */
     CHECK_STR(ptr_color_source(c), PTR_CONFIG);
     ptr_color_close(c);
 
     /* A broken $OCIO is an error, not a fallback to the embedded config. */
     setenv("OCIO", BROKEN_CONFIG, 1);
-    CHECK(ptr_color_open(NULL, &err) == NULL);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_ERR_COLOR);
     CHECK(strstr(err.message, BROKEN_CONFIG) != NULL && strstr(err.message, "$OCIO") != NULL);
     unsetenv("OCIO");
 }
@@ -144,12 +151,13 @@ static void test_lookup_order(void)
 static void test_errors(void)
 {
     PtrError err;
-    CHECK(ptr_color_open(BROKEN_CONFIG, &err) == NULL);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(BROKEN_CONFIG, &c, &err), PTR_ERR_COLOR);
     CHECK(strstr(err.message, BROKEN_CONFIG) != NULL);
-    CHECK(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", &err) == NULL);
+    CHECK_INT(ptr_color_open(PTR_SOURCE_DIR "/no/such.ocio", &c, &err), PTR_ERR_COLOR);
     CHECK_INT(err.code, PTR_ERR_COLOR);
 
-    PtrColor *c = ptr_color_open(NULL, &err);
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     CHECK_INT(ptr_color_select(c, NULL, "Filmic", NULL, 0, &err), PTR_ERR_USAGE);
     CHECK(strstr(err.message, "'Filmic'") && strstr(err.message, "'Standard'") &&
           strstr(err.message, "'Raw'"));
@@ -177,7 +185,8 @@ static void test_errors(void)
 static void test_output_path(void)
 {
     PtrError err;
-    PtrColor *c = ptr_color_open(NULL, &err);
+    PtrColor *c = NULL;
+    CHECK_INT(ptr_color_open(NULL, &c, &err), PTR_OK);
     const float grey[3] = { 0.18f, 0.18f, 0.18f }, doubled[3] = { 0.36f, 0.36f, 0.36f };
     const PtrImageLayout one = { 1, 1, 0, 0, 1, 1 };
 
@@ -202,7 +211,7 @@ static void test_output_path(void)
     PtrOutputInfo info = info_for(c);
     PtrError perr = { 0 };
     info.depth = PTR_DEPTH_16;
-    CHECK_INT(ptr_output_write(test_path("grey16.png"), &one, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(images, test_path("grey16.png"), &one, grey, &info, &perr), PTR_OK);
     PtrImage *img = read_image(test_path("grey16.png"));
     CHECK_NEAR(ptr_image_pixels(img)[0] * 65535.0, 30235.0, 1.0);
     CHECK_STR(ptr_image_attr(img, "ptr:view"), "Standard");
@@ -211,34 +220,36 @@ static void test_output_path(void)
 
     /* EXR stays scene-linear; --bake-view stores the display-referred values. */
     info.depth = PTR_DEPTH_DEFAULT;
-    CHECK_INT(ptr_output_write(test_path("linear.exr"), &one, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(images, test_path("linear.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(test_path("linear.exr"));
     CHECK_FLOAT_EQ(ptr_image_pixels(img)[0], 0.18f);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "lin_rec709");
     ptr_image_free(img);
     info.bake_view = 1;
-    CHECK_INT(ptr_output_write(test_path("baked.exr"), &one, grey, &info, &perr), PTR_OK);
+    CHECK_INT(ptr_output_write(images, test_path("baked.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(test_path("baked.exr"));
     CHECK_NEAR(ptr_image_pixels(img)[0], 0.461356, 1e-5);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "sRGB - Display");
     ptr_image_free(img);
 
     /* Formats refuse depths they cannot hold. */
-    CHECK_INT(ptr_output_check(test_path("x.jpg"), PTR_DEPTH_16, 0, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(test_path("x.exr"), PTR_DEPTH_8, 0, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(test_path("x.tif"), PTR_DEPTH_FLOAT, 0, &perr), PTR_OK);
+    CHECK_INT(ptr_output_check(images, test_path("x.jpg"), PTR_DEPTH_16, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(images, test_path("x.exr"), PTR_DEPTH_8, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(images, test_path("x.tif"), PTR_DEPTH_FLOAT, 0, &perr), PTR_OK);
     ptr_color_close(c);
 }
 
 int main(void)
 {
-    if (!test_dir_create("test-color"))
+    PtrError err;
+    if (!test_dir_create("test-color") || ptr_image_loader_new(&images, &err) != PTR_OK)
         return 1;
     test_oracle();
     test_embedded_matches_file();
     test_lookup_order();
     test_errors();
     test_output_path();
+    ptr_image_loader_free(images);
     test_dir_remove();
     return test_report();
 }

@@ -101,9 +101,9 @@ static void test_same_image(void)
                        "--height", "48", "--samples", "64", cam[0], cam[1], cam[2], cam[3], cam[4],
                        cam[5], "--quiet", NULL), 0);
     PtrError err;
-    PtrImage *a = ptr_image_read(test_path("gltf.exr"), &err);
-    PtrImage *b = ptr_image_read(test_path("obj.exr"), &err);
-    CHECK(a && b);
+    PtrImage *a = NULL, *b = NULL;
+    CHECK_INT(test_image_read(test_path("gltf.exr"), &a, &err), PTR_OK);
+    CHECK_INT(test_image_read(test_path("obj.exr"), &b, &err), PTR_OK);
     if (!a || !b)
         return;
     double worst = 0, mean = 0;

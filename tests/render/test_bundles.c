@@ -102,7 +102,7 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     PtrRegion r = ptr_render_region(&settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
     Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
-    CHECK(ptr_isect_init(&isect, kernel, scene->spheres.count));
+    CHECK_INT(ptr_isect_init(&isect, kernel, ptr_cpu_level(), scene->spheres.count, NULL), PTR_OK);
     CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, integrator == PTR_INTEGRATOR_BUNDLES,
                              scene, 0, NULL),
               PTR_OK);
@@ -145,7 +145,7 @@ int main(void)
         { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_C, "bundles, C kernels" },
         { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_AUTO, "bundles, fastest kernel" },
     };
-    int bundles = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES);
+    int bundles = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level());
     printf("test_bundles: against paths with the C kernels: %s\n",
            bundles ? "paths with the fastest kernel, bundles with C and the fastest"
                    : "paths with the fastest kernel (no bundles at this CPU level)");

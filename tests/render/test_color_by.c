@@ -99,7 +99,7 @@ static PtrScene valued_sphere(PtrMaterial material, float value, float sky)
 static void check_centre(const PtrScene *s, const double expected[3], const char *what)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, s->spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), s->spheres.count, NULL);
     const PtrAccel accel = ptr_accel_brute(&isect, s);
     const PtrRenderSettings settings = { .width = SIZE, .height = SIZE, .samples = 16,
                                          .seed = 1, .max_depth = 50, .threads = 2 };

@@ -124,7 +124,7 @@ int main(void)
     CHECK_INT(ptr_import_scene(PTR_SOURCE_DIR "/scenes/seed.gltf", NULL, &scene, &warnings, &err),
               PTR_OK);
     ptr_strings_free(&warnings);
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
     test_seed_independence();
     test_convergence_rate();
     ptr_scene_free(&scene);

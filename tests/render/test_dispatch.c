@@ -55,8 +55,8 @@ static PtrImage *render_file(const char *scene, const char *out, const char *ker
                      "--quiet", (char *)kernel, NULL };
     CHECK_INT(ptr_cli_main(10, argv), 0);
     PtrError err;
-    PtrImage *img = ptr_image_read(out, &err);
-    CHECK(img != NULL);
+    PtrImage *img = NULL;
+    CHECK_INT(ptr_image_read(NULL, out, &img, &err), PTR_OK);
     return img;
 }
 

@@ -14,7 +14,7 @@ typedef struct Image {
 static Image render(const PtrScene *scene, PtrRenderSettings settings)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_C, scene->spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_C, ptr_cpu_level(), scene->spheres.count, NULL);
     const PtrAccel accel = ptr_accel_brute(&isect, scene);
     Image img = { settings.width, settings.height,
                   malloc((size_t)settings.width * settings.height * 3 * sizeof(float)) };

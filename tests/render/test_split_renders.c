@@ -20,8 +20,8 @@
 static PtrImage *load(const char *path)
 {
     PtrError err;
-    PtrImage *img = ptr_image_read(path, &err);
-    if (!img)
+    PtrImage *img = NULL;
+    if (test_image_read(path, &img, &err) != PTR_OK)
         TEST_FAIL_("%s", err.message);
     return img;
 }
@@ -37,7 +37,7 @@ static void check_passes(const char *path, float noise_threshold)
     CHECK_INT(ptr_import_scene(path, NULL, &scene, &warnings, &err), PTR_OK);
     ptr_strings_free(&warnings);
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, scene.spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
     const PtrAccel accel = ptr_accel_brute(&isect, &scene);
     PtrRenderSettings s = { .width = 40, .height = 40, .seed = 5, .max_depth = 50,
                             .noise_threshold = noise_threshold, .min_samples = 16 };

@@ -1,6 +1,6 @@
 /* For tests that write files and run the command line in process: a
- * temporary folder of their own, paths in it, and ptr_cli_main with a
- * NULL-terminated argument list. */
+ * temporary folder of their own, paths in it, ptr_cli_main with a
+ * NULL-terminated argument list, and images read back in any format. */
 #ifndef PTR_TEST_FILES_H
 #define PTR_TEST_FILES_H
 
@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "image/image.h"
 
 static char test_dir[64];
 
@@ -50,6 +51,17 @@ static int test_ptr(const char *first, ...)
     va_end(ap);
     argv[argc] = NULL;
     return ptr_cli_main(argc, argv);
+}
+
+/* Reads an image as ptr would, with an image module loader of its own. */
+static inline PtrResult test_image_read(const char *path, PtrImage **out, PtrError *err)
+{
+    PtrImageLoader *images = NULL;
+    PtrResult res = ptr_image_loader_new(&images, err);
+    if (res == PTR_OK)
+        res = ptr_image_read(images, path, out, err);
+    ptr_image_loader_free(images);
+    return res;
 }
 
 #endif /* PTR_TEST_FILES_H */

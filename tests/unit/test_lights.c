@@ -98,7 +98,7 @@ enum { SIZE = 32 };
 static float *render(const PtrScene *s, PtrRenderSettings settings)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, s->spheres.count);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), s->spheres.count, NULL);
     float *rgb = malloc((size_t)settings.width * settings.height * 3 * sizeof *rgb);
     PtrError err = { 0 };
     const PtrAccel accel = ptr_accel_brute(&isect, s);
@@ -116,7 +116,7 @@ static float *render(const PtrScene *s, PtrRenderSettings settings)
 static void test_closed_form(void)
 {
     PtrIsectTable isect;
-    ptr_isect_init(&isect, PTR_KERNEL_AUTO, 2);
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), 2, NULL);
     PtrRenderSettings settings = { .samples = 64, .max_depth = 50 };
     double worst = 0;
     for (uint64_t seed = 1; seed <= 4; seed++) {
