@@ -235,11 +235,14 @@ int main(void)
 {
     if (!test_dir_create("test-cli"))
         return 1;
-    test_render_seed_exr();
-    test_png_and_options();
-    test_orthographic_option();
-    test_bad_input();
-    test_image_loaders();
+    const TestCase cases[] = {
+        TEST_CASE(test_render_seed_exr),
+        TEST_CASE(test_png_and_options),
+        TEST_CASE(test_orthographic_option),
+        TEST_CASE(test_bad_input),
+        TEST_CASE(test_image_loaders),
+    };
+    TEST_RUN(cases);
     test_dir_remove();
     return test_report();
 }

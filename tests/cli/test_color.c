@@ -244,11 +244,14 @@ int main(void)
     PtrError err;
     if (!test_dir_create("test-color") || ptr_image_loader_new(&images, &err) != PTR_OK)
         return 1;
-    test_oracle();
-    test_embedded_matches_file();
-    test_lookup_order();
-    test_errors();
-    test_output_path();
+    const TestCase cases[] = {
+        TEST_CASE(test_oracle),
+        TEST_CASE(test_embedded_matches_file),
+        TEST_CASE(test_lookup_order),
+        TEST_CASE(test_errors),
+        TEST_CASE(test_output_path),
+    };
+    TEST_RUN(cases);
     ptr_image_loader_free(images);
     test_dir_remove();
     return test_report();

@@ -127,15 +127,38 @@ static void test_same_image(void)
     ptr_image_free(b);
 }
 
+static void test_gltf_file(void)
+{
+    check_file(BLENDER("spheres.gltf"), 1, 1);
+}
+
+static void test_glb_file(void)
+{
+    check_file(BLENDER("spheres.glb"), 1, 1);
+}
+
+static void test_obj_file(void)
+{
+    check_file(BLENDER("spheres.obj"), 1, 0);
+}
+
+static void test_obj_file_without_pbr(void)
+{
+    check_file(BLENDER("spheres_nopbr.obj"), 0, 0);
+}
+
 int main(void)
 {
     if (!test_dir_create("test-blender"))
         return 1;
-    check_file(BLENDER("spheres.gltf"), 1, 1);
-    check_file(BLENDER("spheres.glb"), 1, 1);
-    check_file(BLENDER("spheres.obj"), 1, 0);
-    check_file(BLENDER("spheres_nopbr.obj"), 0, 0);
-    test_same_image();
+    const TestCase cases[] = {
+        TEST_CASE(test_gltf_file),
+        TEST_CASE(test_glb_file),
+        TEST_CASE(test_obj_file),
+        TEST_CASE(test_obj_file_without_pbr),
+        TEST_CASE(test_same_image),
+    };
+    TEST_RUN(cases);
     test_dir_remove();
     return test_report();
 }

@@ -289,11 +289,14 @@ static void test_orthographic_camera(void)
 
 int main(void)
 {
-    test_hierarchy();
-    test_glb_matches_gltf();
-    test_automatic_camera();
-    test_orbit();
-    test_orthographic_camera();
-    test_bad_input();
+    const TestCase cases[] = {
+        TEST_CASE(test_hierarchy),
+        TEST_CASE(test_glb_matches_gltf),
+        TEST_CASE(test_automatic_camera),
+        TEST_CASE(test_orbit),
+        TEST_CASE(test_orthographic_camera),
+        TEST_CASE(test_bad_input),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -129,9 +129,12 @@ static void test_errors(void)
 
 int main(void)
 {
-    test_materials();
-    test_groups_and_missing_mtl();
-    test_camera_override();
-    test_errors();
+    const TestCase cases[] = {
+        TEST_CASE(test_materials),
+        TEST_CASE(test_groups_and_missing_mtl),
+        TEST_CASE(test_camera_override),
+        TEST_CASE(test_errors),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -206,11 +206,14 @@ static void test_values_only_when_asked(void)
 
 int main(void)
 {
-    test_values_only_when_asked();
-    test_published_entries();
-    test_bins_and_clamping();
-    test_furnace_shows_the_map();
-    test_furnace_clamps();
-    test_materials();
+    const TestCase cases[] = {
+        TEST_CASE(test_values_only_when_asked),
+        TEST_CASE(test_published_entries),
+        TEST_CASE(test_bins_and_clamping),
+        TEST_CASE(test_furnace_shows_the_map),
+        TEST_CASE(test_furnace_clamps),
+        TEST_CASE(test_materials),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -125,8 +125,11 @@ int main(void)
               PTR_OK);
     ptr_strings_free(&warnings);
     ptr_isect_init(&isect, PTR_KERNEL_AUTO, ptr_cpu_level(), scene.spheres.count, NULL);
-    test_seed_independence();
-    test_convergence_rate();
+    const TestCase cases[] = {
+        TEST_CASE(test_seed_independence),
+        TEST_CASE(test_convergence_rate),
+    };
+    TEST_RUN(cases);
     ptr_scene_free(&scene);
     return test_report();
 }

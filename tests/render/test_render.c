@@ -254,11 +254,14 @@ static void test_orthographic_gltf(void)
 
 int main(void)
 {
-    test_furnaces();
-    test_inside_emitter();
-    test_thread_independence();
-    test_orthographic_disc();
-    test_orthographic_furnace();
-    test_orthographic_gltf();
+    const TestCase cases[] = {
+        TEST_CASE(test_furnaces),
+        TEST_CASE(test_inside_emitter),
+        TEST_CASE(test_thread_independence),
+        TEST_CASE(test_orthographic_disc),
+        TEST_CASE(test_orthographic_furnace),
+        TEST_CASE(test_orthographic_gltf),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

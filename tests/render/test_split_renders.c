@@ -263,12 +263,15 @@ int main(void)
 {
     if (!test_dir_create("test-split-renders"))
         return 1;
-    test_passes_are_exact();
-    test_split_and_merge();
-    test_merge_refuses();
-    test_adaptive_parts();
-    test_batch();
-    test_time_budget();
+    const TestCase cases[] = {
+        TEST_CASE(test_passes_are_exact),
+        TEST_CASE(test_split_and_merge),
+        TEST_CASE(test_merge_refuses),
+        TEST_CASE(test_adaptive_parts),
+        TEST_CASE(test_batch),
+        TEST_CASE(test_time_budget),
+    };
+    TEST_RUN(cases);
     test_dir_remove();
     return test_report();
 }

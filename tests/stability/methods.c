@@ -38,3 +38,16 @@ int stability_methods(Method *m, int capacity)
     }
     return n;
 }
+
+int stability_ptr_methods(const Method *methods, int n)
+{
+    int count = 0;
+    for (int i = 0; i < n; i++)
+        count += methods[i].is_ptr;
+    return count;
+}
+
+int stability_ptr_levels(void)
+{
+    return 1 + (ptr_isect_has_asm() ? (int)ptr_cpu_level() - PTR_CPU_NONE : 0);
+}

@@ -22,4 +22,11 @@ enum { FIXED_METHODS = 5, MAX_METHODS = FIXED_METHODS + PTR_CPU_LEVEL_COUNT - 1 
  * a message if they do not fit, rather than writing past the array. */
 int stability_methods(Method *methods, int capacity);
 
+/* How many of the n methods are ptr's own, and how many stability_methods
+ * must give: the C reference, and one a CPU level above none where the
+ * build has assembly. A suite checks the two agree, or it could pass
+ * without testing ptr at all. */
+int stability_ptr_methods(const Method *methods, int n);
+int stability_ptr_levels(void);
+
 #endif

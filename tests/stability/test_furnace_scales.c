@@ -209,21 +209,52 @@ static int resting_sphere_row(const Method *methods, int n)
     return counter_failures;
 }
 
+static Method methods[MAX_METHODS];
+static int method_count;
+static int counter_failures; /* cells where a counter-example failed */
+
+static void test_diffuse(void)
+{
+    const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.5f) };
+    counter_failures += furnace_table(methods, method_count, "diffuse sphere, albedo 0.5: 0.5",
+                                      &diffuse, 0.5);
+}
+
+static void test_mirror(void)
+{
+    const PtrMaterial mirror = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(0.7f) };
+    counter_failures += furnace_table(methods, method_count, "mirror sphere, albedo 0.7: 0.7",
+                                      &mirror, 0.7f);
+}
+
+static void test_glass(void)
+{
+    const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1.0f),
+                                .ior = 1.5f };
+    counter_failures += furnace_table(methods, method_count, "clear glass sphere: 1", &glass, 1.0);
+}
+
+static void test_inside_emitter(void)
+{
+    counter_failures += inside_emitter_table(methods, method_count);
+}
+
+static void test_resting_sphere(void)
+{
+    counter_failures += resting_sphere_row(methods, method_count);
+}
+
 int main(void)
 {
-    Method methods[MAX_METHODS];
-    int n = stability_methods(methods, MAX_METHODS);
-    const PtrMaterial diffuse = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.5f) };
-    const PtrMaterial mirror = { .kind = PTR_MATERIAL_METAL, .albedo = v3_splat(0.7f) };
-    const PtrMaterial glass = { .kind = PTR_MATERIAL_DIELECTRIC, .albedo = v3_splat(1.0f), .ior = 1.5f };
-
+    method_count = stability_methods(methods, MAX_METHODS);
+    CHECK_INT(stability_ptr_methods(methods, method_count), stability_ptr_levels());
     printf("Worst relative error in the middle of the disc ('exact': none at all).\n");
-    int counter_failures = 0;
-    counter_failures += furnace_table(methods, n, "diffuse sphere, albedo 0.5: 0.5", &diffuse, 0.5);
-    counter_failures += furnace_table(methods, n, "mirror sphere, albedo 0.7: 0.7", &mirror, 0.7f);
-    counter_failures += furnace_table(methods, n, "clear glass sphere: 1", &glass, 1.0);
-    counter_failures += inside_emitter_table(methods, n);
-    counter_failures += resting_sphere_row(methods, n);
+    const TestCase cases[] = {
+        TEST_CASE(test_diffuse),        TEST_CASE(test_mirror),
+        TEST_CASE(test_glass),          TEST_CASE(test_inside_emitter),
+        TEST_CASE(test_resting_sphere),
+    };
+    TEST_RUN(cases);
     printf("\ncounter-examples failed %d cells\n", counter_failures);
     CHECK(counter_failures > 0);
     return test_report();

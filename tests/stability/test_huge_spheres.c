@@ -74,6 +74,7 @@ static void lit_ground_table(const Method *methods, int n)
     PtrRenderSettings settings = { .samples = 256, .seed = 1, .max_depth = 50, .threads = 2 };
     printf("\nradius-1e5 ground lit by a small emitter, 256 spp: relative error\n"
            "%-20s %10s %10s\n", "", "worst px", "mean");
+    int ptr_rows = 0;
     for (int i = 0; i < n; i++) {
         if (methods[i].fixed_tmin > 0.0f || !(methods[i].build_flags & PTR_BUILD_RECENTRE))
             continue;
@@ -83,25 +84,31 @@ static void lit_ground_table(const Method *methods, int n)
         if (methods[i].is_ptr) {
             CHECK(e.worst <= 0.015);
             CHECK(e.mean <= 0.005);
+            ptr_rows++;
         }
     }
+    CHECK_INT(ptr_rows, stability_ptr_levels());
 }
 
-int main(void)
-{
-    Method methods[MAX_METHODS];
-    int n = stability_methods(methods, MAX_METHODS);
-    const PtrSky black = { .kind = PTR_SKY_BLACK };
-    const PtrSky bright = { .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(1000.0f) };
+static Method methods[MAX_METHODS];
+static int method_count;
 
+static void test_walls_are_huge(void)
+{
+    const PtrSky black = { .kind = PTR_SKY_BLACK };
     PtrScene probe = room(PTR_BUILD_DEFAULT, black);
     CHECK_INT((int)probe.huge.count, 6); /* the walls, not the lamp */
     ptr_scene_free(&probe);
+}
 
+static void test_closed_room(void)
+{
+    const PtrSky black = { .kind = PTR_SKY_BLACK };
+    const PtrSky bright = { .kind = PTR_SKY_CONSTANT, .radiance = v3_splat(1000.0f) };
     printf("radius-1e5 walls closing a room: pixels that see the sky outside (of %d)\n",
            SIZE * SIZE);
     float *reference = NULL;
-    for (int i = 0; i < n; i++) {
+    for (int i = 0; i < method_count; i++) {
         float *closed = render(&methods[i], black, PTR_ACCEL_BRUTE);
         float *open = render(&methods[i], bright, PTR_ACCEL_BRUTE);
         int leaking = 0;
@@ -127,6 +134,22 @@ int main(void)
         free(open);
     }
     free(reference);
-    lit_ground_table(methods, n);
+}
+
+static void test_lit_ground(void)
+{
+    lit_ground_table(methods, method_count);
+}
+
+int main(void)
+{
+    method_count = stability_methods(methods, MAX_METHODS);
+    CHECK_INT(stability_ptr_methods(methods, method_count), stability_ptr_levels());
+    const TestCase cases[] = {
+        TEST_CASE(test_walls_are_huge),
+        TEST_CASE(test_closed_room),
+        TEST_CASE(test_lit_ground),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

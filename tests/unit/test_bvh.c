@@ -442,14 +442,17 @@ static void test_coincident(void)
 
 int main(void)
 {
-    test_small();
-    test_coincident();
-    test_huge_rule();
-    test_huge();
-    test_scenes();
-    test_threads();
-    test_auto();
-    test_renders_files();
-    test_renders_hard();
+    const TestCase cases[] = {
+        TEST_CASE(test_small),
+        TEST_CASE(test_coincident),
+        TEST_CASE(test_huge_rule),
+        TEST_CASE(test_huge),
+        TEST_CASE(test_scenes),
+        TEST_CASE(test_threads),
+        TEST_CASE(test_auto),
+        TEST_CASE(test_renders_files),
+        TEST_CASE(test_renders_hard),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -162,8 +162,11 @@ static void test_random_against_long_double(void)
 
 int main(void)
 {
-    test_reference_rays();
-    test_many_spheres();
-    test_random_against_long_double();
+    const TestCase cases[] = {
+        TEST_CASE(test_reference_rays),
+        TEST_CASE(test_many_spheres),
+        TEST_CASE(test_random_against_long_double),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -213,9 +213,12 @@ static void test_unbiased(void)
 
 int main(void)
 {
-    test_alias_table();
-    test_sample_pdf();
-    test_closed_form();
-    test_unbiased();
+    const TestCase cases[] = {
+        TEST_CASE(test_alias_table),
+        TEST_CASE(test_sample_pdf),
+        TEST_CASE(test_closed_form),
+        TEST_CASE(test_unbiased),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -183,11 +183,14 @@ static void test_material_density(void)
 
 int main(void)
 {
-    test_diffuse_density();
-    test_material_density();
-    test_schlick();
-    test_energy_and_directions();
-    test_mirror();
-    test_dielectric();
+    const TestCase cases[] = {
+        TEST_CASE(test_diffuse_density),
+        TEST_CASE(test_material_density),
+        TEST_CASE(test_schlick),
+        TEST_CASE(test_energy_and_directions),
+        TEST_CASE(test_mirror),
+        TEST_CASE(test_dielectric),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -272,10 +272,13 @@ static void test_hash_in_file_order(void)
 
 int main(void)
 {
-    test_release_whole_pages_only();
-    test_release_in_steps();
-    test_spheres_release();
-    test_material_widths();
-    test_hash_in_file_order();
+    const TestCase cases[] = {
+        TEST_CASE(test_release_whole_pages_only),
+        TEST_CASE(test_release_in_steps),
+        TEST_CASE(test_spheres_release),
+        TEST_CASE(test_material_widths),
+        TEST_CASE(test_hash_in_file_order),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

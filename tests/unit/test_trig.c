@@ -7,7 +7,7 @@
 
 #include "base/trig.h"
 
-int main(void)
+static void test_every_sample(void)
 {
     double worst = 0, worst_u = 0;
     for (uint32_t i = 0; i < (1u << 24); i++) {
@@ -20,7 +20,11 @@ int main(void)
     }
     printf("worst absolute error %.3g at u = %.9g\n", worst, worst_u);
     CHECK(worst < 1.1e-7); /* 1.07e-7 measured: under one float ulp of 1 */
-    /* The quarter turns are exact. */
+}
+
+/* The quarter turns are exact. */
+static void test_quarter_turns(void)
+{
     const float quarters[4][3] = { { 0.0f, 0.0f, 1.0f }, { 0.25f, 1.0f, 0.0f },
                                    { 0.5f, 0.0f, -1.0f }, { 0.75f, -1.0f, 0.0f } };
     for (int q = 0; q < 4; q++) {
@@ -29,5 +33,11 @@ int main(void)
         CHECK_FLOAT_EQ(s, quarters[q][1]);
         CHECK_FLOAT_EQ(c, quarters[q][2]);
     }
+}
+
+int main(void)
+{
+    const TestCase cases[] = { TEST_CASE(test_every_sample), TEST_CASE(test_quarter_turns) };
+    TEST_RUN(cases);
     return test_report();
 }
