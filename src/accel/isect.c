@@ -56,10 +56,17 @@ PTR_DECL_CLOSEST_HIT(ptr_closest_hit_c)
     return best_index != PTR_NO_HIT;
 }
 
+/* Lane k of a packet as one ray, and one ray's answer as lane k's. */
 static PtrRay packet_lane(const PtrRayPacket *rays, int k)
 {
     return (PtrRay){ { rays->org[0][k], rays->org[1][k], rays->org[2][k] }, rays->tmin[k],
                      { rays->dir[0][k], rays->dir[1][k], rays->dir[2][k] }, rays->tmax[k] };
+}
+
+static void set_lane(PtrHitPacket *hits, int k, PtrHit hit)
+{
+    hits->t[k] = hit.t;
+    hits->sphere[k] = hit.sphere;
 }
 
 /* Lane by lane, the one-ray references: the definitions the packet kernels
@@ -70,8 +77,7 @@ PTR_DECL_CLOSEST_HIT_PACKET(ptr_closest_hit_packet_c)
         const PtrRay ray = packet_lane(rays, k);
         PtrHit hit;
         ptr_closest_hit_c(&ray, spheres, count, &hit);
-        hits->t[k] = hit.t;
-        hits->sphere[k] = hit.sphere;
+        set_lane(hits, k, hit);
     }
 }
 
@@ -81,8 +87,7 @@ PTR_DECL_BVH_CLOSEST_HIT_PACKET(ptr_bvh_closest_hit_packet_c)
         const PtrRay ray = packet_lane(rays, k);
         PtrHit hit;
         ptr_bvh_closest_hit_c(&ray, bvh, spheres, &hit);
-        hits->t[k] = hit.t;
-        hits->sphere[k] = hit.sphere;
+        set_lane(hits, k, hit);
     }
 }
 

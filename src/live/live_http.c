@@ -440,7 +440,7 @@ static PtrResult bind_socket(const char *option, char *host, const char *port, i
     struct addrinfo hints = { .ai_socktype = SOCK_STREAM, .ai_flags = AI_NUMERICSERV }, *list;
     int gai = getaddrinfo(host, port, &hints, &list);
     if (gai)
-        return ptr_live_error(err, PTR_ERR_USAGE, "%s: cannot use host '%s': %s", option, host,
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: cannot use host '%s': %s", option, host,
                               gai_strerror(gai));
     int fd = -1, why = 0;
     for (struct addrinfo *a = list; a && fd < 0; a = a->ai_next) {
@@ -464,7 +464,7 @@ static PtrResult bind_socket(const char *option, char *host, const char *port, i
     }
     freeaddrinfo(list);
     if (fd < 0)
-        return ptr_live_error(err, PTR_ERR_USAGE, "%s %s:%s: %s%s", option, host, port,
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s %s:%s: %s%s", option, host, port,
                               strerror(why),
                               why == EADDRINUSE ? " (another program listens there; try another "
                                                   "port, or 0 for a free one)" : "");
@@ -495,7 +495,7 @@ PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err)
     if (!s->http) {
         close(s->listen_fd);
         s->listen_fd = -1;
-        return ptr_live_error(err, PTR_ERR_NOMEM, "--live: out of memory");
+        return ptr_error_set(err, PTR_ERR_NOMEM, "--live: out of memory");
     }
     unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD;
     if (family == AF_INET6)
@@ -516,7 +516,7 @@ PtrResult ptr_live_http_start(PtrLiveSession *s, PtrError *err)
         s->http = NULL;
         close(s->listen_fd);
         s->listen_fd = -1;
-        return ptr_live_error(err, PTR_ERR_INTERNAL, "--live %s: cannot start the server", s->url);
+        return ptr_error_set(err, PTR_ERR_INTERNAL, "--live %s: cannot start the server", s->url);
     }
     s->listen_fd = -1; /* the server's now: it closes it */
     return PTR_OK;

@@ -6,7 +6,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,21 +21,6 @@ enum { FRAMES_PER_SECOND = 4, VIEW_PIXELS = 4096, ENCODER_NICE = 10 };
  * then for its event stream to end and the image to leave: each wait at
  * most this long. */
 static const double linger_seconds = 1.0;
-
-PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
-{
-    if (!err)
-        return code;
-    err->code = code;
-    va_list args;
-    va_start(args, fmt);
-    vsnprintf(err->message, sizeof err->message, fmt, args);
-    va_end(args);
-    for (char *c = err->message; *c; c++)
-        if (*c == '\n')
-            *c = ' ';
-    return code;
-}
 
 double ptr_live_now(void)
 {
@@ -75,7 +59,7 @@ PtrResult ptr_live_parse_address(const char *option, const char *text, char *hos
     unsigned long n = strtoul(p, &end, 10);
     if (*p < '0' || *p > '9' || *end || errno || n > 65535 || (colon && host_len == 0) ||
         host_len >= host_size || strlen(p) >= port_size)
-        return ptr_live_error(
+        return ptr_error_set(
             err, PTR_ERR_USAGE,
             "%s: '%s' is not [HOST:]PORT (a port from 0 to 65535) (see ptr --help)", option, text);
     if (colon) {
@@ -221,7 +205,7 @@ static PtrResult session_start(const PtrLiveOptions *options, PtrLiveSession **o
 {
     PtrLiveSession *s = calloc(1, sizeof *s);
     if (!s)
-        return ptr_live_error(err, PTR_ERR_NOMEM, "out of memory for the live view");
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the live view");
     s->options = *options;
     s->listen_fd = -1;
     s->status.remaining = -1;
@@ -235,7 +219,7 @@ static PtrResult session_start(const PtrLiveOptions *options, PtrLiveSession **o
     if (options->http) {
         if (pthread_create(&s->encoder, NULL, encode_loop, s)) {
             session_stop(s);
-            return ptr_live_error(err, PTR_ERR_INTERNAL, "--live: cannot start a thread");
+            return ptr_error_set(err, PTR_ERR_INTERNAL, "--live: cannot start a thread");
         }
         s->encoder_started = 1;
     }

@@ -60,11 +60,6 @@ struct PtrLiveSession {
 PtrResult ptr_live_parse_address(const char *option, const char *text, char *host,
                                  size_t host_size, char *port, size_t port_size, PtrError *err);
 
-/* Fills err as ptr_error_set would, err NULL too (the module cannot call
- * into ptr). */
-PtrResult ptr_live_error(PtrError *err, PtrResult code, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
 /* Seconds on a steady clock. */
 double ptr_live_now(void);
 

@@ -313,7 +313,7 @@ PtrResult ptr_live_tev_start(PtrLiveSession *s, PtrError *err)
 {
     LiveTev *t = calloc(1, sizeof *t);
     if (!t)
-        return ptr_live_error(err, PTR_ERR_NOMEM, "out of memory for --tev");
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for --tev");
     t->fd = -1;
     PtrResult res = ptr_live_parse_address("--tev", s->options.tev, t->host, sizeof t->host,
                                            t->port, sizeof t->port, err);
@@ -325,7 +325,7 @@ PtrResult ptr_live_tev_start(PtrLiveSession *s, PtrError *err)
     if (pthread_create(&t->thread, NULL, send_loop, s)) {
         s->tev = NULL;
         free(t);
-        return ptr_live_error(err, PTR_ERR_INTERNAL, "--tev: cannot start a thread");
+        return ptr_error_set(err, PTR_ERR_INTERNAL, "--tev: cannot start a thread");
     }
     return PTR_OK;
 }

@@ -18,7 +18,7 @@
 
 enum { WIDTH = 48, HEIGHT = 32 };
 
-typedef enum SceneKind { CLUSTER, ORTHOGRAPHIC, HUGE_GROUND, CLOUD, EMPTY, SCENE_KINDS } SceneKind;
+typedef enum SceneKind { CLUSTER, ORTHOGRAPHIC, HUGE_GROUND, CLOUD, EMPTY } SceneKind;
 static const char *const scene_names[] = { "cluster", "cluster, orthographic", "huge ground",
                                            "cloud", "empty" };
 
@@ -133,40 +133,44 @@ static int compare(const char *what, Sums a, Sums b, size_t pixels)
     return differ == 0;
 }
 
-int main(void)
+typedef struct Pair {
+    PtrIntegrator integrator;
+    PtrKernel kernel;
+    const char *name;
+} Pair;
+
+static const Pair pairs[] = {
+    { PTR_INTEGRATOR_PATHS, PTR_KERNEL_AUTO, "paths, fastest kernel" },
+    { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_C, "bundles, C kernels" },
+    { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_AUTO, "bundles, fastest kernel" },
+};
+
+typedef struct Variant {
+    const char *name;
+    PtrRenderSettings settings;
+    uint32_t first, count, pass;
+} Variant;
+
+/* Every setting that changes a path, each on the base settings. */
+static Variant variants[] = {
+    { "default", { 0 }, 0, 12, 12 },
+    { "independent sampler, no light sampling", { 0 }, 0, 9, 9 },
+    { "depth 0", { 0 }, 0, 3, 3 },
+    { "depth 1", { 0 }, 0, 5, 5 },
+    { "depth 3", { 0 }, 0, 5, 5 },
+    { "adaptive", { 0 }, 0, 48, 48 },
+    { "region, samples 7..26 in passes of 5, one thread", { 0 }, 7, 19, 5 },
+    { "transparent, in passes of 4", { 0 }, 0, 12, 4 },
+    { "transparent, adaptive", { 0 }, 0, 48, 48 },
+};
+enum { VARIANTS = sizeof variants / sizeof variants[0] };
+
+static void set_variants(void)
 {
-    typedef struct Pair {
-        PtrIntegrator integrator;
-        PtrKernel kernel;
-        const char *name;
-    } Pair;
-    const Pair pairs[] = {
-        { PTR_INTEGRATOR_PATHS, PTR_KERNEL_AUTO, "paths, fastest kernel" },
-        { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_C, "bundles, C kernels" },
-        { PTR_INTEGRATOR_BUNDLES, PTR_KERNEL_AUTO, "bundles, fastest kernel" },
-    };
-    int bundles = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level());
-    printf("test_bundles: against paths with the C kernels: %s\n",
-           bundles ? "paths with the fastest kernel, bundles with C and the fastest"
-                   : "paths with the fastest kernel (no bundles at this CPU level)");
-    typedef struct Variant {
-        const char *name;
-        PtrRenderSettings settings;
-        uint32_t first, count, pass;
-    } Variant;
     const PtrRenderSettings base = { .width = WIDTH, .height = HEIGHT, .seed = 5, .max_depth = 50,
                                      .threads = 2 };
-    Variant variants[] = {
-        { "default", base, 0, 12, 12 },
-        { "independent sampler, no light sampling", base, 0, 9, 9 },
-        { "depth 0", base, 0, 3, 3 },
-        { "depth 1", base, 0, 5, 5 },
-        { "depth 3", base, 0, 5, 5 },
-        { "adaptive", base, 0, 48, 48 },
-        { "region, samples 7..26 in passes of 5, one thread", base, 7, 19, 5 },
-        { "transparent, in passes of 4", base, 0, 12, 4 },
-        { "transparent, adaptive", base, 0, 48, 48 },
-    };
+    for (int v = 0; v < VARIANTS; v++)
+        variants[v].settings = base;
     variants[1].settings.sampler = PTR_SAMPLER_INDEPENDENT;
     variants[1].settings.direct_lighting = PTR_OFF;
     variants[2].settings.max_depth = 0;
@@ -180,33 +184,76 @@ int main(void)
     variants[8].settings.transparent = 1;
     variants[8].settings.noise_threshold = 0.05f;
     variants[8].settings.min_samples = 16;
-    for (int k = 0; k < SCENE_KINDS; k++) {
-        /* A scene of its own for each side, as every render builds over
-         * it again: each cluster goes to the tree with the C kernels (68
-         * spheres, above their crossover) and to brute force with assembly,
-         * which searches the spheres in the build's order too. */
-        PtrScene scene = make_scene((SceneKind)k), other = make_scene((SceneKind)k);
-        for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
-            const Variant *var = &variants[v];
-            PtrRegion r = ptr_render_region(&var->settings);
-            size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-            Sums reference = render(&scene, PTR_KERNEL_C, PTR_INTEGRATOR_PATHS, var->settings,
-                                    var->first, var->count, var->count);
-            for (size_t p = 0; p < sizeof pairs / sizeof pairs[0]; p++) {
-                if (pairs[p].integrator == PTR_INTEGRATOR_BUNDLES && !bundles)
-                    continue;
-                Sums other_sums = render(&other, pairs[p].kernel, pairs[p].integrator,
-                                         var->settings, var->first, var->count, var->pass);
-                char what[200];
-                snprintf(what, sizeof what, "%s, %s: %s", scene_names[k], var->name,
-                         pairs[p].name);
-                if (compare(what, reference, other_sums, pixels))
-                    printf("  %-90s identical\n", what);
-            }
-            free(reference.acc);
+}
+
+/* Every variant of one scene, every pair against the reference. */
+static void test_scene(SceneKind kind)
+{
+    const int bundles = ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level());
+    /* A scene of its own for each side, as every render builds over it
+     * again: each cluster goes to the tree with the C kernels (68 spheres,
+     * above their crossover) and to brute force with assembly, which
+     * searches the spheres in the build's order too. */
+    PtrScene scene = make_scene(kind), other = make_scene(kind);
+    for (int v = 0; v < VARIANTS; v++) {
+        const Variant *var = &variants[v];
+        PtrRegion r = ptr_render_region(&var->settings);
+        size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
+        Sums reference = render(&scene, PTR_KERNEL_C, PTR_INTEGRATOR_PATHS, var->settings,
+                                var->first, var->count, var->count);
+        for (size_t p = 0; p < sizeof pairs / sizeof pairs[0]; p++) {
+            if (pairs[p].integrator == PTR_INTEGRATOR_BUNDLES && !bundles)
+                continue;
+            Sums other_sums = render(&other, pairs[p].kernel, pairs[p].integrator,
+                                     var->settings, var->first, var->count, var->pass);
+            char what[200];
+            snprintf(what, sizeof what, "%s, %s: %s", scene_names[kind], var->name,
+                     pairs[p].name);
+            if (compare(what, reference, other_sums, pixels))
+                printf("  %-90s identical\n", what);
         }
-        ptr_scene_free(&scene);
-        ptr_scene_free(&other);
+        free(reference.acc);
     }
+    ptr_scene_free(&scene);
+    ptr_scene_free(&other);
+}
+
+static void test_cluster(void)
+{
+    test_scene(CLUSTER);
+}
+
+static void test_orthographic(void)
+{
+    test_scene(ORTHOGRAPHIC);
+}
+
+static void test_huge_ground(void)
+{
+    test_scene(HUGE_GROUND);
+}
+
+static void test_cloud(void)
+{
+    test_scene(CLOUD);
+}
+
+static void test_empty(void)
+{
+    test_scene(EMPTY);
+}
+
+int main(void)
+{
+    printf("test_bundles: against paths with the C kernels: %s\n",
+           ptr_integrator_available(PTR_INTEGRATOR_BUNDLES, ptr_cpu_level())
+               ? "paths with the fastest kernel, bundles with C and the fastest"
+               : "paths with the fastest kernel (no bundles at this CPU level)");
+    set_variants();
+    const TestCase cases[] = {
+        TEST_CASE(test_cluster),    TEST_CASE(test_orthographic), TEST_CASE(test_huge_ground),
+        TEST_CASE(test_cloud),      TEST_CASE(test_empty),
+    };
+    TEST_RUN(cases);
     return test_report();
 }

@@ -258,17 +258,27 @@ static void test_framing(const char *projection)
     ptr_image_free(image);
 }
 
+static void test_framing_perspective(void)
+{
+    test_framing("perspective");
+}
+
+static void test_framing_orthographic(void)
+{
+    test_framing("orthographic");
+}
+
 int main(void)
 {
     if (!test_dir_create("transparent"))
         return 1;
-    test_same_bytes(); /* first: its CPU cap must not reach the cases after it */
-    test_alpha_and_composite();
-    test_regions_merge();
-    test_png();
-    test_adaptive();
-    test_framing("perspective");
-    test_framing("orthographic");
+    const TestCase cases[] = {
+        TEST_CASE(test_same_bytes),          TEST_CASE(test_alpha_and_composite),
+        TEST_CASE(test_regions_merge),       TEST_CASE(test_png),
+        TEST_CASE(test_adaptive),            TEST_CASE(test_framing_perspective),
+        TEST_CASE(test_framing_orthographic),
+    };
+    TEST_RUN(cases);
     test_dir_remove();
     return test_report();
 }
