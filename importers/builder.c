@@ -543,3 +543,23 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags)
     ptr_builder_free(b);
     return res;
 }
+
+PtrResult ptr_builder_keep_attributes(PtrSceneBuilder *b, int colors, int values)
+{
+    const int keep[OPTIONAL_ARRAYS] = { [OPTIONAL_COLORS] = colors, [OPTIONAL_VALUES] = values };
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
+        uint32_t **array = optional_array(b, k);
+        if (!keep[k] || *array)
+            continue;
+        *array = malloc((b->capacity ? b->capacity : 1) * optional_arrays[k].words * sizeof **array);
+        if (!*array)
+            return PTR_ERR_NOMEM;
+        fill_none(b, k, 0, b->capacity);
+    }
+    return PTR_OK;
+}
+
+void ptr_builder_fill_value(PtrSceneBuilder *b, size_t n, double value)
+{
+    b->values[n] = (float)value;
+}
