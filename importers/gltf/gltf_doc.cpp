@@ -17,6 +17,7 @@
 #include <unistd.h>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -491,9 +492,8 @@ std::vector<std::string> required_extensions(const nlohmann::json &doc)
 
 // Whether ptr may have to change a glTF JSON text before tinygltf loads it,
 // from the text alone: a .glb's BIN chunk, a "uri" that is not a data: URI
-// (a file, perhaps a buffer to map), a compression extension, or required
-// extensions (to name before tinygltf refuses the file). Where not, the text
-// goes to tinygltf unparsed by ptr.
+// (a file, perhaps a buffer to map), or a compression extension. Where not,
+// the text goes to tinygltf unparsed by ptr.
 bool needs_changes(std::string_view json, bool binary)
 {
     static const char uri[] = "\"uri\"";
@@ -502,8 +502,8 @@ bool needs_changes(std::string_view json, bool binary)
         if (value == json.npos || json.compare(value, 6, "\"data:") != 0)
             return true;
     }
-    return binary || json.find("extensionsRequired") != json.npos ||
-           json.find(meshopt_extension) != json.npos || json.find(draco_extension) != json.npos;
+    return binary || json.find(meshopt_extension) != json.npos ||
+           json.find(draco_extension) != json.npos;
 }
 
 const tinygltf::Value *object_member(const tinygltf::Value &object, const char *key)
@@ -572,19 +572,22 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         std::string_view json;
         size_t rest = 0;
         const bool has_json = fault.empty() && json_of(bytes, binary, &json, &rest);
-        // The one parse of the JSON on ptr's side, where ptr has something
-        // to change in it before tinygltf parses the text it is given: all
-        // that reads or changes the JSON works on this document.
-        nlohmann::json parsed;
-        if (has_json && needs_changes(json, binary))
-            parsed = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
-        const bool object = parsed.is_object();
+        // The JSON as ptr reads and changes it, parsed when first needed
+        // and never again: all that reads or changes the JSON works on this
+        // document, and tinygltf parses only the text it is given.
+        std::optional<nlohmann::json> parsed_json;
+        const auto parsed = [&]() -> nlohmann::json & {
+            if (!parsed_json)
+                parsed_json = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+            return *parsed_json;
+        };
+        const bool object = has_json && needs_changes(json, binary) && parsed().is_object();
         GltfBytes bin = { nullptr, 0 };
         const bool bin_mapped = object && binary && bytes.mapped() &&
-                                bin_kept_out(bytes, rest, parsed, &bin);
+                                bin_kept_out(bytes, rest, parsed(), &bin);
         const bool external_mapped =
-            object && external_buffers_kept_out(dir, parsed, &doc->external);
-        const bool loadable = object && loadable_by_tinygltf(parsed);
+            object && external_buffers_kept_out(dir, parsed(), &doc->external);
+        const bool loadable = object && loadable_by_tinygltf(parsed());
         bool ok = false;
         if (fault.empty() && !bin_mapped && !external_mapped && !loadable) {
             ok = load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
@@ -592,7 +595,7 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
             // The JSON as changed, with the file's other chunks after it, or
             // with a .glb's BIN chunk mapped, a 4-byte stand-in for it.
             static const unsigned char stand_in[12] = { 4, 0, 0, 0, 'B', 'I', 'N', 0 };
-            const std::string text = parsed.dump();
+            const std::string text = parsed().dump();
             if (binary) {
                 const std::vector<unsigned char> glb =
                     bin_mapped ? glb_of(text, stand_in, sizeof stand_in)
@@ -605,8 +608,8 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         }
         // tinygltf stops at what it cannot load before ptr sees the
         // extensions: say first what the file requires that ptr lacks.
-        if (!ok && object)
-            fault = required_extension_fault(required_extensions(parsed));
+        if (!ok && has_json && parsed().is_object())
+            fault = required_extension_fault(required_extensions(parsed()));
         if (!ok && fault.empty())
             fault = error.empty() ? "not a valid glTF file" : error;
         if (fault.empty())
