@@ -415,6 +415,7 @@ typedef struct Instance {
 /* Why a slot gives no sphere. */
 typedef enum Fault { NO_FAULT, TRANSFORM_FAULT, VALUE_FAULT, SPHERE_FAULT } Fault;
 
+/* Instance i of the run, or why it gives no spheres. */
 static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
 {
     out->world = *run->world;
@@ -447,6 +448,8 @@ static size_t set_of(const NodeRun *run, size_t k, size_t *point)
     return set;
 }
 
+/* Point j of ps in instance in as the builder's sphere n, or why it gives
+ * none. */
 static Fault point_sphere(const NodeRun *run, const Instance *in, const PointSet *ps, size_t j,
                           size_t n)
 {
