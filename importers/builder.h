@@ -89,9 +89,9 @@ typedef enum PtrBuildFlags {
 PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags);
 
 /* Makes the builder keep a colour (with colors) and a value (with values)
- * for every sphere, none until given, for an importer that gives them to
- * only some of the spheres ptr_builder_add_spheres adds: it then adds them
- * without with_colors, and fills the ones that have them with
+ * for every sphere, none until one is given: for an importer that gives them
+ * to only some of the spheres ptr_builder_add_spheres adds (without
+ * with_colors, where colours are kept so), filling those with
  * ptr_builder_fill_sphere and ptr_builder_fill_value. */
 PtrResult ptr_builder_keep_attributes(PtrSceneBuilder *builder, int colors, int values);
 
