@@ -78,6 +78,18 @@ static PtrResult no_room(size_t count, PtrError *err)
     return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu spheres", count);
 }
 
+/* Starts optional array k for the builder's capacity, its first filled
+ * spheres none (the others are the caller's to fill). */
+static PtrResult start_optional(PtrSceneBuilder *b, size_t k, size_t filled, PtrError *err)
+{
+    uint32_t **array = optional_array(b, k);
+    *array = malloc((b->capacity ? b->capacity : 1) * optional_arrays[k].words * sizeof **array);
+    if (!*array)
+        return no_room(b->capacity, err);
+    fill_none(b, k, 0, filled);
+    return PTR_OK;
+}
+
 /* Resizes every array to capacity spheres (while they fill, count stays
  * below it; add_spheres shrinks them below count as it empties them). */
 static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
@@ -139,14 +151,12 @@ PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_col
         if (r != PTR_OK)
             return r;
     }
-    uint32_t **colors = optional_array(b, OPTIONAL_color);
-    if (with_colors && !*colors) {
-        *colors = malloc(b->capacity * optional_arrays[OPTIONAL_color].words * sizeof **colors);
-        if (!*colors)
-            return no_room(b->capacity, err);
+    if (with_colors && !*optional_array(b, OPTIONAL_color)) {
         /* The earlier spheres only: the caller writes the new ones' (at
          * 10^8 spheres, 800 MB), and each later one fills its own. */
-        fill_none(b, OPTIONAL_color, 0, b->count);
+        PtrResult r = start_optional(b, OPTIONAL_color, b->count, err);
+        if (r != PTR_OK)
+            return r;
     }
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k) && !(k == OPTIONAL_color && with_colors))
@@ -552,4 +562,22 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
     scene->camera.up = relative(b->up, zero);
     ptr_builder_free(b);
     return res;
+}
+
+PtrResult ptr_builder_keep_attributes(PtrSceneBuilder *b, int colors, int values,
+                                      PtrError *err)
+{
+    const int keep[OPTIONAL_ARRAYS] = { [OPTIONAL_color] = colors, [OPTIONAL_VALUES] = values };
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
+        if (keep[k] && !*optional_array(b, k)) {
+            PtrResult r = start_optional(b, k, b->capacity, err);
+            if (r != PTR_OK)
+                return r;
+        }
+    return PTR_OK;
+}
+
+void ptr_builder_fill_value(PtrSceneBuilder *b, size_t n, double value)
+{
+    b->values[n] = (float)value;
 }

@@ -94,4 +94,16 @@ typedef enum PtrBuildFlags {
  * precision, PTR_ERR_NOMEM if memory runs out. */
 PtrResult ptr_builder_finish(PtrSceneBuilder *builder, unsigned flags, PtrError *err);
 
+/* Makes the builder keep a colour (with colors) and a value (with values)
+ * for every sphere, none until one is given: for an importer that gives them
+ * to only some of the spheres ptr_builder_add_spheres adds (without
+ * with_colors, where colours are kept so), filling those with
+ * ptr_builder_fill_sphere and ptr_builder_fill_value. */
+PtrResult ptr_builder_keep_attributes(PtrSceneBuilder *builder, int colors, int values,
+                                      PtrError *err);
+
+/* Gives sphere n of those ptr_builder_add_spheres added its value (see
+ * PtrSpheres.value), from any thread, once the builder keeps values. */
+void ptr_builder_fill_value(PtrSceneBuilder *builder, size_t n, double value);
+
 #endif /* PTR_BUILDER_H */

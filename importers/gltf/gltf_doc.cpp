@@ -17,7 +17,9 @@
 #include <unistd.h>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "base/shim_error.h"
@@ -314,13 +316,13 @@ bool load(tinygltf::TinyGLTF &loader, const unsigned char *data, size_t size, bo
                                                unsigned(size), dir);
 }
 
-// The JSON of a glTF file's bytes: all of a .gltf, a .glb's JSON chunk (rest:
-// where the chunks after it start). False if there is none.
-bool json_of(const FileBytes &bytes, bool binary, std::string *json, size_t *rest)
+// The JSON of a glTF file's bytes, where it lies: all of a .gltf, a .glb's
+// JSON chunk (rest: where the chunks after it start). False if there is none.
+bool json_of(const FileBytes &bytes, bool binary, std::string_view *json, size_t *rest)
 {
     const unsigned char *b = bytes.data();
     if (!binary) {
-        json->assign(reinterpret_cast<const char *>(b), bytes.size());
+        *json = std::string_view(reinterpret_cast<const char *>(b), bytes.size());
         *rest = bytes.size();
         return true;
     }
@@ -330,7 +332,7 @@ bool json_of(const FileBytes &bytes, bool binary, std::string *json, size_t *res
     std::memcpy(&length, b + 12, 4);
     if (length > bytes.size() - 20)
         return false;
-    json->assign(reinterpret_cast<const char *>(b + 20), length);
+    *json = std::string_view(reinterpret_cast<const char *>(b + 20), length);
     *rest = 20 + size_t(length);
     return true;
 }
@@ -355,10 +357,10 @@ std::vector<unsigned char> glb_of(std::string json, const unsigned char *rest, s
 }
 
 // A mapped .glb's BIN chunk as buffer 0 (its first buffer, with no uri),
-// which tinygltf would copy whole: the JSON it is given instead, that
-// buffer cut to 4 bytes, and the chunk's bytes. False (json untouched) if the
-// file has no such buffer, or its JSON does not parse.
-bool bin_kept_out(const FileBytes &bytes, size_t rest, std::string *json, GltfBytes *bin)
+// which tinygltf would copy whole: that buffer cut to 4 bytes in doc (the
+// JSON object tinygltf is given), and the chunk's bytes. False (doc
+// untouched) if the file has no such buffer.
+bool bin_kept_out(const FileBytes &bytes, size_t rest, nlohmann::json &doc, GltfBytes *bin)
 {
     uint32_t chunk[2]; /* length, type */
     if (bytes.size() - rest < sizeof chunk + 4)
@@ -366,9 +368,7 @@ bool bin_kept_out(const FileBytes &bytes, size_t rest, std::string *json, GltfBy
     std::memcpy(chunk, bytes.data() + rest, sizeof chunk);
     if (std::memcmp(&chunk[1], "BIN", 4) != 0 || chunk[0] > bytes.size() - rest - sizeof chunk)
         return false;
-    nlohmann::json doc = nlohmann::json::parse(*json, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") ||
-        !doc["buffers"].is_array() || doc["buffers"].empty())
+    if (!doc.contains("buffers") || !doc["buffers"].is_array() || doc["buffers"].empty())
         return false;
     nlohmann::json &buffer = doc["buffers"][0];
     if (!buffer.is_object() || buffer.contains("uri") || !buffer.contains("byteLength") ||
@@ -379,7 +379,6 @@ bool bin_kept_out(const FileBytes &bytes, size_t rest, std::string *json, GltfBy
     *bin = GltfBytes{ bytes.data() + rest + sizeof chunk,
                       size_t(buffer["byteLength"].get<unsigned long long>()) };
     buffer["byteLength"] = 4;
-    *json = doc.dump();
     return true;
 }
 
@@ -405,17 +404,13 @@ bool uri_decoded(const std::string &uri, std::string *out)
 // The buffers of a glTF JSON that name a file (not a data: URI), which
 // tinygltf would read whole into memory: each that is a regular file at
 // least its byteLength long is mapped into external and given to tinygltf as
-// a 4-byte data: stand-in. The others are left to tinygltf, which reads
-// them or says what is wrong with them. Returns whether any was (json then
-// rewritten).
-bool external_buffers_kept_out(const std::string &dir, std::string *json,
+// a 4-byte data: stand-in in doc (the JSON object tinygltf is given). The
+// others are left to tinygltf, which reads them or says what is wrong with
+// them. Returns whether any was.
+bool external_buffers_kept_out(const std::string &dir, nlohmann::json &doc,
                                ExternalBuffers *external)
 {
-    if (json->find("\"uri\"") == std::string::npos)
-        return false;
-    nlohmann::json doc = nlohmann::json::parse(*json, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") ||
-        !doc["buffers"].is_array())
+    if (!doc.contains("buffers") || !doc["buffers"].is_array())
         return false;
     nlohmann::json &buffers = doc["buffers"];
     external->file.resize(buffers.size());
@@ -443,8 +438,6 @@ bool external_buffers_kept_out(const std::string &dir, std::string *json,
         buffer["byteLength"] = 4;
         any = true;
     }
-    if (any)
-        *json = doc.dump();
     return any;
 }
 
@@ -459,22 +452,21 @@ const nlohmann::json *json_extension(const nlohmann::json &object, const char *n
     return &object["extensions"][name];
 }
 
-// What tinygltf refuses of compressed files, taken out of their JSON: the
-// fallback buffers of EXT_meshopt_compression (no data: for loaders that
-// cannot decode) get one byte, and primitives compressed by Draco lose their
-// indices (an accessor without data, which ptr never reads). Empty if the
-// text does not parse.
-std::string loadable_by_tinygltf(const std::string &json)
+// What tinygltf refuses of compressed files, taken out of their JSON object
+// doc: the fallback buffers of EXT_meshopt_compression (no data: for
+// loaders that cannot decode) get one byte, and primitives compressed by
+// Draco lose their indices (an accessor without data, which ptr never
+// reads). Returns whether anything was.
+bool loadable_by_tinygltf(nlohmann::json &doc)
 {
-    nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object())
-        return "";
+    bool any = false;
     if (doc.contains("buffers") && doc["buffers"].is_array())
         for (nlohmann::json &buffer : doc["buffers"]) {
             const nlohmann::json *ext = json_extension(buffer, meshopt_extension);
             if (ext && ext->is_object() && ext->value("fallback", false)) {
                 buffer["byteLength"] = 1;
                 buffer["uri"] = "data:application/octet-stream;base64,AA==";
+                any = true;
             }
         }
     if (doc.contains("meshes") && doc["meshes"].is_array())
@@ -482,21 +474,36 @@ std::string loadable_by_tinygltf(const std::string &json)
             if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array())
                 for (nlohmann::json &primitive : mesh["primitives"])
                     if (json_extension(primitive, draco_extension))
-                        primitive.erase("indices");
-    return doc.dump();
+                        any = primitive.erase("indices") > 0 || any;
+    return any;
 }
 
-// The extensionsRequired of a glTF JSON text; none if it does not parse.
-std::vector<std::string> required_extensions(const std::string &json)
+// The extensionsRequired of a glTF JSON object.
+std::vector<std::string> required_extensions(const nlohmann::json &doc)
 {
-    const nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
     std::vector<std::string> names;
-    if (doc.is_object() && doc.contains("extensionsRequired") &&
+    if (doc.contains("extensionsRequired") &&
         doc["extensionsRequired"].is_array())
         for (const nlohmann::json &name : doc["extensionsRequired"])
             if (name.is_string())
                 names.push_back(name.get<std::string>());
     return names;
+}
+
+// Whether ptr may have to change a glTF JSON text before tinygltf loads it,
+// from the text alone: a .glb's BIN chunk, a "uri" that is not a data: URI
+// (a file, perhaps a buffer to map), or a compression extension. Where not,
+// the text goes to tinygltf unparsed by ptr.
+bool needs_changes(std::string_view json, bool binary)
+{
+    static const char uri[] = "\"uri\"";
+    for (size_t at = json.find(uri); at != json.npos; at = json.find(uri, at + 1)) {
+        const size_t value = json.find_first_not_of(" \t\r\n:", at + sizeof uri - 1);
+        if (value == json.npos || json.compare(value, 6, "\"data:") != 0)
+            return true;
+    }
+    return binary || json.find(meshopt_extension) != json.npos ||
+           json.find(draco_extension) != json.npos;
 }
 
 const tinygltf::Value *object_member(const tinygltf::Value &object, const char *key)
@@ -562,47 +569,47 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         std::string fault = bytes.size() > UINT32_MAX ? "larger than 4 GiB, the most glTF holds"
                             : binary                  ? glb_chunk_fault(bytes)
                                                       : "";
-        std::string json;
+        std::string_view json;
         size_t rest = 0;
         const bool has_json = fault.empty() && json_of(bytes, binary, &json, &rest);
+        // The JSON as ptr reads and changes it, parsed when first needed
+        // and never again: all that reads or changes the JSON works on this
+        // document, and tinygltf parses only the text it is given.
+        std::optional<nlohmann::json> parsed_json;
+        const auto parsed = [&]() -> nlohmann::json & {
+            if (!parsed_json)
+                parsed_json = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+            return *parsed_json;
+        };
+        const bool object = has_json && needs_changes(json, binary) && parsed().is_object();
         GltfBytes bin = { nullptr, 0 };
-        const bool bin_mapped = has_json && binary && bytes.mapped() &&
-                                bin_kept_out(bytes, rest, &json, &bin);
+        const bool bin_mapped = object && binary && bytes.mapped() &&
+                                bin_kept_out(bytes, rest, parsed(), &bin);
         const bool external_mapped =
-            has_json && external_buffers_kept_out(dir, &json, &doc->external);
-        // The file, or its JSON as patched here (json) or for tinygltf
-        // (patched); with a .glb's BIN chunk mapped, a 4-byte stand-in for it.
-        const auto load_json = [&](const std::string *patched) {
+            object && external_buffers_kept_out(dir, parsed(), &doc->external);
+        const bool loadable = object && loadable_by_tinygltf(parsed());
+        bool ok = false;
+        if (fault.empty() && !bin_mapped && !external_mapped && !loadable) {
+            ok = load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
+        } else if (fault.empty()) {
+            // The JSON as changed, with the file's other chunks after it, or
+            // with a .glb's BIN chunk mapped, a 4-byte stand-in for it.
             static const unsigned char stand_in[12] = { 4, 0, 0, 0, 'B', 'I', 'N', 0 };
-            const std::string &text = patched ? *patched : json;
-            if (bin_mapped) {
-                const std::vector<unsigned char> glb = glb_of(text, stand_in, sizeof stand_in);
-                return load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
-            }
-            if (!patched && !external_mapped)
-                return load(loader, bytes.data(), bytes.size(), binary, dir, &doc->model, &error);
+            const std::string text = parsed().dump();
             if (binary) {
                 const std::vector<unsigned char> glb =
-                    glb_of(text, bytes.data() + rest, bytes.size() - rest);
-                return load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
+                    bin_mapped ? glb_of(text, stand_in, sizeof stand_in)
+                               : glb_of(text, bytes.data() + rest, bytes.size() - rest);
+                ok = load(loader, glb.data(), glb.size(), true, dir, &doc->model, &error);
+            } else {
+                ok = load(loader, reinterpret_cast<const unsigned char *>(text.data()),
+                          text.size(), false, dir, &doc->model, &error);
             }
-            return load(loader, reinterpret_cast<const unsigned char *>(text.data()), text.size(),
-                        false, dir, &doc->model, &error);
-        };
-        bool ok = fault.empty() && load_json(nullptr);
-        if (!ok && has_json) {
-            // tinygltf stops at what it cannot load before ptr sees the
-            // extensions: say first what the file requires that ptr lacks,
-            // and load a compressed file again without what tinygltf refuses
-            // of it.
-            fault = required_extension_fault(required_extensions(json));
-            const std::string patched =
-                fault.empty() && (json.find(meshopt_extension) != std::string::npos ||
-                                  json.find(draco_extension) != std::string::npos)
-                    ? loadable_by_tinygltf(json) : "";
-            if (!patched.empty())
-                ok = load_json(&patched);
         }
+        // tinygltf stops at what it cannot load before ptr sees the
+        // extensions: say first what the file requires that ptr lacks.
+        if (!ok && has_json && parsed().is_object())
+            fault = required_extension_fault(required_extensions(parsed()));
         if (!ok && fault.empty())
             fault = error.empty() ? "not a valid glTF file" : error;
         if (fault.empty())

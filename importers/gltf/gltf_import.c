@@ -195,15 +195,6 @@ static void warn_nonuniform(Importer *im, const Origin *o, int *warned)
              im->path, o->node_name);
 }
 
-static double largest_scale(const Mat4 *world, Importer *im, const Origin *o, int *warned)
-{
-    int nonuniform = 0;
-    double scale = axis_scale(world, &nonuniform);
-    if (nonuniform)
-        warn_nonuniform(im, o, warned);
-    return scale;
-}
-
 /* Whether a sphere cannot be rendered: its centre or radius in float. */
 static int sphere_fault(const double centre[3], double radius)
 {
@@ -224,23 +215,11 @@ static const char *const sphere_fault_text =
 static const char *const transform_fault_text =
     "has a non-finite transform, a zero rotation or a scale that is not positive";
 
-static PtrResult add_sphere(Importer *im, const Origin *o, const double centre[3], double radius,
-                            uint32_t material, const double *color, const double *value)
-{
-    if (sphere_fault(centre, radius))
-        return part_error(im, o, sphere_fault_text);
-    if (ptr_builder_add_sphere(&im->builder, centre, radius, material, NULL) != PTR_OK ||
-        (color && ptr_builder_set_color(&im->builder, color, NULL) != PTR_OK) ||
-        (value && ptr_builder_set_value(&im->builder, *value, NULL) != PTR_OK))
-        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    return PTR_OK;
-}
-
 /* The sphere of a node's mesh surface under world, where the node has a
- * radius or the mesh bounds; *nonuniform set if world's scale is not
- * uniform. */
+ * radius or the mesh bounds (these sized by scale, world's largest axis
+ * scale). */
 static void surface_sphere(const GltfNode *node, const GltfMesh *mesh, const Mat4 *world,
-                           double centre[3], double *radius, int *nonuniform)
+                           double scale, double centre[3], double *radius)
 {
     if (node->has_radius) {
         const double origin[3] = { 0, 0, 0 };
@@ -254,25 +233,7 @@ static void surface_sphere(const GltfNode *node, const GltfMesh *mesh, const Mat
         extent = fmax(extent, mesh->max[k] - mesh->min[k]);
     }
     mat4_point(world, local, centre);
-    *radius = 0.5 * extent * axis_scale(world, nonuniform);
-}
-
-static PtrResult add_surface_sphere(Importer *im, const Origin *o, const GltfNode *node,
-                                    const GltfMesh *mesh, const Mat4 *world, const double *color,
-                                    const double *value, int *warned)
-{
-    if (!node->has_radius && !mesh->has_bounds)
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
-                             im->path, o->node_index, o->node_name, node->mesh);
-    double centre[3], radius;
-    int nonuniform = 0;
-    surface_sphere(node, mesh, world, centre, &radius, &nonuniform);
-    if (nonuniform)
-        warn_nonuniform(im, o, warned);
-    uint32_t material = 0;
-    PtrResult res = map_material(im, mesh->material, &material);
-    return res != PTR_OK ? res : add_sphere(im, o, centre, radius, material, color, value);
+    *radius = 0.5 * extent * scale;
 }
 
 /* What kinds of stored numbers an attribute accepts. */
@@ -361,228 +322,15 @@ static PtrResult value_accessor(Importer *im, const Origin *o, const char *what,
 }
 
 /* Element i of a value accessor: the number, or the length of a vector
- * (docs/scenes.md); refused unless finite. o names element i. */
-static PtrResult read_value(Importer *im, const Origin *o, const GltfAccessor *a, size_t i,
-                            double *value)
+ * (docs/scenes.md). Returns 0 unless it is finite. */
+static int element_value(const GltfAccessor *a, size_t i, double *value)
 {
     double v[4], sum = 0;
     element(a, i, v);
     for (int c = 0; c < a->components; c++)
         sum += v[c] * v[c];
     *value = a->components == 1 ? v[0] : sqrt(sum);
-    if (isfinite(*value))
-        return PTR_OK;
-    char where[160];
-    origin_text(o, where, sizeof where);
-    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: %s: attribute '%s' is not finite",
-                         im->path, where, im->value_name);
-}
-
-/* Every this many instances or points, the import gives back the pages of
- * the file it has read (see gltf_doc_release). */
-enum { RELEASE_STEP = 1 << 16 };
-
-/* Called after element i of count of the accessors given (NULL: absent) is
- * read: at every RELEASE_STEP-th and the last, those read since *released
- * are given back. */
-static void release_read(const Importer *im, size_t i, size_t count, size_t *released,
-                         const GltfAccessor *const *accessors, size_t n)
-{
-    if ((i + 1) % RELEASE_STEP != 0 && i + 1 != count)
-        return;
-    for (size_t k = 0; k < n; k++)
-        if (accessors[k])
-            gltf_doc_release(im->doc, accessors[k], *released, i + 1);
-    *released = i + 1;
-}
-
-/* Instanced nodes of this many instances of a plain sphere, and POINTS
- * primitives of this many points, with no --color-by value, are turned into
- * spheres on all cores, PARALLEL_BLOCK at a time (the file's pages read are
- * given back after each). */
-enum { PARALLEL_PARTS = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
-
-/* Keeps in *failed the least part index that fails: the one a serial import
- * reports, whichever thread meets it first. */
-static void note_failure(atomic_size_t *failed, size_t i)
-{
-    size_t seen = atomic_load(failed);
-    while (i < seen && !atomic_compare_exchange_weak(failed, &seen, i))
-        ;
-}
-
-/* Runs convert over parts 0 .. count - 1 on all cores, a block at a time,
- * giving back the pages of the n accessors read (NULL entries: none) after
- * each, and stops after the block where a part failed (*failed below
- * SIZE_MAX). */
-static void convert_in_blocks(Importer *im, size_t count, void (*convert)(void *, size_t, size_t),
-                              void *run, atomic_size_t *failed,
-                              const GltfAccessor *const *read, size_t n)
-{
-    const int threads = ptr_online_cpus();
-    for (size_t begin = 0; begin < count; begin += PARALLEL_BLOCK) {
-        const size_t end = count - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : count;
-        ptr_parallel_ranges(threads, begin, end, convert, run);
-        for (size_t k = 0; k < n; k++)
-            if (read[k])
-                gltf_doc_release(im->doc, read[k], begin, end);
-        if (atomic_load(failed) != SIZE_MAX)
-            break;
-    }
-}
-
-/* A point's colour: its COLOR_0 c (NULL: none) times the colour of the
- * instance it is part of (NULL: none); one of them is given. */
-static void point_color(const double *c, const double *instance, double rgb[3])
-{
-    for (int k = 0; k < 3; k++)
-        rgb[k] = c ? c[k] * (instance ? instance[k] : 1.0) : instance[k];
-}
-
-typedef struct PointRun {
-    PtrSceneBuilder *builder;
-    const GltfAccessor *pos, *rad, *col; /* rad, col NULL: absent */
-    const Mat4 *world;
-    const double *color;  /* the instance's, if any */
-    double radius, scale; /* without rad, the node's radius; world's largest axis scale */
-    uint32_t material;
-    size_t first;         /* the builder's sphere for point 0 */
-    atomic_size_t failed; /* the first point that cannot be a sphere; SIZE_MAX: none */
-} PointRun;
-
-/* Points begin .. end - 1 as add_points would add them one by one. */
-static void convert_points(void *arg, size_t begin, size_t end)
-{
-    PointRun *run = arg;
-    for (size_t i = begin; i < end; i++) {
-        double p[4], r[4], centre[3];
-        element(run->pos, i, p);
-        mat4_point(run->world, p, centre);
-        if (run->rad)
-            element(run->rad, i, r);
-        else
-            r[0] = run->radius;
-        const double radius = r[0] * run->scale;
-        if (sphere_fault(centre, radius)) {
-            note_failure(&run->failed, i);
-            break;
-        }
-        double c[4], rgb[3];
-        const int colored = run->col || run->color;
-        if (run->col)
-            element(run->col, i, c);
-        if (colored)
-            point_color(run->col ? c : NULL, run->color, rgb);
-        ptr_builder_fill_sphere(run->builder, run->first + i, centre, radius, run->material,
-                                colored ? rgb : NULL);
-    }
-}
-
-/* The spheres of a POINTS primitive under world (times color, if any), each
- * with its own value of the attribute value_index (-1: none) names, else
- * value (if any). */
-static PtrResult add_points(Importer *im, const Origin *node_origin, const GltfNode *node,
-                            const GltfPrimitive *prim, int value_index, const Mat4 *world,
-                            const double *color, const double *value, int *warned)
-{
-    if (prim->radius < 0 && !node->has_radius)
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: node %zu ('%s') has POINTS without a _RADIUS attribute or an "
-                             "extras.radius", im->path, node_origin->node_index,
-                             node_origin->node_name);
-    if (prim->position < 0)
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: node %zu ('%s') has POINTS without POSITION", im->path,
-                             node_origin->node_index, node_origin->node_name);
-    if (prim->draco)
-        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                             "%s: node %zu ('%s') has POINTS compressed by "
-                             "KHR_draco_mesh_compression, of which ptr reads only the bounds of "
-                             "meshes", im->path, node_origin->node_index, node_origin->node_name);
-    size_t count = 0;
-    GltfAccessor pos, rad, col;
-    PtrResult res = attribute_accessor(im, node_origin, "POSITION", prim->position, 3, 3,
-                                       QUANTIZED, &count, &pos);
-    if (res == PTR_OK && prim->radius >= 0)
-        res = attribute_accessor(im, node_origin, "_RADIUS", prim->radius, 1, 1, FLOATS, &count,
-                                 &rad);
-    if (res == PTR_OK && prim->color >= 0)
-        res = attribute_accessor(im, node_origin, "COLOR_0", prim->color, 3, 4,
-                                 FLOATS_OR_UNSIGNED, &count, &col);
-    GltfAccessor val;
-    if (res == PTR_OK && value_index != -1)
-        res = value_accessor(im, node_origin, "point", value_index, &count, &val);
-    uint32_t material = 0;
-    if (res == PTR_OK)
-        res = map_material(im, prim->material, &material);
-    if (res != PTR_OK)
-        return res;
-    const double scale = largest_scale(world, im, node_origin, warned);
-    Origin o = *node_origin;
-    o.part = "point";
-    /* Points an instance repeats are read again by the next one. */
-    const GltfAccessor *read[] = { &pos, prim->radius >= 0 ? &rad : NULL,
-                                   prim->color >= 0 ? &col : NULL,
-                                   value_index != -1 ? &val : NULL };
-    const size_t release = node_origin->part ? 0 : sizeof read / sizeof read[0];
-    if (count >= PARALLEL_PARTS && value_index == -1 && !value) {
-        PointRun run = { .builder = &im->builder, .pos = &pos,
-                         .rad = prim->radius >= 0 ? &rad : NULL,
-                         .col = prim->color >= 0 ? &col : NULL, .world = world, .color = color,
-                         .radius = node->radius, .scale = scale, .material = material };
-        atomic_init(&run.failed, SIZE_MAX);
-        if (ptr_builder_add_spheres(&im->builder, count, run.col || color, &run.first, NULL) != PTR_OK)
-            return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-        convert_in_blocks(im, count, convert_points, &run, &run.failed, read, release);
-        o.part_index = atomic_load(&run.failed);
-        return o.part_index == SIZE_MAX ? PTR_OK : part_error(im, &o, sphere_fault_text);
-    }
-    size_t released = 0;
-    for (size_t i = 0; i < count && res == PTR_OK; i++) {
-        double p[4], r[4], c[4], centre[3], rgb[3], own_value;
-        element(&pos, i, p);
-        mat4_point(world, p, centre);
-        if (prim->radius >= 0)
-            element(&rad, i, r);
-        else
-            r[0] = node->radius;
-        if (prim->color >= 0) {
-            element(&col, i, c);
-            point_color(c, color, rgb);
-        }
-        o.part_index = i;
-        if (value_index != -1)
-            res = read_value(im, &o, &val, i, &own_value);
-        if (res == PTR_OK)
-            res = add_sphere(im, &o, centre, r[0] * scale, material,
-                             prim->color >= 0 ? rgb : color,
-                             value_index != -1 ? &own_value : value);
-        release_read(im, i, count, &released, read, release);
-    }
-    return res;
-}
-
-/* A node's spheres under world: its surface's and its points'. */
-static PtrResult add_mesh_spheres(Importer *im, const Origin *o, const GltfNode *node,
-                                  const GltfMesh *mesh, const Mat4 *world, const double *color,
-                                  const double *value, int *warned)
-{
-    PtrResult res = PTR_OK;
-    if (mesh->has_surface)
-        res = add_surface_sphere(im, o, node, mesh, world, color, value, warned);
-    /* Looked up only where there are points: an instance of a plain sphere
-     * is a million of these calls. */
-    for (size_t p = 0; mesh->point_primitives && p < mesh->primitive_count && res == PTR_OK;
-         p++) {
-        GltfPrimitive prim;
-        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
-        int value_index = im->value_name ? gltf_doc_primitive_attribute(
-                                               im->doc, (size_t)node->mesh, p, im->value_name)
-                                         : -1;
-        if (prim.points)
-            res = add_points(im, o, node, &prim, value_index, world, color, value, warned);
-    }
-    return res;
+    return isfinite(*value);
 }
 
 /* T * R * S of instance i, from the attributes present. */
@@ -614,152 +362,440 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
     return all_finite(out->m, 16);
 }
 
-typedef struct InstanceRun {
+/* A point's colour: its COLOR_0 c (NULL: none) times the colour of the
+ * instance it is part of (NULL: none); one of them is given. */
+static void point_color(const double *c, const double *instance, double rgb[3])
+{
+    for (int k = 0; k < 3; k++)
+        rgb[k] = c ? c[k] * (instance ? instance[k] : 1.0) : instance[k];
+}
+
+/* A POINTS primitive, checked: each point a sphere. */
+typedef struct PointSet {
+    GltfAccessor pos, rad, col, val; /* rad, col, val read only where has_ says */
+    int has_rad, has_col, has_val;   /* val: the --color-by attribute */
+    double radius;                   /* without rad, the node's extras.radius */
+    uint32_t material;
+    size_t count;
+} PointSet;
+
+/* A node's spheres: for each of its instances (one for a node without
+ * EXT_mesh_gpu_instancing), its mesh's surface sphere if it has a surface,
+ * then each POINTS primitive's points, per_instance spheres in all, placed
+ * in this order from the builder's sphere first. An instance is `slots`
+ * slots, one a sphere (one if it has none: its attributes are checked all
+ * the same), and slot n is converted the same on any thread, so the spheres
+ * do not depend on how many convert them. */
+typedef struct NodeRun {
     PtrSceneBuilder *builder;
     const GltfNode *node;
     const GltfMesh *mesh;
     const Mat4 *world;
-    const GltfAccessor *t, *r, *s, *c; /* NULL: absent */
-    uint32_t material;
-    size_t first;           /* the builder's sphere for instance 0 */
-    atomic_size_t failed;   /* the first instance that cannot be a sphere; SIZE_MAX: none */
-    atomic_int nonuniform;
-} InstanceRun;
+    int instanced;
+    GltfAccessor t, r, s, c, v; /* the instances' attributes, read where has_ says */
+    int has_t, has_r, has_s, has_c, has_v;
+    uint32_t surface_material;
+    PointSet *sets;
+    size_t set_count;
+    int scaled; /* whether any sphere takes world's largest axis scale */
+    size_t instances, per_instance, slots, first;
+    atomic_size_t failed;  /* the least slot that fails; SIZE_MAX: none */
+    atomic_int nonuniform; /* whether a scaled sphere's axis scales differ */
+} NodeRun;
 
-/* Instances begin .. end - 1 as add_instances would add them one by one. */
-static void convert_instances(void *arg, size_t begin, size_t end)
+/* What the spheres of an instance share. */
+typedef struct Instance {
+    Mat4 world;
+    double color[4], value;
+    int has_color, has_value;
+    double scale; /* world's largest axis scale */
+    int uneven;   /* whether its axis scales differ */
+} Instance;
+
+/* Why a slot gives no sphere. */
+typedef enum Fault { NO_FAULT, TRANSFORM_FAULT, VALUE_FAULT, SPHERE_FAULT } Fault;
+
+/* Instance i of the run, or why it gives no spheres. */
+static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
 {
-    InstanceRun *run = arg;
-    int nonuniform = 0;
-    for (size_t i = begin; i < end; i++) {
-        Mat4 local, world;
-        double centre[3], radius;
-        if (!instance_local(run->t, run->r, run->s, i, &local)) {
-            note_failure(&run->failed, i);
-            break;
-        }
-        world = mat4_mul(run->world, &local);
-        surface_sphere(run->node, run->mesh, &world, centre, &radius, &nonuniform);
-        if (sphere_fault(centre, radius)) {
-            note_failure(&run->failed, i);
-            break;
-        }
-        double rgb[4];
-        if (run->c)
-            element(run->c, i, rgb);
-        ptr_builder_fill_sphere(run->builder, run->first + i, centre, radius, run->material,
-                                run->c ? rgb : NULL);
+    out->world = *run->world;
+    if (run->instanced) {
+        Mat4 local;
+        if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
+                            run->has_s ? &run->s : NULL, i, &local))
+            return TRANSFORM_FAULT;
+        out->world = mat4_mul(run->world, &local);
     }
-    if (nonuniform)
+    out->has_color = run->has_c;
+    if (run->has_c)
+        element(&run->c, i, out->color);
+    out->has_value = run->has_v;
+    if (run->has_v && !element_value(&run->v, i, &out->value))
+        return VALUE_FAULT;
+    out->uneven = 0;
+    out->scale = axis_scale(&out->world, &out->uneven);
+    return NO_FAULT;
+}
+
+/* The set that sphere k of an instance (k past its surface sphere) belongs
+ * to, and in *point which of its points it is. */
+static size_t set_of(const NodeRun *run, size_t k, size_t *point)
+{
+    size_t set = 0, j = k - (size_t)run->mesh->has_surface;
+    while (set < run->set_count && j >= run->sets[set].count)
+        j -= run->sets[set++].count;
+    *point = j;
+    return set;
+}
+
+/* Point j of ps in instance in as the builder's sphere n, or why it gives
+ * none. */
+static Fault point_sphere(const NodeRun *run, const Instance *in, const PointSet *ps, size_t j,
+                          size_t n)
+{
+    double p[4], r[4], c[4], centre[3], rgb[3], value = in->has_value ? in->value : 0.0;
+    element(&ps->pos, j, p);
+    mat4_point(&in->world, p, centre);
+    if (ps->has_rad)
+        element(&ps->rad, j, r);
+    else
+        r[0] = ps->radius;
+    if (ps->has_val && !element_value(&ps->val, j, &value))
+        return VALUE_FAULT;
+    const double radius = r[0] * in->scale;
+    if (sphere_fault(centre, radius))
+        return SPHERE_FAULT;
+    if (ps->has_col)
+        element(&ps->col, j, c);
+    if (ps->has_col || in->has_color)
+        point_color(ps->has_col ? c : NULL, in->has_color ? in->color : NULL, rgb);
+    ptr_builder_fill_sphere(run->builder, n, centre, radius, ps->material,
+                            ps->has_col || in->has_color ? rgb : NULL);
+    if (ps->has_val || in->has_value)
+        ptr_builder_fill_value(run->builder, n, value);
+    return NO_FAULT;
+}
+
+/* Slots k .. end - 1 of instance i into the builder; on a fault, *at is
+ * the slot. */
+static Fault instance_spheres(const NodeRun *run, size_t i, const Instance *in, size_t k,
+                              size_t end, size_t *at)
+{
+    size_t n = run->first + i * run->per_instance + k;
+    if (k == 0 && run->mesh->has_surface) {
+        double centre[3], radius;
+        surface_sphere(run->node, run->mesh, &in->world, in->scale, centre, &radius);
+        *at = 0;
+        if (sphere_fault(centre, radius))
+            return SPHERE_FAULT;
+        ptr_builder_fill_sphere(run->builder, n, centre, radius, run->surface_material,
+                                in->has_color ? in->color : NULL);
+        if (in->has_value)
+            ptr_builder_fill_value(run->builder, n, in->value);
+        k++, n++;
+    }
+    if (k >= end)
+        return NO_FAULT;
+    size_t j;
+    for (size_t set = set_of(run, k, &j); k < end && set < run->set_count; k++, n++) {
+        *at = k;
+        const Fault fault = point_sphere(run, in, &run->sets[set], j, n);
+        if (fault != NO_FAULT)
+            return fault;
+        if (++j == run->sets[set].count)
+            set++, j = 0;
+    }
+    return NO_FAULT;
+}
+
+/* Keeps in *failed the least slot that fails: the one a serial import
+ * reports, whichever thread meets it first. */
+static void note_failure(atomic_size_t *failed, size_t slot)
+{
+    size_t seen = atomic_load(failed);
+    while (slot < seen && !atomic_compare_exchange_weak(failed, &seen, slot))
+        ;
+}
+
+/* Slots begin .. end - 1 of the run (see NodeRun). */
+static void convert_slots(void *arg, size_t begin, size_t end)
+{
+    NodeRun *run = arg;
+    int nonuniform = 0;
+    for (size_t slot = begin; slot < end;) {
+        const size_t i = slot / run->slots, k = slot % run->slots;
+        const size_t stop = end - slot < run->slots - k ? k + (end - slot) : run->slots;
+        Instance in;
+        size_t at = 0;
+        if (instance_at(run, i, &in) != NO_FAULT ||
+            instance_spheres(run, i, &in, k, stop, &at) != NO_FAULT) {
+            note_failure(&run->failed, i * run->slots + at);
+            break;
+        }
+        nonuniform |= in.uneven;
+        slot += stop - k;
+    }
+    if (nonuniform && run->scaled)
         atomic_store(&run->nonuniform, 1);
 }
 
-/* add_instances' loop for count instances of a plain sphere (accessors t,
- * r, s, c: NULL where absent), the same spheres, warnings and first error. */
-static PtrResult add_instances_parallel(Importer *im, const Origin *instance,
-                                        const GltfNode *node, const GltfMesh *mesh,
-                                        const Mat4 *world, const GltfAccessor *const tsrc[4],
-                                        size_t count, int *warned)
+/* A node of this many slots or more is converted on all cores, and every
+ * node PARALLEL_BLOCK slots at a time, the file's pages read given back
+ * after each block. */
+enum { PARALLEL_PARTS = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
+
+/* Gives back the file's pages read for slots begin .. end - 1 (see
+ * gltf_doc_release): the instances' attributes, or the points' where no
+ * other instance reads them again. */
+static void release_slots(const Importer *im, const NodeRun *run, size_t begin, size_t end)
 {
-    InstanceRun run = { .builder = &im->builder, .node = node, .mesh = mesh, .world = world,
-                        .t = tsrc[0], .r = tsrc[1], .s = tsrc[2], .c = tsrc[3] };
-    atomic_init(&run.failed, SIZE_MAX);
-    atomic_init(&run.nonuniform, 0);
-    PtrResult res = map_material(im, mesh->material, &run.material);
-    if (res == PTR_OK &&
-        ptr_builder_add_spheres(&im->builder, count, run.c != NULL, &run.first, NULL) != PTR_OK)
-        res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    if (res != PTR_OK)
-        return res;
-    convert_in_blocks(im, count, convert_instances, &run, &run.failed, tsrc, 4);
-    const size_t failed = atomic_load(&run.failed);
-    if (failed != SIZE_MAX) {
-        Origin at = *instance;
-        at.part_index = failed;
-        Mat4 local;
-        return part_error(im, &at, instance_local(run.t, run.r, run.s, failed, &local)
-                                       ? sphere_fault_text : transform_fault_text);
+    if (run->instanced) {
+        const GltfAccessor *read[] = { run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
+                                       run->has_s ? &run->s : NULL, run->has_c ? &run->c : NULL,
+                                       run->has_v ? &run->v : NULL };
+        for (size_t a = 0; a < sizeof read / sizeof read[0]; a++)
+            if (read[a])
+                gltf_doc_release(im->doc, read[a], begin / run->slots, end / run->slots);
+        return;
     }
-    if (atomic_load(&run.nonuniform))
-        warn_nonuniform(im, instance, warned);
-    return PTR_OK;
+    size_t from = (size_t)run->mesh->has_surface; /* the slot of the set's point 0 */
+    for (size_t set = 0; set < run->set_count; from += run->sets[set++].count) {
+        const PointSet *ps = &run->sets[set];
+        if (end <= from || begin >= from + ps->count)
+            continue;
+        const size_t lo = begin > from ? begin - from : 0;
+        const size_t hi = end - from < ps->count ? end - from : ps->count;
+        const GltfAccessor *read[] = { &ps->pos, ps->has_rad ? &ps->rad : NULL,
+                                       ps->has_col ? &ps->col : NULL,
+                                       ps->has_val ? &ps->val : NULL };
+        for (size_t a = 0; a < sizeof read / sizeof read[0]; a++)
+            if (read[a])
+                gltf_doc_release(im->doc, read[a], lo, hi);
+    }
 }
 
-/* EXT_mesh_gpu_instancing: the node's spheres once per instance. */
-static PtrResult add_instances(Importer *im, const Origin *o, const GltfNode *node,
-                               const GltfMesh *mesh, const Mat4 *world, int *warned)
+static PtrResult value_error(Importer *im, const Origin *o)
 {
-    const GltfInstancing *in = &node->instances;
+    char where[160];
+    origin_text(o, where, sizeof where);
+    return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: %s: attribute '%s' is not finite",
+                         im->path, where, im->value_name);
+}
+
+/* The error of the run's slot that failed, as a serial import meets it
+ * (instance: the node's origin, with "instance" if it has instances). */
+static PtrResult slot_error(Importer *im, const NodeRun *run, const Origin *instance,
+                            size_t slot)
+{
+    const size_t i = slot / run->slots, k = slot % run->slots;
+    Origin o = *instance;
+    o.part_index = i;
+    Instance in;
+    Fault fault = instance_at(run, i, &in);
+    if (fault == TRANSFORM_FAULT)
+        return part_error(im, &o, transform_fault_text);
+    if (fault == VALUE_FAULT)
+        return value_error(im, &o);
+    size_t at = k;
+    fault = instance_spheres(run, i, &in, k, k + 1, &at);
+    if (at == 0 && run->mesh->has_surface)
+        return part_error(im, &o, sphere_fault_text);
+    o.part = "point";
+    set_of(run, at, &o.part_index);
+    return fault == SPHERE_FAULT ? part_error(im, &o, sphere_fault_text) : value_error(im, &o);
+}
+
+/* The attributes of an EXT_mesh_gpu_instancing node's instances, checked,
+ * and their count. */
+static PtrResult instance_attributes(Importer *im, const Origin *o, NodeRun *run)
+{
+    const GltfInstancing *in = &run->node->instances;
     if (in->translation < 0 && in->rotation < 0 && in->scale < 0)
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: node %zu ('%s') has EXT_mesh_gpu_instancing without "
                              "TRANSLATION, ROTATION or SCALE", im->path, o->node_index,
                              o->node_name);
+    run->has_t = in->translation >= 0;
+    run->has_r = in->rotation >= 0;
+    run->has_s = in->scale >= 0;
+    run->has_c = in->color >= 0;
     size_t count = 0;
-    GltfAccessor t, r, s, c;
     PtrResult res = PTR_OK;
-    if (in->translation >= 0)
+    if (run->has_t)
         res = attribute_accessor(im, o, "TRANSLATION", in->translation, 3, 3, QUANTIZED, &count,
-                                 &t);
-    if (res == PTR_OK && in->rotation >= 0)
+                                 &run->t);
+    if (res == PTR_OK && run->has_r)
         res = attribute_accessor(im, o, "ROTATION", in->rotation, 4, 4, FLOATS_OR_SIGNED, &count,
-                                 &r);
-    if (res == PTR_OK && in->scale >= 0)
-        res = attribute_accessor(im, o, "SCALE", in->scale, 3, 3, QUANTIZED, &count, &s);
-    if (res == PTR_OK && in->color >= 0)
+                                 &run->r);
+    if (res == PTR_OK && run->has_s)
+        res = attribute_accessor(im, o, "SCALE", in->scale, 3, 3, QUANTIZED, &count, &run->s);
+    if (res == PTR_OK && run->has_c)
         res = attribute_accessor(im, o, "_COLOR_0", in->color, 3, 4, FLOATS_OR_UNSIGNED, &count,
-                                 &c);
-    int value_index = im->value_name
-                          ? gltf_doc_instance_attribute(im->doc, o->node_index, im->value_name)
-                          : -1;
-    GltfAccessor v;
-    if (res == PTR_OK && value_index != -1)
-        res = value_accessor(im, o, "instance", value_index, &count, &v);
-    Origin instance = *o;
-    instance.part = "instance";
-    if (res == PTR_OK && count >= PARALLEL_PARTS && value_index == -1 &&
-        mesh->has_surface && !mesh->point_primitives && (node->has_radius || mesh->has_bounds)) {
-        const GltfAccessor *const tsrc[4] = { in->translation >= 0 ? &t : NULL,
-                                              in->rotation >= 0 ? &r : NULL,
-                                              in->scale >= 0 ? &s : NULL,
-                                              in->color >= 0 ? &c : NULL };
-        return add_instances_parallel(im, &instance, node, mesh, world, tsrc, count, warned);
+                                 &run->c);
+    const int value_index =
+        im->value_name ? gltf_doc_instance_attribute(im->doc, o->node_index, im->value_name) : -1;
+    run->has_v = value_index != -1;
+    if (res == PTR_OK && run->has_v)
+        res = value_accessor(im, o, "instance", value_index, &count, &run->v);
+    run->instances = count;
+    return res;
+}
+
+/* A POINTS primitive of the run's mesh, checked, its material mapped, as
+ * the node's first instance (o, first) meets it; value_index: its --color-by
+ * attribute, -1 if none. */
+static PtrResult point_set(Importer *im, const Origin *o, const NodeRun *run,
+                           const GltfPrimitive *prim, int value_index, const Instance *first,
+                           int *warned, PointSet *ps)
+{
+    if (prim->radius < 0 && !run->node->has_radius)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS without a _RADIUS attribute or an "
+                             "extras.radius", im->path, o->node_index, o->node_name);
+    if (prim->position < 0)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS without POSITION", im->path,
+                             o->node_index, o->node_name);
+    if (prim->draco)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s') has POINTS compressed by "
+                             "KHR_draco_mesh_compression, of which ptr reads only the bounds of "
+                             "meshes", im->path, o->node_index, o->node_name);
+    ps->has_rad = prim->radius >= 0;
+    ps->has_col = prim->color >= 0;
+    ps->has_val = value_index != -1;
+    ps->radius = run->node->radius;
+    ps->count = 0;
+    PtrResult res = attribute_accessor(im, o, "POSITION", prim->position, 3, 3, QUANTIZED,
+                                       &ps->count, &ps->pos);
+    if (res == PTR_OK && ps->has_rad)
+        res = attribute_accessor(im, o, "_RADIUS", prim->radius, 1, 1, FLOATS, &ps->count,
+                                 &ps->rad);
+    if (res == PTR_OK && ps->has_col)
+        res = attribute_accessor(im, o, "COLOR_0", prim->color, 3, 4, FLOATS_OR_UNSIGNED,
+                                 &ps->count, &ps->col);
+    if (res == PTR_OK && ps->has_val)
+        res = value_accessor(im, o, "point", value_index, &ps->count, &ps->val);
+    if (res == PTR_OK)
+        res = map_material(im, prim->material, &ps->material);
+    if (res == PTR_OK && first->uneven)
+        warn_nonuniform(im, o, warned);
+    return res;
+}
+
+/* The run's mesh checked, its materials mapped and its point sets made,
+ * with the warnings in the order a serial import gives them at the node's
+ * first instance (o, first). */
+static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Instance *first,
+                          int *warned)
+{
+    const GltfNode *node = run->node;
+    const GltfMesh *mesh = run->mesh;
+    PtrResult res = PTR_OK;
+    if (mesh->has_surface) {
+        if (!node->has_radius && !mesh->has_bounds)
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
+                                 im->path, o->node_index, o->node_name, node->mesh);
+        if (!node->has_radius && first->uneven)
+            warn_nonuniform(im, o, warned);
+        res = map_material(im, mesh->material, &run->surface_material);
     }
-    const GltfAccessor *read[] = { in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
-                                   in->scale >= 0 ? &s : NULL, in->color >= 0 ? &c : NULL,
-                                   value_index != -1 ? &v : NULL };
-    size_t released = 0;
-    for (size_t i = 0; i < count && res == PTR_OK; i++) {
-        Mat4 local, instance_world;
-        instance.part_index = i;
-        if (!instance_local(in->translation >= 0 ? &t : NULL, in->rotation >= 0 ? &r : NULL,
-                            in->scale >= 0 ? &s : NULL, i, &local))
-            return part_error(im, &instance, transform_fault_text);
-        instance_world = mat4_mul(world, &local);
-        double color[4], value;
-        if (in->color >= 0)
-            element(&c, i, color);
-        if (value_index != -1)
-            res = read_value(im, &instance, &v, i, &value);
-        if (res == PTR_OK)
-            res = add_mesh_spheres(im, &instance, node, mesh, &instance_world,
-                                   in->color >= 0 ? color : NULL,
-                                   value_index != -1 ? &value : NULL, warned);
-        release_read(im, i, count, &released, read, sizeof read / sizeof read[0]);
+    for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        if (!prim.points)
+            continue;
+        const int value_index = im->value_name ? gltf_doc_primitive_attribute(
+                                                     im->doc, (size_t)node->mesh, p,
+                                                     im->value_name)
+                                               : -1;
+        res = point_set(im, o, run, &prim, value_index, first, warned,
+                        &run->sets[run->set_count++]);
     }
     return res;
 }
 
+/* Room in the builder for the run's spheres, with colours and values where
+ * any of them has one. */
+static PtrResult start_run(Importer *im, NodeRun *run)
+{
+    const int surface = run->mesh->has_surface;
+    int colored_all = run->has_c || !surface, colored_any = run->has_c, valued = run->has_v;
+    run->per_instance = (size_t)surface;
+    for (size_t set = 0; set < run->set_count; set++) {
+        const PointSet *ps = &run->sets[set];
+        run->per_instance += ps->count;
+        colored_all = colored_all && (run->has_c || ps->has_col);
+        colored_any = colored_any || ps->has_col;
+        valued = valued || ps->has_val;
+    }
+    run->slots = run->per_instance ? run->per_instance : 1;
+    run->scaled = run->set_count > 0 || (surface && !run->node->has_radius);
+    const size_t spheres = run->instances * run->per_instance;
+    colored_any = colored_any && spheres > 0;
+    colored_all = colored_all && colored_any;
+    valued = valued && spheres > 0;
+    /* Where only some spheres have their own colour, the others have none,
+     * which the builder gives those it adds once it keeps colours. */
+    if (((colored_any && !colored_all) || valued) &&
+        ptr_builder_keep_attributes(run->builder, colored_any && !colored_all, valued, NULL) !=
+            PTR_OK)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    if (ptr_builder_add_spheres(run->builder, spheres, colored_all, &run->first, NULL) != PTR_OK)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    return PTR_OK;
+}
+
+/* Converts the run's slots, on all cores where there are PARALLEL_PARTS or
+ * more, a block at a time, and stops after a block where a slot failed. */
+static void convert_run(const Importer *im, NodeRun *run)
+{
+    const size_t slots = run->instances * run->slots;
+    const int threads = slots >= PARALLEL_PARTS ? ptr_online_cpus() : 1;
+    for (size_t begin = 0; begin < slots && atomic_load(&run->failed) == SIZE_MAX;
+         begin += PARALLEL_BLOCK) {
+        const size_t end = slots - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : slots;
+        ptr_parallel_ranges(threads, begin, end, convert_slots, run);
+        release_slots(im, run, begin, end);
+    }
+}
+
+/* The node's spheres (see NodeRun): what they share checked first, as a
+ * serial import meets it at the first instance. */
 static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNode *node,
                                   const Mat4 *world)
 {
     GltfMesh mesh;
     gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
     const Origin o = { node_index, label(node->name, "unnamed"), NULL, 0 };
+    const Origin instance = { node_index, o.node_name, node->instanced ? "instance" : NULL, 0 };
+    NodeRun run = { .builder = &im->builder, .node = node, .mesh = &mesh, .world = world,
+                    .instanced = node->instanced, .instances = 1, .slots = 1 };
+    atomic_init(&run.failed, SIZE_MAX);
+    atomic_init(&run.nonuniform, 0);
+    run.sets = malloc((mesh.point_primitives ? mesh.point_primitives : 1) * sizeof *run.sets);
+    if (!run.sets)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    PtrResult res = node->instanced ? instance_attributes(im, &o, &run) : PTR_OK;
+    Instance first;
     int warned = 0;
-    if (node->instanced)
-        return add_instances(im, &o, node, &mesh, world, &warned);
-    return add_mesh_spheres(im, &o, node, &mesh, world, NULL, NULL, &warned);
+    if (res == PTR_OK && instance_at(&run, 0, &first) != NO_FAULT)
+        res = slot_error(im, &run, &instance, 0);
+    if (res == PTR_OK)
+        res = run_mesh(im, &instance, &run, &first, &warned);
+    if (res == PTR_OK)
+        res = start_run(im, &run);
+    if (res == PTR_OK) {
+        convert_run(im, &run);
+        const size_t failed = atomic_load(&run.failed);
+        if (failed != SIZE_MAX)
+            res = slot_error(im, &run, &instance, failed);
+        else if (atomic_load(&run.nonuniform))
+            warn_nonuniform(im, &o, &warned);
+    }
+    free(run.sets);
+    return res;
 }
 
 /* The projection of a glTF camera, in the scene's terms; 0 if a value is out

@@ -9,16 +9,16 @@ import sys
 import tempfile
 
 
-def dump_clouds(ptr, write_cloud):
-    """ptr --dump-scene of write_cloud(path, parts, broken) for 1 and 2
-    parts, valid and broken: {(parts, broken): CompletedProcess}."""
+def dump_clouds(ptr, write_cloud, options=()):
+    """ptr --dump-scene (with options) of write_cloud(path, parts, broken)
+    for 1 and 2 parts, valid and broken: {(parts, broken): CompletedProcess}."""
     runs = {}
     with tempfile.TemporaryDirectory() as d:
         for broken in (False, True):
             for parts in (1, 2):
                 path = os.path.join(d, f"cloud-{parts}-{broken}.glb")
                 write_cloud(path, parts, broken)
-                runs[parts, broken] = subprocess.run([ptr, "--dump-scene", path],
+                runs[parts, broken] = subprocess.run([ptr, "--dump-scene", *options, path],
                                                      capture_output=True, text=True, timeout=120)
     return runs
 
