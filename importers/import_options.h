@@ -1,12 +1,14 @@
 /* What the command line asks of an import: the camera, the framing of a
- * scene without one, the --color-by attribute. Apart from importer.h so
- * that the builder, which importer.c uses, reads it without importer.h. */
+ * scene without one, the --color-by attribute, what of a structure is kept.
+ * Apart from importer.h so that the builder, which importer.c uses, reads it
+ * without importer.h. */
 #ifndef PTR_IMPORT_OPTIONS_H
 #define PTR_IMPORT_OPTIONS_H
 
 #include <stddef.h>
 
 #include "scene/scene.h"
+#include "structure/structure_parts.h"
 
 /* A list of lines of text (warnings, file names). */
 typedef struct PtrStrings {
@@ -40,6 +42,11 @@ typedef struct PtrImportOptions {
     /* Degrees the camera, whichever it is, turns about the vertical axis
      * (+Y) through the spheres' centre: a frame of a turntable. */
     double orbit_degrees;
+    /* Structures (PDB, mmCIF): the residues kept, a set of
+     * PTR_STRUCTURE_PROTEIN ... (0: PTR_STRUCTURE_DEFAULT), and whether
+     * hydrogens are dropped (--select, --hydrogens). */
+    unsigned structure_select;
+    int drop_hydrogens;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

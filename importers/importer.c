@@ -22,16 +22,29 @@ static const struct {
     { ".gltf", ptr_import_gltf },
     { ".glb", ptr_import_gltf },
     { ".obj", ptr_import_obj },
+    { ".pdb", ptr_import_structure }, { ".pdb.gz", ptr_import_structure },
+    { ".ent", ptr_import_structure }, { ".ent.gz", ptr_import_structure },
+    { ".cif", ptr_import_structure }, { ".cif.gz", ptr_import_structure },
+    { ".mmcif", ptr_import_structure }, { ".mmcif.gz", ptr_import_structure },
 };
 
 /* Formats that a script turns into an instanced .glb (docs/scenes.md). */
 static const struct {
     const char *extension, *script;
 } converters[] = {
-    { ".pdb", "molecule_to_glb.py" }, { ".ent", "molecule_to_glb.py" },
     { ".xyz", "molecule_to_glb.py" }, { ".extxyz", "molecule_to_glb.py" },
     { ".csv", "particles_to_glb.py" }, { ".ply", "particles_to_glb.py" },
 };
+
+/* What the importers table reads, for the message that a file is none of it. */
+#define KNOWN ".gltf, .glb, .obj, .pdb, .ent, .cif or .mmcif (those four also .gz)"
+
+/* Whether the file name path ends in extension, in any case. */
+static int has_extension(const char *path, const char *extension)
+{
+    const size_t length = strlen(path), tail = strlen(extension);
+    return length > tail && !strcasecmp(path + length - tail, extension);
+}
 
 void ptr_warn(PtrStrings *warnings, const char *fmt, ...)
 {
@@ -89,28 +102,28 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
 
     const char *dot = strrchr(path, '.');
     const char *slash = strrchr(path, '/');
-    if (dot && (!slash || dot > slash)) {
-        for (size_t i = 0; i < sizeof importers / sizeof importers[0]; i++) {
-            if (strcasecmp(dot, importers[i].extension))
-                continue;
-            if (S_ISREG(st.st_mode) && st.st_size == 0)
-                return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
-            PtrResult r = importers[i].import(path, options, scene, warnings, err);
-            if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value)
-                r = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                                  "%s: no instance or point attribute '%s' (--color-by)", path,
-                                  options->value_attribute);
-            if (r != PTR_OK)
-                ptr_scene_free(scene);
-            return r;
-        }
+    if (dot && slash && dot < slash)
+        dot = NULL;
+    for (size_t i = 0; dot && i < sizeof importers / sizeof importers[0]; i++) {
+        if (!has_extension(path, importers[i].extension))
+            continue;
+        if (S_ISREG(st.st_mode) && st.st_size == 0)
+            return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
+        PtrResult r = importers[i].import(path, options, scene, warnings, err);
+        if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value)
+            r = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                              "%s: no instance or point attribute '%s' (--color-by)", path,
+                              options->value_attribute);
+        if (r != PTR_OK)
+            ptr_scene_free(scene);
+        return r;
     }
     for (size_t i = 0; dot && i < sizeof converters / sizeof converters[0]; i++)
         if (!strcasecmp(dot, converters[i].extension))
             return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                                 "%s: unknown scene format (expected .gltf, .glb or .obj); "
-                                 "scripts/%s converts this one to .glb", path,
+                                 "%s: unknown scene format (expected %s); "
+                                 "scripts/%s converts this one to .glb", path, KNOWN,
                                  converters[i].script);
     return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
-                         "%s: unknown scene format (expected .gltf, .glb or .obj)", path);
+                         "%s: unknown scene format (expected %s)", path, KNOWN);
 }

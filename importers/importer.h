@@ -19,6 +19,11 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
  * other is refused, naming it. */
 extern const char *const ptr_gltf_extensions[];
 
+/* Parses --select's list (protein, nucleic, ligand, water, all; comma-
+ * separated) into a set of PTR_STRUCTURE_PROTEIN ... (import_options.h).
+ * Fails with PTR_ERR_USAGE and "'TEXT' is not ...". */
+PtrResult ptr_structure_select_parse(const char *text, unsigned *parts, PtrError *err);
+
 /* Appends a printf-formatted line. */
 void ptr_warn(PtrStrings *lines, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));

@@ -11,6 +11,10 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options,
 PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                           PtrScene *scene, PtrStrings *warnings, PtrError *err);
 
+/* PDB and mmCIF, gzipped or not, through gemmi (structure/). */
+PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options,
+                               PtrScene *scene, PtrStrings *warnings, PtrError *err);
+
 /* ptr_builder_finish with ptr's own flags, its message naming the file. */
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err);
 

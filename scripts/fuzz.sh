@@ -1,5 +1,5 @@
 #!/bin/sh
-# Fuzzes the glTF and OBJ importers with libFuzzer under AddressSanitizer and
+# Fuzzes the glTF, OBJ and structure (PDB, mmCIF) importers with libFuzzer under AddressSanitizer and
 # UndefinedBehaviorSanitizer, each for SECONDS (default 60), starting from the
 # test fixtures and the hostile corpus. A crash leaves crash-* files in
 # build-fuzz/ and fails; add such a file to tests/fixtures/hostile/ (and fix
@@ -17,14 +17,18 @@ if ! command -v clang >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/l
 fi
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPTR_FUZZ=ON \
     -DPTR_BUILD_TESTS=OFF >/dev/null
-cmake --build build-fuzz -j "$(nproc)" --target fuzz_gltf fuzz_obj >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target fuzz_gltf fuzz_obj fuzz_structure >/dev/null
 
-for format in gltf obj; do
+for format in gltf obj structure; do
     corpus=build-fuzz/corpus-$format
     mkdir -p "$corpus"
     case $format in
     gltf) find tests/fixtures scenes -name '*.gltf' -o -name '*.glb' | xargs -I{} cp {} "$corpus"/ ;;
     obj) find tests/fixtures -name '*.obj' -size -200k -o -name '*.mtl' | xargs -I{} cp {} "$corpus"/ ;;
+    structure) find tests/fixtures \( -name '*.pdb' -o -name '*.cif' -o -name '*.gz' \) -size -64k |
+        xargs -I{} cp {} "$corpus"/
+        head -c 60000 scenes/1tii.pdb >"$corpus"/1tii_head.pdb
+        head -c 60000 tests/fixtures/structures/1tii.cif >"$corpus"/1tii_head.cif ;;
     esac
     echo "== fuzz_$format, $seconds s"
     (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 tests/fuzz/fuzz_$format -max_total_time="$seconds" \

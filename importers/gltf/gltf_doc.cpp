@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
-#include <strings.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -22,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "attribute_name.h"
 #include "base/shim_error.h"
 #include "gltf_meshopt.h"
 
@@ -160,16 +160,6 @@ int primitive_attribute(const tinygltf::Primitive &p, const char *name)
 {
     auto it = p.attributes.find(name);
     return it == p.attributes.end() ? -1 : it->second;
-}
-
-// Whether an attribute's name is the one asked for (docs/scenes.md): the same
-// letters in any case, the leading underscore optional.
-bool attribute_named(const std::string &key, const char *name)
-{
-    const char *k = key.c_str();
-    if (*k == '_' && *name != '_')
-        k++;
-    return strcasecmp(k, name) == 0;
 }
 
 std::string required_extension_fault(const std::vector<std::string> &required)
@@ -732,7 +722,7 @@ extern "C" int gltf_doc_instance_attribute(const GltfDoc *doc, size_t node, cons
     if (!a || !a->IsObject())
         return -1;
     for (const std::string &key : a->Keys())
-        if (attribute_named(key, name)) {
+        if (ptr_attribute_named(key.c_str(), name)) {
             int index = attribute(*a, key.c_str());
             return in_range(index, doc->model.accessors.size()) ? index : -2;
         }
@@ -743,7 +733,7 @@ extern "C" int gltf_doc_primitive_attribute(const GltfDoc *doc, size_t mesh, siz
                                             const char *name)
 {
     for (const auto &attr : doc->model.meshes[mesh].primitives[index].attributes)
-        if (attribute_named(attr.first, name))
+        if (ptr_attribute_named(attr.first.c_str(), name))
             return attr.second; /* every primitive attribute was checked at load */
     return -1;
 }

@@ -127,6 +127,14 @@ static int parse_number(const char *text, double *value)
 
 /* The set_ helpers take an option's value into o: PTR_OK, else
  * PTR_ERR_USAGE with err saying what is wrong. */
+static PtrResult set_switch(OptionId id, const char *value, PtrSwitch *out, PtrError *err)
+{
+    if (strcmp(value, "on") && strcmp(value, "off"))
+        return bad_value(id, value, "on or off", err);
+    *out = strcmp(value, "on") ? PTR_OFF : PTR_ON;
+    return PTR_OK;
+}
+
 static PtrResult set_int(OptionId id, const char *value, int lo, int hi, int *out, PtrError *err)
 {
     uint64_t v;
@@ -220,11 +228,7 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
         if (ptr_sampler_parse(value, &o->sampler, &problem) != PTR_OK)
             return option_error(id, &problem, err);
         break;
-    case OPT_direct_lighting:
-        if (strcmp(value, "on") && strcmp(value, "off"))
-            return bad_value(id, value, "on or off", err);
-        o->direct_lighting = strcmp(value, "on") ? PTR_OFF : PTR_ON;
-        break;
+    case OPT_direct_lighting: return set_switch(id, value, &o->direct_lighting, err);
     case OPT_noise_threshold:
         if (!parse_number(value, &x) || !(x > 0 && x <= 1e6))
             return bad_value(id, value, "a number above 0", err);
@@ -277,6 +281,11 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
                                                       : PTR_PROJECTION_PERSPECTIVE;
         break;
     case OPT_fit_all_objects: o->fit_all_objects = 1; break;
+    case OPT_select:
+        if (ptr_structure_select_parse(value, &o->structure_select, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
+        break;
+    case OPT_hydrogens: return set_switch(id, value, &o->hydrogens, err);
     case OPT_color_by:
         if (!*value)
             return bad_value(id, value, "an attribute name", err);
@@ -449,6 +458,8 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .camera_name = o->camera_name,
         .camera = o->has_camera ? &o->camera : NULL,
         .fit_all_objects = o->fit_all_objects,
+        .structure_select = o->structure_select,
+        .drop_hydrogens = o->hydrogens == PTR_OFF,
         .value_attribute = o->color_by,
         .auto_projection = o->auto_camera,
         .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,

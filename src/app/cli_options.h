@@ -43,6 +43,8 @@ typedef struct PtrOptions {
     int has_camera;
     PtrProjection auto_camera; /* the projection of a scene without a camera */
     int fit_all_objects;
+    unsigned structure_select; /* PtrImportOptions.structure_select */
+    PtrSwitch hydrogens;
     const char *color_by;   /* --color-by: the attribute; NULL: none */
     const PtrColormap *colormap;
     int has_color_range;

@@ -21,8 +21,7 @@ PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, doubl
     return v3(c[0], c[1], c[2]);
 }
 
-/* IEC 61966-2-1's sRGB decoding. */
-static float srgb_to_linear(float c)
+float ptr_srgb_to_linear(float c)
 {
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
@@ -30,7 +29,7 @@ static float srgb_to_linear(float c)
 PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, double hi)
 {
     PtrVec3 c = ptr_colormap_srgb(map, value, lo, hi);
-    return v3(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z));
+    return v3(ptr_srgb_to_linear(c.x), ptr_srgb_to_linear(c.y), ptr_srgb_to_linear(c.z));
 }
 
 PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,

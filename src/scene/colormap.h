@@ -19,6 +19,10 @@ extern const PtrColormap ptr_colormaps[];
 /* The map of that name, or NULL. */
 const PtrColormap *ptr_colormap_find(const char *name);
 
+/* IEC 61966-2-1's decoding of an sRGB-encoded channel (0 to 1) to linear
+ * light. */
+float ptr_srgb_to_linear(float c);
+
 /* The entry for value between lo and hi, as matplotlib picks it: the range
  * cut into 256 equal bins (hi itself in the last), values beyond it clamped
  * to the ends, every value the first entry when lo == hi. */

@@ -3,7 +3,8 @@
  * bounded time and memory. FUZZ_FORMAT picks the importer: 1 for glTF (a .glb
  * when the input starts with the binary magic, else a .gltf), 2 for OBJ (the
  * input is also its own fuzz.mtl, so that `mtllib fuzz.mtl` lines reach the
- * MTL reader). */
+ * MTL reader), 3 for structures (an mmCIF when the input starts with data_,
+ * else a PDB; gzipped when it starts with gzip's magic). */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -40,6 +41,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 #if FUZZ_FORMAT == 1
     int binary = size >= 4 && !memcmp(data, "glTF", 4);
     snprintf(path, sizeof path, "%s/fuzz.%s", dir, binary ? "glb" : "gltf");
+#elif FUZZ_FORMAT == 3
+    const int cif = size >= 5 && !memcmp(data, "data_", 5);
+    const int gzipped = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
+    snprintf(path, sizeof path, "%s/fuzz.%s%s", dir, cif ? "cif" : "pdb", gzipped ? ".gz" : "");
 #else
     snprintf(path, sizeof path, "%s/fuzz.mtl", dir);
     write_file(path, data, size);
@@ -52,9 +57,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     PtrError err = { 0 };
     /* Half the inputs also read a value per sphere (--color-by): COLOR_0
      * names both the points' COLOR_0 and the instances' _COLOR_0, which the
-     * seed files have. */
-    PtrImportOptions options = { .dependencies = &dependencies, .fit_all_objects = size & 1,
-                                 .value_attribute = size & 2 ? "color_0" : NULL };
+     * seed files have; a structure's B-factor. Structures are read with
+     * waters or without, hydrogens or without. */
+    PtrImportOptions options = {
+        .dependencies = &dependencies, .fit_all_objects = size & 1,
+        .value_attribute = size & 2 ? (FUZZ_FORMAT == 3 ? "bfactor" : "color_0") : NULL,
+        .structure_select = size & 4 ? PTR_STRUCTURE_ALL : 0, .drop_hydrogens = size & 8 };
     PtrResult r = ptr_import_scene(path, &options, &scene, &warnings, &err);
     /* A refusal is one line that names the file. */
     if (r != PTR_OK && (strchr(err.message, '\n') || strncmp(err.message, path, strlen(dir))))

@@ -296,9 +296,9 @@ for path, words in ((broken("nan.gltf", [1.0, float("nan"), 2.0]), "instance 1")
     expect(f"{path}: {run if isinstance(run, list) else (run.returncode, run.stderr)}", ok)
     expect(f"{path} without --color-by: refused", isinstance(dump(path), list))
 
-# ptr itself points at the converter.
-run = subprocess.run([ptr, pdb, "-o", os.path.join(tmp, "x.png")], capture_output=True, text=True)
-expect(f"ptr {pdb}: {run.returncode}, {run.stderr!r}",
+# ptr itself points at the converter (structures it reads: check_structures.py).
+run = subprocess.run([ptr, xyz, "-o", os.path.join(tmp, "x.png")], capture_output=True, text=True)
+expect(f"ptr {xyz}: {run.returncode}, {run.stderr!r}",
        run.returncode == 4 and "scripts/molecule_to_glb.py" in run.stderr)
 
 # The examples in scenes/ are what their sources and scripts make.

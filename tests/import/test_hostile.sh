@@ -55,7 +55,9 @@ run() {
 
 for file in "$src"/tests/fixtures/bad/*.gltf "$src"/tests/fixtures/bad/*.glb \
     "$src"/tests/fixtures/bad/*.obj "$src"/tests/fixtures/hostile/*.gltf \
-    "$src"/tests/fixtures/hostile/*.glb "$src"/tests/fixtures/hostile/*.obj; do
+    "$src"/tests/fixtures/hostile/*.glb "$src"/tests/fixtures/hostile/*.obj \
+    "$src"/tests/fixtures/hostile/*.pdb "$src"/tests/fixtures/hostile/*.cif \
+    "$src"/tests/fixtures/hostile/*.gz; do
     case $(basename "$file") in
     # Valid: re-centring on the camera makes a sphere 1e300 away renderable,
     # tinygltf reads the JSON of a GLB whose header says version 1, and ptr
