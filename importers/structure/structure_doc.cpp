@@ -156,7 +156,8 @@ PtrResult caught(PtrError *err, const std::string &path)
 } // namespace
 
 extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int hydrogens,
-                                        StructureAtom **atoms, size_t *count, PtrError *err)
+                                        StructureAtom **atoms, size_t *count, size_t *models,
+                                        PtrError *err)
 {
     try {
         gemmi::MaybeGzipped input(path);
@@ -188,6 +189,7 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
         std::copy(kept.begin(), kept.end(), out);
         *atoms = out;
         *count = kept.size();
+        *models = structure.models.size();
         return PTR_OK;
     } catch (const Fault &fault) {
         return ptr_shim_error(err, PTR_ERR_SCENE_INVALID, fault.message);

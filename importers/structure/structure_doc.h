@@ -26,11 +26,12 @@ typedef struct StructureAtom {
  * only with hydrogens, and of an atom's alternate locations the one of
  * highest occupancy (the first of equals) where the first stood. On success
  * *atoms (free with structure_doc_free) holds *count atoms in the file's
- * order. Fails with PTR_ERR_SCENE_UNREADABLE or PTR_ERR_SCENE_INVALID (a
+ * order, and *models the number of models the file has. Fails with PTR_ERR_SCENE_UNREADABLE or PTR_ERR_SCENE_INVALID (a
  * number that is not one, a malformed file), PTR_ERR_NOMEM, each with one
  * line naming the file. */
 PtrResult structure_doc_read(const char *path, unsigned select, int hydrogens,
-                             StructureAtom **atoms, size_t *count, PtrError *err);
+                             StructureAtom **atoms, size_t *count, size_t *models,
+                             PtrError *err);
 void structure_doc_free(StructureAtom *atoms);
 
 #ifdef __cplusplus

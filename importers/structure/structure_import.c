@@ -84,17 +84,19 @@ static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const Str
 PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options,
                                PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {
-    (void)warnings;
     const unsigned select = options && options->structure_select
                                 ? options->structure_select
                                 : PTR_STRUCTURE_DEFAULT;
     AtomValue value;
     PtrResult res = atom_value(path, options ? options->value_attribute : NULL, &value, err);
     StructureAtom *atoms = NULL;
-    size_t count = 0;
+    size_t count = 0, models = 0;
     if (res == PTR_OK)
         res = structure_doc_read(path, select, !(options && options->drop_hydrogens), &atoms,
-                                 &count, err);
+                                 &count, &models, err);
+    if (res == PTR_OK && models > 1)
+        ptr_warn(warnings, "%s: the first of %zu models is read, the others are left out", path,
+                 models);
     if (res == PTR_OK && count == 0)
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: no atoms%s", path,
                             select == PTR_STRUCTURE_ALL ? "" : " of those --select keeps");

@@ -100,6 +100,9 @@ mixed = os.path.join(tmp, "mixed.pdb")
 with open(mixed, "w") as f:
     f.write("MODEL        1\n" + "".join(atoms) + "ENDMDL\nMODEL        2\n" + second +
             "ENDMDL\nEND\n")
+run = subprocess.run([ptr, "--dump-scene", mixed], capture_output=True, text=True)
+expect(f"mixed.pdb: the second model named: {run.stdout[-300:]!r}",
+       "the first of 2 models is read" in run.stdout)
 mixed_glb = to_glb(mixed)
 same_spheres("mixed.pdb", dump(mixed, "--select", "all", "--color-by", "occupancy"),
              dump(mixed_glb, "--color-by", "occupancy"), True)
