@@ -139,6 +139,37 @@ void check_atom_site_columns(const std::string &path, const gemmi::cif::Block &b
         throw Fault{ path + ": _atom_site lacks the columns" + missing };
 }
 
+// gemmi reads whole numbers in an int without checking their size (a signed
+// overflow): a value whose leading digits could overflow one (ten or more) is
+// refused before gemmi reads the block. No real number in a structure has
+// them, whether whole or not.
+bool could_overflow_int(const std::string &value)
+{
+    const size_t start = value.find_first_not_of(" +-");
+    const size_t digits = value.find_first_not_of("0123456789", start == std::string::npos
+                                                                    ? value.size() : start);
+    return start != std::string::npos &&
+           (digits == std::string::npos ? value.size() : digits) - start >= 10;
+}
+
+void check_whole_numbers(const std::string &path, const gemmi::cif::Block &block)
+{
+    const auto check = [&path](const std::string &value) {
+        if (could_overflow_int(value))
+            throw Fault{ path + ": '" + value.substr(0, 40) +
+                         "' has more digits than a number in a structure can" };
+    };
+    for (const gemmi::cif::Item &item : block.items) {
+        if (item.type == gemmi::cif::ItemType::Pair)
+            check(item.pair[1]);
+        else if (item.type == gemmi::cif::ItemType::Loop)
+            for (const std::string &value : item.loop.values)
+                check(value);
+        else if (item.type == gemmi::cif::ItemType::Frame)
+            check_whole_numbers(path, item.frame);
+    }
+}
+
 // gemmi's messages name the file already; others get its name first.
 PtrResult caught(PtrError *err, const std::string &path)
 {
@@ -173,8 +204,10 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
         } else {
             const gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(),
                                                                      path);
-            if (!doc.blocks.empty())
+            if (!doc.blocks.empty()) {
                 check_atom_site_columns(path, doc.blocks[0]);
+                check_whole_numbers(path, doc.blocks[0]);
+            }
             structure = gemmi::make_structure(doc);
         }
         text = gemmi::CharArray();

@@ -3,8 +3,6 @@
  * table scripts/molecule_to_glb.py uses too (elements.def); each atom's
  * B-factor and occupancy as the values --color-by reads (_BFACTOR,
  * _OCCUPANCY, the names the converter gives them). docs/scenes.md. */
-#include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "attribute_name.h"
@@ -43,8 +41,8 @@ static PtrResult atom_value(const char *path, const char *name, AtomValue *value
     return PTR_OK;
 }
 
-/* The spheres of atoms[0 .. count), all of one white diffuse material whose
- * colour each sphere's own replaces. */
+/* The spheres of atoms[0 .. count): one white diffuse material, which each
+ * sphere's own colour (its element's) tints, as the converter's .glb does. */
 static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const StructureAtom *atoms,
                            size_t count, AtomValue value, PtrError *err)
 {
