@@ -3,6 +3,7 @@
 // the first model's atoms selected. Every exception stops here.
 #include "structure_doc.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
