@@ -91,7 +91,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     }
     PtrProgressiveResult done;
     PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, alpha, counts,
-                                           &done, err);
+                                           NULL, NULL, &done, err);
     ptr_progress_done(&printer);
     if (res == PTR_ERR_SCENE_INVALID) {
         /* The renderer does not know where the scene came from. */

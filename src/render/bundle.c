@@ -38,6 +38,7 @@ typedef struct Lanes {
     int slot[LANES];       /* the result the path fills, or FREE */
     int traced[LANES];     /* the lane's hit is found already (a camera ray's) */
     PtrLitVertex lit[LANES];
+    PtrPathPass pass[LANES]; /* with passes only */
 } Lanes;
 
 /* One bounce's findings for every lane. */
@@ -180,6 +181,7 @@ STAGE int refill(const PtrPathJob *job, const Round *round, Lanes *lanes, Camera
             lanes->depth[l] = 0;
             lanes->slot[l] = (int)(*next)++;
             lanes->lit[l].sampled = 0;
+            lanes->pass[l] = ptr_path_pass_start();
             set_lane_v3(lanes->throughput, l, v3_splat(1.0f));
             set_lane_v3(lanes->radiance, l, v3_splat(0.0f));
         }
@@ -314,6 +316,23 @@ STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
     }
 }
 
+/* The passes of the lanes in flight, lane by lane: where they met a
+ * surface, and the sky where they missed. */
+STAGE void record_passes(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v)
+{
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE)
+            continue;
+        PtrVec3 dir = lane_v3(lanes->ray.dir, l);
+        if (v->hit[l])
+            ptr_path_pass_surface(&lanes->pass[l], (PtrMaterialKind)v->kind[l], v->fuzz[l],
+                                  lane_v3(v->albedo, l),
+                                  ptr_facing_normal(dir, lane_v3(v->normal, l)));
+        else
+            ptr_path_pass_sky(&lanes->pass[l], ptr_sky_radiance(&job->scene->sky, dir));
+    }
+}
+
 /* Light sampling at the diffuse vertices, lane by lane. */
 STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
                            uint64_t *rays)
@@ -397,10 +416,11 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
 }
 
 /* The next ray of every path that goes on; the result of every path that
- * ends, which frees its lane: its radiance, and whether its camera ray hit
- * a sphere (a path past its first ray did). */
+ * ends, which frees its lane: its radiance, whether its camera ray hit a
+ * sphere (a path past its first ray did), and its passes if passes is not
+ * NULL. */
 STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
-                            PtrVec3 *results, unsigned char *covered)
+                            PtrVec3 *results, unsigned char *covered, PtrPathPass *passes)
 {
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
@@ -434,6 +454,8 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
         if (!go_on[l]) {
             results[lanes->slot[l]] = lane_v3(lanes->radiance, l);
             covered[lanes->slot[l]] = lanes->depth[l] > 0 || v->hit[l];
+            if (passes)
+                passes[lanes->slot[l]] = lanes->pass[l];
             lanes->slot[l] = FREE;
             continue;
         }
@@ -445,7 +467,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
 }
 
 static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *results,
-                         unsigned char *covered, uint64_t *rays)
+                         unsigned char *covered, PtrPathPass *passes, uint64_t *rays)
 {
     Lanes lanes;
     Vertex vertex;
@@ -472,10 +494,12 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
         find_surfaces(job, &lanes, &vertex);
         emission_weights(job, &lanes, &vertex, weight);
         add_sky_and_emission(job, &lanes, &vertex, weight);
+        if (passes)
+            record_passes(job, &lanes, &vertex);
         if (job->sample_lights)
             sample_emitters(job, &lanes, &vertex, rays);
         scatter(job, &lanes, &vertex);
-        continue_or_end(job, &lanes, &vertex, results, covered);
+        continue_or_end(job, &lanes, &vertex, results, covered, passes);
     }
 }
 
@@ -485,6 +509,8 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
     Round round;
     PtrVec3 results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
     unsigned char covered[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    PtrPathPass pass_results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    PtrPathPass *passes = s->passes ? pass_results : NULL;
     uint64_t end = (uint64_t)job->first + job->count;
     /* Rounds end where adaptive sampling may stop a pixel, so a round's
      * samples are all ones the path tracer would take too. */
@@ -506,17 +532,20 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
             }
         round.items = (uint32_t)round.pixels * round.span;
         if (ptr_path_may_trace(s, 0))
-            render_round(job, &round, results, covered, rays);
+            render_round(job, &round, results, covered, passes, rays);
         else
             for (uint32_t i = 0; i < round.items; i++) {
                 results[i] = v3_splat(0.0f);
                 covered[i] = 0;
+                if (passes)
+                    passes[i] = ptr_path_pass_start();
             }
         for (int p = 0; p < round.pixels; p++)
             for (uint32_t i = 0; i < round.span; i++)
                 ptr_path_accumulate(s, round.sums[p], round.first + i,
                                     results[(uint32_t)p * round.span + i],
-                                    covered[(uint32_t)p * round.span + i]);
+                                    covered[(uint32_t)p * round.span + i],
+                                    passes ? &passes[(uint32_t)p * round.span + i] : NULL);
         a = b;
     }
 }

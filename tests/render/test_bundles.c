@@ -6,7 +6,8 @@
  * take (each material, fuzz, colours, emitters with light sampling, a huge
  * sphere, the tree, no sphere at all, an orthographic camera) under every
  * setting that changes a path (sampler, light sampling, depth limit,
- * adaptive sampling, regions, sample ranges split into passes, threads).
+ * adaptive sampling, regions, sample ranges split into passes, threads),
+ * with the albedo and normal passes' sums too where they are asked for.
  * Below AVX2 there are no bundles, which the test says. */
 #include "test.h"
 
@@ -101,7 +102,7 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     PtrError err = { 0 };
     PtrRegion r = ptr_render_region(&settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-    Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
+    Sums sums = { calloc(pixels * ptr_accum_stride(settings.passes), sizeof(double)), 0 };
     CHECK_INT(ptr_isect_init(&isect, kernel, ptr_cpu_level(), scene->spheres.count, NULL), PTR_OK);
     CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, integrator == PTR_INTEGRATOR_BUNDLES,
                              scene, 0, NULL),
@@ -118,11 +119,11 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     return sums;
 }
 
-/* Frees b's sums, which must be a's. */
-static int compare(const char *what, Sums a, Sums b, size_t pixels)
+/* Frees b's sums (stride doubles a pixel), which must be a's. */
+static int compare(const char *what, Sums a, Sums b, size_t pixels, size_t stride)
 {
     size_t differ = 0;
-    for (size_t i = 0; i < pixels * PTR_ACCUM_STRIDE; i++)
+    for (size_t i = 0; i < pixels * stride; i++)
         differ += memcmp(&a.acc[i], &b.acc[i], sizeof(double)) != 0;
     if (differ || a.rays != b.rays)
         fprintf(stderr, "%s: %zu sums differ, rays %llu against %llu\n", what, differ,
@@ -162,6 +163,11 @@ static Variant variants[] = {
     { "region, samples 7..26 in passes of 5, one thread", { 0 }, 7, 19, 5 },
     { "transparent, in passes of 4", { 0 }, 0, 12, 4 },
     { "transparent, adaptive", { 0 }, 0, 48, 48 },
+    { "passes", { 0 }, 0, 12, 12 },
+    { "passes, depth 0", { 0 }, 0, 3, 3 },
+    { "passes, depth 2", { 0 }, 0, 5, 5 },
+    { "passes, transparent, region, samples 3..20 in passes of 6", { 0 }, 3, 17, 6 },
+    { "passes, adaptive", { 0 }, 0, 48, 48 },
 };
 enum { VARIANTS = sizeof variants / sizeof variants[0] };
 
@@ -184,6 +190,14 @@ static void set_variants(void)
     variants[8].settings.transparent = 1;
     variants[8].settings.noise_threshold = 0.05f;
     variants[8].settings.min_samples = 16;
+    for (int v = 9; v < VARIANTS; v++)
+        variants[v].settings.passes = 1;
+    variants[10].settings.max_depth = 0;
+    variants[11].settings.max_depth = 2;
+    variants[12].settings.transparent = 1;
+    variants[12].settings.region = (PtrRegion){ 5, 3, 37, 29 };
+    variants[13].settings.noise_threshold = 0.05f;
+    variants[13].settings.min_samples = 16;
 }
 
 /* Every variant of one scene, every pair against the reference. */
@@ -209,7 +223,8 @@ static void test_scene(SceneKind kind)
             char what[200];
             snprintf(what, sizeof what, "%s, %s: %s", scene_names[kind], var->name,
                      pairs[p].name);
-            if (compare(what, reference, other_sums, pixels))
+            if (compare(what, reference, other_sums, pixels,
+                        ptr_accum_stride(var->settings.passes)))
                 printf("  %-90s identical\n", what);
         }
         free(reference.acc);
