@@ -38,7 +38,6 @@ typedef struct Lanes {
     int slot[LANES];       /* the result the path fills, or FREE */
     int traced[LANES];     /* the lane's hit is found already (a camera ray's) */
     PtrLitVertex lit[LANES];
-    PtrPathPass pass[LANES]; /* with passes only */
 } Lanes;
 
 /* One bounce's findings for every lane. */
@@ -181,7 +180,6 @@ STAGE int refill(const PtrPathJob *job, const Round *round, Lanes *lanes, Camera
             lanes->depth[l] = 0;
             lanes->slot[l] = (int)(*next)++;
             lanes->lit[l].sampled = 0;
-            lanes->pass[l] = ptr_path_pass_start();
             set_lane_v3(lanes->throughput, l, v3_splat(1.0f));
             set_lane_v3(lanes->radiance, l, v3_splat(0.0f));
         }
@@ -316,20 +314,25 @@ STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
     }
 }
 
-/* The passes of the lanes in flight, lane by lane: where they met a
- * surface, and the sky where they missed. */
-STAGE void record_passes(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v)
+/* The passes of the lanes in flight, lane by lane, kept in the result
+ * each path fills (passes[slot], begun at its camera ray): where they met
+ * a surface, and the sky where they missed. */
+STAGE void record_passes(const PtrPathJob *job, const Lanes *restrict lanes,
+                         const Vertex *restrict v, PtrPathPass *passes)
 {
     for (int l = 0; l < LANES; l++) {
         if (lanes->slot[l] == FREE)
             continue;
+        PtrPathPass *pass = &passes[lanes->slot[l]];
+        if (lanes->depth[l] == 0)
+            *pass = ptr_path_pass_start();
         PtrVec3 dir = lane_v3(lanes->ray.dir, l);
         if (v->hit[l])
-            ptr_path_pass_surface(&lanes->pass[l], (PtrMaterialKind)v->kind[l], v->fuzz[l],
+            ptr_path_pass_surface(pass, (PtrMaterialKind)v->kind[l], v->fuzz[l],
                                   lane_v3(v->albedo, l),
                                   ptr_facing_normal(dir, lane_v3(v->normal, l)));
         else
-            ptr_path_pass_sky(&lanes->pass[l], ptr_sky_radiance(&job->scene->sky, dir));
+            ptr_path_pass_sky(pass, ptr_sky_radiance(&job->scene->sky, dir));
     }
 }
 
@@ -416,11 +419,10 @@ STAGE void scatter(const PtrPathJob *job, Lanes *restrict lanes, Vertex *restric
 }
 
 /* The next ray of every path that goes on; the result of every path that
- * ends, which frees its lane: its radiance, whether its camera ray hit a
- * sphere (a path past its first ray did), and its passes if passes is not
- * NULL. */
+ * ends, which frees its lane: its radiance, and whether its camera ray hit
+ * a sphere (a path past its first ray did). */
 STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
-                            PtrVec3 *results, unsigned char *covered, PtrPathPass *passes)
+                            PtrVec3 *results, unsigned char *covered)
 {
     const PtrScene *scene = job->scene;
     const PtrSpheres *spheres = &scene->spheres;
@@ -454,8 +456,6 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
         if (!go_on[l]) {
             results[lanes->slot[l]] = lane_v3(lanes->radiance, l);
             covered[lanes->slot[l]] = lanes->depth[l] > 0 || v->hit[l];
-            if (passes)
-                passes[lanes->slot[l]] = lanes->pass[l];
             lanes->slot[l] = FREE;
             continue;
         }
@@ -495,11 +495,11 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
         emission_weights(job, &lanes, &vertex, weight);
         add_sky_and_emission(job, &lanes, &vertex, weight);
         if (passes)
-            record_passes(job, &lanes, &vertex);
+            record_passes(job, &lanes, &vertex, passes);
         if (job->sample_lights)
             sample_emitters(job, &lanes, &vertex, rays);
         scatter(job, &lanes, &vertex);
-        continue_or_end(job, &lanes, &vertex, results, covered, passes);
+        continue_or_end(job, &lanes, &vertex, results, covered);
     }
 }
 
