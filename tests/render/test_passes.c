@@ -4,11 +4,16 @@
  * reflects, tinted by its albedo, a fuzzy metal its own), and the same sums
  * bit for bit whatever the thread count or the regions a render is split
  * into. test_bundles holds the integrators and sample ranges to each
- * other with passes too. */
+ * other with passes too. Through the command line: the EXR layers, merges
+ * of regions and of sample ranges, and the refusals. */
 #include "base/cpu.h"
 #include "builder.h"
+#include "image/image.h"
 #include "render/render.h"
 #include "test.h"
+#include "test_files.h"
+
+#define SEED_SCENE PTR_SOURCE_DIR "/scenes/seed.gltf"
 
 enum { SIZE = 33, PIXELS = SIZE * SIZE, CENTRE = SIZE / 2 * SIZE + SIZE / 2, SAMPLES = 16 };
 
@@ -159,14 +164,105 @@ static void test_threads_and_regions(void)
     ptr_scene_free(&scene);
 }
 
+/* seed.gltf at 48 x 48 with passes into name, with up to three options
+ * more (the first NULL ends them); NULL if ptr fails. */
+static PtrImage *render_cli(const char *name, const char *a, const char *b, const char *c)
+{
+    const char *out = test_path(name);
+    if (test_ptr(SEED_SCENE, "-o", out, "--width", "48", "--samples", "8", "--seed", "7",
+                 "--passes", "albedo,normal", "--quiet", a, b, c, NULL) != 0)
+        return NULL;
+    PtrError err;
+    PtrImage *image = NULL;
+    CHECK_INT(test_image_read(out, &image, &err), PTR_OK);
+    return image;
+}
+
+/* The largest difference between two images' layers of three floats a
+ * pixel (colour, albedo or normal as get gives them), or INFINITY if the
+ * sizes differ or a layer is missing. */
+static float layer_difference(const PtrImage *a, const PtrImage *b,
+                              const float *(*get)(const PtrImage *))
+{
+    size_t n = (size_t)ptr_image_width(a) * (size_t)ptr_image_height(a) * 3;
+    if (ptr_image_width(a) != ptr_image_width(b) || ptr_image_height(a) != ptr_image_height(b) ||
+        !get(a) || !get(b))
+        return INFINITY;
+    float most = 0.0f;
+    for (size_t i = 0; i < n; i++)
+        most = fmaxf(most, fabsf(get(a)[i] - get(b)[i]));
+    return most;
+}
+
+/* Regions merged give the whole render's passes bit for bit; sample ranges
+ * merged, to the rounding of their means. */
+static void test_merges(void)
+{
+    PtrImage *whole = render_cli("whole.exr", NULL, NULL, NULL);
+    CHECK(whole && ptr_image_albedo(whole) && ptr_image_normal(whole));
+    PtrImage *top = render_cli("top.exr", "--region", "0,0,48,20", NULL);
+    PtrImage *bottom = render_cli("bottom.exr", "--region", "0,20,48,48", NULL);
+    PtrImage *early = render_cli("early.exr", "--sample-range", "0:3", NULL);
+    PtrImage *late = render_cli("late.exr", "--sample-range", "3:8", NULL);
+    CHECK_INT(test_ptr("merge", test_path("top.exr"), test_path("bottom.exr"), "-o",
+                       test_path("regions.exr"), "--quiet", NULL),
+              0);
+    CHECK_INT(test_ptr("merge", test_path("early.exr"), test_path("late.exr"), "-o",
+                       test_path("ranges.exr"), "--quiet", NULL),
+              0);
+    PtrImage *regions = NULL, *ranges = NULL;
+    PtrError err;
+    CHECK_INT(test_image_read(test_path("regions.exr"), &regions, &err), PTR_OK);
+    CHECK_INT(test_image_read(test_path("ranges.exr"), &ranges, &err), PTR_OK);
+    if (whole && regions && ranges) {
+        CHECK_FLOAT_EQ(layer_difference(whole, regions, ptr_image_pixels), 0.0f);
+        CHECK_FLOAT_EQ(layer_difference(whole, regions, ptr_image_albedo), 0.0f);
+        CHECK_FLOAT_EQ(layer_difference(whole, regions, ptr_image_normal), 0.0f);
+        CHECK(layer_difference(whole, ranges, ptr_image_albedo) < 1e-6f);
+        CHECK(layer_difference(whole, ranges, ptr_image_normal) < 1e-6f);
+    }
+    ptr_image_free(whole);
+    ptr_image_free(top);
+    ptr_image_free(bottom);
+    ptr_image_free(early);
+    ptr_image_free(late);
+    ptr_image_free(regions);
+    ptr_image_free(ranges);
+}
+
+/* The passes go into EXR alone, both together; parts with passes do not
+ * merge with parts without; a render without --passes has none. */
+static void test_refusals(void)
+{
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("p.png"), "--width", "16", "--samples", "1",
+                       "--passes", "albedo,normal", "--quiet", NULL),
+              2);
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("p.exr"), "--passes", "albedo", "--quiet",
+                       NULL),
+              2);
+    PtrImage *with = render_cli("with.exr", "--region", "0,0,48,20", NULL);
+    CHECK_INT(test_ptr(SEED_SCENE, "-o", test_path("without.exr"), "--width", "48", "--samples",
+                       "8", "--seed", "7", "--region", "0,20,48,48", "--quiet", NULL),
+              0);
+    CHECK(test_ptr("merge", test_path("with.exr"), test_path("without.exr"), "-o",
+                   test_path("no.exr"), "--quiet", NULL) != 0);
+    PtrImage *without = NULL;
+    PtrError err;
+    CHECK_INT(test_image_read(test_path("without.exr"), &without, &err), PTR_OK);
+    CHECK(without && !ptr_image_albedo(without) && !ptr_image_normal(without));
+    ptr_image_free(with);
+    ptr_image_free(without);
+}
+
 int main(void)
 {
+    if (!test_dir_create("passes"))
+        return 1;
     const TestCase cases[] = {
-        TEST_CASE(test_diffuse),
-        TEST_CASE(test_mirror),
-        TEST_CASE(test_fuzzy_metal),
-        TEST_CASE(test_threads_and_regions),
+        TEST_CASE(test_diffuse),   TEST_CASE(test_mirror),   TEST_CASE(test_fuzzy_metal),
+        TEST_CASE(test_threads_and_regions), TEST_CASE(test_merges), TEST_CASE(test_refusals),
     };
     TEST_RUN(cases);
+    test_dir_remove();
     return test_report();
 }
