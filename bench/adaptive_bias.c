@@ -32,7 +32,7 @@ static int render(const PtrScene *scene, const PtrIsectTable *isect, PtrRenderSe
         fprintf(stderr, "adaptive_bias: %s\n", err.message);
         return 0;
     }
-    ptr_accum_resolve(acc, PIXELS, rgb, NULL, counts);
+    ptr_accum_resolve(acc, PIXELS, PTR_ACCUM_STRIDE, rgb, NULL, counts);
     *seconds += stats.seconds;
     return 1;
 }

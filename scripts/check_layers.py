@@ -25,8 +25,9 @@ LAYERS = {
     "image": ("src/image", ["base"]),
     "color": ("src/color", ["base"]),
     "live": ("src/live", ["base"]),
+    "denoise": ("src/denoise", ["base"]),
     "app": ("src/app", ["base", "scene", "sampling", "accel", "render", "importers", "image",
-                        "color", "live"]),
+                        "color", "live", "denoise"]),
 }
 # Where a quoted include is looked for, after the including file's folder.
 INCLUDE_DIRS = ["src", "importers", "importers/gltf"]

@@ -256,7 +256,8 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
      * (by their numbers, or the names of its numbered scenes); a list of
      * scenes' may not. */
     for (int i = 0; res == PTR_OK && i < *count; i++) {
-        res = ptr_output_check(o->images, (*items)[i].output, o->depth, o->transparent, err);
+        res = ptr_output_check(o->images, (*items)[i].output, o->depth, o->transparent,
+                               o->passes, err);
         for (int j = 0; res == PTR_OK && !sequence && j < i; j++)
             if (!strcmp((*items)[i].output, (*items)[j].output))
                 res = ptr_error_set(err, PTR_ERR_USAGE, "%s and %s would both be written to %s",

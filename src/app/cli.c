@@ -140,7 +140,7 @@ static int watch_scene(const PtrOptions *o, const PtrColor *color)
     char output[PTR_PATH_SIZE];
     PtrError err = { 0 };
     if (ptr_batch_output(o, o->inputs[0], output, &err) != PTR_OK ||
-        ptr_output_check(o->images, output, o->depth, o->transparent, &err) != PTR_OK)
+        ptr_output_check(o->images, output, o->depth, o->transparent, o->passes, &err) != PTR_OK)
         return fail(&err);
     PtrWatch watch = { 0 };
     int code = 0;

@@ -218,6 +218,12 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width, err);
     case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height, err);
     case OPT_transparent: o->transparent = 1; break;
+    case OPT_passes:
+        /* Both or none: a denoiser takes the albedo and normal together. */
+        if (strcmp(value, "albedo,normal"))
+            return bad_value(id, value, "albedo,normal", err);
+        o->passes = 1;
+        break;
     case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads, err);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))

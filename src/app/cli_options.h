@@ -55,6 +55,7 @@ typedef struct PtrOptions {
     uint64_t seed;
     int width, height;      /* 0: from the scene */
     int transparent;        /* alpha 0 where camera rays meet no sphere */
+    int passes;             /* --passes albedo,normal: EXR layers of both passes */
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;

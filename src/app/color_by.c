@@ -15,7 +15,7 @@ enum { BAR_WIDTH = 512, BAR_HEIGHT = 32 }; /* two columns an entry of 256 */
 static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const char *scene_path,
                            const PtrColor *color, PtrError *err)
 {
-    PtrResult usable = ptr_output_check(o->images, o->color_bar, PTR_DEPTH_DEFAULT, 0, err);
+    PtrResult usable = ptr_output_check(o->images, o->color_bar, PTR_DEPTH_DEFAULT, 0, 0, err);
     if (usable != PTR_OK)
         return usable;
     float *rgb = malloc((size_t)BAR_WIDTH * BAR_HEIGHT * 3 * sizeof *rgb);

@@ -57,7 +57,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = integrator, .transparent = o->transparent,
+        .integrator = integrator, .transparent = o->transparent, .passes = o->passes,
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -82,16 +82,21 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
     float *alpha = o->transparent ? malloc(pixels * sizeof *alpha) : NULL;
-    if (!rgb || (o->noise_threshold > 0 && !counts) || (o->transparent && !alpha)) {
+    float *albedo = o->passes ? malloc(pixels * 3 * sizeof *albedo) : NULL;
+    float *normal = o->passes ? malloc(pixels * 3 * sizeof *normal) : NULL;
+    if (!rgb || (o->noise_threshold > 0 && !counts) || (o->transparent && !alpha) ||
+        (o->passes && (!albedo || !normal))) {
         free(rgb);
         free(counts);
         free(alpha);
+        free(albedo);
+        free(normal);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
                              report->output, layout.width, layout.height);
     }
     PtrProgressiveResult done;
     PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, alpha, counts,
-                                           &done, err);
+                                           albedo, normal, &done, err);
     ptr_progress_done(&printer);
     if (res == PTR_ERR_SCENE_INVALID) {
         /* The renderer does not know where the scene came from. */
@@ -112,7 +117,8 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
             .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
             .direct_lighting = o->direct_lighting == PTR_ON,
             .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-            .sample_counts = counts, .alpha = alpha, .render_seconds = done.stats.seconds, .depth = o->depth,
+            .sample_counts = counts, .albedo = albedo, .normal = normal, .alpha = alpha,
+            .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
             .dither = o->dither,
         };
@@ -124,6 +130,8 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     free(rgb);
     free(counts);
     free(alpha);
+    free(albedo);
+    free(normal);
     ptr_live_view_end(res == PTR_OK && !done.stopped);
     if (res == PTR_OK && done.stopped && o->skip_existing)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,

@@ -57,12 +57,13 @@ void ptr_live_view_close(void)
 /* After each pass, on the thread that runs the render, while its threads
  * wait: the film resolved (a read of it, as the final image's), handed
  * over with the progress. */
-static void pass_done(void *user, const double *film, size_t pixels, const PtrProgress *p)
+static void pass_done(void *user, const double *film, size_t pixels, size_t stride,
+                      const PtrProgress *p)
 {
     (void)user;
     if (pixels != scratch_pixels)
         return;
-    ptr_accum_resolve(film, pixels, scratch, NULL, NULL);
+    ptr_accum_resolve(film, pixels, stride, scratch, NULL, NULL);
     double per_sample = p->samples_done ? p->elapsed / p->samples_done : 0;
     last = (PtrLiveStatus){
         .samples_done = p->samples_done, .samples_total = p->samples_total,

@@ -68,6 +68,11 @@ static void common_attr(const Part *parts, int count, const char *name, char *ou
     snprintf(out, size, "%s", first ? first : "");
 }
 
+static int has_passes(const Part *p)
+{
+    return ptr_image_albedo(p->image) && ptr_image_normal(p->image);
+}
+
 static int overlap(const PtrImageLayout *a, const PtrImageLayout *b)
 {
     return a->x < b->x + b->width && b->x < a->x + a->width && a->y < b->y + b->height &&
@@ -93,6 +98,8 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
                                : NULL;
         if (!what && !ptr_image_alpha(a->image) != !ptr_image_alpha(b->image))
             what = "background (--transparent or not)";
+        if (!what && !has_passes(a) != !has_passes(b))
+            what = "set of passes (--passes or not)";
         if (what)
             return ptr_error_set(err, PTR_ERR_USAGE, "%s: another %s than %s: not parts of one render",
                                  b->path, what, a->path);
@@ -122,14 +129,18 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
 {
     const int w = parts[0].layout.full_width, h = parts[0].layout.full_height;
     size_t pixels = (size_t)w * (size_t)h;
-    /* Premultiplied colour and alpha alike are means over samples. */
-    const int channels = ptr_image_alpha(parts[0].image) ? 4 : 3;
-    double *sum = calloc(pixels * 4, sizeof *sum);
+    /* Premultiplied colour, alpha and the passes alike are means over
+     * samples: a pixel's sums hold colour, alpha, albedo and normal. */
+    enum { ALPHA = 3, ALBEDO = 4, NORMAL = 7, SUMS = 10 };
+    const int transparent = ptr_image_alpha(parts[0].image) != NULL, passes = has_passes(&parts[0]);
+    double *sum = calloc(pixels * SUMS, sizeof *sum);
     long *n = calloc(pixels, sizeof *n);
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
-    float *alpha = channels == 4 ? malloc(pixels * sizeof *alpha) : NULL;
+    float *alpha = transparent ? malloc(pixels * sizeof *alpha) : NULL;
+    float *albedo = passes ? malloc(pixels * 3 * sizeof *albedo) : NULL;
+    float *normal = passes ? malloc(pixels * 3 * sizeof *normal) : NULL;
     PtrResult res = PTR_OK;
-    if (!sum || !n || !rgb || (channels == 4 && !alpha)) {
+    if (!sum || !n || !rgb || (transparent && !alpha) || (passes && (!albedo || !normal))) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", output);
         goto done;
     }
@@ -137,6 +148,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     for (int i = 0; i < count; i++) {
         const Part *p = &parts[i];
         const float *px = ptr_image_pixels(p->image), *pa = ptr_image_alpha(p->image);
+        const float *pal = ptr_image_albedo(p->image), *pn = ptr_image_normal(p->image);
         first = p->first < first ? p->first : first;
         for (int y = 0; y < p->layout.height; y++)
             for (int x = 0; x < p->layout.width; x++) {
@@ -145,8 +157,16 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
                     continue;
                 size_t at = (size_t)fy * (size_t)w + (size_t)fx;
                 size_t from = (size_t)y * p->layout.width + x;
-                for (int c = 0; c < channels; c++)
-                    sum[4 * at + c] += (double)(c < 3 ? px[3 * from + c] : pa[from]) * p->samples;
+                double *s = &sum[SUMS * at];
+                for (int c = 0; c < 3; c++) {
+                    s[c] += (double)px[3 * from + c] * p->samples;
+                    if (passes) {
+                        s[ALBEDO + c] += (double)pal[3 * from + c] * p->samples;
+                        s[NORMAL + c] += (double)pn[3 * from + c] * p->samples;
+                    }
+                }
+                if (transparent)
+                    s[ALPHA] += (double)pa[from] * p->samples;
                 n[at] += p->samples;
             }
     }
@@ -159,10 +179,16 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         }
         fewest = n[at] < fewest ? n[at] : fewest;
         most = n[at] > most ? n[at] : most;
-        for (int c = 0; c < 3; c++)
-            rgb[3 * at + c] = (float)(sum[4 * at + c] / (double)n[at]);
+        const double *s = &sum[SUMS * at];
+        for (int c = 0; c < 3; c++) {
+            rgb[3 * at + c] = (float)(s[c] / (double)n[at]);
+            if (passes) {
+                albedo[3 * at + c] = (float)(s[ALBEDO + c] / (double)n[at]);
+                normal[3 * at + c] = (float)(s[NORMAL + c] / (double)n[at]);
+            }
+        }
         if (alpha)
-            alpha[at] = (float)(sum[4 * at + 3] / (double)n[at]);
+            alpha[at] = (float)(s[ALPHA] / (double)n[at]);
     }
     if (fewest != most)
         fprintf(stderr, "ptr: warning: %s: pixels hold %ld to %ld samples\n", output, fewest, most);
@@ -188,7 +214,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .min_samples = ptr_image_attr(parts[0].image, "ptr:min_samples")
                            ? (uint32_t)atol(ptr_image_attr(parts[0].image, "ptr:min_samples"))
                            : 0,
-        .alpha = alpha, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
+        .alpha = alpha, .albedo = albedo, .normal = normal, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
         .dither = o->dither,
     };
     res = ptr_output_write(o->images, output, &full, rgb, &info, err);
@@ -197,6 +223,8 @@ done:
     free(n);
     free(rgb);
     free(alpha);
+    free(albedo);
+    free(normal);
     return res;
 }
 
@@ -214,7 +242,8 @@ PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOption
     }
     if (res == PTR_OK)
         res = ptr_output_check(o->images, output, o->depth,
-                               ptr_image_alpha(parts[0].image) != NULL, &err);
+                               ptr_image_alpha(parts[0].image) != NULL, has_passes(&parts[0]),
+                               &err);
     if (res == PTR_OK)
         res = check_parts(parts, count, &err);
     if (res == PTR_OK)

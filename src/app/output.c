@@ -72,7 +72,7 @@ static PtrDepth resolve_depth(const char *path, PtrDepth wanted)
 }
 
 PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth depth, int alpha,
-                           PtrError *err)
+                           int passes, PtrError *err)
 {
     const Format *format = find_format(path);
     int known = format != NULL;
@@ -80,6 +80,11 @@ PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth de
         return ptr_error_set(err, PTR_ERR_USAGE,
                              "%s: a transparent image (--transparent) needs a format with "
                              "alpha: .exr, .png or .tif",
+                             path);
+    /* Only EXR names its channels: the passes go nowhere else. */
+    if (passes && !ptr_image_is_exr(path))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "%s: the passes (--passes) are written as layers of an EXR: use .exr",
                              path);
     PtrResult ready = known ? PTR_OK : ptr_image_ready(images, err);
     if (ready != PTR_OK)
@@ -194,8 +199,9 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
+    const PtrImageExtras extras = { info->sample_counts, info->albedo, info->normal };
     PtrResult res = ptr_image_write(images, path, layout, viewed ? viewed : rgb, alpha,
-                                    info->sample_counts, pixel_formats[depth], attrs,
+                                    &extras, pixel_formats[depth], attrs,
                                     sizeof attrs / sizeof attrs[0], err);
     free(viewed);
     return res;

@@ -36,6 +36,9 @@ typedef struct PtrOutputInfo {
     float noise_threshold; /* adaptive sampling; 0: off */
     uint32_t min_samples;
     const float *sample_counts; /* per pixel, written as an EXR channel (may be NULL) */
+    /* The albedo and normal passes, three floats a pixel each, written as
+     * EXR layers (NULL: none; only EXR takes them: ptr_output_check). */
+    const float *albedo, *normal;
     /* Per pixel, the share of its samples that were covered (may be NULL):
      * the image's alpha, the RGB given then premultiplied by it. */
     const float *alpha;
@@ -52,10 +55,11 @@ PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err);
 
 /* Fails early, before any rendering, if no writer exists for the output's
  * extension or it cannot store that depth, or an alpha channel if alpha is
- * set (PTR_ERR_USAGE), or its folder cannot take the file (PTR_ERR_OUTPUT).
- * images loads the module for formats other than EXR (ptr_image_read). */
+ * set, or passes if passes is set (EXR only) (PTR_ERR_USAGE), or its folder
+ * cannot take the file (PTR_ERR_OUTPUT). images loads the module for
+ * formats other than EXR (ptr_image_read). */
 PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth depth, int alpha,
-                           PtrError *err);
+                           int passes, PtrError *err);
 
 /* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
  * full image as layout says) as info says. The file is replaced atomically.

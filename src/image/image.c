@@ -56,7 +56,7 @@ static int temporary_name(const char *path, char *tmp, size_t size)
 }
 
 PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrImageLayout *layout,
-                          const float *rgb, const float *alpha, const float *sample_counts,
+                          const float *rgb, const float *alpha, const PtrImageExtras *extras,
                           PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
                           PtrError *err)
 {
@@ -70,7 +70,7 @@ PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrIma
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
     memcpy(partial_path, tmp, sizeof tmp);
     partial_active = 1;
-    PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, alpha, sample_counts, format,
+    PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, alpha, extras, format,
                                         attrs, attr_count, err)
                         : m->write(tmp, path, layout, rgb, alpha, format, attrs, attr_count, err);
     if (res == PTR_OK && rename(tmp, path) != 0)
@@ -108,6 +108,8 @@ int ptr_image_height(const PtrImage *image) { return image->layout.height; }
 PtrImageLayout ptr_image_layout(const PtrImage *image) { return image->layout; }
 const float *ptr_image_pixels(const PtrImage *image) { return image->rgb; }
 const float *ptr_image_alpha(const PtrImage *image) { return image->alpha; }
+const float *ptr_image_albedo(const PtrImage *image) { return image->albedo; }
+const float *ptr_image_normal(const PtrImage *image) { return image->normal; }
 
 const char *ptr_image_attr(const PtrImage *image, const char *name)
 {

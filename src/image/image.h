@@ -78,10 +78,19 @@ PtrResult ptr_image_ready(PtrImageLoader *loader, PtrError *err);
 /* Whether a writer exists for the file's extension. */
 int ptr_image_can_write(PtrImageLoader *loader, const char *path);
 
+/* What an EXR holds beside the colour and alpha, in float channels of their
+ * own, each where it is not NULL: how many samples each pixel took (one
+ * float a pixel: "samples"), and the albedo and normal passes (three floats
+ * a pixel each: "albedo.R/G/B", "normal.X/Y/Z"). */
+typedef struct PtrImageExtras {
+    const float *sample_counts;
+    const float *albedo, *normal;
+} PtrImageExtras;
+
 /* Writes RGB float pixels (rows top to bottom), stored in the file as format,
  * with an alpha channel (A) from alpha if it is not NULL, and for EXR, whose
- * channels have names, a float channel "samples" from sample_counts if it
- * is not NULL (other formats ignore it). The pixels are written as given:
+ * channels have names, the extras if they are not NULL (other formats
+ * ignore them). The pixels are written as given:
  * the caller premultiplies them or not, as the format expects.
  * The file is created under a temporary name in the same directory and
  * renamed over path only once complete, so an existing file is replaced by a
@@ -89,7 +98,7 @@ int ptr_image_can_write(PtrImageLoader *loader, const char *path);
  * line and returns its code: PTR_ERR_OUTPUT, PTR_ERR_NOMEM, or what
  * ptr_image_ready says. */
 PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrImageLayout *layout,
-                          const float *rgb, const float *alpha, const float *sample_counts,
+                          const float *rgb, const float *alpha, const PtrImageExtras *extras,
                           PtrPixelFormat format, const PtrImageAttr *attrs, size_t attr_count,
                           PtrError *err);
 
@@ -98,7 +107,8 @@ PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrIma
 void ptr_image_discard_partial(void);
 
 /* An image read back as float RGB (grey replicated) and its alpha channel,
- * if it has one; other channels are dropped. */
+ * if it has one, and an EXR's albedo and normal passes, if it has them;
+ * other channels are dropped. */
 typedef struct PtrImage PtrImage;
 
 /* The image into *out (for ptr_image_free): PTR_OK, else PTR_ERR_USAGE for a
@@ -114,6 +124,9 @@ PtrImageLayout ptr_image_layout(const PtrImage *image);
 const float *ptr_image_pixels(const PtrImage *image);
 /* One float a pixel, as stored; NULL if the image has no alpha channel. */
 const float *ptr_image_alpha(const PtrImage *image);
+/* Three floats a pixel each, as stored; NULL if the image has no passes. */
+const float *ptr_image_albedo(const PtrImage *image);
+const float *ptr_image_normal(const PtrImage *image);
 
 /* A header attribute as text (numbers formatted), or NULL if absent. The
  * string lives as long as the image. */

@@ -21,6 +21,7 @@ struct PtrImage {
     PtrImageLayout layout;
     float *rgb;          /* layout.width x layout.height RGB, rows top to bottom */
     float *alpha;        /* one float a pixel, or NULL: no alpha channel */
+    float *albedo, *normal; /* three floats a pixel each, or NULL: no passes (EXR) */
     size_t attr_count;
     char **attr_names;   /* as the file names them */
     char **attr_values;  /* as text: numbers formatted */
@@ -39,6 +40,8 @@ static inline void ptr_image_release(PtrImage *image)
     free(image->attr_values);
     free(image->rgb);
     free(image->alpha);
+    free(image->albedo);
+    free(image->normal);
     free(image);
 }
 
@@ -84,7 +87,7 @@ static inline int ptr_image_set_attr(PtrImage *image, size_t i, const char *name
  * name messages give). OpenEXR (image_exr.cpp): errors are PTR_ERR_OUTPUT
  * when writing, PTR_ERR_USAGE when reading, PTR_ERR_NOMEM either way. */
 PtrResult ptr_exr_write(const char *file, const char *name, const PtrImageLayout *layout,
-                        const float *rgb, const float *alpha, const float *sample_counts,
+                        const float *rgb, const float *alpha, const PtrImageExtras *extras,
                         PtrPixelFormat format,
                         const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
 PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *err);

@@ -4,7 +4,8 @@
  * (tests/cli/test_exr.sh): zip compression, R, G, B at the depth asked and the
  * float "samples" channel of adaptive renders, a data window for regions, the
  * capture date, and every attribute ptr gives but OpenImageIO's own (oiio:*),
- * which it never wrote to EXR. */
+ * which it never wrote to EXR; and now the float layers of the albedo and
+ * normal passes (--passes), which OpenImageIO did not write for ptr. */
 #include "base/shim_error.h"
 #include "image/image_backend.h"
 
@@ -23,6 +24,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdlib>
 #include <cstdio>
 #include <ctime>
 #include <new>
@@ -33,6 +35,8 @@
 namespace {
 
 const char *const rgb_names[3] = { "R", "G", "B" };
+const char *const albedo_names[3] = { "albedo.R", "albedo.G", "albedo.B" };
+const char *const normal_names[3] = { "normal.X", "normal.Y", "normal.Z" };
 
 /* "YYYY:MM:DD HH:MM:SS", local time: the form of EXR's capDate. */
 std::string capture_date()
@@ -54,6 +58,33 @@ Imf::Slice slice(Imf::PixelType type, const char *first, size_t x_stride, size_t
     return Imf::Slice(type, const_cast<char *>(origin), x_stride, y_stride);
 }
 
+/* A layer of three float channels named names, interleaved in pixels, into
+ * frame. */
+void insert_layer(Imf::FrameBuffer &frame, const char *const names[3], const float *pixels,
+                  const PtrImageLayout &layout)
+{
+    const char *first = reinterpret_cast<const char *>(pixels);
+    for (size_t c = 0; c < 3; c++)
+        frame.insert(names[c], slice(Imf::FLOAT, first + c * sizeof(float), 3 * sizeof(float),
+                                     size_t(layout.width) * 3 * sizeof(float), layout));
+}
+
+/* A layer of the file read into a new array of three floats a pixel, or
+ * NULL where the file has no channel of its first name. */
+float *read_layer(Imf::FrameBuffer &frame, const Imf::ChannelList &channels,
+                  const char *const names[3], const PtrImageLayout &layout)
+{
+    if (!channels.findChannel(names[0]))
+        return nullptr;
+    float *pixels = static_cast<float *>(
+        std::malloc(std::max<size_t>(1, size_t(layout.width) * size_t(layout.height)) * 3 *
+                    sizeof(float)));
+    if (!pixels)
+        throw std::bad_alloc();
+    insert_layer(frame, names, pixels, layout);
+    return pixels;
+}
+
 } // namespace
 
 extern "C" PtrResult ptr_exr_set_threads(int threads, PtrError *err)
@@ -69,7 +100,7 @@ extern "C" PtrResult ptr_exr_set_threads(int threads, PtrError *err)
 
 extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
                                    const PtrImageLayout *layout, const float *rgb,
-                                   const float *alpha, const float *sample_counts,
+                                   const float *alpha, const PtrImageExtras *extras,
                                    PtrPixelFormat format,
                                    const PtrImageAttr *attrs, size_t attr_count, PtrError *err)
 {
@@ -86,8 +117,17 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
             header.channels().insert(channel, Imf::Channel(is_half ? Imf::HALF : Imf::FLOAT));
         if (alpha)
             header.channels().insert("A", Imf::Channel(is_half ? Imf::HALF : Imf::FLOAT));
+        const float *sample_counts = extras ? extras->sample_counts : nullptr;
+        const float *albedo = extras ? extras->albedo : nullptr;
+        const float *normal = extras ? extras->normal : nullptr;
         if (sample_counts)
             header.channels().insert("samples", Imf::Channel(Imf::FLOAT));
+        for (size_t c = 0; c < 3; c++) {
+            if (albedo)
+                header.channels().insert(albedo_names[c], Imf::Channel(Imf::FLOAT));
+            if (normal)
+                header.channels().insert(normal_names[c], Imf::Channel(Imf::FLOAT));
+        }
         for (size_t i = 0; i < attr_count; i++) {
             const PtrImageAttr &a = attrs[i];
             if (std::string(a.name).compare(0, 5, "oiio:") == 0)
@@ -127,6 +167,10 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
             frame.insert("samples", slice(Imf::FLOAT, reinterpret_cast<const char *>(sample_counts),
                                           sizeof(float), size_t(layout->width) * sizeof(float),
                                           *layout));
+        if (albedo)
+            insert_layer(frame, albedo_names, albedo, *layout);
+        if (normal)
+            insert_layer(frame, normal_names, normal, *layout);
         Imf::OutputFile out(file, header);
         out.setFrameBuffer(frame);
         out.writePixels(layout->height);
@@ -173,8 +217,8 @@ extern "C" PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *er
             if (!ptr_image_set_attr(image, i, attrs[i].first.c_str(), attrs[i].second.c_str()))
                 throw std::bad_alloc();
 
-        // R, G and B; a grey image (Y alone) in all three; A if there is
-        // one; the rest dropped.
+        // R, G and B; a grey image (Y alone) in all three; A and the
+        // passes if there are; the rest dropped.
         const Imf::ChannelList &channels = header.channels();
         char *first = reinterpret_cast<char *>(image->rgb);
         const size_t row = size_t(layout.width) * 3 * sizeof(float);
@@ -190,6 +234,8 @@ extern "C" PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *er
             frame.insert("A", slice(Imf::FLOAT, reinterpret_cast<char *>(image->alpha),
                                     sizeof(float), size_t(layout.width) * sizeof(float), layout));
         }
+        image->albedo = read_layer(frame, channels, albedo_names, layout);
+        image->normal = read_layer(frame, channels, normal_names, layout);
         in.setFrameBuffer(frame);
         in.readPixels(data.min.y, data.max.y);
         for (size_t p = 0; grey && p < size_t(layout.width) * size_t(layout.height); p++)

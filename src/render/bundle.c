@@ -314,6 +314,28 @@ STAGE void add_sky_and_emission(const PtrPathJob *job, Lanes *restrict lanes,
     }
 }
 
+/* The passes of the lanes in flight, lane by lane, kept in the result
+ * each path fills (passes[slot], begun at its camera ray): where they met
+ * a surface, and the sky where they missed. */
+STAGE void record_passes(const PtrPathJob *job, const Lanes *restrict lanes,
+                         const Vertex *restrict v, PtrPathPass *passes)
+{
+    for (int l = 0; l < LANES; l++) {
+        if (lanes->slot[l] == FREE)
+            continue;
+        PtrPathPass *pass = &passes[lanes->slot[l]];
+        if (lanes->depth[l] == 0)
+            *pass = ptr_path_pass_start();
+        PtrVec3 dir = lane_v3(lanes->ray.dir, l);
+        if (v->hit[l])
+            ptr_path_pass_surface(pass, (PtrMaterialKind)v->kind[l], v->fuzz[l],
+                                  lane_v3(v->albedo, l),
+                                  ptr_facing_normal(dir, lane_v3(v->normal, l)));
+        else
+            ptr_path_pass_sky(pass, ptr_sky_radiance(&job->scene->sky, dir));
+    }
+}
+
 /* Light sampling at the diffuse vertices, lane by lane. */
 STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const Vertex *restrict v,
                            uint64_t *rays)
@@ -445,7 +467,7 @@ STAGE void continue_or_end(const PtrPathJob *job, Lanes *restrict lanes, const V
 }
 
 static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *results,
-                         unsigned char *covered, uint64_t *rays)
+                         unsigned char *covered, PtrPathPass *passes, uint64_t *rays)
 {
     Lanes lanes;
     Vertex vertex;
@@ -472,6 +494,8 @@ static void render_round(const PtrPathJob *job, const Round *round, PtrVec3 *res
         find_surfaces(job, &lanes, &vertex);
         emission_weights(job, &lanes, &vertex, weight);
         add_sky_and_emission(job, &lanes, &vertex, weight);
+        if (passes)
+            record_passes(job, &lanes, &vertex, passes);
         if (job->sample_lights)
             sample_emitters(job, &lanes, &vertex, rays);
         scatter(job, &lanes, &vertex);
@@ -485,6 +509,8 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
     Round round;
     PtrVec3 results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
     unsigned char covered[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    PtrPathPass pass_results[PTR_TILE_PIXELS * PTR_ADAPTIVE_STEP];
+    PtrPathPass *passes = s->passes ? pass_results : NULL;
     uint64_t end = (uint64_t)job->first + job->count;
     /* Rounds end where adaptive sampling may stop a pixel, so a round's
      * samples are all ones the path tracer would take too. */
@@ -506,17 +532,20 @@ PTR_DECL_RENDER_TILE(ptr_render_tile_bundled_avx2)
             }
         round.items = (uint32_t)round.pixels * round.span;
         if (ptr_path_may_trace(s, 0))
-            render_round(job, &round, results, covered, rays);
+            render_round(job, &round, results, covered, passes, rays);
         else
             for (uint32_t i = 0; i < round.items; i++) {
                 results[i] = v3_splat(0.0f);
                 covered[i] = 0;
+                if (passes)
+                    passes[i] = ptr_path_pass_start();
             }
         for (int p = 0; p < round.pixels; p++)
             for (uint32_t i = 0; i < round.span; i++)
                 ptr_path_accumulate(s, round.sums[p], round.first + i,
                                     results[(uint32_t)p * round.span + i],
-                                    covered[(uint32_t)p * round.span + i]);
+                                    covered[(uint32_t)p * round.span + i],
+                                    passes ? &passes[(uint32_t)p * round.span + i] : NULL);
         a = b;
     }
 }

@@ -1,4 +1,4 @@
-/* The film of a render (PTR_ACCUM_STRIDE doubles a pixel): where it lives,
+/* The film of a render (ptr_accum_stride doubles a pixel): where it lives,
  * and what it resolves to. */
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS, madvise */
 #include "render/film.h"
@@ -14,17 +14,17 @@
  * 0.01 s). The buffer is whole huge pages, mapped apart from the heap. */
 enum { HUGE_PAGE = 2 << 20 };
 
-static size_t accum_bytes(size_t pixels)
+static size_t accum_bytes(size_t pixels, size_t stride)
 {
-    size_t bytes = (pixels ? pixels : 1) * PTR_ACCUM_STRIDE * sizeof(double);
+    size_t bytes = (pixels ? pixels : 1) * stride * sizeof(double);
     return (bytes + HUGE_PAGE - 1) / HUGE_PAGE * HUGE_PAGE;
 }
 
-double *ptr_accum_alloc(size_t pixels)
+double *ptr_accum_alloc(size_t pixels, size_t stride)
 {
-    if (pixels > SIZE_MAX / 2 / (PTR_ACCUM_STRIDE * sizeof(double)))
+    if (pixels > SIZE_MAX / 2 / (stride * sizeof(double)))
         return NULL;
-    size_t bytes = accum_bytes(pixels);
+    size_t bytes = accum_bytes(pixels, stride);
     void *acc = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (acc == MAP_FAILED)
         return NULL;
@@ -34,16 +34,16 @@ double *ptr_accum_alloc(size_t pixels)
     return acc; /* anonymous pages read as zero */
 }
 
-void ptr_accum_free(double *acc, size_t pixels)
+void ptr_accum_free(double *acc, size_t pixels, size_t stride)
 {
     if (acc)
-        munmap(acc, accum_bytes(pixels));
+        munmap(acc, accum_bytes(pixels, stride));
 }
 
-void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *alpha,
+void ptr_accum_resolve(const double *acc, size_t pixels, size_t stride, float *rgb, float *alpha,
                        float *sample_counts)
 {
-    for (size_t p = 0; p < pixels; p++, acc += PTR_ACCUM_STRIDE) {
+    for (size_t p = 0; p < pixels; p++, acc += stride) {
         double n = acc[PTR_ACCUM_COUNT];
         for (int c = 0; c < 3; c++)
             rgb[3 * p + c] = n > 0 ? (float)(acc[PTR_ACCUM_SUM + c] / n) : 0.0f;
@@ -51,5 +51,16 @@ void ptr_accum_resolve(const double *acc, size_t pixels, float *rgb, float *alph
             alpha[p] = n > 0 ? (float)(acc[PTR_ACCUM_COVERED] / n) : 0.0f;
         if (sample_counts)
             sample_counts[p] = (float)n;
+    }
+}
+
+void ptr_accum_resolve_passes(const double *acc, size_t pixels, float *albedo, float *normal)
+{
+    for (size_t p = 0; p < pixels; p++, acc += PTR_ACCUM_STRIDE_PASSES) {
+        double n = acc[PTR_ACCUM_COUNT];
+        for (int c = 0; c < 3; c++) {
+            albedo[3 * p + c] = n > 0 ? (float)(acc[PTR_ACCUM_ALBEDO + c] / n) : 0.0f;
+            normal[3 * p + c] = n > 0 ? (float)(acc[PTR_ACCUM_NORMAL + c] / n) : 0.0f;
+        }
     }
 }

@@ -126,22 +126,29 @@ static double pixel_error(const double *acc, int transparent)
     return difference / (1e-4 + sqrt(brightness));
 }
 
+static void add_v3(double *sum, PtrVec3 v)
+{
+    sum[0] += v.x;
+    sum[1] += v.y;
+    sum[2] += v.z;
+}
+
 void ptr_path_accumulate(const PtrRenderSettings *s, double *acc, uint32_t index, PtrVec3 l,
-                         int covered)
+                         int covered, const PtrPathPass *pass)
 {
     if (s->transparent && !covered)
         l = v3_splat(0.0f);
+    /* A transparent background leaves the sky out of the passes too. */
+    if (s->passes && !(s->transparent && !covered)) {
+        add_v3(acc + PTR_ACCUM_ALBEDO, pass->albedo);
+        add_v3(acc + PTR_ACCUM_NORMAL, pass->normal);
+    }
     acc[PTR_ACCUM_COVERED] += covered;
     if (index & 1)
         acc[PTR_ACCUM_COVERED_ODD] += covered;
-    acc[PTR_ACCUM_SUM + 0] += l.x;
-    acc[PTR_ACCUM_SUM + 1] += l.y;
-    acc[PTR_ACCUM_SUM + 2] += l.z;
-    if (index & 1) {
-        acc[PTR_ACCUM_ODD + 0] += l.x;
-        acc[PTR_ACCUM_ODD + 1] += l.y;
-        acc[PTR_ACCUM_ODD + 2] += l.z;
-    }
+    add_v3(acc + PTR_ACCUM_SUM, l);
+    if (index & 1)
+        add_v3(acc + PTR_ACCUM_ODD, l);
     acc[PTR_ACCUM_COUNT] += 1;
     uint32_t taken = index + 1;
     if (s->noise_threshold > 0 && taken >= s->min_samples && taken % PTR_ADAPTIVE_STEP == 0 &&

@@ -26,7 +26,7 @@ typedef struct PtrPathJob {
     int sample_lights; /* light sampling is on and there is an emitter */
     PtrRegion region;
     uint32_t first, count; /* the sample indices of this call */
-    double *sums;          /* PTR_ACCUM_STRIDE doubles a pixel of the region */
+    double *sums;          /* ptr_accum_stride doubles a pixel of the region */
 } PtrPathJob;
 
 /* Threads take the image in tiles of this many pixels square. */
@@ -109,8 +109,8 @@ static inline int ptr_path_in_double(const PtrPathJob *job, uint32_t sphere)
 static inline double *ptr_path_pixel_sums(const PtrPathJob *job, int x, int y)
 {
     const PtrRegion *r = &job->region;
-    return job->sums + PTR_ACCUM_STRIDE * ((size_t)(y - r->y0) * (size_t)(r->x1 - r->x0) +
-                                           (size_t)(x - r->x0));
+    return job->sums + ptr_accum_stride(job->settings->passes) *
+                           ((size_t)(y - r->y0) * (size_t)(r->x1 - r->x0) + (size_t)(x - r->x0));
 }
 
 /* The sampler key of pixel (x, y). Keyed by full-image pixel, so a region
@@ -172,11 +172,61 @@ static inline int ptr_path_weighs_emission(const PtrLitVertex *from, PtrVec3 emi
 float ptr_path_emission_weight(const PtrPathJob *job, const PtrLitVertex *from, uint32_t emitter,
                                PtrVec3 dir, PtrVec3 point, PtrVec3 normal);
 
+/* What a path gives the albedo and normal passes: the albedo and normal
+ * of the first surface it meets that is not a perfect mirror (metal
+ * without fuzz) or glass, which the passes see through, as a denoiser
+ * wants its guides (docs/scenes.md, "Passes"). The albedo seen through
+ * such surfaces is tinted by theirs; a path that ends on one (its last ray
+ * taken) keeps that surface's own; a ray that meets nothing gives the sky
+ * clamped to [0, 1] and a zero normal. Normals are in world space, on the
+ * side the ray arrives from. */
+typedef struct PtrPathPass {
+    PtrVec3 albedo, normal;
+    PtrVec3 tint;  /* the albedos of the surfaces seen through so far */
+    int found;     /* the surface the passes record is found */
+} PtrPathPass;
+
+static inline PtrPathPass ptr_path_pass_start(void)
+{
+    return (PtrPathPass){ .tint = v3_splat(1.0f) };
+}
+
+static inline PtrVec3 ptr_path_pass_clamp(PtrVec3 c)
+{
+    return v3(ptr_minf(ptr_maxf(c.x, 0.0f), 1.0f), ptr_minf(ptr_maxf(c.y, 0.0f), 1.0f),
+              ptr_minf(ptr_maxf(c.z, 0.0f), 1.0f));
+}
+
+/* The passes at a surface of this kind, fuzz and albedo, with normal n on
+ * the side the ray arrives from. */
+static inline void ptr_path_pass_surface(PtrPathPass *pass, PtrMaterialKind kind, float fuzz,
+                                         PtrVec3 albedo, PtrVec3 n)
+{
+    if (pass->found)
+        return;
+    albedo = ptr_path_pass_clamp(albedo);
+    pass->albedo = v3_mul(pass->tint, albedo);
+    pass->normal = n;
+    pass->tint = pass->albedo;
+    pass->found = !(kind == PTR_MATERIAL_DIELECTRIC || (kind == PTR_MATERIAL_METAL && fuzz == 0.0f));
+}
+
+/* The passes where a ray met nothing and saw sky. */
+static inline void ptr_path_pass_sky(PtrPathPass *pass, PtrVec3 sky)
+{
+    if (pass->found)
+        return;
+    pass->albedo = v3_mul(pass->tint, ptr_path_pass_clamp(sky));
+    pass->normal = v3_splat(0.0f);
+    pass->found = 1;
+}
+
 /* Adds radiance as sample index of the pixel whose sums acc are, covered
- * or not (whether its camera ray hit a sphere), and decides whether
+ * or not (whether its camera ray hit a sphere), with its passes where the
+ * settings ask for them (pass is then not NULL), and decides whether
  * adaptive sampling stops the pixel there. */
 void ptr_path_accumulate(const PtrRenderSettings *settings, double *acc, uint32_t index,
-                         PtrVec3 radiance, int covered);
+                         PtrVec3 radiance, int covered, const PtrPathPass *pass);
 
 /* Renders the job's samples of the pixels of [x0, x1) x [y0, y1), counting
  * rays: a path at a time (render.c) or in bundles (bundle.c, built for AVX2

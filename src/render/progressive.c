@@ -23,7 +23,8 @@ static void on_tick(void *user, double pass_fraction)
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb,
-                                 float *alpha, float *sample_counts, PtrProgressiveResult *result, PtrError *err)
+                                 float *alpha, float *sample_counts, float *albedo, float *normal,
+                                 PtrProgressiveResult *result, PtrError *err)
 {
     PtrRegion r = ptr_render_region(settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
@@ -32,7 +33,8 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     if (pixels == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "the region lies outside the %dx%d image",
                              settings->width, settings->height);
-    double *acc = ptr_accum_alloc(pixels);
+    size_t stride = ptr_accum_stride(settings->passes);
+    double *acc = ptr_accum_alloc(pixels, stride);
     if (!acc)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image", r.x1 - r.x0,
                              r.y1 - r.y0);
@@ -64,7 +66,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
             PtrProgress p = watch.progress;
             p.fraction = (double)done / options->samples;
             p.elapsed = elapsed;
-            options->pass_done(options->pass_user, acc, pixels, &p);
+            options->pass_done(options->pass_user, acc, pixels, stride, &p);
         }
 
         if (options->stop && *options->stop) {
@@ -80,8 +82,11 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     }
     result->samples_done = done;
     result->stats.seconds = ptr_now_seconds() - watch.start;
-    if (res == PTR_OK)
-        ptr_accum_resolve(acc, pixels, rgb, alpha, sample_counts);
-    ptr_accum_free(acc, pixels);
+    if (res == PTR_OK) {
+        ptr_accum_resolve(acc, pixels, stride, rgb, alpha, sample_counts);
+        if (settings->passes)
+            ptr_accum_resolve_passes(acc, pixels, albedo, normal);
+    }
+    ptr_accum_free(acc, pixels, stride);
     return res;
 }

@@ -27,8 +27,9 @@ typedef struct PtrProgressiveOptions {
     void *user;
     /* Called after each pass (may be NULL), on the calling thread while the
      * render's threads wait, with the film so far (film.h: pixels pixels of
-     * the region): to be read, never written. */
-    void (*pass_done)(void *user, const double *film, size_t pixels, const PtrProgress *progress);
+     * the region, stride doubles each): to be read, never written. */
+    void (*pass_done)(void *user, const double *film, size_t pixels, size_t stride,
+                      const PtrProgress *progress);
     void *pass_user;
 } PtrProgressiveOptions;
 
@@ -43,11 +44,14 @@ typedef struct PtrProgressiveResult {
  * done into rgb (3 floats a pixel of the region), the same bits as one pass
  * of that many samples would give; if alpha is not NULL, the share of each
  * pixel's samples that were covered; and if sample_counts is not NULL, how
- * many samples each pixel took (fewer where adaptive sampling stopped it). */
+ * many samples each pixel took (fewer where adaptive sampling stopped it);
+ * and with the settings' passes, the mean albedo and normal of each pixel
+ * into albedo and normal (3 floats a pixel each; NULL without passes). */
 PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
                                  const PtrRenderSettings *settings,
                                  const PtrProgressiveOptions *options, float *rgb, float *alpha,
-                                 float *sample_counts, PtrProgressiveResult *result,
+                                 float *sample_counts, float *albedo, float *normal,
+                                 PtrProgressiveResult *result,
                                  PtrError *err);
 
 #endif /* PTR_PROGRESSIVE_H */

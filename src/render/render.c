@@ -17,9 +17,10 @@
  * reference the bundles (bundle.c) match bit for bit. A path has at most
  * max_depth rays from the camera or a scattering; shadow rays do not count,
  * since they estimate what the next ray would find and so only where it may
- * exist. *covered says whether the camera ray hit a sphere. */
+ * exist. *covered says whether the camera ray hit a sphere; *pass gets
+ * the path's passes where the settings ask for them. */
 static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrRay ray,
-                          uint64_t *rays, int *covered)
+                          uint64_t *rays, int *covered, PtrPathPass *pass)
 {
     const PtrScene *scene = job->scene;
     const PtrRenderSettings *settings = job->settings;
@@ -34,9 +35,10 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
         PtrVec3 dir = v3(ray.dir[0], ray.dir[1], ray.dir[2]);
         ++*rays;
         if (!ptr_trace(job->accel, &ray, &hit)) {
-            radiance = ptr_path_add_found(radiance, throughput, 0,
-                                          ptr_sky_radiance(&scene->sky, dir), v3_splat(0.0f),
-                                          1.0f);
+            PtrVec3 sky = ptr_sky_radiance(&scene->sky, dir);
+            radiance = ptr_path_add_found(radiance, throughput, 0, sky, v3_splat(0.0f), 1.0f);
+            if (settings->passes)
+                ptr_path_pass_sky(pass, sky);
             break;
         }
         *covered = 1;
@@ -52,6 +54,8 @@ static PtrVec3 trace_path(const PtrPathJob *job, const PtrSampler *sampler, PtrR
         lit = ptr_path_vertex(job, m.kind, depth, point, hit.sphere,
                               v3_dot(dir, normal) < 0.0f);
         PtrVec3 n = ptr_facing_normal(dir, normal);
+        if (settings->passes)
+            ptr_path_pass_surface(pass, m.kind, m.fuzz, m.albedo, n);
         if (lit.sampled)
             radiance = v3_add(radiance,
                               v3_mul(throughput, ptr_path_sample_emitter(job, sampler, depth, &m,
@@ -87,8 +91,9 @@ static PTR_DECL_RENDER_TILE(render_tile_by_path)
                 ptr_path_camera_ray(job, key, i, x, y, &o, &d);
                 PtrRay ray = { { o.x, o.y, o.z }, 0.0f, { d.x, d.y, d.z }, INFINITY };
                 int covered;
-                PtrVec3 radiance = trace_path(job, &sampler, ray, rays, &covered);
-                ptr_path_accumulate(s, acc, i, radiance, covered);
+                PtrPathPass pass = ptr_path_pass_start();
+                PtrVec3 radiance = trace_path(job, &sampler, ray, rays, &covered, &pass);
+                ptr_path_accumulate(s, acc, i, radiance, covered, &pass);
             }
         }
 }
@@ -316,14 +321,15 @@ PtrResult ptr_render(const PtrScene *scene, const PtrAccel *accel,
         return ptr_error_set(err, PTR_ERR_USAGE, "samples must be positive");
     PtrRegion r = ptr_render_region(settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-    double *acc = ptr_accum_alloc(pixels);
+    size_t stride = ptr_accum_stride(settings->passes);
+    double *acc = ptr_accum_alloc(pixels, stride);
     if (!acc)
         return ptr_error_set(err, PTR_ERR_NOMEM, "cannot allocate a %dx%d image",
                              r.x1 - r.x0, r.y1 - r.y0);
     PtrResult res = ptr_render_samples(scene, accel, settings, 0, settings->samples, acc, NULL,
                                        NULL, stats, err);
     if (res == PTR_OK)
-        ptr_accum_resolve(acc, pixels, rgb, NULL, NULL);
-    ptr_accum_free(acc, pixels);
+        ptr_accum_resolve(acc, pixels, stride, rgb, NULL, NULL);
+    ptr_accum_free(acc, pixels, stride);
     return res;
 }

@@ -50,7 +50,7 @@ PtrResult ptr_integrator_parse(const char *text, PtrIntegrator *integrator, PtrE
  * be scene->spheres) and finds every hit, shadow rays too, with ptr_trace.
  *
  * Adds samples first .. first + count - 1 of every pixel of the region to
- * acc (PTR_ACCUM_STRIDE doubles a pixel, region rows top to bottom, zero
+ * acc (ptr_accum_stride doubles a pixel, region rows top to bottom, zero
  * before the first call), sample by sample in index order: split into passes
  * of any size, the sums come out bit for bit the same, and never depend on
  * the thread count. tick may be NULL; stats (may be NULL) gets this call's

@@ -51,6 +51,9 @@ typedef struct PtrRenderSettings {
      * adds no radiance (the sky it sees is left out), and adaptive sampling
      * weighs the noise of coverage too. Coverage is counted either way. */
     int transparent;
+    /* Albedo and normal passes (path.h, PtrPathPass): the film then keeps
+     * their sums too (film.h, ptr_accum_stride). */
+    int passes;
 } PtrRenderSettings;
 
 #endif /* PTR_SETTINGS_H */

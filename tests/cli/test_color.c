@@ -233,9 +233,9 @@ static void test_output_path(void)
     ptr_image_free(img);
 
     /* Formats refuse depths they cannot hold. */
-    CHECK_INT(ptr_output_check(images, test_path("x.jpg"), PTR_DEPTH_16, 0, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(images, test_path("x.exr"), PTR_DEPTH_8, 0, &perr), PTR_ERR_USAGE);
-    CHECK_INT(ptr_output_check(images, test_path("x.tif"), PTR_DEPTH_FLOAT, 0, &perr), PTR_OK);
+    CHECK_INT(ptr_output_check(images, test_path("x.jpg"), PTR_DEPTH_16, 0, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(images, test_path("x.exr"), PTR_DEPTH_8, 0, 0, &perr), PTR_ERR_USAGE);
+    CHECK_INT(ptr_output_check(images, test_path("x.tif"), PTR_DEPTH_FLOAT, 0, 0, &perr), PTR_OK);
     ptr_color_close(c);
 }
 

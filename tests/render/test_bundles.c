@@ -6,7 +6,8 @@
  * take (each material, fuzz, colours, emitters with light sampling, a huge
  * sphere, the tree, no sphere at all, an orthographic camera) under every
  * setting that changes a path (sampler, light sampling, depth limit,
- * adaptive sampling, regions, sample ranges split into passes, threads).
+ * adaptive sampling, regions, sample ranges split into passes, threads),
+ * with the albedo and normal passes' sums too where they are asked for.
  * Below AVX2 there are no bundles, which the test says. */
 #include "test.h"
 
@@ -101,7 +102,7 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     PtrError err = { 0 };
     PtrRegion r = ptr_render_region(&settings);
     size_t pixels = (size_t)(r.x1 - r.x0) * (size_t)(r.y1 - r.y0);
-    Sums sums = { calloc(pixels * PTR_ACCUM_STRIDE, sizeof(double)), 0 };
+    Sums sums = { calloc(pixels * ptr_accum_stride(settings.passes), sizeof(double)), 0 };
     CHECK_INT(ptr_isect_init(&isect, kernel, ptr_cpu_level(), scene->spheres.count, NULL), PTR_OK);
     CHECK_INT(ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect, integrator == PTR_INTEGRATOR_BUNDLES,
                              scene, 0, NULL),
@@ -118,11 +119,11 @@ static Sums render(PtrScene *scene, PtrKernel kernel, PtrIntegrator integrator,
     return sums;
 }
 
-/* Frees b's sums, which must be a's. */
-static int compare(const char *what, Sums a, Sums b, size_t pixels)
+/* Frees b's sums (stride doubles a pixel), which must be a's. */
+static int compare(const char *what, Sums a, Sums b, size_t pixels, size_t stride)
 {
     size_t differ = 0;
-    for (size_t i = 0; i < pixels * PTR_ACCUM_STRIDE; i++)
+    for (size_t i = 0; i < pixels * stride; i++)
         differ += memcmp(&a.acc[i], &b.acc[i], sizeof(double)) != 0;
     if (differ || a.rays != b.rays)
         fprintf(stderr, "%s: %zu sums differ, rays %llu against %llu\n", what, differ,
@@ -162,7 +163,16 @@ static Variant variants[] = {
     { "region, samples 7..26 in passes of 5, one thread", { 0 }, 7, 19, 5 },
     { "transparent, in passes of 4", { 0 }, 0, 12, 4 },
     { "transparent, adaptive", { 0 }, 0, 48, 48 },
+    /* The albedo and normal passes on the settings of variants above
+     * (with_passes). */
+    { "passes", { 0 }, 0, 12, 12 },
+    { "passes, depth 0", { 0 }, 0, 3, 3 },
+    { "passes, depth 3", { 0 }, 0, 5, 5 },
+    { "passes, region, samples 7..26 in passes of 5, one thread", { 0 }, 7, 19, 5 },
+    { "passes, transparent, in passes of 4", { 0 }, 0, 12, 4 },
+    { "passes, transparent, adaptive", { 0 }, 0, 48, 48 },
 };
+static const int with_passes[] = { 0, 2, 4, 6, 7, 8 };
 enum { VARIANTS = sizeof variants / sizeof variants[0] };
 
 static void set_variants(void)
@@ -184,6 +194,11 @@ static void set_variants(void)
     variants[8].settings.transparent = 1;
     variants[8].settings.noise_threshold = 0.05f;
     variants[8].settings.min_samples = 16;
+    enum { FIRST_WITH_PASSES = VARIANTS - sizeof with_passes / sizeof with_passes[0] };
+    for (int v = FIRST_WITH_PASSES; v < VARIANTS; v++) {
+        variants[v].settings = variants[with_passes[v - FIRST_WITH_PASSES]].settings;
+        variants[v].settings.passes = 1;
+    }
 }
 
 /* Every variant of one scene, every pair against the reference. */
@@ -209,7 +224,8 @@ static void test_scene(SceneKind kind)
             char what[200];
             snprintf(what, sizeof what, "%s, %s: %s", scene_names[kind], var->name,
                      pairs[p].name);
-            if (compare(what, reference, other_sums, pixels))
+            if (compare(what, reference, other_sums, pixels,
+                        ptr_accum_stride(var->settings.passes)))
                 printf("  %-90s identical\n", what);
         }
         free(reference.acc);

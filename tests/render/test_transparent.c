@@ -200,12 +200,12 @@ static void test_adaptive(void)
     int stopped_early[2] = { 0, 0 }, edge_sampled_on = 0, whole_stopped = 1;
     for (int transparent = 0; transparent < 2; transparent++) {
         s.transparent = transparent;
-        double *acc = ptr_accum_alloc(N);
+        double *acc = ptr_accum_alloc(N, PTR_ACCUM_STRIDE);
         PtrError err = { 0 };
         CHECK_INT(ptr_render_samples(&scene, &accel, &s, 0, MAX, acc, NULL, NULL, NULL, &err),
                   PTR_OK);
-        ptr_accum_resolve(acc, N, rgb, alpha, counts);
-        ptr_accum_free(acc, N);
+        ptr_accum_resolve(acc, N, PTR_ACCUM_STRIDE, rgb, alpha, counts);
+        ptr_accum_free(acc, N, PTR_ACCUM_STRIDE);
         for (int p = 0; p < N; p++) {
             stopped_early[transparent] += counts[p] == 16;
             if (transparent && (alpha[p] == 0.0f || alpha[p] == 1.0f))
