@@ -10,7 +10,7 @@ usage: check_parallel_instances.py PTR"""
 import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from glb import write_glb  # noqa: E402
+from glb import uv_sphere, write_glb  # noqa: E402
 from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
 
 ptr = sys.argv[1]
@@ -37,9 +37,9 @@ def write_cloud(path, nodes, broken):
     t, r, s, c = instances(broken)
     blocks = [b"".join(struct.pack("<3f", *v) for v in t), b"".join(struct.pack("<4f", *v) for v in r),
               b"".join(struct.pack("<3f", *v) for v in s), b"".join(struct.pack("<3f", *v) for v in c)]
-    box = struct.pack("<9f", -0.05, -0.05, -0.05, 0.05, 0.05, 0.05, 0.05, -0.05, 0.05)
+    box, indices, vertices, index_count = uv_sphere(0.05)
     binary, views = b"", []
-    for block in blocks + [box]:
+    for block in blocks + [box, indices]:
         views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
         binary += block
     per = COUNT // nodes
@@ -52,8 +52,10 @@ def write_cloud(path, nodes, broken):
         node_list.append({"mesh": 0, "name": "cloud", "extensions": {"EXT_mesh_gpu_instancing": {
             "attributes": {"TRANSLATION": first, "ROTATION": first + 1, "SCALE": first + 2,
                            "_COLOR_0": first + 3}}}})
-    accessors.append({"bufferView": 4, "componentType": 5126, "count": 3, "type": "VEC3",
+    accessors.append({"bufferView": 4, "componentType": 5126, "count": vertices, "type": "VEC3",
                       "min": [-0.05, -0.05, -0.05], "max": [0.05, 0.05, 0.05]})
+    accessors.append({"bufferView": 5, "componentType": 5123, "count": index_count,
+                      "type": "SCALAR"})
     doc = {
         "asset": {"version": "2.0"},
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
@@ -61,7 +63,8 @@ def write_cloud(path, nodes, broken):
         "bufferViews": views,
         "accessors": accessors,
         "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 1}, "material": 0}]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                    "indices": len(accessors) - 1, "material": 0}]}],
         "nodes": node_list + [{"camera": 0, "translation": [0, 3, 10]}],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
         "scenes": [{"nodes": list(range(nodes + 1))}],
