@@ -362,6 +362,13 @@ static size_t part_vertex(const SurfacePart *p, size_t j)
 static void mesh_position(const void *user, size_t v, double out[3])
 {
     const SurfacePart *p = part_of(user, v, 0);
+    if (p->pos.component_type == GLTF_FLOAT) { /* the common case, read at once */
+        float f[3];
+        memcpy(f, p->pos.data + (v - p->first_vertex) * p->pos.stride, sizeof f);
+        for (int k = 0; k < 3; k++)
+            out[k] = f[k];
+        return;
+    }
     double e[4];
     element(&p->pos, v - p->first_vertex, e);
     memcpy(out, e, 3 * sizeof *out);
