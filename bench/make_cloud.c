@@ -476,50 +476,68 @@ static void write_instances(int fd, uint64_t offset, const CloudRng *rng, uint64
         }
 }
 
-/* --joined: vertex k of a sphere's mesh, as the file stores it. */
-static void joined_vertex(const double centre[3], double radius, const double unit[3],
-                          float out[3])
+/* --joined: the ground, then each sphere, as its group and the vertices of
+ * its mesh as the file stores them, handed to each(user, ...). */
+static void joined_spheres(const CloudRng *rng, uint64_t spheres, double radius,
+                           void (*each)(void *user, unsigned group,
+                                        const float (*verts)[3]),
+                           void *user)
 {
-    for (int c = 0; c < 3; c++)
-        out[c] = (float)(centre[c] + radius * unit[c]);
+    double unit[JOINED_VERTICES][3];
+    unsigned triangles[JOINED_TRIANGLES][3];
+    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, triangles);
+    float verts[JOINED_VERTICES][3];
+    for (uint64_t i = 0; i <= spheres; i++) {
+        double centre[3] = { 0.0, -1000.0, 0.0 }, r = 1000.0; /* the ground */
+        unsigned group = 0;
+        if (i > 0) {
+            sphere_centre(rng, i - 1, radius, centre);
+            r = radius;
+            group = sphere_group(rng, i - 1);
+        }
+        for (unsigned v = 0; v < JOINED_VERTICES; v++)
+            for (int c = 0; c < 3; c++)
+                verts[v][c] = (float)(centre[c] + r * unit[v][c]);
+        each(user, group, (const float (*)[3])verts);
+    }
 }
 
-/* --joined: the ground (sphere "-1") and sphere i, their group, centre and
- * radius. */
-static unsigned joined_sphere(const CloudRng *rng, uint64_t i, double radius, double centre[3],
-                              double *r)
+static void add_bounds(void *user, unsigned group, const float (*verts)[3])
 {
-    if (i == UINT64_MAX) {
-        centre[0] = 0.0, centre[1] = -1000.0, centre[2] = 0.0;
-        *r = 1000.0;
-        return 0;
-    }
-    sphere_centre(rng, i, radius, centre);
-    *r = radius;
-    return sphere_group(rng, i);
+    Joined *joined = user;
+    for (unsigned v = 0; v < JOINED_VERTICES; v++)
+        for (int c = 0; c < 3; c++) {
+            joined->lower[group][c] = fmin(joined->lower[group][c], verts[v][c]);
+            joined->upper[group][c] = fmax(joined->upper[group][c], verts[v][c]);
+        }
 }
 
 /* --joined: each group's bounds, over the ground and every sphere. */
 static void joined_bounds(const CloudRng *rng, uint64_t spheres, double radius, Joined *joined)
 {
-    double unit[JOINED_VERTICES][3];
-    unsigned triangles[JOINED_TRIANGLES][3];
-    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, triangles);
     for (unsigned g = 0; g < GROUPS; g++)
         for (int c = 0; c < 3; c++)
             joined->lower[g][c] = HUGE_VAL, joined->upper[g][c] = -HUGE_VAL;
-    for (uint64_t i = UINT64_MAX; i == UINT64_MAX || i < spheres; i++) {
-        double centre[3], r;
-        const unsigned g = joined_sphere(rng, i, radius, centre, &r);
-        for (unsigned v = 0; v < JOINED_VERTICES; v++) {
-            float p[3];
-            joined_vertex(centre, r, unit[v], p);
-            for (int c = 0; c < 3; c++) {
-                joined->lower[g][c] = fmin(joined->lower[g][c], p[c]);
-                joined->upper[g][c] = fmax(joined->upper[g][c], p[c]);
-            }
-        }
-    }
+    joined_spheres(rng, spheres, radius, add_bounds, joined);
+}
+
+/* --joined's second pass: a stream of positions and one of indices a
+ * group, and the spheres each has so far. */
+typedef struct {
+    Stream streams[GROUPS][2];
+    uint64_t written[GROUPS];
+    unsigned triangles[JOINED_TRIANGLES][3];
+} JoinedWriter;
+
+static void write_sphere(void *user, unsigned group, const float (*verts)[3])
+{
+    JoinedWriter *w = user;
+    for (unsigned v = 0; v < JOINED_VERTICES; v++)
+        stream_vec3(&w->streams[group][0], verts[v][0], verts[v][1], verts[v][2]);
+    const uint64_t base = w->written[group]++ * JOINED_VERTICES;
+    for (unsigned t = 0; t < JOINED_TRIANGLES; t++)
+        stream_u32x3(&w->streams[group][1], base + w->triangles[t][0],
+                     base + w->triangles[t][1], base + w->triangles[t][2]);
 }
 
 /* --joined's second pass: each sphere's vertices and triangles into its
@@ -528,38 +546,24 @@ static void write_joined(int fd, uint64_t offset, const CloudRng *rng, uint64_t 
                          double radius, const unsigned *order, unsigned used,
                          const uint64_t *count)
 {
+    JoinedWriter w = { .written = { 0 } };
     double unit[JOINED_VERTICES][3];
-    unsigned triangles[JOINED_TRIANGLES][3];
-    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, triangles);
-    Stream streams[GROUPS][2];
-    uint64_t written[GROUPS] = { 0 };
+    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, w.triangles);
     for (unsigned m = 0; m < used; m++) {
         const uint64_t n = count[order[m]];
         for (unsigned a = 0; a < 2; a++) {
-            streams[order[m]][a] = (Stream){ .fd = fd, .offset = offset,
-                                             .buffer = malloc(STREAM_BYTES) };
-            if (!streams[order[m]][a].buffer)
+            w.streams[order[m]][a] = (Stream){ .fd = fd, .offset = offset,
+                                               .buffer = malloc(STREAM_BYTES) };
+            if (!w.streams[order[m]][a].buffer)
                 fail("out of memory");
             offset += n * (a ? JOINED_INDEX_BYTES : JOINED_POSITION_BYTES);
         }
     }
-    for (uint64_t i = UINT64_MAX; i == UINT64_MAX || i < spheres; i++) {
-        double centre[3], r;
-        const unsigned g = joined_sphere(rng, i, radius, centre, &r);
-        for (unsigned v = 0; v < JOINED_VERTICES; v++) {
-            float p[3];
-            joined_vertex(centre, r, unit[v], p);
-            stream_vec3(&streams[g][0], p[0], p[1], p[2]);
-        }
-        const uint64_t base = written[g]++ * JOINED_VERTICES;
-        for (unsigned t = 0; t < JOINED_TRIANGLES; t++)
-            stream_u32x3(&streams[g][1], base + triangles[t][0], base + triangles[t][1],
-                         base + triangles[t][2]);
-    }
+    joined_spheres(rng, spheres, radius, write_sphere, &w);
     for (unsigned m = 0; m < used; m++)
         for (unsigned a = 0; a < 2; a++) {
-            stream_flush(&streams[order[m]][a]);
-            free(streams[order[m]][a].buffer);
+            stream_flush(&w.streams[order[m]][a]);
+            free(w.streams[order[m]][a].buffer);
         }
 }
 

@@ -10,7 +10,8 @@ usage: check_mapped_buffers.py PTR"""
 import json, os, struct, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from glb import uv_sphere, write_glb  # noqa: E402
+from glb import write_glb  # noqa: E402
+from mesh_files import sphere_bytes  # noqa: E402
 
 ptr = sys.argv[1]
 INSTANCES = 1000
@@ -22,16 +23,16 @@ def scene(unread):
     """The glTF JSON and its buffer: unread zero bytes, then the data."""
     translations = b"".join(struct.pack("<3f", (i % 10) * 0.3, (i // 10 % 10) * 0.3,
                                         (i // 100) * 0.3) for i in range(INSTANCES))
-    box, indices, vertices, index_count = uv_sphere(0.1)
-    binary = bytes(unread) + translations + box + indices
+    sphere, indices, vertices, index_count = sphere_bytes(0.1)
+    binary = bytes(unread) + translations + sphere + indices
     doc = {
         "asset": {"version": "2.0"},
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
         "buffers": [{"byteLength": len(binary)}],
         "bufferViews": [{"buffer": 0, "byteOffset": unread, "byteLength": len(translations)},
                         {"buffer": 0, "byteOffset": unread + len(translations),
-                         "byteLength": len(box)},
-                        {"buffer": 0, "byteOffset": unread + len(translations) + len(box),
+                         "byteLength": len(sphere)},
+                        {"buffer": 0, "byteOffset": unread + len(translations) + len(sphere),
                          "byteLength": len(indices)}],
         "accessors": [{"bufferView": 0, "componentType": 5126, "count": INSTANCES, "type": "VEC3"},
                       {"bufferView": 1, "componentType": 5126, "count": vertices, "type": "VEC3",

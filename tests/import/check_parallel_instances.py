@@ -10,7 +10,8 @@ usage: check_parallel_instances.py PTR"""
 import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from glb import uv_sphere, write_glb  # noqa: E402
+from glb import write_glb  # noqa: E402
+from mesh_files import sphere_bytes  # noqa: E402
 from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
 
 ptr = sys.argv[1]
@@ -37,9 +38,9 @@ def write_cloud(path, nodes, broken):
     t, r, s, c = instances(broken)
     blocks = [b"".join(struct.pack("<3f", *v) for v in t), b"".join(struct.pack("<4f", *v) for v in r),
               b"".join(struct.pack("<3f", *v) for v in s), b"".join(struct.pack("<3f", *v) for v in c)]
-    box, indices, vertices, index_count = uv_sphere(0.05)
+    sphere, indices, vertices, index_count = sphere_bytes(0.05)
     binary, views = b"", []
-    for block in blocks + [box, indices]:
+    for block in blocks + [sphere, indices]:
         views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
         binary += block
     per = COUNT // nodes

@@ -14,15 +14,19 @@ import os
 import struct
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "../../scripts"))
+import make_scenes  # noqa: E402
 from glb import write_glb  # noqa: E402
 
 FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
 
 
 def uv_sphere(centre, radius, segments=8, rings=6, turn=0.0):
-    """Positions and triangles of a UV sphere, turned by `turn` radians about
-    the axis (1, 1, 1) (so that its bounds are not its sphere's)."""
+    """Positions and triangles of scripts/make_scenes.py's UV sphere, turned
+    by `turn` radians about the axis (1, 1, 1) (so that its bounds are not
+    its sphere's)."""
     axis = [1 / math.sqrt(3)] * 3
     c, s = math.cos(turn), math.sin(turn)
 
@@ -32,26 +36,17 @@ def uv_sphere(centre, radius, segments=8, rings=6, turn=0.0):
                  axis[0] * v[1] - axis[1] * v[0])
         return [v[k] * c + cross[k] * s + axis[k] * dot * (1 - c) for k in range(3)]
 
-    verts = [(0.0, 1.0, 0.0)]
-    for j in range(1, rings):
-        t = math.pi * j / rings
-        for i in range(segments):
-            p = 2 * math.pi * i / segments
-            verts.append((math.sin(t) * math.cos(p), math.cos(t), math.sin(t) * math.sin(p)))
-    verts.append((0.0, -1.0, 0.0))
-    last = len(verts) - 1
+    verts, tris = make_scenes.unit_sphere(segments, rings)
+    return [[centre[k] + radius * x for k, x in enumerate(rotate(v))] for v in verts], tris
 
-    def at(ring, seg):
-        return 1 + (ring - 1) * segments + seg % segments
 
-    tris = []
-    for seg in range(segments):
-        tris += [(0, at(1, seg + 1), at(1, seg)), (last, at(rings - 1, seg), at(rings - 1, seg + 1))]
-        for ring in range(1, rings - 1):
-            a, b, c2, d = at(ring, seg), at(ring, seg + 1), at(ring + 1, seg), at(ring + 1, seg + 1)
-            tris += [(a, b, d), (a, d, c2)]
-    positions = [[centre[k] + radius * x for k, x in enumerate(rotate(v))] for v in verts]
-    return positions, tris
+def sphere_bytes(radius):
+    """A UV sphere of 8 segments and 6 rings about the origin, bounds exactly
+    [-radius, radius]^3, as float VEC3 positions and unsigned-short indices,
+    with its vertex and index counts."""
+    verts, tris = uv_sphere((0, 0, 0), radius)
+    return (b"".join(struct.pack("<3f", *v) for v in verts),
+            b"".join(struct.pack("<3H", *t) for t in tris), len(verts), 3 * len(tris))
 
 
 def cube(centre, half):
