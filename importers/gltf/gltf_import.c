@@ -119,7 +119,8 @@ typedef struct Importer {
     const char *value_name; /* the attribute --color-by asks for, or NULL */
     SurfaceSpheres *surfaces; /* one a mesh */
     size_t skipped;           /* mesh parts not drawn, for the one warning */
-    char skipped_names[256];  /* where they are, cut to size */
+    char skipped_names[256];  /* where they are, as many as fit */
+    int skipped_more;         /* whether more did not fit */
 } Importer;
 
 static const char *label(const char *name, const char *fallback)
@@ -560,9 +561,14 @@ static void note_skipped(Importer *im, const Origin *o, const GltfMesh *mesh, si
     if (!parts)
         return;
     im->skipped += parts;
+    char name[sizeof im->skipped_names];
     const size_t used = strlen(im->skipped_names);
-    snprintf(im->skipped_names + used, sizeof im->skipped_names - used, "%snode '%s' (mesh '%s')",
-             used ? ", " : "", o->node_name, label(mesh->name, "unnamed"));
+    const int n = snprintf(name, sizeof name, "%snode '%s' (mesh '%s')", used ? ", " : "",
+                           o->node_name, label(mesh->name, "unnamed"));
+    if (n < 0 || used + (size_t)n >= sizeof im->skipped_names)
+        im->skipped_more = 1;
+    else
+        memcpy(im->skipped_names + used, name, (size_t)n + 1);
 }
 
 /* Checks the accessor of the attribute --color-by names (index from
@@ -1382,8 +1388,9 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         check_far_plane(&im);
     if (res == PTR_OK && im.skipped)
         ptr_warn(warnings, "%s: %zu mesh part%s not drawn: %s not a sphere (docs/scenes.md, "
-                 "\"Spheres\"): %s", path, im.skipped, im.skipped == 1 ? "" : "s",
-                 im.skipped == 1 ? "it is" : "they are", im.skipped_names);
+                 "\"Spheres\"): %s%s", path, im.skipped, im.skipped == 1 ? "" : "s",
+                 im.skipped == 1 ? "it is" : "they are", im.skipped_names,
+                 im.skipped_more ? ", ..." : "");
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
     /* The file's buffers go before the scene's arrays are filled. */

@@ -11,7 +11,9 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
   node, within the tolerance;
 - cube, torus, plane, cylinder, each alone: no sphere, the warning;
 - mixed: spheres, a cube and a torus joined, with a degenerate triangle of
-  its own: the spheres, and one warning counting 3 parts and naming the node.
+  its own: the spheres, and one warning counting 3 parts and naming the node;
+- a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
+  ", ..." to fit the line.
 Usage: check_mesh_spheres.py PTR"""
 import json
 import os
@@ -126,6 +128,16 @@ def main():
         path = os.path.join(folder, "mixed.glb")
         w.write(path)
         expect(path, [((0, 0, 0), 1, 0), ((8, 0, 0), 1, 0)], 3, ["node 'Mixed' (mesh 'MixedMesh')"])
+
+        # One mesh, a cube, under 40 nodes: 40 parts, the names cut with "...".
+        w = mf.Writer()
+        box = w.mesh("Box", [(mf.cube((0, 0, 0), 1), 0)])
+        for i in range(40):
+            w.node(f"Cube{i}", box, translation=[3 * i, 0, 0])
+        w.node("Ball", w.mesh("Ball", [(mf.uv_sphere((0, -5, 0), 1), 0)]))
+        path = os.path.join(folder, "cubes.glb")
+        w.write(path)
+        expect(path, [((0, -5, 0), 1, 0)], 40, ["node 'Cube0' (mesh 'Box')", ", ..."])
 
     for f in failures:
         print("FAIL " + f)
