@@ -12,4 +12,3 @@ def write_glb(path, doc, binary):
         f.write(struct.pack("<3I", 0x46546C67, 2, 12 + 8 + len(text) + 8 + len(binary)))
         f.write(struct.pack("<2I", len(text), 0x4E4F534A) + text)
         f.write(struct.pack("<2I", len(binary), 0x004E4942) + binary)
-
