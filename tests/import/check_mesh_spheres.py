@@ -13,7 +13,10 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - mixed: spheres, a cube and a torus joined, with a degenerate triangle of
   its own: the spheres, and one warning counting 3 parts and naming the node;
 - a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
-  ", ..." to fit the line.
+  ", ..." to fit the line;
+- OBJ: an object of two joined spheres and a cube named like a sphere: the
+  two spheres and the warning; with --fit-all-objects one sphere an object,
+  unchecked, no warning.
 Usage: check_mesh_spheres.py PTR"""
 import json
 import os
@@ -38,7 +41,8 @@ def dump(path):
 
 
 def expect(path, spheres, skipped, names=(), tol=1e-5):
-    """spheres: (centre, radius, material index) in the file's order."""
+    """spheres: (centre, radius, material index, -1 for the default grey) in
+    the file's order."""
     name = os.path.basename(path)
     scene, stderr = dump(path)
     if scene is None:
@@ -51,7 +55,7 @@ def expect(path, spheres, skipped, names=(), tol=1e-5):
         off = max(abs(a - b) for a, b in zip(gc, wc))
         if off > tol * wr or abs(gr - wr) > tol * wr:
             failures.append(f"{name}: sphere {gc} r {gr}, not {wc} r {wr}")
-        if abs(ga - 0.25 * (wm + 1)) > 1e-6:
+        if abs(ga - (0.8 if wm < 0 else 0.25 * (wm + 1))) > 1e-6:
             failures.append(f"{name}: sphere at {wc} has material albedo {ga}, not material {wm}'s")
     lines = [line for line in stderr.splitlines() if WARNING in line]
     if not skipped:
@@ -138,6 +142,29 @@ def main():
         path = os.path.join(folder, "cubes.glb")
         w.write(path)
         expect(path, [((0, -5, 0), 1, 0)], 40, ["node 'Cube0' (mesh 'Box')", ", ..."])
+
+        # OBJ, under its naming rule: an object of two joined spheres, a cube
+        # named like a sphere; --fit-all-objects fits each object, unchecked.
+        verts, tris = mf.combine(mf.uv_sphere((0, 0, 0), 1), mf.uv_sphere((5, 0, 0), 2))
+        cube_verts, cube_tris = mf.cube((0, 9, 0), 1)
+        path = os.path.join(folder, "joined.obj")
+        with open(path, "w") as f:
+            f.write("o TwoSpheres\n")
+            f.writelines(f"v {x} {y} {z}\n" for x, y, z in verts)
+            f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tris)
+            f.write("o CubeSphere\n")
+            f.writelines(f"v {x} {y} {z}\n" for x, y, z in cube_verts)
+            f.writelines(f"f {a + 1 + len(verts)} {b + 1 + len(verts)} {c + 1 + len(verts)}\n"
+                         for a, b, c in cube_tris)
+        expect(path, [((0, 0, 0), 1, -1), ((5, 0, 0), 2, -1)], 1, ["object 'CubeSphere' (line"])
+        run = subprocess.run([ptr, "--dump-scene", "--fit-all-objects", path], capture_output=True,
+                             text=True, timeout=60)
+        fitted = [(s["center"], s["radius"]) for s in json.loads(run.stdout)["spheres"]]
+        want = [((3, 0, 0), 4), ((0, 9, 0), 1)]  # the objects' bounds
+        if len(fitted) != 2 or WARNING in run.stderr or any(
+                abs(gr - wr) > 1e-5 or max(abs(a - b) for a, b in zip(gc, wc)) > 1e-5
+                for (gc, gr), (wc, wr) in zip(fitted, want)):
+            failures.append(f"joined.obj --fit-all-objects: {fitted} {run.stderr}")
 
     for f in failures:
         print("FAIL " + f)
