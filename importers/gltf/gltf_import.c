@@ -394,8 +394,10 @@ static double position_quantum(const GltfAccessor *a)
     return a->normalized ? gltf_component_value(a->component_type, 1, 1.0) : 1.0;
 }
 
-/* Primitive p of mesh as a surface part (none: *part->triangles stays 0 for
- * lines), checked: its positions, its indices and that they are in range. */
+/* Primitive p of mesh as a surface part, checked: its positions, its
+ * indices and that they are in range. Lines (and fewer than 3 corners) give
+ * no triangles: part->triangles 0. part->first_vertex holds its vertex
+ * count until find_surface places it. */
 static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t p,
                               const GltfPrimitive *prim, SurfacePart *part)
 {
@@ -433,7 +435,7 @@ static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t
     }
     part->triangles = prim->mode == 4 ? n / 3 : (prim->mode == 5 || prim->mode == 6) && n >= 3
                                                     ? n - 2 : 0;
-    part->first_vertex = vertices; /* its count, until surface_spheres places it */
+    part->first_vertex = vertices;
     return PTR_OK;
 }
 
