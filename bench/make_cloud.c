@@ -6,7 +6,14 @@
  * two uniforms a channel, 15% metal with a fuzz from {0, 0.1, ..., 0.5}, 5%
  * glass), fast enough for 10^8 spheres and in a few megabytes of memory.
  *
- *   make_cloud N OUT.glb [SEED]
+ *   make_cloud [--joined] N OUT.glb [SEED]
+ *
+ * --joined writes the same spheres as one mesh instead, as `gltf-transform
+ * join` and Blender's Join leave them: a primitive a material holding a UV
+ * sphere of 8 segments and 6 rings for each sphere (its transform baked into
+ * float positions, 32-bit indices), 1464 bytes a sphere; the spheres' own
+ * colours are not written (a mesh has no per-sphere colour). It measures
+ * the import of joined meshes against instances (README, "Scaling").
  *
  * Its random numbers are its own (splitmix64), not Python's: the same N and
  * SEED give the same file, not the file make_cloud.py gives.
@@ -33,6 +40,9 @@ enum {
     SEGMENTS = 32, RINGS = 16, /* make_scenes.py's unit UV sphere */
     VERTICES = 1 + (RINGS - 1) * SEGMENTS + 1,
     TRIANGLES = 2 * SEGMENTS * (RINGS - 1),
+    JOINED_SEGMENTS = 8, JOINED_RINGS = 6, /* --joined: each sphere's mesh */
+    JOINED_VERTICES = 1 + (JOINED_RINGS - 1) * JOINED_SEGMENTS + 1,
+    JOINED_TRIANGLES = 2 * JOINED_SEGMENTS * (JOINED_RINGS - 1),
     SLOTS_PER_SPHERE = 16, /* splitmix64 outputs reserved for each sphere */
     FUZZES = 6,
     GROUPS = 1 + FUZZES + 1, /* diffuse, metal with each fuzz, glass */
@@ -141,34 +151,47 @@ static void stream_vec3(Stream *s, double x, double y, double z)
     s->used += 12;
 }
 
-/* The binary chunk's first bytes: make_scenes.py's unit UV sphere (bounds
- * exactly +-1), positions then triangle indices. */
-static size_t unit_sphere(unsigned char *out)
+/* Three 32-bit little-endian integers (indices below 2^32: the file's
+ * length is a 32-bit number). */
+static void stream_u32x3(Stream *s, uint64_t a, uint64_t b, uint64_t c)
 {
-    unsigned char *p = put_vec3(out, 0.0, 1.0, 0.0);
-    for (int ring = 1; ring < RINGS; ring++) {
-        double theta = M_PI * ring / RINGS, y = 2 * ring == RINGS ? 0.0 : cos(theta);
+    if (s->used + 12 > STREAM_BYTES)
+        stream_flush(s);
+    const uint64_t v[3] = { a, b, c };
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 4; k++)
+            s->buffer[s->used++] = (unsigned char)(v[i] >> 8 * k);
+}
+
+/* make_scenes.py's unit UV sphere of `segments` and `rings` (bounds exactly
+ * +-1): its vertices and triangles. */
+static void sphere_geometry(unsigned segments, unsigned rings, double (*verts)[3],
+                            unsigned (*triangles)[3])
+{
+    unsigned v = 0, t = 0;
+    verts[v][0] = 0.0, verts[v][1] = 1.0, verts[v++][2] = 0.0;
+    for (unsigned ring = 1; ring < rings; ring++) {
+        double theta = M_PI * ring / rings, y = 2 * ring == rings ? 0.0 : cos(theta);
         double sin_theta = sin(theta);
-        for (int seg = 0; seg < SEGMENTS; seg++) {
-            double phi = 2.0 * M_PI * seg / SEGMENTS;
-            int quarter = 4 * seg % SEGMENTS == 0; /* exactly +-1 where the bounds are */
+        for (unsigned seg = 0; seg < segments; seg++) {
+            double phi = 2.0 * M_PI * seg / segments;
+            int quarter = 4 * seg % segments == 0; /* exactly +-1 where the bounds are */
             double x = quarter ? (double)lround(cos(phi)) : cos(phi);
             double z = quarter ? (double)lround(sin(phi)) : sin(phi);
-            p = put_vec3(p, sin_theta * x, y, sin_theta * z);
+            verts[v][0] = sin_theta * x, verts[v][1] = y, verts[v++][2] = sin_theta * z;
         }
     }
-    p = put_vec3(p, 0.0, -1.0, 0.0);
-    const unsigned bottom = VERTICES - 1;
-#define RING_VERTEX(ring, seg) (1u + ((ring) - 1u) * SEGMENTS + (seg) % SEGMENTS)
-    unsigned triangles[TRIANGLES][3], t = 0;
-    for (unsigned seg = 0; seg < SEGMENTS; seg++) {
+    verts[v][0] = 0.0, verts[v][1] = -1.0, verts[v][2] = 0.0;
+    const unsigned bottom = v;
+#define RING_VERTEX(ring, seg) (1u + ((ring) - 1u) * segments + (seg) % segments)
+    for (unsigned seg = 0; seg < segments; seg++) {
         unsigned top[3] = { 0, RING_VERTEX(1, seg + 1), RING_VERTEX(1, seg) };
-        unsigned low[3] = { bottom, RING_VERTEX(RINGS - 1, seg), RING_VERTEX(RINGS - 1, seg + 1) };
+        unsigned low[3] = { bottom, RING_VERTEX(rings - 1, seg), RING_VERTEX(rings - 1, seg + 1) };
         memcpy(triangles[t++], top, sizeof top);
         memcpy(triangles[t++], low, sizeof low);
     }
-    for (unsigned ring = 1; ring < RINGS - 1; ring++)
-        for (unsigned seg = 0; seg < SEGMENTS; seg++) {
+    for (unsigned ring = 1; ring < rings - 1; ring++)
+        for (unsigned seg = 0; seg < segments; seg++) {
             unsigned a = RING_VERTEX(ring, seg), b = RING_VERTEX(ring, seg + 1);
             unsigned c = RING_VERTEX(ring + 1, seg), d = RING_VERTEX(ring + 1, seg + 1);
             unsigned first[3] = { a, b, d }, second[3] = { a, d, c };
@@ -176,6 +199,18 @@ static size_t unit_sphere(unsigned char *out)
             memcpy(triangles[t++], second, sizeof second);
         }
 #undef RING_VERTEX
+}
+
+/* The binary chunk's first bytes: make_scenes.py's unit UV sphere,
+ * positions then triangle indices. */
+static size_t unit_sphere(unsigned char *out)
+{
+    double verts[VERTICES][3];
+    unsigned triangles[TRIANGLES][3];
+    sphere_geometry(SEGMENTS, RINGS, verts, triangles);
+    unsigned char *p = out;
+    for (unsigned v = 0; v < VERTICES; v++)
+        p = put_vec3(p, verts[v][0], verts[v][1], verts[v][2]);
     for (unsigned i = 0; i < TRIANGLES * 3; i++) {
         *p++ = (unsigned char)(triangles[i / 3][i % 3] & 0xff);
         *p++ = (unsigned char)(triangles[i / 3][i % 3] >> 8);
@@ -256,11 +291,50 @@ static void json_material(FILE *f, unsigned group, unsigned index)
             index);
 }
 
+/* --joined: bytes a sphere in its primitive's positions and indices. */
+enum { JOINED_POSITION_BYTES = 12 * JOINED_VERTICES, JOINED_INDEX_BYTES = 12 * JOINED_TRIANGLES };
+
+/* What --joined writes of group g: its primitive's positions' bounds. */
+typedef struct {
+    int joined;
+    double lower[GROUPS][3], upper[GROUPS][3];
+} Joined;
+
+/* --joined: the accessors and buffer views of each group's primitive, its
+ * positions then its indices, group after group in `order`. */
+static void joined_accessors(FILE *f, const unsigned *order, unsigned used, const uint64_t *count,
+                             const Joined *joined)
+{
+    fputs("],\"accessors\":[", f);
+    for (unsigned m = 0; m < used; m++) {
+        const unsigned g = order[m];
+        fprintf(f, "%s{\"bufferView\":%u,\"componentType\":5126,\"count\":%" PRIu64
+                   ",\"type\":\"VEC3\",\"min\":", m ? "," : "", 2 * m, count[g] * JOINED_VERTICES);
+        json_reals(f, joined->lower[g], 3);
+        fputs(",\"max\":", f);
+        json_reals(f, joined->upper[g], 3);
+        fprintf(f, "},{\"bufferView\":%u,\"componentType\":5125,\"count\":%" PRIu64
+                   ",\"type\":\"SCALAR\"}", 2 * m + 1, count[g] * 3 * JOINED_TRIANGLES);
+    }
+    fputs("],\"bufferViews\":[", f);
+    uint64_t offset = 0;
+    for (unsigned m = 0; m < used; m++) {
+        const uint64_t positions = count[order[m]] * JOINED_POSITION_BYTES;
+        const uint64_t indices = count[order[m]] * JOINED_INDEX_BYTES;
+        fprintf(f, "%s{\"buffer\":0,\"byteOffset\":%" PRIu64 ",\"byteLength\":%" PRIu64
+                   ",\"target\":34962},{\"buffer\":0,\"byteOffset\":%" PRIu64
+                   ",\"byteLength\":%" PRIu64 ",\"target\":34963}",
+                m ? "," : "", offset, positions, offset + positions, indices);
+        offset += positions + indices;
+    }
+}
+
 /* The JSON chunk, in make_scenes.py's order of keys; `order` lists the groups
  * present in the order of their first sphere (the ground's, diffuse, first),
  * as make_scenes.py numbers materials. */
 static char *json_chunk(uint64_t spheres, const unsigned *order, unsigned used, const uint64_t *count,
-                        uint64_t mesh_bytes, uint64_t binary_bytes, size_t *size)
+                        uint64_t mesh_bytes, uint64_t binary_bytes, const Joined *joined,
+                        size_t *size)
 {
     char *text = NULL;
     FILE *f = open_memstream(&text, size);
@@ -269,10 +343,13 @@ static char *json_chunk(uint64_t spheres, const unsigned *order, unsigned used, 
     fprintf(f, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"ptr bench/make_cloud\"},\"scene\":0,"
                "\"scenes\":[{\"name\":\"cloud%" PRIu64 "\",\"nodes\":[",
             spheres);
-    for (unsigned i = 0; i <= used; i++)
+    const unsigned nodes = joined->joined ? 1 : used;
+    for (unsigned i = 0; i <= nodes; i++)
         fprintf(f, "%s%u", i ? "," : "", i);
     fputs("],\"extras\":{\"sky\":\"gradient\",\"resolution\":[400,225]}}],\"nodes\":[", f);
-    for (unsigned m = 0; m < used; m++)
+    if (joined->joined)
+        fputs("{\"name\":\"Spheres\",\"mesh\":0},", f);
+    for (unsigned m = 0; m < used && !joined->joined; m++)
         fprintf(f,
                 "{\"name\":\"Spheres.%03u\",\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":"
                 "{\"TRANSLATION\":%u,\"SCALE\":%u,\"_COLOR_0\":%u}}},\"mesh\":%u},",
@@ -295,7 +372,14 @@ static char *json_chunk(uint64_t spheres, const unsigned *order, unsigned used, 
     fputs(",\"focus_distance\":", f);
     json_real(f, 26.0);
     fputs("}}],\"meshes\":[", f);
-    for (unsigned m = 0; m < used; m++)
+    if (joined->joined) {
+        fputs("{\"name\":\"Spheres\",\"primitives\":[", f);
+        for (unsigned m = 0; m < used; m++)
+            fprintf(f, "%s{\"attributes\":{\"POSITION\":%u},\"indices\":%u,\"material\":%u}",
+                    m ? "," : "", 2 * m, 2 * m + 1, m);
+        fputs("]}", f);
+    }
+    for (unsigned m = 0; m < used && !joined->joined; m++)
         fprintf(f,
                 "%s{\"name\":\"Sphere.%03u\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":0},"
                 "\"indices\":1,\"material\":%u}]}",
@@ -305,6 +389,13 @@ static char *json_chunk(uint64_t spheres, const unsigned *order, unsigned used, 
         if (m)
             fputc(',', f);
         json_material(f, order[m], m);
+    }
+    if (joined->joined) {
+        joined_accessors(f, order, used, count, joined);
+        fprintf(f, "],\"buffers\":[{\"byteLength\":%" PRIu64 "}]%s}", binary_bytes,
+                count[GLASS] ? ",\"extensionsUsed\":[\"KHR_materials_transmission\","
+                               "\"KHR_materials_ior\"]" : "");
+        goto done;
     }
     const double lower[3] = { -1.0, -1.0, -1.0 }, upper[3] = { 1.0, 1.0, 1.0 };
     fprintf(f, "],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\",\"min\":",
@@ -331,9 +422,149 @@ static char *json_chunk(uint64_t spheres, const unsigned *order, unsigned used, 
     fprintf(f, "],\"buffers\":[{\"byteLength\":%" PRIu64 "}],"
                "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],\"extensionsUsed\":[%s\"EXT_mesh_gpu_instancing\"]}",
             binary_bytes, count[GLASS] ? "\"KHR_materials_transmission\",\"KHR_materials_ior\"," : "");
+done:
     if (ferror(f) || fclose(f))
         fail("out of memory");
     return text;
+}
+
+/* Sphere i's centre, spheres of `radius` in the box above the ground. */
+static void sphere_centre(const CloudRng *rng, uint64_t i, double radius, double centre[3])
+{
+    centre[0] = -BOX[0] / 2 + BOX[0] * draw(rng, i, SLOT_CENTRE);
+    centre[1] = radius + (BOX[1] - radius) * draw(rng, i, SLOT_CENTRE + 1);
+    centre[2] = -BOX[2] / 2 + BOX[2] * draw(rng, i, SLOT_CENTRE + 2);
+}
+
+/* The instanced form's second pass: each sphere into its material's three
+ * blocks, which start at `offset`. */
+static void write_instances(int fd, uint64_t offset, const CloudRng *rng, uint64_t spheres,
+                            double radius, const unsigned *order, unsigned used,
+                            const uint64_t *count)
+{
+    /* Second pass: each sphere into its material's three blocks. */
+    Stream streams[GROUPS][ATTRIBUTES];
+    for (unsigned m = 0; m < used; m++)
+        for (unsigned a = 0; a < ATTRIBUTES; a++) {
+            Stream *s = &streams[order[m]][a];
+            *s = (Stream){ .fd = fd, .offset = offset, .buffer = malloc(STREAM_BYTES) };
+            if (!s->buffer)
+                fail("out of memory");
+            offset += 12 * count[order[m]];
+        }
+    Stream *ground = streams[0];
+    stream_vec3(&ground[0], 0.0, -1000.0, 0.0);
+    stream_vec3(&ground[1], 1000.0, 1000.0, 1000.0);
+    stream_vec3(&ground[2], 0.5, 0.5, 0.5);
+    for (uint64_t i = 0; i < spheres; i++) {
+        unsigned g = sphere_group(rng, i);
+        Stream *s = streams[g];
+        double centre[3];
+        sphere_centre(rng, i, radius, centre);
+        stream_vec3(&s[0], centre[0], centre[1], centre[2]);
+        stream_vec3(&s[1], radius, radius, radius);
+        double colour[3] = { 1.0, 1.0, 1.0 };
+        for (unsigned c = 0; c < 3 && g != GLASS; c++)
+            colour[c] = g == 0 ? draw(rng, i, SLOT_COLOUR + 2 * c) * draw(rng, i, SLOT_COLOUR + 2 * c + 1)
+                               : 0.5 + 0.5 * draw(rng, i, SLOT_COLOUR + c);
+        stream_vec3(&s[2], colour[0], colour[1], colour[2]);
+    }
+    for (unsigned g = 0; g < GROUPS; g++)
+        for (unsigned a = 0; a < ATTRIBUTES && count[g]; a++) {
+            stream_flush(&streams[g][a]);
+            free(streams[g][a].buffer);
+        }
+}
+
+/* --joined: the ground, then each sphere, as its group and the vertices of
+ * its mesh as the file stores them, handed to each(user, ...). */
+static void joined_spheres(const CloudRng *rng, uint64_t spheres, double radius,
+                           void (*each)(void *user, unsigned group,
+                                        const float (*verts)[3]),
+                           void *user)
+{
+    double unit[JOINED_VERTICES][3];
+    unsigned triangles[JOINED_TRIANGLES][3];
+    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, triangles);
+    float verts[JOINED_VERTICES][3];
+    for (uint64_t i = 0; i <= spheres; i++) {
+        double centre[3] = { 0.0, -1000.0, 0.0 }, r = 1000.0; /* the ground */
+        unsigned group = 0;
+        if (i > 0) {
+            sphere_centre(rng, i - 1, radius, centre);
+            r = radius;
+            group = sphere_group(rng, i - 1);
+        }
+        for (unsigned v = 0; v < JOINED_VERTICES; v++)
+            for (int c = 0; c < 3; c++)
+                verts[v][c] = (float)(centre[c] + r * unit[v][c]);
+        each(user, group, (const float (*)[3])verts);
+    }
+}
+
+static void add_bounds(void *user, unsigned group, const float (*verts)[3])
+{
+    Joined *joined = user;
+    for (unsigned v = 0; v < JOINED_VERTICES; v++)
+        for (int c = 0; c < 3; c++) {
+            joined->lower[group][c] = fmin(joined->lower[group][c], verts[v][c]);
+            joined->upper[group][c] = fmax(joined->upper[group][c], verts[v][c]);
+        }
+}
+
+/* --joined: each group's bounds, over the ground and every sphere. */
+static void joined_bounds(const CloudRng *rng, uint64_t spheres, double radius, Joined *joined)
+{
+    for (unsigned g = 0; g < GROUPS; g++)
+        for (int c = 0; c < 3; c++)
+            joined->lower[g][c] = HUGE_VAL, joined->upper[g][c] = -HUGE_VAL;
+    joined_spheres(rng, spheres, radius, add_bounds, joined);
+}
+
+/* --joined's second pass: a stream of positions and one of indices a
+ * group, and the spheres each has so far. */
+typedef struct {
+    Stream streams[GROUPS][2];
+    uint64_t written[GROUPS];
+    unsigned triangles[JOINED_TRIANGLES][3];
+} JoinedWriter;
+
+static void write_sphere(void *user, unsigned group, const float (*verts)[3])
+{
+    JoinedWriter *w = user;
+    for (unsigned v = 0; v < JOINED_VERTICES; v++)
+        stream_vec3(&w->streams[group][0], verts[v][0], verts[v][1], verts[v][2]);
+    const uint64_t base = w->written[group]++ * JOINED_VERTICES;
+    for (unsigned t = 0; t < JOINED_TRIANGLES; t++)
+        stream_u32x3(&w->streams[group][1], base + w->triangles[t][0],
+                     base + w->triangles[t][1], base + w->triangles[t][2]);
+}
+
+/* --joined's second pass: each sphere's vertices and triangles into its
+ * group's primitive, the groups' blocks in `order` from `offset`. */
+static void write_joined(int fd, uint64_t offset, const CloudRng *rng, uint64_t spheres,
+                         double radius, const unsigned *order, unsigned used,
+                         const uint64_t *count)
+{
+    JoinedWriter w = { .written = { 0 } };
+    double unit[JOINED_VERTICES][3];
+    sphere_geometry(JOINED_SEGMENTS, JOINED_RINGS, unit, w.triangles);
+    for (unsigned m = 0; m < used; m++) {
+        const uint64_t n = count[order[m]];
+        for (unsigned a = 0; a < 2; a++) {
+            w.streams[order[m]][a] = (Stream){ .fd = fd, .offset = offset,
+                                               .buffer = malloc(STREAM_BYTES) };
+            if (!w.streams[order[m]][a].buffer)
+                fail("out of memory");
+            offset += n * (a ? JOINED_INDEX_BYTES : JOINED_POSITION_BYTES);
+        }
+    }
+    joined_spheres(rng, spheres, radius, write_sphere, &w);
+    for (unsigned m = 0; m < used; m++)
+        for (unsigned a = 0; a < 2; a++) {
+            stream_flush(&w.streams[order[m]][a]);
+            free(w.streams[order[m]][a].buffer);
+        }
 }
 
 static void put_u32(unsigned char *p, uint64_t v)
@@ -344,8 +575,10 @@ static void put_u32(unsigned char *p, uint64_t v)
 
 int main(int argc, char **argv)
 {
+    Joined joined = { .joined = argc > 1 && strcmp(argv[1], "--joined") == 0 };
+    argc -= joined.joined, argv += joined.joined;
     if (argc < 3 || argc > 4) {
-        fputs("usage: make_cloud N OUT.glb [SEED]\n", stderr);
+        fputs("usage: make_cloud [--joined] N OUT.glb [SEED]\n", stderr);
         return 2;
     }
     out_path = argv[2];
@@ -378,11 +611,17 @@ int main(int argc, char **argv)
             order[at] = g;
         }
 
+    const double radius = pow(0.08 * BOX[0] * BOX[1] * BOX[2] / (double)spheres * 3 / (4 * M_PI), 1.0 / 3);
     unsigned char mesh[VERTICES * 12 + TRIANGLES * 6];
-    size_t mesh_bytes = unit_sphere(mesh);
+    size_t mesh_bytes = joined.joined ? 0 : unit_sphere(mesh);
     uint64_t binary_bytes = mesh_bytes + 36 * (spheres + 1);
+    if (joined.joined) {
+        joined_bounds(&rng, spheres, radius, &joined);
+        binary_bytes = (spheres + 1) * (uint64_t)(JOINED_POSITION_BYTES + JOINED_INDEX_BYTES);
+    }
     size_t json_bytes;
-    char *json = json_chunk(spheres, order, used, count, mesh_bytes, binary_bytes, &json_bytes);
+    char *json = json_chunk(spheres, order, used, count, mesh_bytes, binary_bytes, &joined,
+                            &json_bytes);
     size_t json_padded = (json_bytes + 3) & ~(size_t)3;
     uint64_t binary_start = 12 + 8 + json_padded + 8, total = binary_start + binary_bytes;
     if (total > UINT32_MAX)
@@ -414,40 +653,10 @@ int main(int argc, char **argv)
     write_at(fd, mesh, mesh_bytes, binary_start);
     free(json);
 
-    /* Second pass: each sphere into its material's three blocks. */
-    Stream streams[GROUPS][ATTRIBUTES];
-    uint64_t offset = binary_start + mesh_bytes;
-    for (unsigned m = 0; m < used; m++)
-        for (unsigned a = 0; a < ATTRIBUTES; a++) {
-            Stream *s = &streams[order[m]][a];
-            *s = (Stream){ .fd = fd, .offset = offset, .buffer = malloc(STREAM_BYTES) };
-            if (!s->buffer)
-                fail("out of memory");
-            offset += 12 * count[order[m]];
-        }
-    Stream *ground = streams[0];
-    stream_vec3(&ground[0], 0.0, -1000.0, 0.0);
-    stream_vec3(&ground[1], 1000.0, 1000.0, 1000.0);
-    stream_vec3(&ground[2], 0.5, 0.5, 0.5);
-    const double radius = pow(0.08 * BOX[0] * BOX[1] * BOX[2] / (double)spheres * 3 / (4 * M_PI), 1.0 / 3);
-    for (uint64_t i = 0; i < spheres; i++) {
-        unsigned g = sphere_group(&rng, i);
-        Stream *s = streams[g];
-        stream_vec3(&s[0], -BOX[0] / 2 + BOX[0] * draw(&rng, i, SLOT_CENTRE),
-                    radius + (BOX[1] - radius) * draw(&rng, i, SLOT_CENTRE + 1),
-                    -BOX[2] / 2 + BOX[2] * draw(&rng, i, SLOT_CENTRE + 2));
-        stream_vec3(&s[1], radius, radius, radius);
-        double colour[3] = { 1.0, 1.0, 1.0 };
-        for (unsigned c = 0; c < 3 && g != GLASS; c++)
-            colour[c] = g == 0 ? draw(&rng, i, SLOT_COLOUR + 2 * c) * draw(&rng, i, SLOT_COLOUR + 2 * c + 1)
-                               : 0.5 + 0.5 * draw(&rng, i, SLOT_COLOUR + c);
-        stream_vec3(&s[2], colour[0], colour[1], colour[2]);
-    }
-    for (unsigned g = 0; g < GROUPS; g++)
-        for (unsigned a = 0; a < ATTRIBUTES && count[g]; a++) {
-            stream_flush(&streams[g][a]);
-            free(streams[g][a].buffer);
-        }
+    if (joined.joined)
+        write_joined(fd, binary_start, &rng, spheres, radius, order, used, count);
+    else
+        write_instances(fd, binary_start + mesh_bytes, &rng, spheres, radius, order, used, count);
     if (close(fd) != 0)
         fail(strerror(errno));
     if (rename(tmp_path, out_path) != 0)

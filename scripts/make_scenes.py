@@ -27,16 +27,17 @@ import sys
 SEGMENTS, RINGS = 32, 16  # multiples of 4 and 2: the bounds are exactly +-1
 
 
-def unit_sphere():
-    """Positions (also the normals) and triangle indices of a UV sphere."""
+def unit_sphere(segments=SEGMENTS, rings=RINGS):
+    """Positions (also the normals) and triangle indices of a UV sphere
+    (segments a multiple of 4 and rings even: the bounds are exactly +-1)."""
     verts = [(0.0, 1.0, 0.0)]
-    for ring in range(1, RINGS):
-        theta = math.pi * ring / RINGS
-        y = 0.0 if 2 * ring == RINGS else math.cos(theta)
+    for ring in range(1, rings):
+        theta = math.pi * ring / rings
+        y = 0.0 if 2 * ring == rings else math.cos(theta)
         s = math.sin(theta)
-        for seg in range(SEGMENTS):
-            phi = 2.0 * math.pi * seg / SEGMENTS
-            quarter = 4 * seg % SEGMENTS == 0  # exact +-1 where the bounds are
+        for seg in range(segments):
+            phi = 2.0 * math.pi * seg / segments
+            quarter = 4 * seg % segments == 0  # exact +-1 where the bounds are
             x = s * (round(math.cos(phi)) if quarter else math.cos(phi))
             z = s * (round(math.sin(phi)) if quarter else math.sin(phi))
             verts.append((x, y, z))
@@ -44,14 +45,14 @@ def unit_sphere():
     bottom = len(verts) - 1
 
     def ring_vertex(ring, seg):
-        return 1 + (ring - 1) * SEGMENTS + seg % SEGMENTS
+        return 1 + (ring - 1) * segments + seg % segments
 
     tris = []
-    for seg in range(SEGMENTS):
+    for seg in range(segments):
         tris.append((0, ring_vertex(1, seg + 1), ring_vertex(1, seg)))
-        tris.append((bottom, ring_vertex(RINGS - 1, seg), ring_vertex(RINGS - 1, seg + 1)))
-    for ring in range(1, RINGS - 1):
-        for seg in range(SEGMENTS):
+        tris.append((bottom, ring_vertex(rings - 1, seg), ring_vertex(rings - 1, seg + 1)))
+    for ring in range(1, rings - 1):
+        for seg in range(segments):
             a, b = ring_vertex(ring, seg), ring_vertex(ring, seg + 1)
             c, d = ring_vertex(ring + 1, seg), ring_vertex(ring + 1, seg + 1)
             tris += [(a, b, d), (a, d, c)]

@@ -215,6 +215,9 @@ std::string check_indices(const tinygltf::Model &m, const std::vector<GltfBytes>
             if (p.material != -1 && !in_range(p.material, m.materials.size()))
                 return "mesh " + std::to_string(i) + " refers to material " +
                        std::to_string(p.material) + ", which does not exist";
+            if (p.indices != -1 && !in_range(p.indices, m.accessors.size()))
+                return "mesh " + std::to_string(i) + " refers to index accessor " +
+                       std::to_string(p.indices) + ", which does not exist";
             for (const auto &attr : p.attributes)
                 if (!in_range(attr.second, m.accessors.size()))
                     return "mesh " + std::to_string(i) + " attribute " + attr.first +
@@ -640,6 +643,7 @@ extern "C" void gltf_doc_free(GltfDoc *doc) { delete doc; }
 extern "C" size_t gltf_doc_file_count(const GltfDoc *d) { return d->files.size(); }
 extern "C" const char *gltf_doc_file(const GltfDoc *d, size_t i) { return d->files[i].c_str(); }
 extern "C" size_t gltf_doc_node_count(const GltfDoc *d) { return d->model.nodes.size(); }
+extern "C" size_t gltf_doc_mesh_count(const GltfDoc *d) { return d->model.meshes.size(); }
 extern "C" size_t gltf_doc_material_count(const GltfDoc *d) { return d->model.materials.size(); }
 
 extern "C" void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *out)
@@ -713,7 +717,7 @@ extern "C" void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index
     *out = GltfPrimitive{ p.mode == TINYGLTF_MODE_POINTS, p.material,
                           primitive_attribute(p, "POSITION"), primitive_attribute(p, "_RADIUS"),
                           primitive_attribute(p, "COLOR_0"),
-                          p.extensions.count(draco_extension) > 0 };
+                          p.extensions.count(draco_extension) > 0, p.mode, p.indices };
 }
 
 extern "C" int gltf_doc_instance_attribute(const GltfDoc *doc, size_t node, const char *name)

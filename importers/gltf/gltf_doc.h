@@ -61,6 +61,8 @@ typedef struct GltfPrimitive {
     int material; /* -1 if none */
     int position, radius, color; /* POSITION, _RADIUS, COLOR_0; -1 if absent */
     int draco;    /* compressed by KHR_draco_mesh_compression: bounds only */
+    int mode;     /* glTF's: 0 POINTS ... 4 TRIANGLES, 5 strip, 6 fan */
+    int indices;  /* accessor, -1 if absent */
 } GltfPrimitive;
 
 typedef struct GltfNode {
@@ -79,7 +81,8 @@ typedef struct GltfNode {
 } GltfNode;
 
 /* A mesh's surface is what its primitives other than POINTS cover: a node
- * with the mesh makes one sphere of it. */
+ * with the mesh makes a sphere of each of its connected components that is
+ * one. */
 typedef struct GltfMesh {
     const char *name;
     int has_surface;   /* a primitive other than POINTS */
@@ -137,6 +140,7 @@ size_t gltf_doc_file_count(const GltfDoc *doc);
 const char *gltf_doc_file(const GltfDoc *doc, size_t index);
 
 size_t gltf_doc_node_count(const GltfDoc *doc);
+size_t gltf_doc_mesh_count(const GltfDoc *doc);
 size_t gltf_doc_material_count(const GltfDoc *doc);
 
 /* Index arguments must be below the matching count; every index the

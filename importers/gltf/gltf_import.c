@@ -11,6 +11,7 @@
 #include "builder.h"
 #include "gltf_doc.h"
 #include "importer_internal.h"
+#include "mesh_spheres.h"
 
 enum { MAX_RESOLUTION = 1 << 16 };
 
@@ -91,6 +92,16 @@ static PtrVec3 vec_from(const double v[3])
     return v3((float)v[0], (float)v[1], (float)v[2]);
 }
 
+/* A mesh's surface spheres (docs/scenes.md "Spheres"), found once however
+ * many nodes use the mesh. */
+typedef struct SurfaceSpheres {
+    int found;
+    size_t count;
+    double *spheres;  /* 4 a sphere: the centre and radius in the mesh's frame */
+    int *materials;   /* each one's glTF material, -1 if none */
+    size_t skipped;   /* the parts that are not spheres */
+} SurfaceSpheres;
+
 typedef struct Importer {
     const char *path;
     const GltfDoc *doc;
@@ -106,6 +117,10 @@ typedef struct Importer {
     uint32_t default_material;
     int warned_texture;
     const char *value_name; /* the attribute --color-by asks for, or NULL */
+    SurfaceSpheres *surfaces; /* one a mesh */
+    size_t skipped;           /* mesh parts not drawn, for the one warning */
+    char skipped_names[256];  /* where they are, as many as fit */
+    int skipped_more;         /* whether more did not fit */
 } Importer;
 
 static const char *label(const char *name, const char *fallback)
@@ -215,11 +230,10 @@ static const char *const sphere_fault_text =
 static const char *const transform_fault_text =
     "has a non-finite transform, a zero rotation or a scale that is not positive";
 
-/* The sphere of a node's mesh surface under world, where the node has a
- * radius or the mesh bounds (these sized by scale, world's largest axis
- * scale). */
-static void surface_sphere(const GltfNode *node, const GltfMesh *mesh, const Mat4 *world,
-                           double scale, double centre[3], double *radius)
+/* Surface sphere k of a node under world, where the node has a radius or
+ * the mesh's sphere k (sized by scale, world's largest axis scale). */
+static void surface_sphere(const GltfNode *node, const SurfaceSpheres *surface, size_t k,
+                           const Mat4 *world, double scale, double centre[3], double *radius)
 {
     if (node->has_radius) {
         const double origin[3] = { 0, 0, 0 };
@@ -227,13 +241,8 @@ static void surface_sphere(const GltfNode *node, const GltfMesh *mesh, const Mat
         *radius = node->radius;
         return;
     }
-    double local[3], extent = 0.0;
-    for (int k = 0; k < 3; k++) {
-        local[k] = 0.5 * (mesh->min[k] + mesh->max[k]);
-        extent = fmax(extent, mesh->max[k] - mesh->min[k]);
-    }
-    mat4_point(world, local, centre);
-    *radius = 0.5 * extent * scale;
+    mat4_point(world, &surface->spheres[4 * k], centre);
+    *radius = surface->spheres[4 * k + 3] * scale;
 }
 
 /* What kinds of stored numbers an attribute accepts. */
@@ -304,6 +313,264 @@ static void element(const GltfAccessor *a, size_t i, double out[4])
         }
         out[c] = gltf_component_value(a->component_type, a->normalized, raw);
     }
+}
+
+/* A surface primitive's part of its mesh's vertices and triangles. */
+typedef struct SurfacePart {
+    GltfAccessor pos, idx; /* idx read where has_idx says */
+    int has_idx, mode, material;
+    size_t first_vertex, first_triangle, triangles;
+} SurfacePart;
+
+typedef struct SurfaceParts {
+    SurfacePart *parts;
+    size_t count;
+} SurfaceParts;
+
+/* The part holding vertex or triangle `at` (by_triangle), parts in order. */
+static const SurfacePart *part_of(const SurfaceParts *s, size_t at, int by_triangle)
+{
+    size_t lo = 0, hi = s->count;
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        const SurfacePart *p = &s->parts[mid];
+        if ((by_triangle ? p->first_triangle : p->first_vertex) <= at)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return &s->parts[lo];
+}
+
+static size_t index_at(const GltfAccessor *a, size_t i)
+{
+    const unsigned char *p = a->data + i * a->stride;
+    uint32_t u32;
+    uint16_t u16;
+    switch (a->component_type) {
+    case GLTF_UNSIGNED_BYTE: return p[0];
+    case GLTF_UNSIGNED_SHORT: memcpy(&u16, p, 2); return u16;
+    default: memcpy(&u32, p, 4); return u32;
+    }
+}
+
+/* Vertex j of a part's triangle list, strip or fan (as its mode says). */
+static size_t part_vertex(const SurfacePart *p, size_t j)
+{
+    return p->first_vertex + (p->has_idx ? index_at(&p->idx, j) : j);
+}
+
+static void mesh_position(const void *user, size_t v, double out[3])
+{
+    const SurfacePart *p = part_of(user, v, 0);
+    if (p->pos.component_type == GLTF_FLOAT) { /* the common case, read at once */
+        float f[3];
+        memcpy(f, p->pos.data + (v - p->first_vertex) * p->pos.stride, sizeof f);
+        for (int k = 0; k < 3; k++)
+            out[k] = f[k];
+        return;
+    }
+    double e[4];
+    element(&p->pos, v - p->first_vertex, e);
+    memcpy(out, e, 3 * sizeof *out);
+}
+
+static void mesh_triangle(const void *user, size_t t, uint32_t out[3])
+{
+    const SurfacePart *p = part_of(user, t, 1);
+    const size_t j = t - p->first_triangle;
+    const size_t at[3] = { p->mode == 4 ? 3 * j : p->mode == 6 ? 0 : j,
+                           p->mode == 4 ? 3 * j + 1 : j + 1,
+                           p->mode == 4 ? 3 * j + 2 : j + 2 };
+    for (int i = 0; i < 3; i++)
+        out[i] = (uint32_t)part_vertex(p, at[i]);
+}
+
+/* The step of a position accessor's storage (mesh_spheres.h). */
+static double position_quantum(const GltfAccessor *a)
+{
+    if (a->component_type == GLTF_FLOAT)
+        return 0.0;
+    return a->normalized ? gltf_component_value(a->component_type, 1, 1.0) : 1.0;
+}
+
+/* Primitive p of mesh as a surface part, checked: its positions, its
+ * indices and that they are in range. Lines (and fewer than 3 corners) give
+ * no triangles: part->triangles 0. part->first_vertex holds its vertex
+ * count until find_surface places it. */
+static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t p,
+                              const GltfPrimitive *prim, SurfacePart *part)
+{
+    char where[160];
+    origin_text(o, where, sizeof where);
+    if (prim->position < 0)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: %s: mesh %zu primitive %zu has no POSITION", im->path, where,
+                             mesh, p);
+    size_t vertices = 0;
+    PtrResult res = attribute_accessor(im, o, "POSITION", prim->position, 3, 3, QUANTIZED,
+                                       &vertices, &part->pos);
+    if (res != PTR_OK)
+        return res;
+    part->mode = prim->mode;
+    part->material = prim->material;
+    part->has_idx = prim->indices >= 0;
+    size_t n = vertices;
+    if (part->has_idx) {
+        gltf_doc_accessor(im->doc, (size_t)prim->indices, &part->idx);
+        const GltfAccessor *a = &part->idx;
+        if (!a->data || a->sparse || a->components != 1 || a->normalized ||
+            !(a->component_type == GLTF_UNSIGNED_BYTE || a->component_type == GLTF_UNSIGNED_SHORT ||
+              a->component_type == GLTF_UNSIGNED_INT))
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: %s: mesh %zu primitive %zu has indices that are not "
+                                 "unsigned integers in a buffer", im->path, where, mesh, p);
+        n = a->count;
+        for (size_t i = 0; i < n; i++)
+            if (index_at(a, i) >= vertices)
+                return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                     "%s: %s: mesh %zu primitive %zu has index %zu past its "
+                                     "%zu vertices", im->path, where, mesh, p, index_at(a, i),
+                                     vertices);
+    }
+    part->triangles = prim->mode == 4 ? n / 3 : (prim->mode == 5 || prim->mode == 6) && n >= 3
+                                                    ? n - 2 : 0;
+    part->first_vertex = vertices;
+    return PTR_OK;
+}
+
+/* A mesh's spheres from its bounds alone: one, unchecked, where its
+ * vertices are not there to read: compressed by Draco, which ptr does not
+ * decode, or a POSITION accessor with bounds but no buffer view (files
+ * written by hand to place a sphere). */
+static PtrResult bounds_sphere(Importer *im, const Origin *o, size_t mesh_index,
+                               const GltfMesh *mesh, SurfaceSpheres *out)
+{
+    if (!mesh->has_bounds)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: node %zu ('%s'): mesh %zu has no POSITION min/max bounds",
+                             im->path, o->node_index, o->node_name, mesh_index);
+    double extent = 0.0;
+    for (int k = 0; k < 3; k++) {
+        out->spheres[k] = 0.5 * (mesh->min[k] + mesh->max[k]);
+        extent = fmax(extent, mesh->max[k] - mesh->min[k]);
+    }
+    out->spheres[3] = 0.5 * extent;
+    out->materials[0] = mesh->material;
+    out->count = 1;
+    return PTR_OK;
+}
+
+/* The components of a mesh's surface primitives, as o first meets them. */
+static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
+                              const GltfMesh *mesh, SurfaceSpheres *out)
+{
+    SurfaceParts s = { malloc((mesh->primitive_count ? mesh->primitive_count : 1) *
+                              sizeof *s.parts), 0 };
+    if (!s.parts)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    PtrResult res = PTR_OK;
+    size_t vertices = 0, triangles = 0, lines = 0;
+    for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, mesh_index, p, &prim);
+        if (prim.points)
+            continue;
+        SurfacePart *part = &s.parts[s.count];
+        res = surface_part(im, o, mesh_index, p, &prim, part);
+        if (res != PTR_OK || !part->triangles) {
+            lines += res == PTR_OK;
+            continue;
+        }
+        const size_t count = part->first_vertex;
+        part->first_vertex = vertices;
+        part->first_triangle = triangles;
+        vertices += count;
+        triangles += part->triangles;
+        s.count++;
+    }
+    if (res == PTR_OK && vertices >= UINT32_MAX)
+        res = ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                            "%s: mesh %zu has more vertices than ptr reads (%zu)", im->path,
+                            mesh_index, vertices);
+    PtrMeshSphere *found = NULL;
+    size_t components = 0;
+    const PtrMeshSource source = {
+        .vertex_count = vertices, .triangle_count = triangles, .position = mesh_position,
+        .triangle = mesh_triangle, .user = &s,
+    };
+    PtrMeshSource quantised = source;
+    for (size_t p = 0; p < s.count; p++)
+        quantised.quantum = fmax(quantised.quantum, position_quantum(&s.parts[p].pos));
+    if (res == PTR_OK)
+        res = ptr_mesh_spheres(&quantised, im->path, &found, &components, im->err);
+    if (res == PTR_OK) {
+        out->spheres = malloc((components ? components : 1) * 4 * sizeof *out->spheres);
+        out->materials = malloc((components ? components : 1) * sizeof *out->materials);
+        if (!out->spheres || !out->materials)
+            res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    }
+    out->skipped = lines;
+    for (size_t c = 0; res == PTR_OK && c < components; c++) {
+        if (!found[c].is_sphere) {
+            out->skipped++;
+            continue;
+        }
+        memcpy(&out->spheres[4 * out->count], found[c].centre, sizeof found[c].centre);
+        out->spheres[4 * out->count + 3] = found[c].radius;
+        out->materials[out->count++] = part_of(&s, found[c].first_triangle, 1)->material;
+    }
+    free(found);
+    free(s.parts);
+    return res;
+}
+
+/* The spheres of mesh_index's surface, found at the first node using it
+ * (o); the node's extras.radius aside, which needs none. */
+static PtrResult surface_spheres(Importer *im, const Origin *o, size_t mesh_index,
+                                 const SurfaceSpheres **out)
+{
+    SurfaceSpheres *s = &im->surfaces[mesh_index];
+    *out = s;
+    if (s->found)
+        return PTR_OK;
+    s->found = 1;
+    GltfMesh mesh;
+    gltf_doc_mesh(im->doc, mesh_index, &mesh);
+    if (!mesh.has_surface)
+        return PTR_OK;
+    int unread = 0;
+    for (size_t p = 0; p < mesh.primitive_count; p++) {
+        GltfPrimitive prim;
+        GltfAccessor a = { .data = NULL };
+        gltf_doc_primitive(im->doc, mesh_index, p, &prim);
+        if (!prim.points && prim.position >= 0)
+            gltf_doc_accessor(im->doc, (size_t)prim.position, &a);
+        unread |= !prim.points && (prim.draco || (prim.position >= 0 && !a.data));
+    }
+    if (!unread)
+        return find_surface(im, o, mesh_index, &mesh, s);
+    s->spheres = malloc(4 * sizeof *s->spheres);
+    s->materials = malloc(sizeof *s->materials);
+    if (!s->spheres || !s->materials)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    return bounds_sphere(im, o, mesh_index, &mesh, s);
+}
+
+/* Notes a node's mesh parts that are not spheres for the file's warning. */
+static void note_skipped(Importer *im, const Origin *o, const GltfMesh *mesh, size_t parts)
+{
+    if (!parts)
+        return;
+    im->skipped += parts;
+    char name[sizeof im->skipped_names];
+    const size_t used = strlen(im->skipped_names);
+    const int n = snprintf(name, sizeof name, "%snode '%s' (mesh '%s')", used ? ", " : "",
+                           o->node_name, label(mesh->name, "unnamed"));
+    if (n < 0 || used + (size_t)n >= sizeof im->skipped_names)
+        im->skipped_more = 1;
+    else
+        memcpy(im->skipped_names + used, name, (size_t)n + 1);
 }
 
 /* Checks the accessor of the attribute --color-by names (index from
@@ -390,11 +657,13 @@ typedef struct NodeRun {
     PtrSceneBuilder *builder;
     const GltfNode *node;
     const GltfMesh *mesh;
+    const SurfaceSpheres *surface;
+    size_t surface_count;        /* surface spheres an instance */
+    uint32_t *surface_materials; /* theirs */
     const Mat4 *world;
     int instanced;
     GltfAccessor t, r, s, c, v; /* the instances' attributes, read where has_ says */
     int has_t, has_r, has_s, has_c, has_v;
-    uint32_t surface_material;
     PointSet *sets;
     size_t set_count;
     int scaled; /* whether any sphere takes world's largest axis scale */
@@ -441,7 +710,7 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
  * to, and in *point which of its points it is. */
 static size_t set_of(const NodeRun *run, size_t k, size_t *point)
 {
-    size_t set = 0, j = k - (size_t)run->mesh->has_surface;
+    size_t set = 0, j = k - run->surface_count;
     while (set < run->set_count && j >= run->sets[set].count)
         j -= run->sets[set++].count;
     *point = j;
@@ -482,17 +751,16 @@ static Fault instance_spheres(const NodeRun *run, size_t i, const Instance *in, 
                               size_t end, size_t *at)
 {
     size_t n = run->first + i * run->per_instance + k;
-    if (k == 0 && run->mesh->has_surface) {
+    for (; k < end && k < run->surface_count; k++, n++) {
         double centre[3], radius;
-        surface_sphere(run->node, run->mesh, &in->world, in->scale, centre, &radius);
-        *at = 0;
+        surface_sphere(run->node, run->surface, k, &in->world, in->scale, centre, &radius);
+        *at = k;
         if (sphere_fault(centre, radius))
             return SPHERE_FAULT;
-        ptr_builder_fill_sphere(run->builder, n, centre, radius, run->surface_material,
+        ptr_builder_fill_sphere(run->builder, n, centre, radius, run->surface_materials[k],
                                 in->has_color ? in->color : NULL);
         if (in->has_value)
             ptr_builder_fill_value(run->builder, n, in->value);
-        k++, n++;
     }
     if (k >= end)
         return NO_FAULT;
@@ -558,7 +826,7 @@ static void release_slots(const Importer *im, const NodeRun *run, size_t begin, 
                 gltf_doc_release(im->doc, read[a], begin / run->slots, end / run->slots);
         return;
     }
-    size_t from = (size_t)run->mesh->has_surface; /* the slot of the set's point 0 */
+    size_t from = run->surface_count; /* the slot of the set's point 0 */
     for (size_t set = 0; set < run->set_count; from += run->sets[set++].count) {
         const PointSet *ps = &run->sets[set];
         if (end <= from || begin >= from + ps->count)
@@ -598,7 +866,7 @@ static PtrResult slot_error(Importer *im, const NodeRun *run, const Origin *inst
         return value_error(im, &o);
     size_t at = k;
     fault = instance_spheres(run, i, &in, k, k + 1, &at);
-    if (at == 0 && run->mesh->has_surface)
+    if (at < run->surface_count)
         return part_error(im, &o, sphere_fault_text);
     o.part = "point";
     set_of(run, at, &o.part_index);
@@ -692,15 +960,11 @@ static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Ins
     const GltfNode *node = run->node;
     const GltfMesh *mesh = run->mesh;
     PtrResult res = PTR_OK;
-    if (mesh->has_surface) {
-        if (!node->has_radius && !mesh->has_bounds)
-            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                 "%s: node %zu ('%s'): mesh %d has no POSITION min/max bounds",
-                                 im->path, o->node_index, o->node_name, node->mesh);
-        if (!node->has_radius && first->uneven)
-            warn_nonuniform(im, o, warned);
-        res = map_material(im, mesh->material, &run->surface_material);
-    }
+    if (run->surface_count && !node->has_radius && first->uneven)
+        warn_nonuniform(im, o, warned);
+    for (size_t k = 0; k < run->surface_count && res == PTR_OK; k++)
+        res = map_material(im, node->has_radius ? mesh->material : run->surface->materials[k],
+                           &run->surface_materials[k]);
     for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
@@ -720,9 +984,9 @@ static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Ins
  * any of them has one. */
 static PtrResult start_run(Importer *im, NodeRun *run)
 {
-    const int surface = run->mesh->has_surface;
+    const int surface = run->surface_count > 0;
     int colored_all = run->has_c || !surface, colored_any = run->has_c, valued = run->has_v;
-    run->per_instance = (size_t)surface;
+    run->per_instance = run->surface_count;
     for (size_t set = 0; set < run->set_count; set++) {
         const PointSet *ps = &run->sets[set];
         run->per_instance += ps->count;
@@ -774,10 +1038,19 @@ static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNod
                     .instanced = node->instanced, .instances = 1, .slots = 1 };
     atomic_init(&run.failed, SIZE_MAX);
     atomic_init(&run.nonuniform, 0);
+    PtrResult res = surface_spheres(im, &o, (size_t)node->mesh, &run.surface);
+    if (res != PTR_OK)
+        return res;
+    run.surface_count = node->has_radius ? (size_t)mesh.has_surface : run.surface->count;
     run.sets = malloc((mesh.point_primitives ? mesh.point_primitives : 1) * sizeof *run.sets);
-    if (!run.sets)
-        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    PtrResult res = node->instanced ? instance_attributes(im, &o, &run) : PTR_OK;
+    run.surface_materials = malloc((run.surface_count ? run.surface_count : 1) *
+                                   sizeof *run.surface_materials);
+    if (!run.sets || !run.surface_materials)
+        res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    if (res == PTR_OK && node->instanced)
+        res = instance_attributes(im, &o, &run);
+    if (res == PTR_OK && !node->has_radius)
+        note_skipped(im, &o, &mesh, run.surface->skipped * run.instances);
     Instance first;
     int warned = 0;
     if (res == PTR_OK && instance_at(&run, 0, &first) != NO_FAULT)
@@ -795,6 +1068,7 @@ static PtrResult add_node_spheres(Importer *im, size_t node_index, const GltfNod
             warn_nonuniform(im, &o, &warned);
     }
     free(run.sets);
+    free(run.surface_materials);
     return res;
 }
 
@@ -898,13 +1172,20 @@ static uint64_t mul_saturating(uint64_t a, uint64_t b)
     return b && a > UINT64_MAX / b ? UINT64_MAX : a * b;
 }
 
-/* The spheres of a node: its surface's and its points', once per instance,
- * from the accessors' counts alone. */
-static uint64_t node_sphere_count(const Importer *im, const GltfNode *node)
+/* The spheres of a node (o): its surface's and its points', once per
+ * instance, from the surface's components and the accessors' counts. */
+static PtrResult node_sphere_count(Importer *im, const Origin *o, const GltfNode *node,
+                                   uint64_t *out)
 {
     GltfMesh mesh;
     gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
-    uint64_t spheres = mesh.has_surface ? 1 : 0;
+    const SurfaceSpheres *surface = NULL;
+    if (!node->has_radius) {
+        PtrResult res = surface_spheres(im, o, (size_t)node->mesh, &surface);
+        if (res != PTR_OK)
+            return res;
+    }
+    uint64_t spheres = surface ? surface->count : (uint64_t)mesh.has_surface;
     for (size_t p = 0; p < mesh.primitive_count; p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
@@ -918,11 +1199,13 @@ static uint64_t node_sphere_count(const Importer *im, const GltfNode *node)
     const int per_instance = in->translation >= 0 ? in->translation
                            : in->rotation >= 0    ? in->rotation
                                                   : in->scale;
+    *out = spheres;
     if (!node->instanced || per_instance < 0)
-        return spheres;
+        return PTR_OK;
     GltfAccessor a;
     gltf_doc_accessor(im->doc, (size_t)per_instance, &a);
-    return mul_saturating(spheres, a.count);
+    *out = mul_saturating(spheres, a.count);
+    return PTR_OK;
 }
 
 /* What walk_nodes does at each node, under its world transform. */
@@ -936,11 +1219,14 @@ typedef PtrResult (*NodeVisit)(Importer *im, size_t index, const GltfNode *node,
 static PtrResult count_spheres(Importer *im, size_t index, const GltfNode *node,
                                const Mat4 *world, void *user)
 {
-    (void)index, (void)world;
-    uint64_t *spheres = user;
-    if (node->mesh >= 0)
-        *spheres = add_saturating(*spheres, node_sphere_count(im, node));
-    return PTR_OK;
+    (void)world;
+    uint64_t *spheres = user, count = 0;
+    if (node->mesh < 0)
+        return PTR_OK;
+    const Origin o = { index, label(node->name, "unnamed"), NULL, 0 };
+    PtrResult res = node_sphere_count(im, &o, node, &count);
+    *spheres = add_saturating(*spheres, count);
+    return res;
 }
 
 /* The node's spheres and camera into the scene. */
@@ -1065,11 +1351,12 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .value_name = options ? options->value_attribute : NULL,
     };
     ptr_builder_init(&im.builder, scene, options);
-    size_t materials = gltf_doc_material_count(doc);
+    size_t materials = gltf_doc_material_count(doc), meshes = gltf_doc_mesh_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
+    im.surfaces = calloc(meshes ? meshes : 1, sizeof *im.surfaces);
     PtrResult res = PTR_OK;
     GltfScene gs;
-    if (!im.material_index) {
+    if (!im.material_index || !im.surfaces) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     } else if (!gltf_doc_scene(doc, &gs)) {
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file has no scene", path);
@@ -1101,11 +1388,21 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     }
     if (res == PTR_OK)
         check_far_plane(&im);
+    if (res == PTR_OK && im.skipped)
+        ptr_warn(warnings, "%s: %zu mesh part%s not drawn: %s not a sphere (docs/scenes.md, "
+                 "\"Spheres\"): %s%s", path, im.skipped, im.skipped == 1 ? "" : "s",
+                 im.skipped == 1 ? "it is" : "they are", im.skipped_names,
+                 im.skipped_more ? ", ..." : "");
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
     /* The file's buffers go before the scene's arrays are filled. */
     gltf_doc_free(doc);
     free(im.material_index);
+    for (size_t m = 0; im.surfaces && m < meshes; m++) {
+        free(im.surfaces[m].spheres);
+        free(im.surfaces[m].materials);
+    }
+    free(im.surfaces);
     if (res == PTR_OK)
         res = ptr_import_finish(&im.builder, path, err);
     ptr_builder_free(&im.builder);

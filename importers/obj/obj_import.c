@@ -17,6 +17,7 @@
 
 #include "builder.h"
 #include "importer_internal.h"
+#include "mesh_spheres.h"
 
 enum { MAX_LINE = 64 << 20 }; /* longer lines are not OBJ */
 
@@ -26,6 +27,8 @@ typedef struct Part { /* an object (o) or a group (g) */
     double lo[3], hi[3];
     size_t faces;
     char *material;   /* usemtl in force at its first face */
+    uint32_t *tris;   /* its faces as triangles (fans), 3 vertex indices each */
+    size_t ntris, tris_capacity;
 } Part;
 
 typedef struct Parts {
@@ -57,6 +60,8 @@ typedef struct Reader {
     Mtl *mtls;
     size_t nmtls;
     int missing_lib;  /* an mtllib could not be read (and was reported) */
+    uint32_t *corners; /* the face being read */
+    size_t corners_capacity;
 } Reader;
 
 static char *copy(const char *s)
@@ -167,9 +172,24 @@ static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int
     return PTR_OK;
 }
 
+/* The face just read (n corners) into the current part as a fan of
+ * triangles. */
+static PtrResult add_triangles(Reader *r, Parts *parts, size_t n)
+{
+    Part *part = &parts->items[parts->current];
+    if (grow((void **)&part->tris, &part->tris_capacity, 3 * (part->ntris + n - 2),
+             sizeof *part->tris))
+        return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+    for (size_t c = 1; c + 1 < n; c++) {
+        uint32_t *t = &part->tris[3 * part->ntris++];
+        t[0] = r->corners[0], t[1] = r->corners[c], t[2] = r->corners[c + 1];
+    }
+    return PTR_OK;
+}
+
 static PtrResult face(Reader *r, char *s, long line)
 {
-    int corners = 0;
+    size_t corners = 0;
     char *save;
     for (char *tok = strtok_r(s, " \t\r\n", &save); tok; tok = strtok_r(NULL, " \t\r\n", &save)) {
         char *end;
@@ -184,15 +204,26 @@ static PtrResult face(Reader *r, char *s, long line)
             return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
                                  "%s:%ld: vertex %ld does not exist (%zu defined so far)", r->path,
                                  line, i, r->nv);
+        if ((size_t)index >= UINT32_MAX)
+            return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
+                                 "%s:%ld: vertex %ld is past the vertices ptr reads", r->path,
+                                 line, i);
         const double *p = &r->v[3 * index];
         if (add_to(r, &r->objects, p, line, corners == 0) != PTR_OK ||
             add_to(r, &r->groups, p, line, corners == 0) != PTR_OK)
             return r->err->code;
-        corners++;
+        if (grow((void **)&r->corners, &r->corners_capacity, corners + 1, sizeof *r->corners))
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        r->corners[corners++] = (uint32_t)index;
     }
     if (corners == 0)
         return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s:%ld: a face with no vertices",
                              r->path, line);
+    if (corners < 3) /* a point or a line: no surface */
+        return PTR_OK;
+    if (add_triangles(r, &r->objects, corners) != PTR_OK ||
+        add_triangles(r, &r->groups, corners) != PTR_OK)
+        return r->err->code;
     return PTR_OK;
 }
 
@@ -392,6 +423,68 @@ static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint
     return PTR_OK;
 }
 
+/* A part's triangles over its own vertices: local vertex k is the file's
+ * vertex global[k]. */
+typedef struct PartMesh {
+    const double *v;
+    const uint32_t *global;
+    const uint32_t *tris;
+} PartMesh;
+
+static void part_position(const void *user, size_t k, double out[3])
+{
+    const PartMesh *m = user;
+    memcpy(out, &m->v[3 * (size_t)m->global[k]], 3 * sizeof *out);
+}
+
+static void part_triangle(const void *user, size_t t, uint32_t out[3])
+{
+    const PartMesh *m = user;
+    memcpy(out, &m->tris[3 * t], 3 * sizeof *out);
+}
+
+/* The spheres of part p (docs/scenes.md): its components, checked; local_of
+ * (one a vertex of the file, UNSET) is left as it was found. Adds the
+ * components that are not spheres to *skipped. */
+static PtrResult part_spheres(Reader *r, const Part *p, uint32_t *local_of,
+                              PtrSceneBuilder *builder, uint32_t material, size_t *skipped)
+{
+    const size_t corners = 3 * p->ntris;
+    uint32_t *global = malloc((corners ? corners : 1) * sizeof *global);
+    uint32_t *tris = malloc((corners ? corners : 1) * sizeof *tris);
+    size_t n = 0, count = 0;
+    PtrMeshSphere *spheres = NULL;
+    PtrResult res = global && tris ? PTR_OK
+                                   : ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory",
+                                                   r->path);
+    for (size_t i = 0; res == PTR_OK && i < corners; i++) {
+        if (local_of[p->tris[i]] == UINT32_MAX) {
+            local_of[p->tris[i]] = (uint32_t)n;
+            global[n++] = p->tris[i];
+        }
+        tris[i] = local_of[p->tris[i]];
+    }
+    for (size_t k = 0; global && k < n; k++)
+        local_of[global[k]] = UINT32_MAX;
+    const PartMesh mesh = { r->v, global, tris };
+    const PtrMeshSource source = { .vertex_count = n, .triangle_count = p->ntris,
+                                   .position = part_position, .triangle = part_triangle,
+                                   .user = &mesh };
+    if (res == PTR_OK)
+        res = ptr_mesh_spheres(&source, r->path, &spheres, &count, r->err);
+    for (size_t c = 0; res == PTR_OK && c < count; c++) {
+        if (!spheres[c].is_sphere)
+            ++*skipped;
+        else if (ptr_builder_add_sphere(builder, spheres[c].centre, spheres[c].radius, material,
+                                        NULL))
+            res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+    }
+    free(spheres);
+    free(global);
+    free(tris);
+    return res;
+}
+
 static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *scene)
 {
     /* Objects; in a file without any o, groups. */
@@ -400,14 +493,22 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
     PtrSceneBuilder builder;
     ptr_builder_init(&builder, scene, options);
     uint32_t grey = UINT32_MAX;
-    size_t fitted = 0;
-    PtrResult res = PTR_OK;
+    size_t fitted = 0, skipped = 0, named = 0;
+    char names[256] = "";
+    int more = 0; /* names that did not fit */
+    const int fit_all = options && options->fit_all_objects;
+    uint32_t *local_of = fit_all ? NULL : malloc((r->nv ? r->nv : 1) * sizeof *local_of);
+    PtrResult res = fit_all || local_of ? PTR_OK
+                                        : ptr_error_set(r->err, PTR_ERR_NOMEM,
+                                                        "%s: out of memory", r->path);
+    if (local_of)
+        memset(local_of, 0xff, (r->nv ? r->nv : 1) * sizeof *local_of);
     for (size_t i = 0; res == PTR_OK && i < parts->count; i++) {
         const Part *p = &parts->items[i];
         const char *name = p->name ? p->name : base;
         if (!p->faces)
             continue;
-        if (!contains_sphere(name) && !(options && options->fit_all_objects)) {
+        if (!contains_sphere(name) && !fit_all) {
             ptr_warn(r->warnings, "%s:%ld: object '%s' is skipped: its name lacks 'sphere' "
                                   "(--fit-all-objects fits every object)", r->path, p->line, name);
             continue;
@@ -425,10 +526,30 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
         }
         uint32_t material;
         res = material_for(r, p->material, scene, &material, &grey);
-        if (res == PTR_OK && ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material, NULL))
+        const size_t before = skipped;
+        if (res == PTR_OK && !fit_all)
+            res = part_spheres(r, p, local_of, &builder, material, &skipped);
+        else if (res == PTR_OK &&
+                 ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        if (skipped > before) {
+            const size_t used = strlen(names);
+            char one[sizeof names];
+            const int n = snprintf(one, sizeof one, "%sobject '%s' (line %ld)", used ? ", " : "",
+                                   name, p->line);
+            if (n < 0 || used + (size_t)n >= sizeof names)
+                more = 1;
+            else
+                memcpy(names + used, one, (size_t)n + 1);
+            named++;
+        }
         fitted++;
     }
+    free(local_of);
+    if (res == PTR_OK && skipped)
+        ptr_warn(r->warnings, "%s: %zu mesh part%s not drawn: %s not a sphere (docs/scenes.md, "
+                 "\"Spheres\"): %s%s", r->path, skipped, skipped == 1 ? "" : "s",
+                 skipped == 1 ? "it is" : "they are", names, more ? ", ..." : "");
     if (res == PTR_OK && fitted == 0 && r->nv == 0)
         res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: no vertices: not an OBJ file?",
                             r->path);
@@ -443,6 +564,7 @@ static void free_parts(Parts *parts)
     for (size_t i = 0; i < parts->count; i++) {
         free(parts->items[i].name);
         free(parts->items[i].material);
+        free(parts->items[i].tris);
     }
     free(parts->items);
 }
@@ -464,6 +586,7 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options, PtrS
     free_parts(&r.objects);
     free_parts(&r.groups);
     free(r.material);
+    free(r.corners);
     for (size_t i = 0; i < r.nlibs; i++)
         free(r.libs[i]);
     free(r.libs);

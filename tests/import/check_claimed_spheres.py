@@ -12,6 +12,7 @@ import json, os, resource, struct, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from glb import write_glb  # noqa: E402
+from mesh_files import sphere_bytes  # noqa: E402
 
 ptr = sys.argv[1]
 INSTANCES = 100_000
@@ -20,18 +21,22 @@ INSTANCES = 100_000
 def write_claim(path, nodes):
     translations = b"".join(struct.pack("<3f", (i % 100) * 0.1, (i // 100 % 100) * 0.1,
                                         (i // 10000) * 0.1) for i in range(INSTANCES))
-    box = struct.pack("<9f", -0.01, -0.01, -0.01, 0.01, 0.01, 0.01, 0.01, -0.01, 0.01)
-    binary = translations + box
+    sphere, indices, vertices, index_count = sphere_bytes(0.01)
+    binary = translations + sphere + indices
     doc = {
         "asset": {"version": "2.0"},
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
         "buffers": [{"byteLength": len(binary)}],
         "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(translations)},
-                        {"buffer": 0, "byteOffset": len(translations), "byteLength": len(box)}],
+                        {"buffer": 0, "byteOffset": len(translations), "byteLength": len(sphere)},
+                        {"buffer": 0, "byteOffset": len(translations) + len(sphere),
+                         "byteLength": len(indices)}],
         "accessors": [{"bufferView": 0, "componentType": 5126, "count": INSTANCES, "type": "VEC3"},
-                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3",
-                       "min": [-0.01, -0.01, -0.01], "max": [0.01, 0.01, 0.01]}],
-        "meshes": [{"name": "sphere", "primitives": [{"attributes": {"POSITION": 1}}]}],
+                      {"bufferView": 1, "componentType": 5126, "count": vertices, "type": "VEC3",
+                       "min": [-0.01, -0.01, -0.01], "max": [0.01, 0.01, 0.01]},
+                      {"bufferView": 2, "componentType": 5123, "count": index_count,
+                       "type": "SCALAR"}],
+        "meshes": [{"name": "sphere", "primitives": [{"attributes": {"POSITION": 1}, "indices": 2}]}],
         "nodes": [{"mesh": 0, "translation": [0, 0, -20 - n * 0.001],
                    "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 0}}}}
                   for n in range(nodes)],

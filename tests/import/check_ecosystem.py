@@ -5,9 +5,11 @@ as the scenes they were made from, and render.
 
 - three_instanced.glb (three.js GLTFExporter, an InstancedMesh) against
   three_instanced.json, the centres, radii and colours the script used.
-- instance, quantize, meshopt, draco, optimize, instance_meshopt and gltfpack
-  (.glb) against nodes.glb, the node-per-sphere scene they were made from
-  (which itself must match nodes.json exactly).
+- instance, quantize, meshopt, draco, optimize, instance_meshopt, gltfpack,
+  join and join_meshopt (.glb) against nodes.glb, the node-per-sphere scene
+  they were made from (which itself must match nodes.json exactly): join
+  merges the 60 spheres into one mesh of 4 primitives, one a material, and
+  ptr finds each sphere again as a connected component.
   Compared: the number of spheres; each reference sphere is paired with the
   nearest one imported (instancing reorders them); centre components and
   radius within TOL(r) = 2 * r / (2^14 - 1) + 1e-6 * SIZE: 14 bits is the
@@ -15,6 +17,9 @@ as the scenes they were made from, and render.
   and gltfpack, over the mesh's bounds (the sphere's diameter 2r in world
   units), so a bound, the centre and the radius each move by at most one step
   2r / (2^14 - 1); SIZE (the largest centre coordinate) covers float rounding.
+  join_meshopt is quantised over the joined mesh's bounds, the whole scene:
+  its step is SPAN / (2^14 - 1), SPAN the largest extent of the spheres'
+  bounds.
   Files without quantisation (three_instanced, instance) get 1e-6 * SIZE only.
   Materials: the same kind, fuzz and ior within 1e-6, and the colour (the
   material's albedo times the sphere's own colour, where it has one) within
@@ -38,8 +43,10 @@ import tempfile
 ptr, folder = sys.argv[1], sys.argv[2]
 POSITION_BITS = 14
 GLTF_TRANSFORM = ["instance", "quantize", "meshopt", "draco", "optimize", "instance_meshopt",
-                  "gltfpack"]
+                  "gltfpack", "join", "join_meshopt"]
+# Quantised over each sphere's mesh, or over one mesh holding them all.
 QUANTISED = {"quantize", "meshopt", "draco", "optimize", "instance_meshopt", "gltfpack"}
+QUANTISED_JOINED = {"join_meshopt"}
 
 
 class Failure(Exception):
@@ -74,18 +81,22 @@ def flatten(scene):
     return out
 
 
-def compare(got, want, quantised):
-    """Problems of `got` against `want` (lists from flatten), at most a few."""
+def compare(got, want, quantised, joined=False):
+    """Problems of `got` against `want` (lists from flatten), at most a few;
+    quantised over each sphere's bounds, or (joined) over all of them."""
     if len(got) != len(want):
         return [f"{len(got)} spheres, not {len(want)}"]
     size = max(abs(x) for s in want for x in s["center"])
+    span = max(max(s["center"][k] + s["radius"] for s in want) -
+               min(s["center"][k] - s["radius"] for s in want) for k in range(3))
     problems, free = [], list(range(len(got)))
     for i, w in enumerate(want):
         j = min(free, key=lambda k: sum((a - b) ** 2 for a, b in zip(got[k]["center"],
                                                                      w["center"])))
         free.remove(j)
         g = got[j]
-        tol = 1e-6 * size + (2 * w["radius"] / (2 ** POSITION_BITS - 1) if quantised else 0)
+        extent = span if joined else 2 * w["radius"]
+        tol = 1e-6 * size + (extent / (2 ** POSITION_BITS - 1) if quantised else 0)
         err = max(abs(a - b) for a, b in zip(g["center"], w["center"]))
         if err > tol:
             problems.append(f"sphere {i}: centre {g['center']}, not {w['center']} "
@@ -168,7 +179,9 @@ def main():
             if nodes is None:
                 results[name] = ["nodes.glb, the reference, did not import"]
                 continue
-            check(name, lambda: compare(flatten(dump(name)), nodes, stem in QUANTISED))
+            check(name, lambda: compare(flatten(dump(name)), nodes,
+                                        stem in QUANTISED | QUANTISED_JOINED,
+                                        stem in QUANTISED_JOINED))
         check("ortho.gltf", lambda: check_ortho(dump("ortho.gltf")))
 
     failed = 0

@@ -11,6 +11,7 @@ import json, os, struct, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from glb import write_glb  # noqa: E402
+from mesh_files import sphere_bytes  # noqa: E402
 
 ptr = sys.argv[1]
 INSTANCES = 1000
@@ -22,19 +23,23 @@ def scene(unread):
     """The glTF JSON and its buffer: unread zero bytes, then the data."""
     translations = b"".join(struct.pack("<3f", (i % 10) * 0.3, (i // 10 % 10) * 0.3,
                                         (i // 100) * 0.3) for i in range(INSTANCES))
-    box = struct.pack("<9f", -0.1, -0.1, -0.1, 0.1, 0.1, 0.1, 0.1, -0.1, 0.1)
-    binary = bytes(unread) + translations + box
+    sphere, indices, vertices, index_count = sphere_bytes(0.1)
+    binary = bytes(unread) + translations + sphere + indices
     doc = {
         "asset": {"version": "2.0"},
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
         "buffers": [{"byteLength": len(binary)}],
         "bufferViews": [{"buffer": 0, "byteOffset": unread, "byteLength": len(translations)},
                         {"buffer": 0, "byteOffset": unread + len(translations),
-                         "byteLength": len(box)}],
+                         "byteLength": len(sphere)},
+                        {"buffer": 0, "byteOffset": unread + len(translations) + len(sphere),
+                         "byteLength": len(indices)}],
         "accessors": [{"bufferView": 0, "componentType": 5126, "count": INSTANCES, "type": "VEC3"},
-                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3",
-                       "min": [-0.1, -0.1, -0.1], "max": [0.1, 0.1, 0.1]}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}],
+                      {"bufferView": 1, "componentType": 5126, "count": vertices, "type": "VEC3",
+                       "min": [-0.1, -0.1, -0.1], "max": [0.1, 0.1, 0.1]},
+                      {"bufferView": 2, "componentType": 5123, "count": index_count,
+                       "type": "SCALAR"}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}, "indices": 2}]}],
         "nodes": [{"mesh": 0, "translation": [-1.5, -1.5, -8],
                    "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 0}}}}],
         "scenes": [{"nodes": [0]}],

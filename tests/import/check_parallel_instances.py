@@ -11,6 +11,7 @@ import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from glb import write_glb  # noqa: E402
+from mesh_files import sphere_bytes  # noqa: E402
 from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
 
 ptr = sys.argv[1]
@@ -37,9 +38,9 @@ def write_cloud(path, nodes, broken):
     t, r, s, c = instances(broken)
     blocks = [b"".join(struct.pack("<3f", *v) for v in t), b"".join(struct.pack("<4f", *v) for v in r),
               b"".join(struct.pack("<3f", *v) for v in s), b"".join(struct.pack("<3f", *v) for v in c)]
-    box = struct.pack("<9f", -0.05, -0.05, -0.05, 0.05, 0.05, 0.05, 0.05, -0.05, 0.05)
+    sphere, indices, vertices, index_count = sphere_bytes(0.05)
     binary, views = b"", []
-    for block in blocks + [box]:
+    for block in blocks + [sphere, indices]:
         views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
         binary += block
     per = COUNT // nodes
@@ -52,8 +53,10 @@ def write_cloud(path, nodes, broken):
         node_list.append({"mesh": 0, "name": "cloud", "extensions": {"EXT_mesh_gpu_instancing": {
             "attributes": {"TRANSLATION": first, "ROTATION": first + 1, "SCALE": first + 2,
                            "_COLOR_0": first + 3}}}})
-    accessors.append({"bufferView": 4, "componentType": 5126, "count": 3, "type": "VEC3",
+    accessors.append({"bufferView": 4, "componentType": 5126, "count": vertices, "type": "VEC3",
                       "min": [-0.05, -0.05, -0.05], "max": [0.05, 0.05, 0.05]})
+    accessors.append({"bufferView": 5, "componentType": 5123, "count": index_count,
+                      "type": "SCALAR"})
     doc = {
         "asset": {"version": "2.0"},
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
@@ -61,7 +64,8 @@ def write_cloud(path, nodes, broken):
         "bufferViews": views,
         "accessors": accessors,
         "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 1}, "material": 0}]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                    "indices": len(accessors) - 1, "material": 0}]}],
         "nodes": node_list + [{"camera": 0, "translation": [0, 3, 10]}],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
         "scenes": [{"nodes": list(range(nodes + 1))}],

@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""A mesh gives one sphere per connected component that is a sphere
+(docs/scenes.md, "Spheres"), and what is not one is skipped with one warning
+that counts and names it, never drawn as its bounding sphere.
+
+Files from tests/support/mesh_files.py, each imported with --dump-scene:
+- joined: spheres in one primitive (welded, one turned so its bounds are not
+  its sphere's), and two more in a second primitive of another material;
+- unwelded: every triangle its own vertices (components by position);
+- quantised: normalised 16-bit and plain 8-bit positions, scaled back by the
+  node, within the tolerance;
+- cube, torus, plane, cylinder, each alone: no sphere, the warning;
+- mixed: spheres, a cube and a torus joined, with a degenerate triangle of
+  its own: the spheres, and one warning counting 3 parts and naming the node;
+- a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
+  ", ..." to fit the line;
+- OBJ: an object of two joined spheres and a cube named like a sphere: the
+  two spheres and the warning; with --fit-all-objects one sphere an object,
+  unchecked, no warning.
+Usage: check_mesh_spheres.py PTR"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../support"))
+import mesh_files as mf  # noqa: E402
+
+ptr = sys.argv[1]
+WARNING = "mesh part"
+failures = []
+
+
+def dump(path):
+    run = subprocess.run([ptr, "--dump-scene", path], capture_output=True, text=True, timeout=60)
+    if run.returncode != 0:
+        failures.append(f"{os.path.basename(path)}: exit {run.returncode}: {run.stderr.strip()}")
+        return None, run.stderr
+    return json.loads(run.stdout), run.stderr
+
+
+def expect(path, spheres, skipped, names=(), tol=1e-5):
+    """spheres: (centre, radius, material index, -1 for the default grey) in
+    the file's order."""
+    name = os.path.basename(path)
+    scene, stderr = dump(path)
+    if scene is None:
+        return
+    got = [(s["center"], s["radius"], scene["materials"][s["material"]]["albedo"][0])
+           for s in scene["spheres"]]
+    if len(got) != len(spheres):
+        failures.append(f"{name}: {len(got)} spheres, not {len(spheres)}: {got}")
+    for (gc, gr, ga), (wc, wr, wm) in zip(got, spheres):
+        off = max(abs(a - b) for a, b in zip(gc, wc))
+        if off > tol * wr or abs(gr - wr) > tol * wr:
+            failures.append(f"{name}: sphere {gc} r {gr}, not {wc} r {wr}")
+        if abs(ga - (0.8 if wm < 0 else 0.25 * (wm + 1))) > 1e-6:
+            failures.append(f"{name}: sphere at {wc} has material albedo {ga}, not material {wm}'s")
+    lines = [line for line in stderr.splitlines() if WARNING in line]
+    if not skipped:
+        if lines:
+            failures.append(f"{name}: unexpected warning {lines}")
+        return
+    if len(lines) != 1:
+        failures.append(f"{name}: {len(lines)} warnings about skipped parts, not 1: {stderr}")
+        return
+    counted = f"{skipped} {WARNING}{'s' if skipped > 1 else ''} not drawn"
+    if counted not in lines[0]:
+        failures.append(f"{name}: warning does not say '{counted}': {lines[0]}")
+    for n in names:
+        if n not in lines[0]:
+            failures.append(f"{name}: warning does not name {n}: {lines[0]}")
+
+
+def single(folder, name, shape, skipped=1):
+    w = mf.Writer()
+    w.node(name, w.mesh(name + "_mesh", [(shape, 0)]))
+    path = os.path.join(folder, name + ".glb")
+    w.write(path)
+    expect(path, [], skipped, [f"node '{name}' (mesh '{name}_mesh')"])
+
+
+def main():
+    with tempfile.TemporaryDirectory() as folder:
+        # Joined, over two primitives of materials 1 and 2.
+        first = [((0, 0, 0), 1.0, 0.0), ((3, 0, 0), 0.5, 0.4), ((0, 4, 1), 2.0, 0.0)]
+        second = [((-5, 1, 0), 0.25, 0.0), ((-5, 3, 0), 0.75, 0.0)]
+        w = mf.Writer()
+        w.node("joined", w.mesh("joined", [
+            (mf.combine(*[mf.uv_sphere(c, r, turn=t) for c, r, t in first]), 1),
+            (mf.combine(*[mf.uv_sphere(c, r, 16, 8) for c, r, _ in second]), 2)]))
+        path = os.path.join(folder, "joined.glb")
+        w.write(path)
+        # The turned sphere's fit is its bounds': centre and radius within 10%.
+        want = [(c, r, 1) for c, r, _ in first] + [(c, r, 2) for c, r, _ in second]
+        expect(path, want, 0, tol=0.1)
+
+        # Unwelded: the triangles share positions, not indices.
+        w = mf.Writer()
+        w.node("flat", w.mesh("flat", [(mf.unweld(mf.combine(
+            mf.uv_sphere((1, 2, 3), 1.5), mf.uv_sphere((6, 2, 3), 0.5))), 0)]))
+        path = os.path.join(folder, "unwelded.glb")
+        w.write(path)
+        expect(path, [((1, 2, 3), 1.5, 0), ((6, 2, 3), 0.5, 0)], 0)
+
+        # Quantised: 16-bit normalised over [0, 1], and 8-bit integers; the
+        # node's scale and translation map them back to (10, 0, 0) radius 2.
+        for kind, top in (("short", 1.0), ("byte", 255.0)):
+            w = mf.Writer()
+            sphere = mf.uv_sphere((top / 2,) * 3, top / 2, 32, 16)
+            w.node("q", w.mesh("q", [(sphere, 0)], quantise=kind), scale=[4 / top] * 3,
+                   translation=[8, -2, -2])
+            path = os.path.join(folder, f"quantised_{kind}.glb")
+            w.write(path)
+            expect(path, [((10, 0, 0), 2, 0)], 0, tol=0.02)
+
+        single(folder, "cube", mf.cube((0, 0, 0), 1))
+        single(folder, "torus", mf.torus((0, 0, 0), 1, 0.3))
+        single(folder, "fat_torus", mf.torus((0, 0, 0), 1, 0.9))
+        single(folder, "plane", mf.plane((0, 0, 0), 1))
+        single(folder, "cylinder", mf.cylinder((0, 0, 0), 1, 2))
+        single(folder, "tall_cylinder", mf.cylinder((0, 0, 0), 1, 2.5))
+
+        # Mixed: two spheres, a cube, a torus and a degenerate triangle.
+        verts, tris = mf.combine(mf.uv_sphere((0, 0, 0), 1), mf.cube((4, 0, 0), 1),
+                                 mf.uv_sphere((8, 0, 0), 1), mf.torus((12, 0, 0), 1, 0.3))
+        verts.append([20, 0, 0])
+        tris.append((len(verts) - 1,) * 3)
+        w = mf.Writer()
+        w.node("Mixed", w.mesh("MixedMesh", [((verts, tris), 0)]))
+        path = os.path.join(folder, "mixed.glb")
+        w.write(path)
+        expect(path, [((0, 0, 0), 1, 0), ((8, 0, 0), 1, 0)], 3, ["node 'Mixed' (mesh 'MixedMesh')"])
+
+        # One mesh, a cube, under 40 nodes: 40 parts, the names cut with "...".
+        w = mf.Writer()
+        box = w.mesh("Box", [(mf.cube((0, 0, 0), 1), 0)])
+        for i in range(40):
+            w.node(f"Cube{i}", box, translation=[3 * i, 0, 0])
+        w.node("Ball", w.mesh("Ball", [(mf.uv_sphere((0, -5, 0), 1), 0)]))
+        path = os.path.join(folder, "cubes.glb")
+        w.write(path)
+        expect(path, [((0, -5, 0), 1, 0)], 40, ["node 'Cube0' (mesh 'Box')", ", ..."])
+
+        # OBJ, under its naming rule: an object of two joined spheres, a cube
+        # named like a sphere; --fit-all-objects fits each object, unchecked.
+        verts, tris = mf.combine(mf.uv_sphere((0, 0, 0), 1), mf.uv_sphere((5, 0, 0), 2))
+        cube_verts, cube_tris = mf.cube((0, 9, 0), 1)
+        path = os.path.join(folder, "joined.obj")
+        with open(path, "w") as f:
+            f.write("o TwoSpheres\n")
+            f.writelines(f"v {x} {y} {z}\n" for x, y, z in verts)
+            f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tris)
+            f.write("o CubeSphere\n")
+            f.writelines(f"v {x} {y} {z}\n" for x, y, z in cube_verts)
+            f.writelines(f"f {a + 1 + len(verts)} {b + 1 + len(verts)} {c + 1 + len(verts)}\n"
+                         for a, b, c in cube_tris)
+        expect(path, [((0, 0, 0), 1, -1), ((5, 0, 0), 2, -1)], 1, ["object 'CubeSphere' (line"])
+        run = subprocess.run([ptr, "--dump-scene", "--fit-all-objects", path], capture_output=True,
+                             text=True, timeout=60)
+        fitted = [(s["center"], s["radius"]) for s in json.loads(run.stdout)["spheres"]]
+        want = [((3, 0, 0), 4), ((0, 9, 0), 1)]  # the objects' bounds
+        if len(fitted) != 2 or WARNING in run.stderr or any(
+                abs(gr - wr) > 1e-5 or max(abs(a - b) for a, b in zip(gc, wc)) > 1e-5
+                for (gc, gr), (wc, wr) in zip(fitted, want)):
+            failures.append(f"joined.obj --fit-all-objects: {fitted} {run.stderr}")
+
+    for f in failures:
+        print("FAIL " + f)
+    print("PASS" if not failures else f"{len(failures)} failures")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
