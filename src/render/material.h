@@ -166,6 +166,13 @@ static inline PtrVec3 ptr_diffuse_eval(const PtrMaterial *material, PtrVec3 n, P
     return v3_scale(material->albedo, ptr_diffuse_pdf(n, out_dir));
 }
 
+/* Whether the passes see through a material of this kind and fuzz, as a
+ * denoiser wants its guides (render/path.h): a perfect mirror or glass. */
+static inline int ptr_material_is_see_through(PtrMaterialKind kind, float fuzz)
+{
+    return kind == PTR_MATERIAL_DIELECTRIC || (kind == PTR_MATERIAL_METAL && fuzz == 0.0f);
+}
+
 /* Whether scattering off a material of this kind has a density that light
  * sampling can weigh its directions against (ptr_material_pdf): where it
  * has none (a mirror's or glass's single direction, metal's fuzz), light

@@ -208,7 +208,7 @@ static inline void ptr_path_pass_surface(PtrPathPass *pass, PtrMaterialKind kind
     pass->albedo = v3_mul(pass->tint, albedo);
     pass->normal = n;
     pass->tint = pass->albedo;
-    pass->found = !(kind == PTR_MATERIAL_DIELECTRIC || (kind == PTR_MATERIAL_METAL && fuzz == 0.0f));
+    pass->found = !ptr_material_is_see_through(kind, fuzz);
 }
 
 /* The passes where a ray met nothing and saw sky. */
