@@ -40,10 +40,22 @@ bool is_number_field(const char *line, size_t length, size_t start, size_t end, 
     return *stop == '\0' && std::isfinite(value);
 }
 
+// gemmi compares record and residue names by shifting their chars as ints,
+// which a byte above 0x7f (a negative char) makes undefined: such bytes are
+// refused where names come from (PDB and PDBx/mmCIF names are ASCII).
+bool is_ascii(const char *text, size_t length)
+{
+    for (size_t i = 0; i < length; i++)
+        if (static_cast<unsigned char>(text[i]) > 0x7f)
+            return false;
+    return true;
+}
+
 // gemmi reads a PDB atom's numbers without checking them (a letter reads as
 // 0): each is checked here first, so that no sphere lands where the file did
-// not put it. Line lengths below gemmi's 55 columns are gemmi's to refuse.
-void check_pdb_numbers(const std::string &path, const char *data, size_t size)
+// not put it; and every line must be ASCII (see is_ascii). Line lengths below
+// gemmi's 55 columns are gemmi's to refuse.
+void check_pdb_lines(const std::string &path, const char *data, size_t size)
 {
     static const struct {
         size_t start, end;
@@ -59,6 +71,9 @@ void check_pdb_numbers(const std::string &path, const char *data, size_t size)
         size_t length = (next ? next : end) - line;
         if (length && line[length - 1] == '\r')
             length--;
+        if (!is_ascii(line, length))
+            throw Fault{ path + ":" + std::to_string(number + 1) +
+                         ": not ASCII text, as a PDB file is" };
         if (length >= 55 && (!std::strncmp(line, "ATOM  ", 6) || !std::strncmp(line, "HETATM", 6)))
             for (const auto &f : fields)
                 if (!is_number_field(line, length, f.start, f.end, f.blank))
@@ -153,21 +168,26 @@ bool could_overflow_int(const std::string &value)
            (digits == std::string::npos ? value.size() : digits) - start >= 10;
 }
 
-void check_whole_numbers(const std::string &path, const gemmi::cif::Block &block)
+// Every value of the block: no whole number that could overflow, and the
+// atoms' (_atom_site, where the names come from) ASCII (see is_ascii).
+void check_values(const std::string &path, const gemmi::cif::Block &block)
 {
-    const auto check = [&path](const std::string &value) {
+    const auto check = [&path](const std::string &value, bool atoms) {
         if (could_overflow_int(value))
             throw Fault{ path + ": '" + value.substr(0, 40) +
                          "' has more digits than a number in a structure can" };
+        if (atoms && !is_ascii(value.data(), value.size()))
+            throw Fault{ path + ": an _atom_site value is not ASCII text, as names are" };
     };
+    const auto of_atoms = [](const std::string &tag) { return tag.rfind("_atom_site.", 0) == 0; };
     for (const gemmi::cif::Item &item : block.items) {
         if (item.type == gemmi::cif::ItemType::Pair)
-            check(item.pair[1]);
+            check(item.pair[1], of_atoms(item.pair[0]));
         else if (item.type == gemmi::cif::ItemType::Loop)
             for (const std::string &value : item.loop.values)
-                check(value);
+                check(value, !item.loop.tags.empty() && of_atoms(item.loop.tags[0]));
         else if (item.type == gemmi::cif::ItemType::Frame)
-            check_whole_numbers(path, item.frame);
+            check_values(path, item.frame);
     }
 }
 
@@ -200,14 +220,14 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
         gemmi::CharArray text = gemmi::read_into_buffer(input);
         gemmi::Structure structure;
         if (format == gemmi::CoorFormat::Pdb) {
-            check_pdb_numbers(path, text.data(), text.size());
+            check_pdb_lines(path, text.data(), text.size());
             structure = gemmi::read_pdb_from_memory(text.data(), text.size(), path);
         } else {
             const gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(),
                                                                      path);
             if (!doc.blocks.empty()) {
                 check_atom_site_columns(path, doc.blocks[0]);
-                check_whole_numbers(path, doc.blocks[0]);
+                check_values(path, doc.blocks[0]);
             }
             structure = gemmi::make_structure(doc);
         }
