@@ -41,21 +41,22 @@ bool is_number_field(const char *line, size_t length, size_t start, size_t end, 
 }
 
 // gemmi compares record and residue names by shifting their chars as ints,
-// which a byte above 0x7f (a negative char) makes undefined: such bytes are
-// refused where names come from (PDB and PDBx/mmCIF names are ASCII).
-bool is_ascii(const char *text, size_t length)
+// which a byte above 0x7f (a negative char) makes undefined: such a byte is
+// refused anywhere in the file, which the PDB archive writes in ASCII, in
+// either format.
+void check_ascii(const std::string &path, const char *data, size_t size)
 {
-    for (size_t i = 0; i < length; i++)
-        if (static_cast<unsigned char>(text[i]) > 0x7f)
-            return false;
-    return true;
+    size_t line = 1;
+    for (size_t i = 0; i < size; line += data[i++] == '\n')
+        if (static_cast<unsigned char>(data[i]) > 0x7f)
+            throw Fault{ path + ":" + std::to_string(line) +
+                         ": not ASCII text, as PDB and mmCIF files are" };
 }
 
 // gemmi reads a PDB atom's numbers without checking them (a letter reads as
 // 0): each is checked here first, so that no sphere lands where the file did
-// not put it; and every line must be ASCII (see is_ascii). Line lengths below
-// gemmi's 55 columns are gemmi's to refuse.
-void check_pdb_lines(const std::string &path, const char *data, size_t size)
+// not put it. Line lengths below gemmi's 55 columns are gemmi's to refuse.
+void check_pdb_numbers(const std::string &path, const char *data, size_t size)
 {
     static const struct {
         size_t start, end;
@@ -71,9 +72,6 @@ void check_pdb_lines(const std::string &path, const char *data, size_t size)
         size_t length = (next ? next : end) - line;
         if (length && line[length - 1] == '\r')
             length--;
-        if (!is_ascii(line, length))
-            throw Fault{ path + ":" + std::to_string(number + 1) +
-                         ": not ASCII text, as a PDB file is" };
         if (length >= 55 && (!std::strncmp(line, "ATOM  ", 6) || !std::strncmp(line, "HETATM", 6)))
             for (const auto &f : fields)
                 if (!is_number_field(line, length, f.start, f.end, f.blank))
@@ -168,26 +166,21 @@ bool could_overflow_int(const std::string &value)
            (digits == std::string::npos ? value.size() : digits) - start >= 10;
 }
 
-// Every value of the block: no whole number that could overflow, and the
-// atoms' (_atom_site, where the names come from) ASCII (see is_ascii).
-void check_values(const std::string &path, const gemmi::cif::Block &block)
+void check_whole_numbers(const std::string &path, const gemmi::cif::Block &block)
 {
-    const auto check = [&path](const std::string &value, bool atoms) {
+    const auto check = [&path](const std::string &value) {
         if (could_overflow_int(value))
             throw Fault{ path + ": '" + value.substr(0, 40) +
                          "' has more digits than a number in a structure can" };
-        if (atoms && !is_ascii(value.data(), value.size()))
-            throw Fault{ path + ": an _atom_site value is not ASCII text, as names are" };
     };
-    const auto of_atoms = [](const std::string &tag) { return tag.rfind("_atom_site.", 0) == 0; };
     for (const gemmi::cif::Item &item : block.items) {
         if (item.type == gemmi::cif::ItemType::Pair)
-            check(item.pair[1], of_atoms(item.pair[0]));
+            check(item.pair[1]);
         else if (item.type == gemmi::cif::ItemType::Loop)
             for (const std::string &value : item.loop.values)
-                check(value, !item.loop.tags.empty() && of_atoms(item.loop.tags[0]));
+                check(value);
         else if (item.type == gemmi::cif::ItemType::Frame)
-            check_values(path, item.frame);
+            check_whole_numbers(path, item.frame);
     }
 }
 
@@ -218,16 +211,17 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
             return ptr_shim_error(err, PTR_ERR_SCENE_INVALID,
                                   std::string(path) + ": not .pdb, .ent, .cif or .mmcif");
         gemmi::CharArray text = gemmi::read_into_buffer(input);
+        check_ascii(path, text.data(), text.size());
         gemmi::Structure structure;
         if (format == gemmi::CoorFormat::Pdb) {
-            check_pdb_lines(path, text.data(), text.size());
+            check_pdb_numbers(path, text.data(), text.size());
             structure = gemmi::read_pdb_from_memory(text.data(), text.size(), path);
         } else {
             const gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(),
                                                                      path);
             if (!doc.blocks.empty()) {
                 check_atom_site_columns(path, doc.blocks[0]);
-                check_values(path, doc.blocks[0]);
+                check_whole_numbers(path, doc.blocks[0]);
             }
             structure = gemmi::make_structure(doc);
         }

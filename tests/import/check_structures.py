@@ -147,9 +147,10 @@ for name, says in (
         ("structure_coordinate_infinite.cif", "atom 2 (CA of GLY 1, chain A) has no finite"),
         ("structure_absurd_numbers.cif", "'99999999999999999999999' has more digits than"),
         ("structure_unknown_element.pdb", "atom 1: no element ptr knows"),
-        ("structure_non_ascii_record.pdb", ":1: not ASCII text, as a PDB file is"),
-        ("structure_non_ascii_residue.pdb", ":1: not ASCII text, as a PDB file is"),
-        ("structure_non_ascii_residue.cif", "an _atom_site value is not ASCII text"),
+        ("structure_non_ascii_record.pdb", ":1: not ASCII text, as PDB and mmCIF files are"),
+        ("structure_non_ascii_residue.pdb", ":1: not ASCII text, as PDB and mmCIF files are"),
+        ("structure_non_ascii_residue.cif", ":19: not ASCII text, as PDB and mmCIF files are"),
+        ("structure_non_ascii_mangled_tag.cif", ":19: not ASCII text, as PDB and mmCIF files are"),
         ("structure_no_atoms.pdb", "no atoms of those --select keeps"),
         ("structure_bomb.pdb.gz", "Cannot determine uncompressed size"),
         ("structure_not_gzip.cif.gz", "Cannot determine uncompressed size")):
