@@ -53,9 +53,31 @@ void check_ascii(const std::string &path, const char *data, size_t size)
                          ": not ASCII text, as PDB and mmCIF files are" };
 }
 
+// A PDB line is 80 columns, and gemmi reads some records' columns (a LINK's
+// distance, 74-78) without checking that the line has them: every line is
+// padded with blanks, which the fixed columns read as empty, to 80.
+std::string padded_pdb_lines(const char *data, size_t size)
+{
+    std::string out;
+    out.reserve(size + size / 8);
+    for (const char *line = data, *end = data + size; line < end;) {
+        const char *next = static_cast<const char *>(std::memchr(line, '\n', end - line));
+        size_t length = (next ? next : end) - line;
+        if (length && line[length - 1] == '\r')
+            length--;
+        out.append(line, length);
+        if (length < 80)
+            out.append(80 - length, ' ');
+        out += '\n';
+        line = next ? next + 1 : end;
+    }
+    return out;
+}
+
 // gemmi reads a PDB atom's numbers without checking them (a letter reads as
 // 0): each is checked here first, so that no sphere lands where the file did
-// not put it. Line lengths below gemmi's 55 columns are gemmi's to refuse.
+// not put it; an atom line that ends before its coordinates is refused
+// (padded_pdb_lines would give it blank ones).
 void check_pdb_numbers(const std::string &path, const char *data, size_t size)
 {
     static const struct {
@@ -72,7 +94,12 @@ void check_pdb_numbers(const std::string &path, const char *data, size_t size)
         size_t length = (next ? next : end) - line;
         if (length && line[length - 1] == '\r')
             length--;
-        if (length >= 55 && (!std::strncmp(line, "ATOM  ", 6) || !std::strncmp(line, "HETATM", 6)))
+        const bool atom = length >= 6 &&
+                          (!std::strncmp(line, "ATOM  ", 6) || !std::strncmp(line, "HETATM", 6));
+        if (atom && length < 54)
+            throw Fault{ path + ":" + std::to_string(number + 1) + ": an atom line of " +
+                         std::to_string(length) + " columns, short of its coordinates (31-54)" };
+        if (atom)
             for (const auto &f : fields)
                 if (!is_number_field(line, length, f.start, f.end, f.blank))
                     throw Fault{ path + ":" + std::to_string(number + 1) + ": " + f.what +
@@ -215,7 +242,8 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
         gemmi::Structure structure;
         if (format == gemmi::CoorFormat::Pdb) {
             check_pdb_numbers(path, text.data(), text.size());
-            structure = gemmi::read_pdb_from_memory(text.data(), text.size(), path);
+            const std::string lines = padded_pdb_lines(text.data(), text.size());
+            structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(), path);
         } else {
             const gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(),
                                                                      path);

@@ -138,7 +138,7 @@ expect(f"ptr 1tii.pdb -o 1tii.png: exit {run.returncode}, {run.stderr!r}",
 # the file.
 hostile = os.path.join(src, "tests", "fixtures", "hostile")
 for name, says in (
-        ("structure_truncated.pdb", "Problem in line 23: The line is too short"),
+        ("structure_truncated.pdb", ":23: an atom line of 40 columns, short of its coordinates (31-54)"),
         ("structure_truncated.cif", "structure_truncated.cif:820:1: Wrong number of values"),
         ("structure_wrong_columns.pdb", ":2: x (columns 31-38) '42.704 -' is not a number"),
         ("structure_loop_missing_values.cif", ":2:1: Wrong number of values in the loop"),
