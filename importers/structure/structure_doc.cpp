@@ -12,6 +12,8 @@
 #include <tuple>
 #include <vector>
 
+#include <strings.h>
+
 #include <gemmi/gz.hpp>
 #include <gemmi/mmcif.hpp>
 #include <gemmi/mmread.hpp>
@@ -53,10 +55,13 @@ void check_ascii(const std::string &path, const char *data, size_t size)
                          ": not ASCII text, as PDB and mmCIF files are" };
 }
 
-// A PDB line is 80 columns, and gemmi reads some records' columns (a LINK's
-// distance, 74-78) without checking that the line has them: every line is
-// padded with blanks, which the fixed columns read as empty, to 80.
-std::string padded_pdb_lines(const char *data, size_t size)
+// The lines of a PDB file as gemmi is to read them. gemmi reads some columns
+// without checking that a line has them: every line is padded with blanks,
+// which the fixed columns read as empty, to its 80 columns; and the
+// connection records (SSBOND, LINK, CISPEP), whose columns gemmi reads past
+// the end of its own trimmed copy of a line, are left out: no sphere depends
+// on them.
+std::string pdb_lines_for_gemmi(const char *data, size_t size)
 {
     std::string out;
     out.reserve(size + size / 8);
@@ -65,6 +70,14 @@ std::string padded_pdb_lines(const char *data, size_t size)
         size_t length = (next ? next : end) - line;
         if (length && line[length - 1] == '\r')
             length--;
+        const auto is = [line, length](const char *record) {
+            const size_t n = std::strlen(record);
+            return length >= n && !strncasecmp(line, record, n);
+        };
+        if (is("SSBOND") || is("LINK") || is("CISPEP")) {
+            line = next ? next + 1 : end;
+            continue;
+        }
         out.append(line, length);
         if (length < 80)
             out.append(80 - length, ' ');
@@ -242,7 +255,7 @@ extern "C" PtrResult structure_doc_read(const char *path, unsigned select, int h
         gemmi::Structure structure;
         if (format == gemmi::CoorFormat::Pdb) {
             check_pdb_numbers(path, text.data(), text.size());
-            const std::string lines = padded_pdb_lines(text.data(), text.size());
+            const std::string lines = pdb_lines_for_gemmi(text.data(), text.size());
             structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(), path);
         } else {
             const gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(),
