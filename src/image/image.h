@@ -80,11 +80,13 @@ int ptr_image_can_write(PtrImageLoader *loader, const char *path);
 
 /* What an EXR holds beside the colour and alpha, in float channels of their
  * own, each where it is not NULL: how many samples each pixel took (one
- * float a pixel: "samples"), and the albedo and normal passes (three floats
- * a pixel each: "albedo.R/G/B", "normal.X/Y/Z"). */
+ * float a pixel: "samples"), the albedo and normal passes, and the noisy
+ * colour of a denoised image (three floats a pixel each: "albedo.R/G/B",
+ * "normal.X/Y/Z", "noisy.R/G/B"). */
 typedef struct PtrImageExtras {
     const float *sample_counts;
     const float *albedo, *normal;
+    const float *noisy;
 } PtrImageExtras;
 
 /* Writes RGB float pixels (rows top to bottom), stored in the file as format,
@@ -107,8 +109,8 @@ PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrIma
 void ptr_image_discard_partial(void);
 
 /* An image read back as float RGB (grey replicated) and its alpha channel,
- * if it has one, and an EXR's albedo and normal passes, if it has them;
- * other channels are dropped. */
+ * if it has one, and an EXR's albedo and normal passes and noisy colour, if
+ * it has them; other channels are dropped. */
 typedef struct PtrImage PtrImage;
 
 /* The image into *out (for ptr_image_free): PTR_OK, else PTR_ERR_USAGE for a
@@ -127,6 +129,8 @@ const float *ptr_image_alpha(const PtrImage *image);
 /* Three floats a pixel each, as stored; NULL if the image has no passes. */
 const float *ptr_image_albedo(const PtrImage *image);
 const float *ptr_image_normal(const PtrImage *image);
+/* Three floats a pixel, as stored; NULL unless the image was denoised. */
+const float *ptr_image_noisy(const PtrImage *image);
 
 /* A header attribute as text (numbers formatted), or NULL if absent. The
  * string lives as long as the image. */

@@ -22,6 +22,7 @@ struct PtrImage {
     float *rgb;          /* layout.width x layout.height RGB, rows top to bottom */
     float *alpha;        /* one float a pixel, or NULL: no alpha channel */
     float *albedo, *normal; /* three floats a pixel each, or NULL: no passes (EXR) */
+    float *noisy;        /* three floats a pixel, or NULL: not denoised (EXR) */
     size_t attr_count;
     char **attr_names;   /* as the file names them */
     char **attr_values;  /* as text: numbers formatted */
@@ -42,6 +43,7 @@ static inline void ptr_image_release(PtrImage *image)
     free(image->alpha);
     free(image->albedo);
     free(image->normal);
+    free(image->noisy);
     free(image);
 }
 

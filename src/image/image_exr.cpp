@@ -5,7 +5,8 @@
  * float "samples" channel of adaptive renders, a data window for regions, the
  * capture date, and every attribute ptr gives but OpenImageIO's own (oiio:*),
  * which it never wrote to EXR; and now the float layers of the albedo and
- * normal passes (--passes), which OpenImageIO did not write for ptr. */
+ * normal passes (--passes) and of a denoised image's noisy colour
+ * (--denoise), which OpenImageIO did not write for ptr. */
 #include "base/shim_error.h"
 #include "image/image_backend.h"
 
@@ -37,6 +38,7 @@ namespace {
 const char *const rgb_names[3] = { "R", "G", "B" };
 const char *const albedo_names[3] = { "albedo.R", "albedo.G", "albedo.B" };
 const char *const normal_names[3] = { "normal.X", "normal.Y", "normal.Z" };
+const char *const noisy_names[3] = { "noisy.R", "noisy.G", "noisy.B" };
 
 /* "YYYY:MM:DD HH:MM:SS", local time: the form of EXR's capDate. */
 std::string capture_date()
@@ -120,6 +122,7 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
         const float *sample_counts = extras ? extras->sample_counts : nullptr;
         const float *albedo = extras ? extras->albedo : nullptr;
         const float *normal = extras ? extras->normal : nullptr;
+        const float *noisy = extras ? extras->noisy : nullptr;
         if (sample_counts)
             header.channels().insert("samples", Imf::Channel(Imf::FLOAT));
         for (size_t c = 0; c < 3; c++) {
@@ -127,6 +130,8 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
                 header.channels().insert(albedo_names[c], Imf::Channel(Imf::FLOAT));
             if (normal)
                 header.channels().insert(normal_names[c], Imf::Channel(Imf::FLOAT));
+            if (noisy)
+                header.channels().insert(noisy_names[c], Imf::Channel(Imf::FLOAT));
         }
         for (size_t i = 0; i < attr_count; i++) {
             const PtrImageAttr &a = attrs[i];
@@ -171,6 +176,8 @@ extern "C" PtrResult ptr_exr_write(const char *file, const char *name,
             insert_layer(frame, albedo_names, albedo, *layout);
         if (normal)
             insert_layer(frame, normal_names, normal, *layout);
+        if (noisy)
+            insert_layer(frame, noisy_names, noisy, *layout);
         Imf::OutputFile out(file, header);
         out.setFrameBuffer(frame);
         out.writePixels(layout->height);
@@ -217,8 +224,8 @@ extern "C" PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *er
             if (!ptr_image_set_attr(image, i, attrs[i].first.c_str(), attrs[i].second.c_str()))
                 throw std::bad_alloc();
 
-        // R, G and B; a grey image (Y alone) in all three; A and the
-        // passes if there are; the rest dropped.
+        // R, G and B; a grey image (Y alone) in all three; A, the passes
+        // and the noisy colour if there are; the rest dropped.
         const Imf::ChannelList &channels = header.channels();
         char *first = reinterpret_cast<char *>(image->rgb);
         const size_t row = size_t(layout.width) * 3 * sizeof(float);
@@ -236,6 +243,7 @@ extern "C" PtrResult ptr_exr_read(const char *path, PtrImage **out, PtrError *er
         }
         image->albedo = read_layer(frame, channels, albedo_names, layout);
         image->normal = read_layer(frame, channels, normal_names, layout);
+        image->noisy = read_layer(frame, channels, noisy_names, layout);
         in.setFrameBuffer(frame);
         in.readPixels(data.min.y, data.max.y);
         for (size_t p = 0; grey && p < size_t(layout.width) * size_t(layout.height); p++)
