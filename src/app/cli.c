@@ -241,9 +241,18 @@ int ptr_cli_main(int argc, char **argv)
         return 0;
     }
     ptr_signals_install();
-    if (ptr_image_loader_new(&o.images, &err) != PTR_OK)
+    /* The weights load once for every image of the run, and a missing file
+     * is said before anything renders. */
+    if (o.denoise && !o.dump_scene && !o.list_views &&
+        ptr_denoiser_new(o.denoise_quality, NULL, o.cpu_level, &o.denoiser, &err) != PTR_OK)
         return fail(&err);
-    int code = o.dump_scene ? dump_scenes(&o) : run(&o);
-    ptr_image_loader_free(o.images);
+    int code;
+    if (ptr_image_loader_new(&o.images, &err) != PTR_OK) {
+        code = fail(&err);
+    } else {
+        code = o.dump_scene ? dump_scenes(&o) : run(&o);
+        ptr_image_loader_free(o.images);
+    }
+    ptr_denoiser_free(o.denoiser);
     return code;
 }

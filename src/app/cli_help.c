@@ -54,7 +54,8 @@ static void print_option(const char *name, char short_name, const char *metavar,
 static void print_help(void)
 {
     fputs("Usage: ptr SCENE... -o OUTPUT [options]\n"
-          "       ptr merge PART.exr... -o OUTPUT [output options]\n"
+          "       ptr merge PART.exr... -o OUTPUT [output options] [--denoise [QUALITY]]\n"
+          "       ptr denoise IMAGE.exr -o OUTPUT [--denoise QUALITY] [--threads N]\n"
           "       ptr --dump-scene SCENE [--camera NAME] [--sky SKY]\n"
           "       ptr --list-views [--ocio-config FILE]\n"
           "Renders scenes of spheres with a path tracer. SCENE is glTF (.gltf, .glb:\n"

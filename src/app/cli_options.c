@@ -224,6 +224,11 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
             return bad_value(id, value, "albedo,normal", err);
         o->passes = 1;
         break;
+    case OPT_denoise:
+        o->denoise = value ? value : PTR_DEFAULT_DENOISE;
+        if (ptr_denoise_quality_parse(o->denoise, &o->denoise_quality, &problem) != PTR_OK)
+            return option_error(id, &problem, err);
+        break;
     case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads, err);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))
@@ -371,6 +376,15 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     return PTR_OK;
 }
 
+/* Whether text, the argument after an option whose value is optional and
+ * not given with '=', is that value (getopt_long takes only --denoise=fast):
+ * it is if it is one of the option's values, else it is an operand. */
+static int is_optional_value(OptionId id, const char *text)
+{
+    PtrDenoiseQuality quality;
+    return id == OPT_denoise && ptr_denoise_quality_parse(text, &quality, NULL) == PTR_OK;
+}
+
 /* Takes argv's options into o, leaving optind at the first operand, up to
  * the first that asks for something printed instead of a render. */
 static PtrResult read_options(int argc, char **argv, PtrOptions *o, PtrError *err)
@@ -387,7 +401,11 @@ static PtrResult read_options(int argc, char **argv, PtrOptions *o, PtrError *er
         if (id < 0)
             return ptr_error_set(err, PTR_ERR_USAGE, "unknown option '%s' (see ptr --help)",
                                  argv[optind - 1]);
-        PtrResult res = apply_option((OptionId)id, optarg, o, err);
+        const char *value = optarg;
+        if (long_options[id].has_arg == optional_argument && !value && optind < argc &&
+            is_optional_value((OptionId)id, argv[optind]))
+            value = argv[optind++];
+        PtrResult res = apply_option((OptionId)id, value, o, err);
         if (res != PTR_OK || o->print != PTR_PRINT_NOTHING)
             return res;
     }
@@ -408,7 +426,11 @@ static const char *usage_problem(const PtrOptions *o)
     if (!o->color_by && (o->colormap || o->has_color_range || o->color_bar))
         return "--colormap, --color-range and --color-bar need --color-by";
     if (o->input_count == 0)
-        return o->merge ? "no parts given" : "no scene file given";
+        return o->denoise_command ? "no image given"
+               : o->merge         ? "no parts given"
+                                  : "no scene file given";
+    if (o->denoise_command && o->input_count > 1)
+        return "ptr denoise takes one image";
     if (!o->output && !o->dump_scene)
         return "no output given (-o)";
     if (o->watch && o->input_count > 1)
@@ -441,12 +463,18 @@ PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *o, PtrError *err)
     const char *env_integrator = getenv("PTR_INTEGRATOR");
     if (env_integrator && ptr_integrator_parse(env_integrator, &o->integrator, &problem) != PTR_OK)
         return value_error("PTR_INTEGRATOR", &problem, err);
-    if (argc > 1 && !strcmp(argv[1], "merge")) {
+    /* ptr denoise is ptr merge of one image with --denoise: its default
+     * quality, unless the options give another. */
+    o->denoise_command = argc > 1 && !strcmp(argv[1], "denoise");
+    PtrResult res = o->denoise_command ? apply_option(OPT_denoise, NULL, o, err) : PTR_OK;
+    if (res != PTR_OK)
+        return res;
+    if (argc > 1 && (o->denoise_command || !strcmp(argv[1], "merge"))) {
         o->merge = 1;
         argv++;
         argc--;
     }
-    PtrResult res = read_options(argc, argv, o, err);
+    res = read_options(argc, argv, o, err);
     if (res != PTR_OK || o->print != PTR_PRINT_NOTHING || o->list_views)
         return res;
     o->inputs = argv + optind;

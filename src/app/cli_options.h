@@ -9,6 +9,7 @@
 #include "app/output.h"
 #include "base/cpu.h"
 #include "base/result.h"
+#include "denoise/denoise.h"
 #include "importer.h"
 #include "render/render.h"
 #include "scene/colormap.h"
@@ -19,6 +20,7 @@
 #define PTR_DEFAULT_SAMPLES 100
 #define PTR_DEFAULT_MAX_DEPTH 50
 #define PTR_DEFAULT_MIN_SAMPLES 32
+#define PTR_DEFAULT_DENOISE "balanced"
 
 enum { PTR_MAX_IMAGE_SIZE = 1 << 16 };
 
@@ -36,7 +38,8 @@ typedef enum PtrPrintRequest {
 typedef struct PtrOptions {
     char **inputs;          /* scenes; for `ptr merge`, the parts */
     int input_count;
-    int merge;              /* `ptr merge PART... -o OUT` */
+    int merge;              /* `ptr merge PART... -o OUT`, and `ptr denoise` */
+    int denoise_command;    /* `ptr denoise IN.exr -o OUT`: a merge of one part, denoised */
     const char *output;     /* a file, a folder, or a pattern with {name} */
     const char *camera_name;
     PtrCameraSpec camera;   /* --lookfrom ... */
@@ -56,6 +59,8 @@ typedef struct PtrOptions {
     int width, height;      /* 0: from the scene */
     int transparent;        /* alpha 0 where camera rays meet no sphere */
     int passes;             /* --passes albedo,normal: EXR layers of both passes */
+    const char *denoise;    /* --denoise's quality as given; NULL: no denoising */
+    PtrDenoiseQuality denoise_quality;
     PtrRegion region;       /* all zero: the whole image */
     int max_depth;
     PtrSamplerKind sampler;
@@ -91,6 +96,9 @@ typedef struct PtrOptions {
     /* Not an option: the image module's loader of the run, which
      * ptr_cli_main owns (NULL from ptr_options_parse). */
     PtrImageLoader *images;
+    /* Not an option either: the denoiser of the run, with --denoise, which
+     * ptr_cli_main owns too (NULL from ptr_options_parse). */
+    PtrDenoiser *denoiser;
 } PtrOptions;
 
 /* What the importers need of the options. */

@@ -57,7 +57,8 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = integrator, .transparent = o->transparent, .passes = o->passes,
+        .integrator = integrator, .transparent = o->transparent,
+        .passes = o->passes || o->denoise, /* the denoiser's guides */
     };
     choose_size(o, scene, &settings.width, &settings.height);
     report->width = settings.width;
@@ -82,10 +83,10 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
     float *alpha = o->transparent ? malloc(pixels * sizeof *alpha) : NULL;
-    float *albedo = o->passes ? malloc(pixels * 3 * sizeof *albedo) : NULL;
-    float *normal = o->passes ? malloc(pixels * 3 * sizeof *normal) : NULL;
+    float *albedo = settings.passes ? malloc(pixels * 3 * sizeof *albedo) : NULL;
+    float *normal = settings.passes ? malloc(pixels * 3 * sizeof *normal) : NULL;
     if (!rgb || (o->noise_threshold > 0 && !counts) || (o->transparent && !alpha) ||
-        (o->passes && (!albedo || !normal))) {
+        (settings.passes && (!albedo || !normal))) {
         free(rgb);
         free(counts);
         free(alpha);
@@ -118,6 +119,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
             .direct_lighting = o->direct_lighting == PTR_ON,
             .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
             .sample_counts = counts, .albedo = albedo, .normal = normal, .alpha = alpha,
+            .denoiser = o->denoiser, .denoise_quality = o->denoise, .threads = o->threads,
             .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
             .dither = o->dither,

@@ -73,6 +73,32 @@ static int has_passes(const Part *p)
     return ptr_image_albedo(p->image) && ptr_image_normal(p->image);
 }
 
+/* A part's colour as rendered: a denoised image's noisy layer, so that
+ * nothing denoised is ever merged or denoised again. */
+static const float *beauty(const Part *p)
+{
+    const float *noisy = ptr_image_noisy(p->image);
+    return noisy ? noisy : ptr_image_pixels(p->image);
+}
+
+/* With --denoise: every part holds the passes the network needs. */
+static PtrResult check_denoisable(const Part *parts, int count, PtrError *err)
+{
+    for (int i = 0; i < count; i++) {
+        const int albedo = ptr_image_albedo(parts[i].image) != NULL,
+                  normal = ptr_image_normal(parts[i].image) != NULL;
+        if (!albedo || !normal)
+            return ptr_error_set(err, PTR_ERR_USAGE,
+                                 "%s: no %s layers to denoise with: render it with --passes "
+                                 "albedo,normal or --denoise",
+                                 parts[i].path,
+                                 !albedo && !normal ? "albedo.R/G/B and normal.X/Y/Z"
+                                 : !albedo          ? "albedo.R/G/B"
+                                                    : "normal.X/Y/Z");
+    }
+    return PTR_OK;
+}
+
 static int overlap(const PtrImageLayout *a, const PtrImageLayout *b)
 {
     return a->x < b->x + b->width && b->x < a->x + a->width && a->y < b->y + b->height &&
@@ -147,7 +173,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     long first = parts[0].first;
     for (int i = 0; i < count; i++) {
         const Part *p = &parts[i];
-        const float *px = ptr_image_pixels(p->image), *pa = ptr_image_alpha(p->image);
+        const float *px = beauty(p), *pa = ptr_image_alpha(p->image);
         const float *pal = ptr_image_albedo(p->image), *pn = ptr_image_normal(p->image);
         first = p->first < first ? p->first : first;
         for (int y = 0; y < p->layout.height; y++)
@@ -216,6 +242,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
                            : 0,
         .alpha = alpha, .albedo = albedo, .normal = normal, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
         .dither = o->dither,
+        .denoiser = o->denoiser, .denoise_quality = o->denoise, .threads = o->threads,
     };
     res = ptr_output_write(o->images, output, &full, rgb, &info, err);
 done:
@@ -240,10 +267,14 @@ PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOption
         parts[i].path = paths[i];
         res = read_part(o->images, &parts[i], &err);
     }
+    if (res == PTR_OK && o->denoise)
+        res = check_denoisable(parts, count, &err);
+    /* The passes a denoiser takes go where a --denoise render's go: into an
+     * EXR, and nowhere in other formats. */
     if (res == PTR_OK)
         res = ptr_output_check(o->images, output, o->depth,
-                               ptr_image_alpha(parts[0].image) != NULL, has_passes(&parts[0]),
-                               &err);
+                               ptr_image_alpha(parts[0].image) != NULL,
+                               has_passes(&parts[0]) && !o->denoise, &err);
     if (res == PTR_OK)
         res = check_parts(parts, count, &err);
     if (res == PTR_OK)
@@ -254,8 +285,12 @@ PtrResult ptr_merge(char **paths, int count, const char *output, const PtrOption
     report->result = res;
     if (res != PTR_OK)
         snprintf(report->error, sizeof report->error, "%s", err.message);
+    else if (!o->quiet && o->denoise_command)
+        fprintf(stderr, "ptr: %s: denoised %s (%s), %dx%d, %" PRIu32 " spp\n", output, paths[0],
+                o->denoise, report->width, report->height, report->samples);
     else if (!o->quiet)
-        fprintf(stderr, "ptr: %s: merged %d parts, %dx%d, %" PRIu32 " spp\n", output, count,
-                report->width, report->height, report->samples);
+        fprintf(stderr, "ptr: %s: merged %d parts%s%s, %dx%d, %" PRIu32 " spp\n", output, count,
+                o->denoise ? ", denoised: " : "", o->denoise ? o->denoise : "", report->width,
+                report->height, report->samples);
     return res;
 }

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/cpu.h"
 #include "base/version.h"
 #include "image/image.h"
 
@@ -126,6 +127,38 @@ static void scale_by_alpha(float *rgb, const float *alpha, size_t pixels, int pr
             rgb[3 * p + c] = premultiply ? rgb[3 * p + c] * alpha[p] : rgb[3 * p + c] / alpha[p];
 }
 
+/* The denoised colour of the image into *out (for free), from its colour
+ * (premultiplied by alpha, if there is one) and passes. The premultiplied
+ * colour is what the network takes: where camera rays met nothing it adds
+ * nothing, as a black background would. Where no camera ray met anything
+ * (alpha 0), the colour stays 0: the network's blur must not put light
+ * where the image holds nothing to composite. */
+static PtrResult denoise(const char *path, const PtrImageLayout *layout, const float *rgb,
+                         const PtrOutputInfo *info, float **out, PtrError *err)
+{
+    size_t pixels = (size_t)layout->width * (size_t)layout->height;
+    float *denoised = malloc(pixels * 3 * sizeof *denoised);
+    if (!denoised)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+    const PtrDenoiseInput input = {
+        .color = rgb, .albedo = info->albedo, .normal = info->normal,
+        .color_stride = 3, .albedo_stride = 3, .normal_stride = 3,
+        .width = (size_t)layout->width, .height = (size_t)layout->height,
+    };
+    int threads = info->threads > 0 ? info->threads : ptr_online_cpus();
+    PtrError problem;
+    PtrResult res = ptr_denoise(info->denoiser, &input, threads, denoised, 3, &problem);
+    if (res != PTR_OK) {
+        free(denoised);
+        return ptr_error_set(err, res, "%s: %s", path, problem.message);
+    }
+    for (size_t p = 0; info->alpha && p < pixels; p++)
+        for (int c = 0; c < 3 && info->alpha[p] == 0.0f; c++)
+            denoised[3 * p + c] = 0.0f;
+    *out = denoised;
+    return PTR_OK;
+}
+
 PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrImageLayout *layout,
                            const float *rgb, const PtrOutputInfo *info, PtrError *err)
 {
@@ -134,18 +167,33 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
     int display_referred = !is_float || info->bake_view;
     size_t pixels = (size_t)layout->width * (size_t)layout->height;
 
+    /* From here on rgb is the colour the file shows; an EXR keeps the noisy
+     * one beside it. */
+    const float *noisy = NULL;
+    float *denoised = NULL;
+    if (info->denoiser) {
+        PtrResult res = denoise(path, layout, rgb, info, &denoised, err);
+        if (res != PTR_OK)
+            return res;
+        noisy = rgb;
+        rgb = denoised;
+    }
+
     const float *alpha = info->alpha;
     int straight = alpha && !ptr_image_is_exr(path);
     float *viewed = NULL;
     if (display_referred || straight) {
         viewed = malloc(pixels * 3 * sizeof *viewed);
-        if (!viewed)
+        if (!viewed) {
+            free(denoised);
             return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+        }
         memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
         scale_by_alpha(viewed, alpha, pixels, 0);
         PtrError color_err;
         if (display_referred && ptr_color_apply(info->color, viewed, pixels, &color_err) != PTR_OK) {
             free(viewed);
+            free(denoised);
             return ptr_error_set(err, color_err.code, "%s: %s", path, color_err.message);
         }
         if (!straight)
@@ -194,15 +242,19 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         { .name = "ptr:look", .type = PTR_ATTR_STRING, .string_value = ptr_color_look(info->color) },
         { .name = "ptr:exposure", .type = PTR_ATTR_STRING, .string_value = exposure },
         { .name = "oiio:dither", .type = PTR_ATTR_INT, .int_value = info->dither ? 1 : 0 },
+        /* Last, and only in a denoised image's header: the others' stay as
+         * they were. */
+        { .name = "ptr:denoised", .type = PTR_ATTR_STRING, .string_value = info->denoise_quality },
     };
+    const size_t attr_count = sizeof attrs / sizeof attrs[0] - (info->denoiser ? 0 : 1);
     static const PtrPixelFormat pixel_formats[] = {
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,
     };
-    const PtrImageExtras extras = { info->sample_counts, info->albedo, info->normal };
+    const PtrImageExtras extras = { info->sample_counts, info->albedo, info->normal, noisy };
     PtrResult res = ptr_image_write(images, path, layout, viewed ? viewed : rgb, alpha,
-                                    &extras, pixel_formats[depth], attrs,
-                                    sizeof attrs / sizeof attrs[0], err);
+                                    &extras, pixel_formats[depth], attrs, attr_count, err);
     free(viewed);
+    free(denoised);
     return res;
 }

@@ -6,6 +6,7 @@
 
 #include "base/result.h"
 #include "color/color.h"
+#include "denoise/denoise.h"
 #include "image/image.h"
 
 /* What each channel is stored as. Integer depths always hold the
@@ -39,6 +40,11 @@ typedef struct PtrOutputInfo {
     /* The albedo and normal passes, three floats a pixel each, written as
      * EXR layers (NULL: none; only EXR takes them: ptr_output_check). */
     const float *albedo, *normal;
+    /* With a denoiser (and both passes), the file gets the denoised colour,
+     * and an EXR the noisy one too, as a layer. */
+    const PtrDenoiser *denoiser;
+    const char *denoise_quality; /* its name, for the metadata */
+    int threads;           /* the denoiser's; 0: one per CPU */
     /* Per pixel, the share of its samples that were covered (may be NULL):
      * the image's alpha, the RGB given then premultiplied by it. */
     const float *alpha;
@@ -62,7 +68,8 @@ PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth de
                            int passes, PtrError *err);
 
 /* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
- * full image as layout says) as info says. The file is replaced atomically.
+ * full image as layout says) as info says, denoised first if info has a
+ * denoiser. The file is replaced atomically.
  * With an alpha channel, EXR stores the colour premultiplied, as OpenEXR
  * defines it, and every other format straight (divided by alpha); the view
  * of an integer format is taken of the straight colour, as OpenColorIO's

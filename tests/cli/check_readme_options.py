@@ -9,10 +9,11 @@ import subprocess
 import sys
 
 ptr, src = sys.argv[1], sys.argv[2]
-# "-o, --output FILE", "--samples N", "--help", "--live [HOST:]PORT": a
-# value's name never starts with '-', and README puts optional options in
-# brackets (a value's optional part, "[HOST:]", is upper case).
-OPTION = re.compile(r"(?:-\w, )?--[a-z][a-z-]*(?: (?!-)(?:\[[A-Z:]+\])?[^\s\[\]]+)?")
+# "-o, --output FILE", "--samples N", "--help", "--live [HOST:]PORT",
+# "--denoise [QUALITY]": a value's name never starts with '-', and README puts
+# optional options in brackets (a value's optional part, "[HOST:]", or an
+# optional value, "[QUALITY]", is upper case).
+OPTION = re.compile(r"(?:-\w, )?--[a-z][a-z-]*(?: (?!-)(?:\[[A-Z:]+\])?[^\s\[\]]*(?<! ))?")
 
 
 def help_options():

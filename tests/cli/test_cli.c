@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "app/cli_options.h"
 #include "base/result.h"
 #include "image/image.h"
 #include "test.h"
@@ -207,6 +208,45 @@ static void test_bad_input(void)
     CHECK_INT(file_count(), ok_files);
 }
 
+/* --denoise's value is optional: given with '=' or as the next argument if
+ * that is a quality (else the argument is an operand); ptr denoise is a
+ * merge of one image with --denoise's default, or the quality given. */
+static void test_denoise_options(void)
+{
+    struct {
+        const char *args[6];
+        int parsed, inputs, command;
+        PtrDenoiseQuality quality;
+    } cases[] = {
+        { { "s.gltf", "--denoise", "fast", "-o", "x.exr" }, 1, 1, 0, PTR_DENOISE_FAST },
+        { { "--denoise", "s.gltf", "-o", "x.exr" }, 1, 1, 0, PTR_DENOISE_BALANCED },
+        { { "--denoise=high", "s.gltf", "-o", "x.exr" }, 1, 1, 0, PTR_DENOISE_HIGH },
+        { { "--denoise", "high", "fast.gltf", "-o", "x.exr" }, 1, 1, 0, PTR_DENOISE_HIGH },
+        { { "s.gltf", "-o", "x.exr", "--denoise=slow" }, 0, 0, 0, 0 },
+        { { "denoise", "in.exr", "-o", "x.exr" }, 1, 1, 1, PTR_DENOISE_BALANCED },
+        { { "denoise", "in.exr", "-o", "x.exr", "--denoise", "fast" }, 1, 1, 1, PTR_DENOISE_FAST },
+        { { "denoise", "a.exr", "b.exr", "-o", "x.exr" }, 0, 0, 0, 0 },
+        { { "denoise", "-o", "x.exr" }, 0, 0, 0, 0 },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char *argv[8] = { "ptr" };
+        int argc = 1;
+        for (int k = 0; k < 6 && cases[i].args[k]; k++)
+            argv[argc++] = (char *)cases[i].args[k];
+        PtrOptions o;
+        PtrError err;
+        PtrResult res = ptr_options_parse(argc, argv, &o, &err);
+        CHECK_INT(res, cases[i].parsed ? PTR_OK : PTR_ERR_USAGE);
+        if (res != PTR_OK || !cases[i].parsed)
+            continue;
+        CHECK_INT(o.input_count, cases[i].inputs);
+        CHECK(o.denoise != NULL);
+        CHECK_INT(o.denoise_quality, cases[i].quality);
+        CHECK_INT(o.denoise_command, cases[i].command);
+        CHECK_INT(o.merge, cases[i].command);
+    }
+}
+
 /* Image module loaders are their owners' alone: one freed leaves another
  * working, and a caller without one reads EXR only, whatever another has
  * loaded in the same process. */
@@ -240,6 +280,7 @@ int main(void)
         TEST_CASE(test_png_and_options),
         TEST_CASE(test_orthographic_option),
         TEST_CASE(test_bad_input),
+        TEST_CASE(test_denoise_options),
         TEST_CASE(test_image_loaders),
     };
     TEST_RUN(cases);
