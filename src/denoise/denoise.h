@@ -52,7 +52,7 @@ PtrResult ptr_denoise(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
  * which overlap by PTR_DENOISE_OVERLAP pixels, more than half its receptive
  * field, and start at multiples of 16: each output pixel is computed from
  * the same values in the same order as in one tile of the whole image, so
- * the tiles bound memory (about 170 MB for the default network) without
+ * the tiles bound memory (about 190 MB for the default network) without
  * changing a bit of the result. The tiling depends only on the image's size. */
 enum { PTR_DENOISE_TILE = 512, PTR_DENOISE_OVERLAP = 96 };
 

@@ -196,6 +196,8 @@ static void run_conv_rows(void *arg, size_t y0, size_t y1)
 {
     const Step *s = arg;
     size_t in = s->conv->in, out = s->conv->out;
+    if (y0 == y1) /* more threads than rows: the kernels are not asked for none */
+        return;
     s->unet->table.conv3x3(s->dst + ((y0 + 1) * (s->width + 2) + 1) * out,
                            s->src + y0 * (s->width + 2) * in, s->conv->weights, s->conv->bias,
                            s->width, y1 - y0, in, out, s->relu);
