@@ -1,0 +1,236 @@
+#include "denoise/denoise.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "base/module.h"
+#include "base/threads.h"
+#include "denoise/transfer.h"
+#include "denoise/unet.h"
+
+struct PtrDenoiser {
+    PtrUnet *unet;
+};
+
+PtrResult ptr_denoise_quality_parse(const char *text, PtrDenoiseQuality *out, PtrError *err)
+{
+    static const char *const names[] = { "fast", "balanced", "high" };
+    for (int q = 0; q < 3; q++)
+        if (!strcmp(text, names[q])) {
+            *out = (PtrDenoiseQuality)q;
+            return PTR_OK;
+        }
+    return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not fast, balanced or high", text);
+}
+
+static int is_dir(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/* The folder of the weights: weights_dir, else $PTR_WEIGHTS_DIR, else
+ * share/ptr/weights beside the executable's bin/ (an installation moved
+ * elsewhere), else under the prefix ptr was built for. */
+static PtrResult weights_folder(const char *weights_dir, char *path, size_t size, PtrError *err)
+{
+    const char *env = getenv("PTR_WEIGHTS_DIR");
+    const char *chosen = weights_dir ? weights_dir : env && *env ? env : NULL;
+    if (!chosen) {
+        if (ptr_module_path("../share/ptr/weights", "denoiser's weights", path, size, NULL) ==
+                PTR_OK &&
+            is_dir(path))
+            return PTR_OK;
+        chosen = PTR_INSTALL_PREFIX "/share/ptr/weights";
+    }
+    if ((size_t)snprintf(path, size, "%s", chosen) >= size)
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: path too long for the weights' folder",
+                             chosen);
+    return PTR_OK;
+}
+
+PtrResult ptr_denoiser_new(PtrDenoiseQuality quality, const char *weights_dir,
+                           PtrCpuLevel level, PtrDenoiser **out, PtrError *err)
+{
+    if (quality == PTR_DENOISE_HIGH)
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "denoising quality 'high' is not available yet (it needs the large "
+                             "networks' filtering of albedo and normal first): use balanced or "
+                             "fast");
+    char folder[4096], path[4096 + 64];
+    PtrResult res = weights_folder(weights_dir, folder, sizeof folder, err);
+    if (res != PTR_OK)
+        return res;
+    snprintf(path, sizeof path, "%s/%s", folder,
+             quality == PTR_DENOISE_FAST ? "rt_hdr_alb_nrm_small.tza" : "rt_hdr_alb_nrm.tza");
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return ptr_error_set(err, PTR_ERR_INSTALL,
+                             "%s: no such weight file: scripts/install-deps.sh installs the "
+                             "denoiser's weights (or set PTR_WEIGHTS_DIR to their folder)",
+                             path);
+    PtrDenoiser *denoiser = malloc(sizeof *denoiser);
+    if (!denoiser)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoiser");
+    res = ptr_unet_load(path, level, &denoiser->unet, err);
+    if (res != PTR_OK) {
+        free(denoiser);
+        return res;
+    }
+    *out = denoiser;
+    return PTR_OK;
+}
+
+void ptr_denoiser_free(PtrDenoiser *denoiser)
+{
+    if (!denoiser)
+        return;
+    ptr_unet_free(denoiser->unet);
+    free(denoiser);
+}
+
+/* One dimension's tiles: tile j reads the image from begin, size pixels
+ * (padded to a multiple of 16 with zeros), and keeps out_begin .. out_end. */
+typedef struct Span {
+    size_t begin, size, out_begin, out_end;
+} Span;
+
+static size_t round_up16(size_t n)
+{
+    return (n + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
+}
+
+static size_t tile_count(size_t n, size_t tile)
+{
+    size_t stride = tile - 2 * PTR_DENOISE_OVERLAP;
+    return round_up16(n) <= tile ? 1 : 1 + (n - tile + stride - 1) / stride;
+}
+
+static Span tile_span(size_t n, size_t tile, size_t count, size_t j)
+{
+    if (count == 1)
+        return (Span){ 0, n, 0, n };
+    size_t begin = j * (tile - 2 * PTR_DENOISE_OVERLAP);
+    Span s = { begin, n - begin < tile ? n - begin : tile, begin + PTR_DENOISE_OVERLAP,
+               begin + tile - PTR_DENOISE_OVERLAP };
+    if (j == 0)
+        s.out_begin = 0;
+    if (j == count - 1)
+        s.out_end = n;
+    return s;
+}
+
+/* A tile's work beyond the network, row by row, for ptr_parallel_ranges. */
+typedef struct TileJob {
+    const PtrDenoiseInput *input;
+    PtrTransfer transfer;
+    Span x, y;
+    size_t map_width; /* the tile's padded width */
+    float *map;       /* the network's input, or its output */
+    float *result;    /* the whole image's denoised RGB */
+} TileJob;
+
+static void fill_input_rows(void *arg, size_t from, size_t to)
+{
+    const TileJob *job = arg;
+    const PtrDenoiseInput *in = job->input;
+    for (size_t ty = from; ty < to; ty++) {
+        float *row = job->map + ((ty + 1) * (job->map_width + 2) + 1) * PTR_CONV_BLOCK;
+        for (size_t tx = 0; tx < job->x.size; tx++) {
+            size_t i = (job->y.begin + ty) * in->width + job->x.begin + tx;
+            ptr_transfer_input(&job->transfer, in->color + i * in->color_stride,
+                               in->albedo + i * in->albedo_stride,
+                               in->normal + i * in->normal_stride, row + tx * PTR_CONV_BLOCK);
+        }
+    }
+}
+
+static void keep_output_rows(void *arg, size_t from, size_t to)
+{
+    const TileJob *job = arg;
+    size_t width = job->input->width;
+    for (size_t y = from; y < to; y++) {
+        size_t ty = y - job->y.begin;
+        for (size_t x = job->x.out_begin; x < job->x.out_end; x++) {
+            size_t tx = x - job->x.begin;
+            ptr_transfer_output(&job->transfer,
+                                job->map + ((ty + 1) * (job->map_width + 2) + tx + 1) *
+                                               PTR_CONV_BLOCK,
+                                job->result + (y * width + x) * 3);
+        }
+    }
+}
+
+/* Runs the network on one tile into job->result. */
+static PtrResult denoise_tile(const PtrDenoiser *denoiser, TileJob *job, int threads,
+                              PtrError *err)
+{
+    size_t w = round_up16(job->x.size), h = round_up16(job->y.size);
+    size_t floats = ptr_unet_map_floats(w, h, PTR_CONV_BLOCK);
+    size_t bytes = (floats * sizeof(float) + 63) / 64 * 64;
+    float *input = aligned_alloc(64, bytes), *output = aligned_alloc(64, bytes);
+    PtrResult res = PTR_ERR_NOMEM;
+    if (input && output) {
+        memset(input, 0, bytes);
+        memset(output, 0, bytes);
+        job->map_width = w;
+        job->map = input;
+        ptr_parallel_ranges(threads, 0, job->y.size, fill_input_rows, job);
+        res = ptr_unet_run(denoiser->unet, input, w, h, threads, output, err);
+        job->map = output;
+        if (res == PTR_OK)
+            ptr_parallel_ranges(threads, job->y.out_begin, job->y.out_end, keep_output_rows, job);
+    } else {
+        ptr_error_set(err, res, "out of memory for the denoiser's tile of %zux%zu pixels", w, h);
+    }
+    free(input);
+    free(output);
+    return res;
+}
+
+PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
+                            size_t tile, int threads, float *out, size_t out_stride,
+                            PtrError *err)
+{
+    if (tile % PTR_UNET_ALIGNMENT || tile <= 2 * PTR_DENOISE_OVERLAP)
+        return ptr_error_set(err, PTR_ERR_INTERNAL,
+                             "denoiser tiles of %zu pixels: not a multiple of 16 above %d", tile,
+                             2 * PTR_DENOISE_OVERLAP);
+    size_t width = input->width, height = input->height;
+    if (!width || !height)
+        return PTR_OK;
+    /* The tiles read the input where others have written their output: the
+     * result is gathered apart and copied out at the end, so that out may be
+     * the colour's own buffer. */
+    if (width * height > SIZE_MAX / (3 * sizeof(float)))
+        return ptr_error_set(err, PTR_ERR_NOMEM, "an image of %zux%zu pixels is too large",
+                             width, height);
+    float *result = malloc(width * height * 3 * sizeof(float));
+    if (!result)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoised image");
+    TileJob job = { .input = input, .result = result };
+    ptr_transfer_init(&job.transfer,
+                      ptr_autoexposure(input->color, input->color_stride, width, height));
+    size_t columns = tile_count(width, tile), rows = tile_count(height, tile);
+    PtrResult res = PTR_OK;
+    for (size_t j = 0; res == PTR_OK && j < rows; j++)
+        for (size_t i = 0; res == PTR_OK && i < columns; i++) {
+            job.y = tile_span(height, tile, rows, j);
+            job.x = tile_span(width, tile, columns, i);
+            res = denoise_tile(denoiser, &job, threads, err);
+        }
+    if (res == PTR_OK)
+        for (size_t p = 0; p < width * height; p++)
+            memcpy(out + p * out_stride, result + p * 3, 3 * sizeof(float));
+    free(result);
+    return res;
+}
+
+PtrResult ptr_denoise(const PtrDenoiser *denoiser, const PtrDenoiseInput *input, int threads,
+                      float *out, size_t out_stride, PtrError *err)
+{
+    return ptr_denoise_tiled(denoiser, input, PTR_DENOISE_TILE, threads, out, out_stride, err);
+}

@@ -1,0 +1,79 @@
+/* Open Image Denoise's U-Net, built from the tensors of a weight archive and
+ * run on one tile: 16 3x3 convolutions (ReLU after all but the last), four
+ * 2x2 max-poolings on the way down, four nearest-neighbour upsamplings on
+ * the way up, each followed by the concatenation of the encoder's feature
+ * map of that size (docs/denoise.md). */
+#ifndef PTR_UNET_H
+#define PTR_UNET_H
+
+#include <stddef.h>
+
+#include "base/cpu.h"
+#include "base/result.h"
+#include "denoise/conv.h"
+
+/* The network's input: colour, albedo and normal, three channels each, in
+ * channels 0..8 of PTR_CONV_BLOCK; its output: colour, channels 0..2. */
+enum { PTR_UNET_INPUT_CHANNELS = 9, PTR_UNET_OUTPUT_CHANNELS = 3 };
+
+/* Four poolings: a tile's sides are multiples of 16. */
+enum { PTR_UNET_ALIGNMENT = 16 };
+
+/* The convolutions in the order they run: encoder convolution k (0 to 4)
+ * is number k, and the decoder's come in pairs, a and b, a level each. */
+enum {
+    PTR_UNET_ENC_CONV0, PTR_UNET_ENC_CONV1, PTR_UNET_ENC_CONV2, PTR_UNET_ENC_CONV3,
+    PTR_UNET_ENC_CONV4, PTR_UNET_ENC_CONV5A, PTR_UNET_ENC_CONV5B,
+    PTR_UNET_DEC_CONV4A, PTR_UNET_DEC_CONV4B, PTR_UNET_DEC_CONV3A, PTR_UNET_DEC_CONV3B,
+    PTR_UNET_DEC_CONV2A, PTR_UNET_DEC_CONV2B, PTR_UNET_DEC_CONV1A, PTR_UNET_DEC_CONV1B,
+    PTR_UNET_DEC_CONV0, PTR_UNET_CONVS
+};
+
+typedef struct PtrUnetConv {
+    size_t in, out; /* padded channels, multiples of PTR_CONV_BLOCK */
+    float *weights; /* packed (conv.h) */
+    float *bias;    /* out floats, zero past the tensor's */
+} PtrUnetConv;
+
+typedef struct PtrUnet {
+    PtrUnetConv conv[PTR_UNET_CONVS];
+    PtrConvTable table;
+} PtrUnet;
+
+/* The network whose weights are in the archive at path, its convolutions
+ * run through the kernel table of this CPU level. PTR_ERR_INSTALL naming
+ * the file for a tensor missing or of a shape other than the U-Net's;
+ * PTR_ERR_NOMEM. */
+PtrResult ptr_unet_load(const char *path, PtrCpuLevel level, PtrUnet **out, PtrError *err);
+
+void ptr_unet_free(PtrUnet *unet);
+
+/* Floats of a feature map of width x height pixels and channels channels,
+ * with its border (conv.h). */
+static inline size_t ptr_unet_map_floats(size_t width, size_t height, size_t channels)
+{
+    return (width + 2) * (height + 2) * channels;
+}
+
+/* Runs the network on a tile of width x height pixels (multiples of
+ * PTR_UNET_ALIGNMENT): input is a feature map of PTR_CONV_BLOCK channels
+ * (its border zero), output one of PTR_CONV_BLOCK channels too, of which
+ * the first PTR_UNET_OUTPUT_CHANNELS hold the result. Each layer's rows are
+ * split between threads threads; the result does not depend on how.
+ * PTR_ERR_NOMEM. */
+PtrResult ptr_unet_run(const PtrUnet *unet, const float *input, size_t width, size_t height,
+                       int threads, float *output, PtrError *err);
+
+/* The network's two resamplings, on feature maps with borders (only their
+ * interiors are written), rows y0 .. y1 - 1 of the output:
+ * 2x2 max-pooling of a map of 2*width x 2*height into width x height... */
+void ptr_unet_pool(float *dst, const float *src, size_t width, size_t channels, size_t y0,
+                   size_t y1);
+
+/* ...and nearest upsampling of a map of width/2 x height/2 with up_channels
+ * channels, concatenated with a map of width x height with skip_channels:
+ * dst has up_channels + skip_channels. */
+void ptr_unet_upsample_concat(float *dst, const float *up, size_t up_channels, const float *skip,
+                              size_t skip_channels, size_t width, size_t y0, size_t y1);
+
+#endif /* PTR_UNET_H */

@@ -1,0 +1,113 @@
+"""ptr's denoiser (through denoise_raw) against the NumPy reference
+(denoise_reference.py) on small images that are not multiples of 16: random
+HDR colour with a few very bright pixels, albedo and unit normals, to 1e-4
+relative, with the default and the small network. Then the same output, byte
+for byte, at every CPU level ($PTR_CPUMASK: none, sse41, avx2, or only the
+one the environment sets), with 1 and 2 threads, and cut into tiles across
+and down. Skipped (77) when the weights are not installed, or NumPy is not."""
+import os
+import subprocess
+import sys
+import tempfile
+
+try:
+    import numpy as np
+except ImportError:
+    print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
+    sys.exit(77)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import denoise_reference  # noqa: E402
+
+WEIGHTS = {"balanced": "rt_hdr_alb_nrm.tza", "fast": "rt_hdr_alb_nrm_small.tza"}
+TOLERANCE = 1e-4
+
+denoise_raw = sys.argv[2]
+weights_dir = os.environ.get("PTR_WEIGHTS_DIR", "")
+if not all(os.path.isfile(os.path.join(weights_dir, f)) for f in WEIGHTS.values()):
+    print(f"skipped: the denoiser's weights are not in '{weights_dir}' "
+          "(scripts/install-deps.sh installs them)")
+    sys.exit(77)
+
+failures = []
+work = tempfile.mkdtemp(prefix="ptr_denoise_")
+
+
+def scene(width, height, seed):
+    """Noisy HDR colour with a few very bright pixels, albedo in [0, 1],
+    unit normals (and one pixel that hit nothing), as float32."""
+    rng = np.random.default_rng(seed)
+    color = rng.gamma(0.8, 0.6, (height, width, 3))
+    for _ in range(3):
+        color[rng.integers(height), rng.integers(width)] = rng.uniform(1e2, 3e4, 3)
+    albedo = rng.uniform(0.0, 1.0, (height, width, 3))
+    normal = rng.normal(size=(height, width, 3))
+    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+    normal[0, 0] = 0.0
+    return [a.astype("<f4") for a in (color, albedo, normal)]
+
+
+def run_ptr(quality, images, threads=1, tile=0, level=None):
+    """ptr's denoised image, as raw bytes."""
+    height, width, _ = images[0].shape
+    paths = [os.path.join(work, name) for name in ("color", "albedo", "normal", "out")]
+    for image, path in zip(images, paths):
+        image.tofile(path)
+    env = dict(os.environ)
+    if level:
+        env["PTR_CPUMASK"] = level
+    done = subprocess.run([denoise_raw, quality, str(width), str(height), str(threads),
+                           str(tile)] + paths, env=env, capture_output=True, text=True)
+    if done.returncode == 77:
+        print(done.stderr.strip())
+        sys.exit(77)
+    if done.returncode != 0:
+        sys.exit(f"denoise_raw failed: {done.stderr.strip()}")
+    return open(paths[3], "rb").read()
+
+
+def compare_with_reference(quality, width, height, seed):
+    images = scene(width, height, seed)
+    tensors = denoise_reference.read_tza(os.path.join(weights_dir, WEIGHTS[quality]))
+    expected = denoise_reference.denoise(tensors, *(a.astype(np.float64) for a in images))
+    got = np.frombuffer(run_ptr(quality, images), dtype="<f4").reshape(height, width, 3)
+    relative = np.abs(got - expected) / np.abs(expected)
+    worst = np.unravel_index(np.argmax(relative), relative.shape)
+    print(f"{quality} {width}x{height}: largest relative difference {relative.max():.3g} "
+          f"at {worst} (ptr {got[worst]:.9g}, NumPy {expected[worst]:.9g})")
+    if not relative.max() <= TOLERANCE:
+        failures.append(f"{quality} {width}x{height}: {relative.max():.3g} > {TOLERANCE}")
+
+
+def check_same(what, outputs):
+    """outputs: (label, bytes); all must be the first's."""
+    first_label, first = outputs[0]
+    differ = [label for label, data in outputs[1:] if data != first]
+    failures.extend(f"{what}: {label} differs from {first_label}" for label in differ)
+    print(f"{what}: {'; '.join(label for label, _ in outputs)}: "
+          f"{'differ' if differ else 'identical'}")
+
+
+compare_with_reference("balanced", 40, 24, 1)
+compare_with_reference("balanced", 70, 50, 2)
+compare_with_reference("fast", 70, 50, 3)
+
+levels = [os.environ["PTR_CPUMASK"]] if os.environ.get("PTR_CPUMASK") else ["none", "sse41",
+                                                                            "avx2"]
+images = scene(40, 24, 1)
+check_same("levels and threads",
+           [(f"{level} with {threads} thread(s)", run_ptr("balanced", images, threads, 0, level))
+            for level in levels for threads in (1, 2)])
+
+# Tiles of 208 pixels (the smallest: 16 beyond twice the overlap) across a
+# 224-pixel side make two; each pixel is the untiled image's, bit for bit.
+for width, height in ((224, 24), (24, 224)):
+    images = scene(width, height, 4)
+    check_same(f"tiles of {width}x{height}",
+               [("one tile", run_ptr("fast", images)),
+                ("tiles of 208", run_ptr("fast", images, 1, 208)),
+                ("tiles of 208, 2 threads", run_ptr("fast", images, 2, 208))])
+
+for failure in failures:
+    print("FAILED:", failure)
+sys.exit(1 if failures else 0)

@@ -1,0 +1,184 @@
+/* The denoiser's parts that have closed forms (denoise/transfer.h,
+ * denoise/unet.h): the PU transfer function and its inverse, the exposure
+ * of constant images, pooling and upsampling; its errors: a quality that
+ * does not exist or is not there yet, a missing weight file, an archive
+ * whose tensors are not the U-Net's. The network itself is checked against
+ * NumPy by check_denoise_network. */
+#include "denoise/denoise.h"
+#include "denoise/transfer.h"
+#include "denoise/unet.h"
+#include "test.h"
+
+#include <unistd.h>
+
+static void pu_round_trip(void)
+{
+    for (float y = 1e-9f; y < 65504.0f; y *= 1.37f) {
+        float back = ptr_pu_inverse(ptr_pu_forward(y));
+        CHECK_NEAR(back / y, 1.0, 2e-5);
+    }
+    CHECK_FLOAT_EQ(ptr_pu_forward(0.0f), 0.0f);
+    /* The three pieces meet where the curve's constants say. */
+    CHECK_NEAR(ptr_pu_forward(1.57945760e-06f), 2.23151711e-03, 1e-8);
+    CHECK_NEAR(ptr_pu_forward(3.22087631e-02f), 3.70974749e-01, 1e-6);
+    PtrTransfer t;
+    ptr_transfer_init(&t, 2.0f);
+    float color[3] = { 65504.0f / 2, 1.0f, 0.0f }, albedo[3] = { -1.0f, 0.5f, 2.0f },
+          normal[3] = { -2.0f, 0.0f, NAN }, in[9], out[3];
+    ptr_transfer_input(&t, color, albedo, normal, in);
+    CHECK_NEAR(in[0], 1.0, 1e-6); /* the largest value maps to 1 */
+    CHECK_FLOAT_EQ(in[2], 0.0f);
+    CHECK_FLOAT_EQ(in[3], 0.0f);
+    CHECK_FLOAT_EQ(in[4], 0.5f);
+    CHECK_FLOAT_EQ(in[5], 1.0f);
+    CHECK_FLOAT_EQ(in[6], 0.0f);
+    CHECK_FLOAT_EQ(in[7], 0.5f);
+    CHECK_FLOAT_EQ(in[8], 0.5f);
+    ptr_transfer_output(&t, in, out);
+    for (int k = 0; k < 3; k++)
+        CHECK_NEAR(out[k], color[k], 2e-5 * color[k]);
+}
+
+static void autoexposure_of_constant_images(void)
+{
+    enum { W = 37, H = 21 };
+    static float image[W * H * 4];
+    for (size_t i = 0; i < W * H; i++) {
+        image[4 * i] = 0.5f;
+        image[4 * i + 1] = 2.0f;
+        image[4 * i + 2] = 4.0f;
+        image[4 * i + 3] = NAN; /* the fourth float is not read */
+    }
+    double luminance = 0.212671 * 0.5 + 0.715160 * 2.0 + 0.072169 * 4.0;
+    CHECK_NEAR(ptr_autoexposure(image, 4, W, H), 0.18 / luminance, 1e-6);
+    memset(image, 0, sizeof image);
+    CHECK_FLOAT_EQ(ptr_autoexposure(image, 4, W, H), 1.0f);
+}
+
+static void pooling_and_upsampling(void)
+{
+    enum { C = PTR_CONV_BLOCK, W = 4, H = 4 };
+    float src[(W + 2) * (H + 2) * C] = { 0 }, pooled[(W / 2 + 2) * (H / 2 + 2) * C] = { 0 };
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < C; c++)
+                src[((y + 1) * (W + 2) + x + 1) * C + c] = (float)((y * 7 + x * 3) % 5 - c);
+    ptr_unet_pool(pooled, src, W / 2, C, 0, H / 2);
+    for (int y = 0; y < H / 2; y++)
+        for (int x = 0; x < W / 2; x++)
+            for (int c = 0; c < C; c++) {
+                float m = -1e30f;
+                for (int k = 0; k < 4; k++) {
+                    float v = (float)(((2 * y + k / 2) * 7 + (2 * x + k % 2) * 3) % 5 - c);
+                    m = v > m ? v : m;
+                }
+                CHECK_FLOAT_EQ(pooled[((y + 1) * (W / 2 + 2) + x + 1) * C + c], m);
+            }
+    float joined[(W + 2) * (H + 2) * 2 * C] = { 0 };
+    ptr_unet_upsample_concat(joined, pooled, C, src, C, W, 0, H);
+    for (int y = 0; y < H + 2; y++)
+        for (int x = 0; x < W + 2; x++)
+            for (int c = 0; c < 2 * C; c++) {
+                float got = joined[(y * (W + 2) + x) * 2 * C + c];
+                int inside = y > 0 && y <= H && x > 0 && x <= W;
+                float want = !inside ? 0.0f
+                             : c < C ? pooled[(((y - 1) / 2 + 1) * (W / 2 + 2) + (x - 1) / 2 + 1) * C + c]
+                                     : src[(y * (W + 2) + x) * C + c - C];
+                CHECK_FLOAT_EQ(got, want);
+            }
+}
+
+static void qualities(void)
+{
+    PtrDenoiseQuality q;
+    PtrError err;
+    CHECK_INT(ptr_denoise_quality_parse("fast", &q, NULL), PTR_OK);
+    CHECK_INT(q, PTR_DENOISE_FAST);
+    CHECK_INT(ptr_denoise_quality_parse("balanced", &q, NULL), PTR_OK);
+    CHECK_INT(q, PTR_DENOISE_BALANCED);
+    CHECK_INT(ptr_denoise_quality_parse("high", &q, NULL), PTR_OK);
+    CHECK_INT(q, PTR_DENOISE_HIGH);
+    CHECK_INT(ptr_denoise_quality_parse("best", &q, &err), PTR_ERR_USAGE);
+    CHECK(strstr(err.message, "'best'") != NULL);
+    PtrDenoiser *d = NULL;
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_HIGH, NULL, PTR_CPU_NONE, &d, &err), PTR_ERR_USAGE);
+    CHECK(strstr(err.message, "not available yet") != NULL);
+    CHECK(d == NULL);
+}
+
+static void missing_weights(void)
+{
+    PtrDenoiser *d = NULL;
+    PtrError err;
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_BALANCED, "/nonexistent/weights", PTR_CPU_NONE, &d,
+                               &err),
+              PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, "/nonexistent/weights/rt_hdr_alb_nrm.tza") != NULL);
+    CHECK(strstr(err.message, "scripts/install-deps.sh") != NULL);
+    CHECK(d == NULL);
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_FAST, "/nonexistent/weights", PTR_CPU_NONE, &d, NULL),
+              PTR_ERR_INSTALL);
+}
+
+/* Writes an archive of one layer, enc_conv0, with in input channels. */
+static void write_one_layer(const char *path, uint32_t in)
+{
+    FILE *f = fopen(path, "wb");
+    uint32_t out = 32, count = out * in * 9;
+    unsigned char header[16] = { 0xD7, 0x41, 2, 0 };
+    uint64_t table = 64 + ((uint64_t)count * 4 + 63) / 64 * 64 + 128;
+    memcpy(header + 4, &table, 8); /* the test runs on little-endian x86-64 */
+    fwrite(header, 1, 12, f);
+    for (long at = 12; at < (long)table; at++)
+        fputc(0, f);
+    uint32_t n = 2;
+    fwrite(&n, 4, 1, f);
+    const char *names[2] = { "enc_conv0.weight", "enc_conv0.bias" };
+    uint64_t offsets[2] = { 64, table - 128 };
+    for (int t = 0; t < 2; t++) {
+        uint16_t length = (uint16_t)strlen(names[t]);
+        fwrite(&length, 2, 1, f);
+        fwrite(names[t], 1, length, f);
+        unsigned char ndims = t ? 1 : 4;
+        fputc(ndims, f);
+        uint32_t dims[4] = { out, in, 3, 3 };
+        fwrite(dims, 4, ndims, f);
+        fwrite(t ? "x" : "oihw", 1, ndims, f);
+        fputc('f', f);
+        fwrite(&offsets[t], 8, 1, f);
+    }
+    fclose(f);
+}
+
+static void archives_not_a_unet(void)
+{
+    char dir[] = "/tmp/ptr_denoise_XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[64];
+    snprintf(path, sizeof path, "%s/rt_hdr_alb_nrm.tza", dir);
+    PtrDenoiser *d = NULL;
+    PtrError err;
+    write_one_layer(path, 8); /* the input has 9 channels */
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_BALANCED, dir, PTR_CPU_NONE, &d, &err),
+              PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, path) != NULL);
+    CHECK(strstr(err.message, "enc_conv0.weight") != NULL);
+    write_one_layer(path, 9); /* right, but the rest is missing */
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_BALANCED, dir, PTR_CPU_NONE, &d, &err),
+              PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, "no tensor enc_conv1.weight") != NULL);
+    CHECK(d == NULL);
+    unlink(path);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    static const TestCase cases[] = {
+        TEST_CASE(pu_round_trip),   TEST_CASE(autoexposure_of_constant_images),
+        TEST_CASE(pooling_and_upsampling), TEST_CASE(qualities),
+        TEST_CASE(missing_weights), TEST_CASE(archives_not_a_unet),
+    };
+    TEST_RUN(cases);
+    return test_report();
+}
