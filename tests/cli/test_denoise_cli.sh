@@ -5,7 +5,7 @@
 # come from $PTR_WEIGHTS_DIR, else where scripts/install-deps.sh puts them;
 # without them only the missing-weights error is checked, and the test is
 # skipped. Needs iinfo, idiff and oiiotool (openimageio-tools).
-# Usage: test_denoise.sh PTR SOURCE_DIR
+# Usage: test_denoise_cli.sh PTR SOURCE_DIR
 set -u
 ptr=$1
 src=$2
@@ -51,8 +51,8 @@ done
 grep -q 'ptr:denoised: "balanced"' "$dir/info" || fail "--denoise: no ptr:denoised in the header"
 
 # Its noisy layer is the plain render's colour, and the denoised colour is
-# another, closer to a 1024-sample render: its RMS error at most 0.7 times
-# the noisy colour's.
+# another, closer to a 1024-sample render: its RMS error at most 0.8 times
+# the noisy colour's (0.65 with OIDN's default network on this image).
 render --samples 4 -o "$dir/noisy.exr" || fail "plain render: exit code $?"
 render --samples 1024 -o "$dir/reference.exr" || fail "reference: exit code $?"
 channels "$dir/denoised.exr" "$dir/rgb.exr" R,G,B
@@ -61,8 +61,8 @@ same "$dir/noisy.exr" "$dir/noisy_layer.exr" || fail "noisy.R/G/B is not the ren
 same "$dir/noisy.exr" "$dir/rgb.exr" && fail "the denoised colour is the noisy one"
 noisy_error=$(rms "$dir/reference.exr" "$dir/noisy.exr")
 denoised_error=$(rms "$dir/reference.exr" "$dir/rgb.exr")
-awk "BEGIN { exit !($denoised_error <= 0.7 * $noisy_error) }" ||
-    fail "denoised RMS error $denoised_error, not at most 0.7 x the noisy $noisy_error"
+awk "BEGIN { exit !($denoised_error <= 0.8 * $noisy_error) }" ||
+    fail "denoised RMS error $denoised_error, not at most 0.8 x the noisy $noisy_error"
 
 # ptr denoise on the render with its passes gives the --denoise render; on
 # a denoised image, the same again from its noisy layer.
@@ -112,8 +112,8 @@ idiff -a -fail 1e-5 "$dir/denoised.exr" "$dir/ranges.exr" >/dev/null 2>&1 ||
 # --transparent: the colour denoised, alpha exactly the render's, in EXR
 # (premultiplied colour) as in PNG (straight).
 for ext in exr png; do
-    render --samples 4 --transparent -o "$dir/clear.$ext" &&
-        render --samples 4 --transparent --denoise -o "$dir/clear_denoised.$ext" ||
+    render --width 16 --samples 4 --transparent -o "$dir/clear.$ext" &&
+        render --width 16 --samples 4 --transparent --denoise -o "$dir/clear_denoised.$ext" ||
         fail "--transparent --denoise to .$ext: exit code $?"
     channels "$dir/clear.$ext" "$dir/alpha.$ext" A
     channels "$dir/clear_denoised.$ext" "$dir/alpha_denoised.$ext" A
@@ -121,7 +121,8 @@ for ext in exr png; do
 done
 
 # A sequence: every frame denoised.
-render --samples 2 --turntable 2 --denoise -o "$dir/turn_#.exr" || fail "--turntable: exit code $?"
+render --width 16 --samples 2 --turntable 2 --denoise -o "$dir/turn_#.exr" ||
+    fail "--turntable: exit code $?"
 for frame in 0 1; do
     iinfo -v "$dir/turn_$frame.exr" | grep -q 'ptr:denoised: "balanced"' ||
         fail "frame $frame of a sequence not denoised"
