@@ -1,9 +1,9 @@
 /* The denoiser's parts that have closed forms (denoise/transfer.h,
  * denoise/unet.h): the PU transfer function and its inverse, the exposure
  * of constant images, pooling and upsampling; its errors: a quality that
- * does not exist or is not there yet, a missing weight file, an archive
- * whose tensors are not the U-Net's. The network itself is checked against
- * NumPy by check_denoise_network. */
+ * does not exist, a missing weight file (for each quality), an archive
+ * whose tensors are not the U-Net's. The networks themselves are checked
+ * against NumPy by check_denoise_network. */
 #include "denoise/denoise.h"
 #include "denoise/transfer.h"
 #include "denoise/unet.h"
@@ -100,10 +100,6 @@ static void qualities(void)
     CHECK_INT(q, PTR_DENOISE_HIGH);
     CHECK_INT(ptr_denoise_quality_parse("best", &q, &err), PTR_ERR_USAGE);
     CHECK(strstr(err.message, "'best'") != NULL);
-    PtrDenoiser *d = NULL;
-    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_HIGH, NULL, PTR_CPU_NONE, &d, &err), PTR_ERR_USAGE);
-    CHECK(strstr(err.message, "not available yet") != NULL);
-    CHECK(d == NULL);
 }
 
 static void missing_weights(void)
@@ -118,6 +114,11 @@ static void missing_weights(void)
     CHECK(d == NULL);
     CHECK_INT(ptr_denoiser_new(PTR_DENOISE_FAST, "/nonexistent/weights", PTR_CPU_NONE, &d, NULL),
               PTR_ERR_INSTALL);
+    /* High quality filters the albedo first. */
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_HIGH, "/nonexistent/weights", PTR_CPU_NONE, &d, &err),
+              PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, "/nonexistent/weights/rt_alb_large.tza") != NULL);
+    CHECK(d == NULL);
 }
 
 /* Writes an archive of one layer, enc_conv0, with in input channels. */
