@@ -200,13 +200,10 @@ static void keep_output_rows(void *arg, size_t from, size_t to)
 static PtrResult filter_tile(const PtrUnet *unet, TileJob *job, int threads, PtrError *err)
 {
     size_t w = round_up16(job->x.size), h = round_up16(job->y.size);
-    size_t floats = ptr_unet_map_floats(w, h, PTR_CONV_BLOCK);
-    size_t bytes = (floats * sizeof(float) + 63) / 64 * 64;
-    float *input = aligned_alloc(64, bytes), *output = aligned_alloc(64, bytes);
+    float *input = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
+    float *output = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
     PtrResult res = PTR_ERR_NOMEM;
     if (input && output) {
-        memset(input, 0, bytes);
-        memset(output, 0, bytes);
         job->map_width = w;
         job->map = input;
         ptr_parallel_ranges(threads, 0, job->y.size, fill_input_rows, job);

@@ -45,6 +45,11 @@ static float *zeroed_floats(size_t count)
     return p;
 }
 
+float *ptr_unet_map_new(size_t width, size_t height, size_t channels)
+{
+    return zeroed_floats((width + 2) * (height + 2) * channels);
+}
+
 /* The archive and where the build has come to: the channels of the map the
  * next convolution reads, the real ones and their padded count. */
 typedef struct Builder {
@@ -259,7 +264,7 @@ typedef struct Run {
  * set) when memory runs out. */
 static float *new_map(Run *run, size_t width, size_t height, size_t channels)
 {
-    float *map = zeroed_floats(ptr_unet_map_floats(width, height, channels));
+    float *map = ptr_unet_map_new(width, height, channels);
     if (!map)
         ptr_error_set(run->err, PTR_ERR_NOMEM,
                       "out of memory for the denoiser's feature maps (%zux%zu pixels)", width,

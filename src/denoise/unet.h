@@ -51,12 +51,9 @@ PtrResult ptr_unet_load(const char *path, size_t input_channels, PtrCpuLevel lev
 
 void ptr_unet_free(PtrUnet *unet);
 
-/* Floats of a feature map of width x height pixels and channels channels,
- * with its border (conv.h). */
-static inline size_t ptr_unet_map_floats(size_t width, size_t height, size_t channels)
-{
-    return (width + 2) * (height + 2) * channels;
-}
+/* A feature map of width x height pixels and channels channels with its
+ * border (conv.h), all zeros, 64-byte aligned (for free), or NULL. */
+float *ptr_unet_map_new(size_t width, size_t height, size_t channels);
 
 /* Runs the network on a tile of width x height pixels (multiples of
  * PTR_UNET_ALIGNMENT): input is a feature map of PTR_CONV_BLOCK channels

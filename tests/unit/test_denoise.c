@@ -1,5 +1,6 @@
 /* The denoiser's parts that have closed forms (denoise/transfer.h,
- * denoise/unet.h): the PU transfer function and its inverse, the exposure
+ * denoise/unet.h): the PU transfer function and its inverse, the guides'
+ * mappings for their own networks (sRGB, [-1, 1] to [0, 1]), the exposure
  * of constant images, pooling and upsampling; its errors: a quality that
  * does not exist, a missing weight file (for each quality), an archive
  * whose tensors are not the U-Net's. The networks themselves are checked
@@ -37,6 +38,33 @@ static void pu_round_trip(void)
     ptr_transfer_output(&t, in, out);
     for (int k = 0; k < 3; k++)
         CHECK_NEAR(out[k], color[k], 2e-5 * color[k]);
+}
+
+static void guides_round_trip(void)
+{
+    for (float y = 1e-6f; y <= 1.0f; y *= 1.21f)
+        CHECK_NEAR(ptr_srgb_inverse(ptr_srgb_forward(y)) / y, 1.0, 1e-5);
+    CHECK_NEAR(ptr_srgb_forward(1.0f), 1.0, 1e-6);
+    float albedo[3] = { 0.25f, 1.5f, NAN }, normal[3] = { -0.6f, 0.8f, 3.0f }, x[3], back[3];
+    ptr_transfer_albedo_input(albedo, x);
+    CHECK_NEAR(x[1], 1.0, 1e-6); /* clamped to 1 first */
+    CHECK_FLOAT_EQ(x[2], 0.0f);
+    ptr_transfer_albedo_output(x, back);
+    CHECK_NEAR(back[0], 0.25, 1e-6);
+    CHECK_FLOAT_EQ(back[1], 1.0f);
+    CHECK_FLOAT_EQ(back[2], 0.0f);
+    ptr_transfer_normal_input(normal, x);
+    CHECK_NEAR(x[0], 0.2, 1e-7);
+    CHECK_FLOAT_EQ(x[2], 1.0f);
+    ptr_transfer_normal_output(x, back);
+    CHECK_NEAR(back[0], -0.6, 1e-6);
+    CHECK_NEAR(back[1], 0.8, 1e-6);
+    CHECK_FLOAT_EQ(back[2], 1.0f);
+    float below[3] = { -1.0f, NAN, 7.0f }; /* a network's output out of range */
+    ptr_transfer_normal_output(below, back);
+    CHECK_FLOAT_EQ(back[0], -1.0f);
+    CHECK_FLOAT_EQ(back[1], -1.0f);
+    CHECK_FLOAT_EQ(back[2], 1.0f);
 }
 
 static void autoexposure_of_constant_images(void)
@@ -176,7 +204,8 @@ static void archives_not_a_unet(void)
 int main(void)
 {
     static const TestCase cases[] = {
-        TEST_CASE(pu_round_trip),   TEST_CASE(autoexposure_of_constant_images),
+        TEST_CASE(pu_round_trip),   TEST_CASE(guides_round_trip),
+        TEST_CASE(autoexposure_of_constant_images),
         TEST_CASE(pooling_and_upsampling), TEST_CASE(qualities),
         TEST_CASE(missing_weights), TEST_CASE(archives_not_a_unet),
     };
