@@ -7,13 +7,19 @@ for byte, at every CPU level ($PTR_CPUMASK: none, sse41, avx2, or only the
 one the environment sets), with 1 and 2 threads, and cut into tiles across
 and down. Skipped (77) when the weights are not installed, or NumPy is not."""
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
 
+SYSTEM_PYTHON = "/usr/bin/python3"
 try:
     import numpy as np
 except ImportError:
+    # scripts/install-deps.sh installs Debian's python3-numpy, which only
+    # Debian's own python3 imports, not one that comes first in PATH (pyenv).
+    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
     print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
     sys.exit(77)
 
@@ -61,11 +67,10 @@ def run_ptr(quality, images, threads=1, tile=0, level=None):
         env["PTR_CPUMASK"] = level
     done = subprocess.run([denoise_raw, quality, str(width), str(height), str(threads),
                            str(tile)] + paths, env=env, capture_output=True, text=True)
-    if done.returncode == 77:
-        print(done.stderr.strip())
-        sys.exit(77)
     if done.returncode != 0:
-        sys.exit(f"denoise_raw failed: {done.stderr.strip()}")
+        shutil.rmtree(work)
+        print(done.stderr.strip())
+        sys.exit(77 if done.returncode == 77 else 1)
     return open(paths[3], "rb").read()
 
 
@@ -114,6 +119,7 @@ for width, height in ((256, 24), (24, 256)):
                 ("tiles of 240", run_ptr("fast", images, 1, 240)),
                 ("tiles of 240, 2 threads", run_ptr("fast", images, 2, 240))])
 
+shutil.rmtree(work)
 for failure in failures:
     print("FAILED:", failure)
 sys.exit(1 if failures else 0)
