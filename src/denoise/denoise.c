@@ -11,8 +11,10 @@
 #include "denoise/transfer.h"
 #include "denoise/unet.h"
 
+/* The network that denoises the colour; for high quality, also those that
+ * filter the albedo and the normal first (otherwise NULL). */
 struct PtrDenoiser {
-    PtrUnet *unet;
+    PtrUnet *color, *albedo, *normal;
 };
 
 PtrResult ptr_denoise_quality_parse(const char *text, PtrDenoiseQuality *out, PtrError *err)
@@ -52,35 +54,47 @@ static PtrResult weights_folder(const char *weights_dir, char *path, size_t size
     return PTR_OK;
 }
 
-PtrResult ptr_denoiser_new(PtrDenoiseQuality quality, const char *weights_dir,
-                           PtrCpuLevel level, PtrDenoiser **out, PtrError *err)
+/* Loads the network of this file in folder into *out. */
+static PtrResult load(const char *folder, const char *file, size_t input_channels,
+                      PtrCpuLevel level, PtrUnet **out, PtrError *err)
 {
-    if (quality == PTR_DENOISE_HIGH)
-        return ptr_error_set(err, PTR_ERR_USAGE,
-                             "denoising quality 'high' is not available yet (it needs the large "
-                             "networks' filtering of albedo and normal first): use balanced or "
-                             "fast");
-    char folder[4096], path[4096 + 64];
-    PtrResult res = weights_folder(weights_dir, folder, sizeof folder, err);
-    if (res != PTR_OK)
-        return res;
-    snprintf(path, sizeof path, "%s/%s", folder,
-             quality == PTR_DENOISE_FAST ? "rt_hdr_alb_nrm_small.tza" : "rt_hdr_alb_nrm.tza");
+    char path[4096 + 64];
+    snprintf(path, sizeof path, "%s/%s", folder, file);
     struct stat st;
     if (stat(path, &st) != 0)
         return ptr_error_set(err, PTR_ERR_INSTALL,
                              "%s: no such weight file: scripts/install-deps.sh installs the "
                              "denoiser's weights (or set PTR_WEIGHTS_DIR to their folder)",
                              path);
-    PtrDenoiser *denoiser = malloc(sizeof *denoiser);
-    if (!denoiser)
+    return ptr_unet_load(path, input_channels, level, out, err);
+}
+
+PtrResult ptr_denoiser_new(PtrDenoiseQuality quality, const char *weights_dir,
+                           PtrCpuLevel level, PtrDenoiser **out, PtrError *err)
+{
+    char folder[4096];
+    PtrResult res = weights_folder(weights_dir, folder, sizeof folder, err);
+    if (res != PTR_OK)
+        return res;
+    PtrDenoiser *d = calloc(1, sizeof *d);
+    if (!d)
         return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoiser");
-    res = ptr_unet_load(path, level, &denoiser->unet, err);
+    if (quality == PTR_DENOISE_HIGH) {
+        res = load(folder, "rt_alb_large.tza", 3, level, &d->albedo, err);
+        if (res == PTR_OK)
+            res = load(folder, "rt_nrm_large.tza", 3, level, &d->normal, err);
+        if (res == PTR_OK)
+            res = load(folder, "rt_hdr_calb_cnrm_large.tza", 9, level, &d->color, err);
+    } else {
+        res = load(folder,
+                   quality == PTR_DENOISE_FAST ? "rt_hdr_alb_nrm_small.tza" : "rt_hdr_alb_nrm.tza",
+                   9, level, &d->color, err);
+    }
     if (res != PTR_OK) {
-        free(denoiser);
+        ptr_denoiser_free(d);
         return res;
     }
-    *out = denoiser;
+    *out = d;
     return PTR_OK;
 }
 
@@ -88,7 +102,9 @@ void ptr_denoiser_free(PtrDenoiser *denoiser)
 {
     if (!denoiser)
         return;
-    ptr_unet_free(denoiser->unet);
+    ptr_unet_free(denoiser->color);
+    ptr_unet_free(denoiser->albedo);
+    ptr_unet_free(denoiser->normal);
     free(denoiser);
 }
 
@@ -123,14 +139,19 @@ static Span tile_span(size_t n, size_t tile, size_t count, size_t j)
     return s;
 }
 
+/* What a network takes and gives: the colour guided by albedo and normal,
+ * or one guide alone. */
+typedef enum Mode { MODE_COLOR, MODE_ALBEDO, MODE_NORMAL } Mode;
+
 /* A tile's work beyond the network, row by row, for ptr_parallel_ranges. */
 typedef struct TileJob {
     const PtrDenoiseInput *input;
+    Mode mode;
     PtrTransfer transfer;
     Span x, y;
     size_t map_width; /* the tile's padded width */
     float *map;       /* the network's input, or its output */
-    float *result;    /* the whole image's denoised RGB */
+    float *result;    /* the whole image's filtered RGB */
 } TileJob;
 
 static void fill_input_rows(void *arg, size_t from, size_t to)
@@ -141,9 +162,15 @@ static void fill_input_rows(void *arg, size_t from, size_t to)
         float *row = job->map + ((ty + 1) * (job->map_width + 2) + 1) * PTR_CONV_BLOCK;
         for (size_t tx = 0; tx < job->x.size; tx++) {
             size_t i = (job->y.begin + ty) * in->width + job->x.begin + tx;
-            ptr_transfer_input(&job->transfer, in->color + i * in->color_stride,
-                               in->albedo + i * in->albedo_stride,
-                               in->normal + i * in->normal_stride, row + tx * PTR_CONV_BLOCK);
+            float *dst = row + tx * PTR_CONV_BLOCK;
+            if (job->mode == MODE_ALBEDO)
+                ptr_transfer_albedo_input(in->albedo + i * in->albedo_stride, dst);
+            else if (job->mode == MODE_NORMAL)
+                ptr_transfer_normal_input(in->normal + i * in->normal_stride, dst);
+            else
+                ptr_transfer_input(&job->transfer, in->color + i * in->color_stride,
+                                   in->albedo + i * in->albedo_stride,
+                                   in->normal + i * in->normal_stride, dst);
         }
     }
 }
@@ -155,31 +182,32 @@ static void keep_output_rows(void *arg, size_t from, size_t to)
     for (size_t y = from; y < to; y++) {
         size_t ty = y - job->y.begin;
         for (size_t x = job->x.out_begin; x < job->x.out_end; x++) {
-            size_t tx = x - job->x.begin;
-            ptr_transfer_output(&job->transfer,
-                                job->map + ((ty + 1) * (job->map_width + 2) + tx + 1) *
-                                               PTR_CONV_BLOCK,
-                                job->result + (y * width + x) * 3);
+            const float *src =
+                job->map + ((ty + 1) * (job->map_width + 2) + x - job->x.begin + 1) *
+                               PTR_CONV_BLOCK;
+            float *dst = job->result + (y * width + x) * 3;
+            if (job->mode == MODE_ALBEDO)
+                ptr_transfer_albedo_output(src, dst);
+            else if (job->mode == MODE_NORMAL)
+                ptr_transfer_normal_output(src, dst);
+            else
+                ptr_transfer_output(&job->transfer, src, dst);
         }
     }
 }
 
 /* Runs the network on one tile into job->result. */
-static PtrResult denoise_tile(const PtrDenoiser *denoiser, TileJob *job, int threads,
-                              PtrError *err)
+static PtrResult filter_tile(const PtrUnet *unet, TileJob *job, int threads, PtrError *err)
 {
     size_t w = round_up16(job->x.size), h = round_up16(job->y.size);
-    size_t floats = ptr_unet_map_floats(w, h, PTR_CONV_BLOCK);
-    size_t bytes = (floats * sizeof(float) + 63) / 64 * 64;
-    float *input = aligned_alloc(64, bytes), *output = aligned_alloc(64, bytes);
+    float *input = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
+    float *output = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
     PtrResult res = PTR_ERR_NOMEM;
     if (input && output) {
-        memset(input, 0, bytes);
-        memset(output, 0, bytes);
         job->map_width = w;
         job->map = input;
         ptr_parallel_ranges(threads, 0, job->y.size, fill_input_rows, job);
-        res = ptr_unet_run(denoiser->unet, input, w, h, threads, output, err);
+        res = ptr_unet_run(unet, input, w, h, threads, output, err);
         job->map = output;
         if (res == PTR_OK)
             ptr_parallel_ranges(threads, job->y.out_begin, job->y.out_end, keep_output_rows, job);
@@ -191,6 +219,27 @@ static PtrResult denoise_tile(const PtrDenoiser *denoiser, TileJob *job, int thr
     return res;
 }
 
+/* Runs the network over the image, tile by tile, into result (RGB, the
+ * image's size). */
+static PtrResult filter_image(const PtrUnet *unet, Mode mode, const PtrDenoiseInput *input,
+                              size_t tile, int threads, float *result, PtrError *err)
+{
+    size_t width = input->width, height = input->height;
+    TileJob job = { .input = input, .mode = mode, .result = result };
+    if (mode == MODE_COLOR)
+        ptr_transfer_init(&job.transfer,
+                          ptr_autoexposure(input->color, input->color_stride, width, height));
+    size_t columns = tile_count(width, tile), rows = tile_count(height, tile);
+    PtrResult res = PTR_OK;
+    for (size_t j = 0; res == PTR_OK && j < rows; j++)
+        for (size_t i = 0; res == PTR_OK && i < columns; i++) {
+            job.y = tile_span(height, tile, rows, j);
+            job.x = tile_span(width, tile, columns, i);
+            res = filter_tile(unet, &job, threads, err);
+        }
+    return res;
+}
+
 PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
                             size_t tile, int threads, float *out, size_t out_stride,
                             PtrError *err)
@@ -199,31 +248,36 @@ PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *
         return ptr_error_set(err, PTR_ERR_INTERNAL,
                              "denoiser tiles of %zu pixels: not a multiple of 16 above %d", tile,
                              2 * PTR_DENOISE_OVERLAP);
-    size_t width = input->width, height = input->height;
-    if (!width || !height)
+    size_t pixels = input->width * input->height;
+    if (!pixels)
         return PTR_OK;
     /* The tiles read the input where others have written their output: the
      * result is gathered apart and copied out at the end, so that out may be
-     * the colour's own buffer. */
-    if (width * height > SIZE_MAX / (3 * sizeof(float)))
+     * the colour's own buffer. The guides, when filtered first, are kept
+     * beside it. */
+    int guides = denoiser->albedo != NULL;
+    if (pixels > SIZE_MAX / (9 * sizeof(float)))
         return ptr_error_set(err, PTR_ERR_NOMEM, "an image of %zux%zu pixels is too large",
-                             width, height);
-    float *result = malloc(width * height * 3 * sizeof(float));
+                             input->width, input->height);
+    float *result = malloc(pixels * (guides ? 9 : 3) * sizeof(float));
     if (!result)
         return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoised image");
-    TileJob job = { .input = input, .result = result };
-    ptr_transfer_init(&job.transfer,
-                      ptr_autoexposure(input->color, input->color_stride, width, height));
-    size_t columns = tile_count(width, tile), rows = tile_count(height, tile);
+    PtrDenoiseInput clean = *input;
     PtrResult res = PTR_OK;
-    for (size_t j = 0; res == PTR_OK && j < rows; j++)
-        for (size_t i = 0; res == PTR_OK && i < columns; i++) {
-            job.y = tile_span(height, tile, rows, j);
-            job.x = tile_span(width, tile, columns, i);
-            res = denoise_tile(denoiser, &job, threads, err);
-        }
+    if (guides) {
+        clean.albedo = result + pixels * 3;
+        clean.normal = result + pixels * 6;
+        clean.albedo_stride = clean.normal_stride = 3;
+        res = filter_image(denoiser->albedo, MODE_ALBEDO, input, tile, threads,
+                           (float *)clean.albedo, err);
+        if (res == PTR_OK)
+            res = filter_image(denoiser->normal, MODE_NORMAL, input, tile, threads,
+                               (float *)clean.normal, err);
+    }
     if (res == PTR_OK)
-        for (size_t p = 0; p < width * height; p++)
+        res = filter_image(denoiser->color, MODE_COLOR, &clean, tile, threads, result, err);
+    if (res == PTR_OK)
+        for (size_t p = 0; p < pixels; p++)
             memcpy(out + p * out_stride, result + p * 3, 3 * sizeof(float));
     free(result);
     return res;

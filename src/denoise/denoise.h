@@ -15,7 +15,8 @@
 typedef enum PtrDenoiseQuality {
     PTR_DENOISE_FAST,     /* the small network */
     PTR_DENOISE_BALANCED, /* the default network */
-    PTR_DENOISE_HIGH,     /* the large network where the weights ship one */
+    PTR_DENOISE_HIGH,     /* the large networks: albedo and normal filtered
+                           * first, then the colour with them as clean guides */
 } PtrDenoiseQuality;
 
 /* Parses "fast", "balanced" or "high" (the option-value convention). */
@@ -49,12 +50,13 @@ PtrResult ptr_denoise(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
                       int threads, float *out, size_t out_stride, PtrError *err);
 
 /* The network runs on tiles of at most PTR_DENOISE_TILE pixels a side,
- * which overlap by PTR_DENOISE_OVERLAP pixels, more than half its receptive
- * field, and start at multiples of 16: each output pixel is computed from
- * the same values in the same order as in one tile of the whole image, so
- * the tiles bound memory (about 190 MB for the default network) without
- * changing a bit of the result. The tiling depends only on the image's size. */
-enum { PTR_DENOISE_TILE = 512, PTR_DENOISE_OVERLAP = 96 };
+ * which overlap by PTR_DENOISE_OVERLAP pixels, more than half the receptive
+ * field of the larger networks (202 pixels), and start at multiples of 16:
+ * each output pixel is computed from the same values in the same order as
+ * in one tile of the whole image, so the tiles bound memory (about 420 MB
+ * for the default network, 500 MB for the large) without changing a bit of
+ * the result. The tiling depends only on the image's size. */
+enum { PTR_DENOISE_TILE = 768, PTR_DENOISE_OVERLAP = 112 };
 
 /* ptr_denoise with tiles of at most tile pixels a side (a multiple of 16
  * above 2 * PTR_DENOISE_OVERLAP), for the tests of the tiling. */

@@ -30,6 +30,20 @@ float ptr_pu_inverse(float x)
     return expf((x - PU_G) / PU_E) - PU_F;
 }
 
+/* The sRGB curve's constants (core/color.h). */
+static const float SRGB_A = 12.92f, SRGB_B = 1.055f, SRGB_C = 1.0f / 2.4f, SRGB_D = -0.055f,
+                   SRGB_Y0 = 0.0031308f, SRGB_X0 = 0.04045f;
+
+float ptr_srgb_forward(float y)
+{
+    return y <= SRGB_Y0 ? SRGB_A * y : SRGB_B * powf(y, SRGB_C) + SRGB_D;
+}
+
+float ptr_srgb_inverse(float x)
+{
+    return x <= SRGB_X0 ? x / SRGB_A : powf((x - SRGB_D) / SRGB_B, 1.0f / SRGB_C);
+}
+
 /* NaN to 0, then clamped to [lo, hi]. */
 static float sanitize(float v, float lo, float hi)
 {
@@ -80,12 +94,38 @@ void ptr_transfer_input(const PtrTransfer *t, const float *color, const float *a
     for (int k = 0; k < 3; k++) {
         dst[k] = ptr_pu_forward(sanitize(color[k] * t->input_scale, 0.0f, FLT_MAX)) * t->norm;
         dst[3 + k] = sanitize(albedo[k], 0.0f, 1.0f);
-        dst[6 + k] = sanitize(normal[k], -1.0f, 1.0f) * 0.5f + 0.5f;
     }
+    ptr_transfer_normal_input(normal, dst + 6);
 }
 
 void ptr_transfer_output(const PtrTransfer *t, const float *src, float *rgb)
 {
     for (int k = 0; k < 3; k++)
         rgb[k] = ptr_pu_inverse(sanitize(src[k], 0.0f, FLT_MAX) * t->rcp_norm) * t->output_scale;
+}
+
+void ptr_transfer_albedo_input(const float *albedo, float *dst)
+{
+    for (int k = 0; k < 3; k++)
+        dst[k] = ptr_srgb_forward(sanitize(albedo[k], 0.0f, 1.0f));
+}
+
+void ptr_transfer_albedo_output(const float *src, float *albedo)
+{
+    for (int k = 0; k < 3; k++) {
+        float v = ptr_srgb_inverse(sanitize(src[k], 0.0f, FLT_MAX));
+        albedo[k] = v < 1.0f ? v : 1.0f;
+    }
+}
+
+void ptr_transfer_normal_input(const float *normal, float *dst)
+{
+    for (int k = 0; k < 3; k++)
+        dst[k] = sanitize(normal[k], -1.0f, 1.0f) * 0.5f + 0.5f;
+}
+
+void ptr_transfer_normal_output(const float *src, float *normal)
+{
+    for (int k = 0; k < 3; k++)
+        normal[k] = sanitize(sanitize(src[k], 0.0f, FLT_MAX) * 2.0f - 1.0f, -1.0f, 1.0f);
 }

@@ -11,6 +11,10 @@
 float ptr_pu_forward(float y);
 float ptr_pu_inverse(float x);
 
+/* The sRGB curve, from linear and back. */
+float ptr_srgb_forward(float y);
+float ptr_srgb_inverse(float x);
+
 /* 0.18 over the geometric mean of the luminance of the image's bins (at
  * most 16x16 pixels, as many as fit), counting bins brighter than 1e-8;
  * 1 if none is. color: pixel i at color + i * stride. */
@@ -31,5 +35,14 @@ void ptr_transfer_input(const PtrTransfer *t, const float *color, const float *a
 
 /* One pixel of the network's output (3 values) back to linear RGB. */
 void ptr_transfer_output(const PtrTransfer *t, const float *src, float *rgb);
+
+/* The networks that filter a guide alone (OIDN's rt_alb, rt_nrm): albedo
+ * goes in through the sRGB curve, clamped to [0, 1], and comes out clamped
+ * to [0, 1]; a normal goes in mapped from [-1, 1] to [0, 1] and comes out
+ * mapped back. Each from 3 values to 3. */
+void ptr_transfer_albedo_input(const float *albedo, float *dst);
+void ptr_transfer_albedo_output(const float *src, float *albedo);
+void ptr_transfer_normal_input(const float *normal, float *dst);
+void ptr_transfer_normal_output(const float *src, float *normal);
 
 #endif /* PTR_TRANSFER_H */

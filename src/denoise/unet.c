@@ -7,21 +7,27 @@
 #include "base/threads.h"
 #include "denoise/tza.h"
 
-/* Where a convolution's input comes from, besides the previous layer's
- * output: the feature map concatenated after it (OIDN's training/model.py). */
-enum { NO_SKIP = -1, SKIP_INPUT = -2 };
+/* An architecture: its convolutions' names in the order they run, and how
+ * many run at each encoder level before its pooling, at the bottom, and at
+ * each decoder level after its upsampling (OIDN's training/model.py). */
+typedef struct Architecture {
+    const char *names[PTR_UNET_MAX_CONVS];
+    int encoder[4], bottom, decoder[4]; /* decoder[k]: level k, run from 3 to 0 */
+} Architecture;
 
-static const struct {
-    const char *name;
-    int skip; /* the layer whose output, pooled, is concatenated; or the above */
-} layers[PTR_UNET_CONVS] = {
-    { "enc_conv0", NO_SKIP },  { "enc_conv1", NO_SKIP },  { "enc_conv2", NO_SKIP },
-    { "enc_conv3", NO_SKIP },  { "enc_conv4", NO_SKIP },  { "enc_conv5a", NO_SKIP },
-    { "enc_conv5b", NO_SKIP }, { "dec_conv4a", PTR_UNET_ENC_CONV3 },
-    { "dec_conv4b", NO_SKIP }, { "dec_conv3a", PTR_UNET_ENC_CONV2 },
-    { "dec_conv3b", NO_SKIP }, { "dec_conv2a", PTR_UNET_ENC_CONV1 },
-    { "dec_conv2b", NO_SKIP }, { "dec_conv1a", SKIP_INPUT },
-    { "dec_conv1b", NO_SKIP }, { "dec_conv0", NO_SKIP },
+static const Architecture unet_base = {
+    { "enc_conv0", "enc_conv1", "enc_conv2", "enc_conv3", "enc_conv4", "enc_conv5a",
+      "enc_conv5b", "dec_conv4a", "dec_conv4b", "dec_conv3a", "dec_conv3b", "dec_conv2a",
+      "dec_conv2b", "dec_conv1a", "dec_conv1b", "dec_conv0" },
+    { 2, 1, 1, 1 }, 2, { 3, 2, 2, 2 },
+};
+
+static const Architecture unet_large = {
+    { "enc_conv1a", "enc_conv1b", "enc_conv2a", "enc_conv2b", "enc_conv3a", "enc_conv3b",
+      "enc_conv4a", "enc_conv4b", "enc_conv5a", "enc_conv5b", "dec_conv4a", "dec_conv4b",
+      "dec_conv3a", "dec_conv3b", "dec_conv2a", "dec_conv2b", "dec_conv1a", "dec_conv1b",
+      "dec_conv1c" },
+    { 2, 2, 2, 2 }, 2, { 3, 2, 2, 2 },
 };
 
 static size_t padded(size_t channels)
@@ -39,40 +45,28 @@ static float *zeroed_floats(size_t count)
     return p;
 }
 
-/* The weight tensor of layer index and its bias, checked against the input
- * channels the U-Net feeds it (in) and, for the last, its output. */
-static PtrResult find_layer(const char *path, const PtrTensorArchive *archive, int index,
-                            size_t in, const PtrTensor **weight, const PtrTensor **bias,
-                            PtrError *err)
+float *ptr_unet_map_new(size_t width, size_t height, size_t channels)
 {
-    char name[64];
-    snprintf(name, sizeof name, "%s.weight", layers[index].name);
-    *weight = ptr_tza_find(archive, name);
-    snprintf(name, sizeof name, "%s.bias", layers[index].name);
-    *bias = ptr_tza_find(archive, name);
-    const PtrTensor *w = *weight, *b = *bias;
-    if (!w || !b)
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: no tensor %s.%s: not a U-Net's weights",
-                             path, layers[index].name, w ? "bias" : "weight");
-    if (w->ndims != 4 || strcmp(w->layout, "oihw") || w->dims[2] != 3 || w->dims[3] != 3 ||
-        w->dims[1] != in ||
-        (index == PTR_UNET_DEC_CONV0 && w->dims[0] != PTR_UNET_OUTPUT_CHANNELS))
-        return ptr_error_set(err, PTR_ERR_INSTALL,
-                             "%s: tensor %s.weight is not a 3x3 convolution (oihw) of %zu input "
-                             "channels%s, as the U-Net's layers before it make it",
-                             path, layers[index].name, in,
-                             index == PTR_UNET_DEC_CONV0 ? " to 3 outputs" : "");
-    if (b->ndims != 1 || b->dims[0] != w->dims[0])
-        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: tensor %s.bias does not have %u values",
-                             path, layers[index].name, (unsigned)w->dims[0]);
-    return PTR_OK;
+    return zeroed_floats((width + 2) * (height + 2) * channels);
 }
 
-/* Packs a layer whose input is a channels (padded to a_padded) followed by
- * skip channels: the tensor's input channel i moves to where the
- * concatenated feature map holds it. */
-static PtrResult pack_layer(PtrUnetConv *conv, const PtrTensor *w, const PtrTensor *b, size_t a,
-                            size_t a_padded, size_t skip, PtrError *err)
+/* The archive and where the build has come to: the channels of the map the
+ * next convolution reads, the real ones and their padded count. */
+typedef struct Builder {
+    const char *path;
+    const PtrTensorArchive *archive;
+    const Architecture *arch;
+    PtrUnet *unet;
+    size_t channels, padded_channels;
+    size_t input_channels;
+    size_t pooled[5]; /* the real channels of each pooled map */
+} Builder;
+
+/* Packs a convolution whose input is a channels (padded to a_padded)
+ * followed by skip channels: the tensor's input channel i moves to where
+ * the concatenated feature map holds it. */
+static PtrResult pack(PtrUnetConv *conv, const PtrTensor *w, const PtrTensor *b, size_t a,
+                      size_t a_padded, size_t skip, PtrError *err)
 {
     size_t out = w->dims[0];
     conv->in = a_padded + padded(skip);
@@ -94,37 +88,80 @@ static PtrResult pack_layer(PtrUnetConv *conv, const PtrTensor *w, const PtrTens
     return PTR_OK;
 }
 
-static PtrResult build(const char *path, const PtrTensorArchive *archive, PtrUnet *unet,
-                       PtrError *err)
+/* Adds the next convolution, running at level, its input joined by pooled
+ * map number concat (0: the input; -1: none): its tensors found and their
+ * shapes checked against the channels the layers before it make. */
+static PtrResult add(Builder *b, int level, int concat, PtrError *err)
 {
-    size_t real_out[PTR_UNET_CONVS];
-    for (int l = 0; l < PTR_UNET_CONVS; l++) {
-        size_t a = l == 0 ? PTR_UNET_INPUT_CHANNELS : real_out[l - 1];
-        size_t a_padded = l == 0 ? PTR_CONV_BLOCK : unet->conv[l - 1].out;
-        int s = layers[l].skip;
-        size_t skip = s == NO_SKIP      ? 0
-                      : s == SKIP_INPUT ? PTR_UNET_INPUT_CHANNELS
-                                        : real_out[s];
-        const PtrTensor *w, *b;
-        PtrResult res = find_layer(path, archive, l, a + skip, &w, &b, err);
-        if (res == PTR_OK)
-            res = pack_layer(&unet->conv[l], w, b, a, a_padded, skip, err);
-        if (res != PTR_OK)
-            return res;
-        real_out[l] = w->dims[0];
-    }
+    int l = b->unet->count;
+    const char *name = b->arch->names[l];
+    char key[64];
+    snprintf(key, sizeof key, "%s.weight", name);
+    const PtrTensor *w = ptr_tza_find(b->archive, key);
+    snprintf(key, sizeof key, "%s.bias", name);
+    const PtrTensor *bias = ptr_tza_find(b->archive, key);
+    if (!w || !bias)
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: no tensor %s.%s: not a U-Net's weights",
+                             b->path, name, w ? "bias" : "weight");
+    size_t skip = concat < 0 ? 0 : concat == 0 ? b->input_channels : b->pooled[concat];
+    int last = l == PTR_UNET_MAX_CONVS - 1 || !b->arch->names[l + 1];
+    if (w->ndims != 4 || strcmp(w->layout, "oihw") || w->dims[2] != 3 || w->dims[3] != 3 ||
+        w->dims[1] != b->channels + skip || (last && w->dims[0] != PTR_UNET_OUTPUT_CHANNELS))
+        return ptr_error_set(err, PTR_ERR_INSTALL,
+                             "%s: tensor %s.weight is not a 3x3 convolution (oihw) of %zu input "
+                             "channels%s, as the network's layers before it make it",
+                             b->path, name, b->channels + skip, last ? " to 3 outputs" : "");
+    if (bias->ndims != 1 || bias->dims[0] != w->dims[0])
+        return ptr_error_set(err, PTR_ERR_INSTALL, "%s: tensor %s.bias does not have %u values",
+                             b->path, name, (unsigned)w->dims[0]);
+    PtrUnetConv *conv = &b->unet->conv[l];
+    conv->level = level;
+    conv->concat = concat;
+    conv->concat_channels = concat < 0 ? 0 : padded(skip);
+    PtrResult res = pack(conv, w, bias, b->channels, b->padded_channels, skip, err);
+    if (res != PTR_OK)
+        return res;
+    b->unet->count++;
+    b->channels = w->dims[0];
+    b->padded_channels = conv->out;
     return PTR_OK;
 }
 
-PtrResult ptr_unet_load(const char *path, PtrCpuLevel level, PtrUnet **out, PtrError *err)
+static PtrResult build(Builder *b, PtrError *err)
+{
+    PtrResult res = PTR_OK;
+    for (int k = 0; k < 4; k++) {
+        for (int i = 0; res == PTR_OK && i < b->arch->encoder[k]; i++)
+            res = add(b, k, -1, err);
+        if (res != PTR_OK)
+            return res;
+        b->unet->conv[b->unet->count - 1].pool = k + 1;
+        b->pooled[k + 1] = b->channels;
+    }
+    for (int i = 0; res == PTR_OK && i < b->arch->bottom; i++)
+        res = add(b, 4, -1, err);
+    for (int k = 3; k >= 0; k--)
+        for (int i = 0; res == PTR_OK && i < b->arch->decoder[k]; i++)
+            res = add(b, k, i == 0 ? k : -1, err);
+    return res;
+}
+
+PtrResult ptr_unet_load(const char *path, size_t input_channels, PtrCpuLevel level,
+                        PtrUnet **out, PtrError *err)
 {
     PtrTensorArchive *archive;
     PtrResult res = ptr_tza_read(path, &archive, err);
     if (res != PTR_OK)
         return res;
     PtrUnet *unet = calloc(1, sizeof *unet);
-    res = unet ? build(path, archive, unet, err)
-               : ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoiser");
+    if (unet) {
+        Builder b = { path, archive,
+                      ptr_tza_find(archive, "enc_conv1b.weight") ? &unet_large : &unet_base,
+                      unet, input_channels, PTR_CONV_BLOCK, input_channels, { 0 } };
+        res = build(&b, err);
+    } else {
+        res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoiser");
+    }
     ptr_tza_free(archive);
     if (res != PTR_OK) {
         ptr_unet_free(unet);
@@ -139,7 +176,7 @@ void ptr_unet_free(PtrUnet *unet)
 {
     if (!unet)
         return;
-    for (int l = 0; l < PTR_UNET_CONVS; l++) {
+    for (int l = 0; l < PTR_UNET_MAX_CONVS; l++) { /* a failed build's last too */
         free(unet->conv[l].weights);
         free(unet->conv[l].bias);
     }
@@ -216,18 +253,18 @@ static void run_upsample_rows(void *arg, size_t y0, size_t y1)
                              s->width, y0, y1);
 }
 
-/* The run of one tile: the feature maps alive, freed as soon as unused. */
+/* What the steps of one tile's run share. */
 typedef struct Run {
     const PtrUnet *unet;
     int threads;
     PtrError *err;
 } Run;
 
-/* A new zeroed map of width x height x channels into *out, or NULL (with the
- * error set) when memory runs out. */
+/* A new zeroed map of width x height x channels, or NULL (with the error
+ * set) when memory runs out. */
 static float *new_map(Run *run, size_t width, size_t height, size_t channels)
 {
-    float *map = zeroed_floats(ptr_unet_map_floats(width, height, channels));
+    float *map = ptr_unet_map_new(width, height, channels);
     if (!map)
         ptr_error_set(run->err, PTR_ERR_NOMEM,
                       "out of memory for the denoiser's feature maps (%zux%zu pixels)", width,
@@ -243,15 +280,14 @@ static float *conv(Run *run, int l, const float *src, size_t width, size_t heigh
     float *out = dst ? dst : new_map(run, width, height, c->out);
     if (!out)
         return NULL;
-    Step s = { run->unet, c, out, src, NULL, width, 0, 0, l != PTR_UNET_DEC_CONV0 };
+    Step s = { run->unet, c, out, src, NULL, width, 0, 0, l != run->unet->count - 1 };
     ptr_parallel_ranges(run->threads, 0, height, run_conv_rows, &s);
     return out;
 }
 
-/* 2x2 max-pooling of src (width x height, the output of conv l). */
-static float *pool(Run *run, int l, const float *src, size_t width, size_t height)
+/* 2x2 max-pooling of src (width x height, channels channels). */
+static float *pool(Run *run, const float *src, size_t channels, size_t width, size_t height)
 {
-    size_t channels = run->unet->conv[l].out;
     float *out = new_map(run, width / 2, height / 2, channels);
     if (!out)
         return NULL;
@@ -260,12 +296,11 @@ static float *pool(Run *run, int l, const float *src, size_t width, size_t heigh
     return out;
 }
 
-/* src (width/2 x height/2, the output of conv l) upsampled and followed by
+/* src (width/2 x height/2, channels channels) upsampled and followed by
  * skip's skip_channels. */
-static float *upsample_concat(Run *run, int l, const float *src, const float *skip,
+static float *upsample_concat(Run *run, const float *src, size_t channels, const float *skip,
                               size_t skip_channels, size_t width, size_t height)
 {
-    size_t channels = run->unet->conv[l].out;
     float *out = new_map(run, width, height, channels + skip_channels);
     if (!out)
         return NULL;
@@ -278,44 +313,39 @@ PtrResult ptr_unet_run(const PtrUnet *unet, const float *input, size_t width, si
                        int threads, float *output, PtrError *err)
 {
     Run run = { unet, threads, err };
-    size_t w[5], h[5]; /* the sizes of the five levels */
-    for (int k = 0; k < 5; k++) {
-        w[k] = width >> k;
-        h[k] = height >> k;
+    /* pools[k], k = 1 to 4: the map pooled to level k, kept for the decoder;
+     * src: the map the next step reads, which owned holds when it is not
+     * the input, a pooled map or the output. */
+    float *pools[5] = { NULL }, *owned = NULL;
+    const float *src = input;
+    for (int l = 0; l < unet->count; l++) {
+        const PtrUnetConv *c = &unet->conv[l];
+        size_t w = width >> c->level, h = height >> c->level;
+        int last = l == unet->count - 1;
+        if (c->concat >= 0) {
+            float *joined = upsample_concat(&run, src, unet->conv[l - 1].out,
+                                            c->concat ? pools[c->concat] : input,
+                                            c->concat_channels, w, h);
+            free(owned);
+            src = owned = joined;
+            if (!joined)
+                break;
+        }
+        float *out = conv(&run, l, src, w, h, last ? output : NULL);
+        free(owned);
+        owned = last ? NULL : out;
+        if (!(src = out))
+            break;
+        if (c->pool) {
+            pools[c->pool] = pool(&run, src, c->out, w, h);
+            free(owned);
+            owned = NULL;
+            if (!(src = pools[c->pool]))
+                break;
+        }
     }
-    /* pools[k]: the output of encoder convolution k (at level k - 1) pooled
-     * to level k, kept for the decoder; x: the current map. */
-    float *pools[5] = { NULL }, *x = NULL, *y = NULL;
-#define STEP(expr)                                                                             \
-    do {                                                                                       \
-        float *next_ = (expr);                                                                 \
-        free(x);                                                                               \
-        x = next_;                                                                             \
-        if (!x)                                                                                \
-            goto fail;                                                                         \
-    } while (0)
-    STEP(conv(&run, PTR_UNET_ENC_CONV0, input, w[0], h[0], NULL));
-    for (int k = 1; k <= 4; k++) {
-        STEP(conv(&run, k, k == 1 ? x : pools[k - 1], w[k - 1], h[k - 1], NULL));
-        if (!(pools[k] = pool(&run, k, x, w[k - 1], h[k - 1])))
-            goto fail;
-    }
-    STEP(conv(&run, PTR_UNET_ENC_CONV5A, pools[4], w[4], h[4], NULL));
-    STEP(conv(&run, PTR_UNET_ENC_CONV5B, x, w[4], h[4], NULL));
-    /* Each level of the decoder: the map upsampled and joined by the
-     * encoder's of that size (the input at the top), two convolutions. */
-    for (int k = 3; k >= 0; k--) {
-        int a = PTR_UNET_DEC_CONV4A + 2 * (3 - k);
-        STEP(upsample_concat(&run, a - 1, x, k ? pools[k] : input,
-                             k ? unet->conv[k].out : PTR_CONV_BLOCK, w[k], h[k]));
-        STEP(conv(&run, a, x, w[k], h[k], NULL));
-        STEP(conv(&run, a + 1, x, w[k], h[k], NULL));
-    }
-#undef STEP
-    y = conv(&run, PTR_UNET_DEC_CONV0, x, w[0], h[0], output);
-fail:
-    free(x);
+    free(owned);
     for (int k = 1; k <= 4; k++)
         free(pools[k]);
-    return y ? PTR_OK : PTR_ERR_NOMEM;
+    return src == output ? PTR_OK : PTR_ERR_NOMEM;
 }

@@ -1,5 +1,5 @@
-/* Open Image Denoise's U-Net, built from the tensors of a weight archive and
- * run on one tile: 16 3x3 convolutions (ReLU after all but the last), four
+/* Open Image Denoise's U-Nets, built from the tensors of a weight archive
+ * and run on one tile: 3x3 convolutions (ReLU after all but the last), four
  * 2x2 max-poolings on the way down, four nearest-neighbour upsamplings on
  * the way up, each followed by the concatenation of the encoder's feature
  * map of that size (docs/denoise.md). */
@@ -12,48 +12,48 @@
 #include "base/result.h"
 #include "denoise/conv.h"
 
-/* The network's input: colour, albedo and normal, three channels each, in
- * channels 0..8 of PTR_CONV_BLOCK; its output: colour, channels 0..2. */
-enum { PTR_UNET_INPUT_CHANNELS = 9, PTR_UNET_OUTPUT_CHANNELS = 3 };
+/* Channels of the networks' outputs: colour, albedo or normal. */
+enum { PTR_UNET_OUTPUT_CHANNELS = 3 };
 
 /* Four poolings: a tile's sides are multiples of 16. */
 enum { PTR_UNET_ALIGNMENT = 16 };
 
-/* The convolutions in the order they run: encoder convolution k (0 to 4)
- * is number k, and the decoder's come in pairs, a and b, a level each. */
-enum {
-    PTR_UNET_ENC_CONV0, PTR_UNET_ENC_CONV1, PTR_UNET_ENC_CONV2, PTR_UNET_ENC_CONV3,
-    PTR_UNET_ENC_CONV4, PTR_UNET_ENC_CONV5A, PTR_UNET_ENC_CONV5B,
-    PTR_UNET_DEC_CONV4A, PTR_UNET_DEC_CONV4B, PTR_UNET_DEC_CONV3A, PTR_UNET_DEC_CONV3B,
-    PTR_UNET_DEC_CONV2A, PTR_UNET_DEC_CONV2B, PTR_UNET_DEC_CONV1A, PTR_UNET_DEC_CONV1B,
-    PTR_UNET_DEC_CONV0, PTR_UNET_CONVS
-};
+/* The most convolutions a network has (OIDN's UNetLarge). */
+enum { PTR_UNET_MAX_CONVS = 19 };
 
+/* One convolution and what surrounds it in the network. */
 typedef struct PtrUnetConv {
-    size_t in, out; /* padded channels, multiples of PTR_CONV_BLOCK */
-    float *weights; /* packed (conv.h) */
-    float *bias;    /* out floats, zero past the tensor's */
+    size_t in, out;  /* padded channels, multiples of PTR_CONV_BLOCK */
+    float *weights;  /* packed (conv.h) */
+    float *bias;     /* out floats, zero past the tensor's */
+    int level;       /* the resolution it runs at: 1 / 2^level */
+    int concat;      /* -1; or its input is the map before it upsampled, then
+                      * pooled map number concat (0: the network's input) */
+    size_t concat_channels; /* that map's padded channels */
+    int pool;        /* 0; or its output is pooled into map number pool */
 } PtrUnetConv;
 
 typedef struct PtrUnet {
-    PtrUnetConv conv[PTR_UNET_CONVS];
+    int count; /* convolutions, in the order they run */
+    PtrUnetConv conv[PTR_UNET_MAX_CONVS];
     PtrConvTable table;
 } PtrUnet;
 
-/* The network whose weights are in the archive at path, its convolutions
- * run through the kernel table of this CPU level. PTR_ERR_INSTALL naming
- * the file for a tensor missing or of a shape other than the U-Net's;
- * PTR_ERR_NOMEM. */
-PtrResult ptr_unet_load(const char *path, PtrCpuLevel level, PtrUnet **out, PtrError *err);
+/* The network whose weights are in the archive at path, which takes
+ * input_channels channels (9: colour, albedo and normal; 3: one of them),
+ * its convolutions run through the kernel table of this CPU level. Both of
+ * OIDN's architectures: UNet (enc_conv0 .. dec_conv0) and UNetLarge
+ * (enc_conv1a .. dec_conv1c), told apart as OIDN does, by enc_conv1b.
+ * PTR_ERR_INSTALL naming the file for a tensor missing or of a shape other
+ * than the network's; PTR_ERR_NOMEM. */
+PtrResult ptr_unet_load(const char *path, size_t input_channels, PtrCpuLevel level,
+                        PtrUnet **out, PtrError *err);
 
 void ptr_unet_free(PtrUnet *unet);
 
-/* Floats of a feature map of width x height pixels and channels channels,
- * with its border (conv.h). */
-static inline size_t ptr_unet_map_floats(size_t width, size_t height, size_t channels)
-{
-    return (width + 2) * (height + 2) * channels;
-}
+/* A feature map of width x height pixels and channels channels with its
+ * border (conv.h), all zeros, 64-byte aligned (for free), or NULL. */
+float *ptr_unet_map_new(size_t width, size_t height, size_t channels);
 
 /* Runs the network on a tile of width x height pixels (multiples of
  * PTR_UNET_ALIGNMENT): input is a feature map of PTR_CONV_BLOCK channels

@@ -1,30 +1,39 @@
 """ptr's denoiser (through denoise_raw) against the NumPy reference
 (denoise_reference.py) on small images that are not multiples of 16: random
 HDR colour with a few very bright pixels, albedo and unit normals, to 1e-4
-relative, with the default and the small network. Then the same output, byte
+relative, with the default and the small network, and the large ones that
+filter albedo and normal first. Then the same output, byte
 for byte, at every CPU level ($PTR_CPUMASK: none, sse41, avx2, or only the
 one the environment sets), with 1 and 2 threads, and cut into tiles across
 and down. Skipped (77) when the weights are not installed, or NumPy is not."""
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
 
+SYSTEM_PYTHON = "/usr/bin/python3"
 try:
     import numpy as np
 except ImportError:
+    # scripts/install-deps.sh installs Debian's python3-numpy, which only
+    # Debian's own python3 imports, not one that comes first in PATH (pyenv).
+    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
     print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
     sys.exit(77)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import denoise_reference  # noqa: E402
 
-WEIGHTS = {"balanced": "rt_hdr_alb_nrm.tza", "fast": "rt_hdr_alb_nrm_small.tza"}
+# Each quality's networks: the colour's, then those filtering albedo and normal.
+WEIGHTS = {"balanced": ["rt_hdr_alb_nrm.tza"], "fast": ["rt_hdr_alb_nrm_small.tza"],
+           "high": ["rt_hdr_calb_cnrm_large.tza", "rt_alb_large.tza", "rt_nrm_large.tza"]}
 TOLERANCE = 1e-4
 
 denoise_raw = sys.argv[2]
 weights_dir = os.environ.get("PTR_WEIGHTS_DIR", "")
-if not all(os.path.isfile(os.path.join(weights_dir, f)) for f in WEIGHTS.values()):
+if not all(os.path.isfile(os.path.join(weights_dir, f)) for fs in WEIGHTS.values() for f in fs):
     print(f"skipped: the denoiser's weights are not in '{weights_dir}' "
           "(scripts/install-deps.sh installs them)")
     sys.exit(77)
@@ -58,18 +67,19 @@ def run_ptr(quality, images, threads=1, tile=0, level=None):
         env["PTR_CPUMASK"] = level
     done = subprocess.run([denoise_raw, quality, str(width), str(height), str(threads),
                            str(tile)] + paths, env=env, capture_output=True, text=True)
-    if done.returncode == 77:
-        print(done.stderr.strip())
-        sys.exit(77)
     if done.returncode != 0:
-        sys.exit(f"denoise_raw failed: {done.stderr.strip()}")
+        shutil.rmtree(work)
+        print(done.stderr.strip())
+        sys.exit(77 if done.returncode == 77 else 1)
     return open(paths[3], "rb").read()
 
 
 def compare_with_reference(quality, width, height, seed):
     images = scene(width, height, seed)
-    tensors = denoise_reference.read_tza(os.path.join(weights_dir, WEIGHTS[quality]))
-    expected = denoise_reference.denoise(tensors, *(a.astype(np.float64) for a in images))
+    color_net, *guide_nets = [denoise_reference.read_tza(os.path.join(weights_dir, f))
+                              for f in WEIGHTS[quality]]
+    expected = denoise_reference.denoise(color_net, *(a.astype(np.float64) for a in images),
+                                         guide_nets)
     got = np.frombuffer(run_ptr(quality, images), dtype="<f4").reshape(height, width, 3)
     relative = np.abs(got - expected) / np.abs(expected)
     worst = np.unravel_index(np.argmax(relative), relative.shape)
@@ -91,6 +101,7 @@ def check_same(what, outputs):
 compare_with_reference("balanced", 40, 24, 1)
 compare_with_reference("balanced", 70, 50, 2)
 compare_with_reference("fast", 70, 50, 3)
+compare_with_reference("high", 40, 24, 5)
 
 levels = [os.environ["PTR_CPUMASK"]] if os.environ.get("PTR_CPUMASK") else ["none", "sse41",
                                                                             "avx2"]
@@ -99,15 +110,16 @@ check_same("levels and threads",
            [(f"{level} with {threads} thread(s)", run_ptr("balanced", images, threads, 0, level))
             for level in levels for threads in (1, 2)])
 
-# Tiles of 208 pixels (the smallest: 16 beyond twice the overlap) across a
-# 224-pixel side make two; each pixel is the untiled image's, bit for bit.
-for width, height in ((224, 24), (24, 224)):
+# Tiles of 240 pixels (the smallest: 16 beyond twice the overlap) across a
+# 256-pixel side make two; each pixel is the untiled image's, bit for bit.
+for width, height in ((256, 24), (24, 256)):
     images = scene(width, height, 4)
     check_same(f"tiles of {width}x{height}",
                [("one tile", run_ptr("fast", images)),
-                ("tiles of 208", run_ptr("fast", images, 1, 208)),
-                ("tiles of 208, 2 threads", run_ptr("fast", images, 2, 208))])
+                ("tiles of 240", run_ptr("fast", images, 1, 240)),
+                ("tiles of 240, 2 threads", run_ptr("fast", images, 2, 240))])
 
+shutil.rmtree(work)
 for failure in failures:
     print("FAILED:", failure)
 sys.exit(1 if failures else 0)

@@ -5,6 +5,7 @@ Denoise's description (docs/denoise.md), sharing no code with ptr's.
 
     denoise_reference.py list FILE.tza
     denoise_reference.py run FILE.tza WIDTH HEIGHT COLOR ALBEDO NORMAL OUT
+                             [ALBEDO_FILTER.tza NORMAL_FILTER.tza]
 
 COLOR, ALBEDO and NORMAL are raw little-endian float32 RGB, row by row; OUT
 is written the same way (float64 rounded to float32)."""
@@ -64,22 +65,33 @@ def upsample(x):
 
 
 def unet(tensors, x):
-    def conv(name, x, relu=True):
-        y = conv3x3(x, tensors[name + ".weight"][1], tensors[name + ".bias"][1])
-        return np.maximum(y, 0.0) if relu else y
+    """OIDN's UNet (enc_conv0 ..) or UNetLarge (enc_conv1a ..), told apart
+    by the names of the tensors."""
+    large = "enc_conv1b.weight" in tensors
+    encoder = ([["enc_conv1a", "enc_conv1b"], ["enc_conv2a", "enc_conv2b"],
+                ["enc_conv3a", "enc_conv3b"], ["enc_conv4a", "enc_conv4b"]] if large else
+               [["enc_conv0", "enc_conv1"], ["enc_conv2"], ["enc_conv3"], ["enc_conv4"]])
+    decoder = [["dec_conv4a", "dec_conv4b"], ["dec_conv3a", "dec_conv3b"],
+               ["dec_conv2a", "dec_conv2b"],
+               ["dec_conv1a", "dec_conv1b", "dec_conv1c" if large else "dec_conv0"]]
+    last = decoder[-1][-1]
 
-    inp = x
-    x = conv("enc_conv0", x)
-    pool1 = x = pool(conv("enc_conv1", x))
-    pool2 = x = pool(conv("enc_conv2", x))
-    pool3 = x = pool(conv("enc_conv3", x))
-    x = pool(conv("enc_conv4", x))
+    def conv(name, x):
+        y = conv3x3(x, tensors[name + ".weight"][1], tensors[name + ".bias"][1])
+        return y if name == last else np.maximum(y, 0.0)
+
+    skips = [x]
+    for names in encoder:
+        for name in names:
+            x = conv(name, x)
+        x = pool(x)
+        skips.append(x)
     x = conv("enc_conv5b", conv("enc_conv5a", x))
-    x = conv("dec_conv4b", conv("dec_conv4a", np.concatenate([upsample(x), pool3])))
-    x = conv("dec_conv3b", conv("dec_conv3a", np.concatenate([upsample(x), pool2])))
-    x = conv("dec_conv2b", conv("dec_conv2a", np.concatenate([upsample(x), pool1])))
-    x = conv("dec_conv1b", conv("dec_conv1a", np.concatenate([upsample(x), inp])))
-    return conv("dec_conv0", x, relu=False)
+    for names, skip in zip(decoder, reversed(skips[:-1])):
+        x = np.concatenate([upsample(x), skip])
+        for name in names:
+            x = conv(name, x)
+    return x
 
 
 # The PU curve (Aydin et al. 2008) as OIDN fits it, normalised at 65504.
@@ -121,20 +133,38 @@ def autoexposure(color):
     return 0.18 / np.exp2(np.mean(logs)) if logs else 1.0
 
 
-def denoise(tensors, color, albedo, normal):
-    """color, albedo, normal: H x W x 3. The denoised colour, H x W x 3."""
-    h, w, _ = color.shape
+def srgb_forward(y):
+    return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1 / 2.4) - 0.055)
+
+
+def srgb_inverse(x):
+    return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))
+
+
+def run(tensors, planes):
+    """The network on the planes (H x W x C), padded with zeros at the right
+    and the bottom to a multiple of 16, so that every pooling halves exactly;
+    its 3 output channels, H x W x 3, negatives as 0."""
+    h, w, c = planes.shape
+    x = np.zeros((c, -(-h // 16) * 16, -(-w // 16) * 16))
+    x[:, :h, :w] = planes.transpose(2, 0, 1)
+    return np.maximum(unet(tensors, x)[:3, :h, :w].transpose(1, 2, 0), 0.0)
+
+
+def denoise(tensors, color, albedo, normal, guide_filters=None):
+    """color, albedo, normal: H x W x 3. The denoised colour, H x W x 3.
+    guide_filters: the albedo's and the normal's networks, which filter them
+    first (OIDN's way to its best quality), or None."""
+    if guide_filters:
+        albedo_net, normal_net = guide_filters
+        albedo = np.minimum(srgb_inverse(run(albedo_net, srgb_forward(np.clip(albedo, 0, 1)))),
+                            1.0)
+        normal = np.clip(run(normal_net, np.clip(normal, -1, 1) * 0.5 + 0.5) * 2 - 1, -1, 1)
     scale = autoexposure(np.maximum(np.nan_to_num(color, nan=0.0), 0.0))
     colour_in = pu_forward(np.maximum(np.nan_to_num(color, nan=0.0) * scale, 0.0)) * PU_NORM
-    albedo_in = np.clip(albedo, 0.0, 1.0)
-    normal_in = np.clip(normal, -1.0, 1.0) * 0.5 + 0.5
-    # The image padded with zeros at the right and the bottom to a multiple
-    # of 16, so that every pooling halves exactly.
-    ph, pw = -(-h // 16) * 16, -(-w // 16) * 16
-    x = np.zeros((9, ph, pw))
-    x[:, :h, :w] = np.concatenate([colour_in, albedo_in, normal_in], axis=2).transpose(2, 0, 1)
-    y = unet(tensors, x)[:3, :h, :w].transpose(1, 2, 0)
-    return pu_inverse(np.maximum(y, 0.0) / PU_NORM) / scale
+    planes = np.concatenate([colour_in, np.clip(albedo, 0.0, 1.0),
+                             np.clip(normal, -1.0, 1.0) * 0.5 + 0.5], axis=2)
+    return pu_inverse(run(tensors, planes) / PU_NORM) / scale
 
 
 def main():
@@ -142,10 +172,11 @@ def main():
         for name, (layout, t) in read_tza(sys.argv[2]).items():
             print(name, layout, "x".join(map(str, t.shape)))
         return
-    _, _, path, width, height, color, albedo, normal, out = sys.argv
+    path, width, height, color, albedo, normal, out = sys.argv[2:9]
     shape = (int(height), int(width), 3)
     load = lambda p: np.fromfile(p, dtype="<f4").astype(np.float64).reshape(shape)
-    result = denoise(read_tza(path), load(color), load(albedo), load(normal))
+    filters = [read_tza(p) for p in sys.argv[9:11]] or None
+    result = denoise(read_tza(path), load(color), load(albedo), load(normal), filters)
     result.astype("<f4").tofile(out)
 
 

@@ -1,9 +1,10 @@
 /* The denoiser's parts that have closed forms (denoise/transfer.h,
- * denoise/unet.h): the PU transfer function and its inverse, the exposure
+ * denoise/unet.h): the PU transfer function and its inverse, the guides'
+ * mappings for their own networks (sRGB, [-1, 1] to [0, 1]), the exposure
  * of constant images, pooling and upsampling; its errors: a quality that
- * does not exist or is not there yet, a missing weight file, an archive
- * whose tensors are not the U-Net's. The network itself is checked against
- * NumPy by check_denoise_network. */
+ * does not exist, a missing weight file (for each quality), an archive
+ * whose tensors are not the U-Net's. The networks themselves are checked
+ * against NumPy by check_denoise_network. */
 #include "denoise/denoise.h"
 #include "denoise/transfer.h"
 #include "denoise/unet.h"
@@ -37,6 +38,33 @@ static void pu_round_trip(void)
     ptr_transfer_output(&t, in, out);
     for (int k = 0; k < 3; k++)
         CHECK_NEAR(out[k], color[k], 2e-5 * color[k]);
+}
+
+static void guides_round_trip(void)
+{
+    for (float y = 1e-6f; y <= 1.0f; y *= 1.21f)
+        CHECK_NEAR(ptr_srgb_inverse(ptr_srgb_forward(y)) / y, 1.0, 1e-5);
+    CHECK_NEAR(ptr_srgb_forward(1.0f), 1.0, 1e-6);
+    float albedo[3] = { 0.25f, 1.5f, NAN }, normal[3] = { -0.6f, 0.8f, 3.0f }, x[3], back[3];
+    ptr_transfer_albedo_input(albedo, x);
+    CHECK_NEAR(x[1], 1.0, 1e-6); /* clamped to 1 first */
+    CHECK_FLOAT_EQ(x[2], 0.0f);
+    ptr_transfer_albedo_output(x, back);
+    CHECK_NEAR(back[0], 0.25, 1e-6);
+    CHECK_FLOAT_EQ(back[1], 1.0f);
+    CHECK_FLOAT_EQ(back[2], 0.0f);
+    ptr_transfer_normal_input(normal, x);
+    CHECK_NEAR(x[0], 0.2, 1e-7);
+    CHECK_FLOAT_EQ(x[2], 1.0f);
+    ptr_transfer_normal_output(x, back);
+    CHECK_NEAR(back[0], -0.6, 1e-6);
+    CHECK_NEAR(back[1], 0.8, 1e-6);
+    CHECK_FLOAT_EQ(back[2], 1.0f);
+    float below[3] = { -1.0f, NAN, 7.0f }; /* a network's output out of range */
+    ptr_transfer_normal_output(below, back);
+    CHECK_FLOAT_EQ(back[0], -1.0f);
+    CHECK_FLOAT_EQ(back[1], -1.0f);
+    CHECK_FLOAT_EQ(back[2], 1.0f);
 }
 
 static void autoexposure_of_constant_images(void)
@@ -100,10 +128,6 @@ static void qualities(void)
     CHECK_INT(q, PTR_DENOISE_HIGH);
     CHECK_INT(ptr_denoise_quality_parse("best", &q, &err), PTR_ERR_USAGE);
     CHECK(strstr(err.message, "'best'") != NULL);
-    PtrDenoiser *d = NULL;
-    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_HIGH, NULL, PTR_CPU_NONE, &d, &err), PTR_ERR_USAGE);
-    CHECK(strstr(err.message, "not available yet") != NULL);
-    CHECK(d == NULL);
 }
 
 static void missing_weights(void)
@@ -118,6 +142,11 @@ static void missing_weights(void)
     CHECK(d == NULL);
     CHECK_INT(ptr_denoiser_new(PTR_DENOISE_FAST, "/nonexistent/weights", PTR_CPU_NONE, &d, NULL),
               PTR_ERR_INSTALL);
+    /* High quality filters the albedo first. */
+    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_HIGH, "/nonexistent/weights", PTR_CPU_NONE, &d, &err),
+              PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, "/nonexistent/weights/rt_alb_large.tza") != NULL);
+    CHECK(d == NULL);
 }
 
 /* Writes an archive of one layer, enc_conv0, with in input channels. */
@@ -175,7 +204,8 @@ static void archives_not_a_unet(void)
 int main(void)
 {
     static const TestCase cases[] = {
-        TEST_CASE(pu_round_trip),   TEST_CASE(autoexposure_of_constant_images),
+        TEST_CASE(pu_round_trip),   TEST_CASE(guides_round_trip),
+        TEST_CASE(autoexposure_of_constant_images),
         TEST_CASE(pooling_and_upsampling), TEST_CASE(qualities),
         TEST_CASE(missing_weights), TEST_CASE(archives_not_a_unet),
     };
