@@ -157,7 +157,7 @@ PtrResult ptr_unet_load(const char *path, size_t input_channels, PtrCpuLevel lev
     if (unet) {
         Builder b = { path, archive,
                       ptr_tza_find(archive, "enc_conv1b.weight") ? &unet_large : &unet_base,
-                      unet, input_channels, PTR_CONV_BLOCK, input_channels, { 0 } };
+                      unet, input_channels, padded(input_channels), input_channels, { 0 } };
         res = build(&b, err);
     } else {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoiser");

@@ -27,8 +27,8 @@ typedef struct PtrUnetConv {
     float *weights;  /* packed (conv.h) */
     float *bias;     /* out floats, zero past the tensor's */
     int level;       /* the resolution it runs at: 1 / 2^level */
-    int concat;      /* -1; or its input is the map before it upsampled, then
-                      * pooled map number concat (0: the network's input) */
+    int concat;      /* -1: it reads the map before it; else that map upsampled,
+                      * followed by pooled map number concat (0: the input) */
     size_t concat_channels; /* that map's padded channels */
     int pool;        /* 0; or its output is pooled into map number pool */
 } PtrUnetConv;
