@@ -110,7 +110,10 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
         if (S_ISREG(st.st_mode) && st.st_size == 0)
             return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
         PtrResult r = importers[i].import(path, options, scene, warnings, err);
-        if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value)
+        /* A structure's --color-by may name a colour scheme, which gives
+         * colours, not values (structure_import.c checks its own). */
+        if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value &&
+            importers[i].import != ptr_import_structure)
             r = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                               "%s: no instance or point attribute '%s' (--color-by)", path,
                               options->value_attribute);

@@ -45,6 +45,7 @@ typedef struct PtrOptions {
     int fit_all_objects;
     unsigned structure_select; /* PtrImportOptions.structure_select */
     PtrSwitch hydrogens;
+    const char *structure_assembly; /* PtrImportOptions.structure_assembly */
     const char *color_by;   /* --color-by: the attribute; NULL: none */
     const PtrColormap *colormap;
     int has_color_range;
