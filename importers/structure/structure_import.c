@@ -39,7 +39,7 @@ static const unsigned char categories[10][3] = {
 /* Residues: RasMol's "shapely" colours, with Jmol's for the nucleotides
  * (DNA's as RNA's), and shapely's magenta for every other residue. */
 static const struct {
-    const char *names;
+    const char *name;
     unsigned char srgb[3];
 } residues[] = {
     { "ALA", { 140, 255, 140 } }, { "ARG", { 0, 0, 124 } },     { "ASN", { 255, 124, 112 } },
@@ -48,9 +48,11 @@ static const struct {
     { "ILE", { 0, 76, 0 } },      { "LEU", { 69, 94, 69 } },    { "LYS", { 71, 71, 184 } },
     { "MET", { 184, 160, 66 } },  { "PHE", { 83, 76, 66 } },    { "PRO", { 82, 82, 82 } },
     { "SER", { 255, 112, 66 } },  { "THR", { 184, 76, 0 } },    { "TRP", { 79, 70, 0 } },
-    { "TYR", { 140, 112, 76 } },  { "VAL", { 255, 140, 255 } }, { "A DA", { 160, 160, 255 } },
-    { "C DC", { 255, 140, 75 } }, { "G DG", { 255, 112, 112 } }, { "T DT", { 160, 255, 160 } },
-    { "U DU", { 255, 128, 128 } }, { "I DI", { 128, 255, 255 } },
+    { "TYR", { 140, 112, 76 } },  { "VAL", { 255, 140, 255 } }, { "A", { 160, 160, 255 } },
+    { "DA", { 160, 160, 255 } },  { "C", { 255, 140, 75 } },    { "DC", { 255, 140, 75 } },
+    { "G", { 255, 112, 112 } },   { "DG", { 255, 112, 112 } },  { "T", { 160, 255, 160 } },
+    { "DT", { 160, 255, 160 } },  { "U", { 255, 128, 128 } },   { "DU", { 255, 128, 128 } },
+    { "I", { 128, 255, 255 } },   { "DI", { 128, 255, 255 } },
 };
 static const unsigned char other_residue[3] = { 255, 0, 255 };
 
@@ -86,12 +88,9 @@ static PtrResult atom_coloring(const char *path, const char *name, AtomColoring 
 
 static const unsigned char *residue_color(const char *name)
 {
-    for (size_t i = 0; i < sizeof residues / sizeof residues[0]; i++) {
-        const char *names = residues[i].names;
-        for (const char *n = names; *n; n += strcspn(n, " "), n += *n == ' ')
-            if (strcspn(n, " ") == strlen(name) && !strncmp(n, name, strlen(name)))
-                return residues[i].srgb;
-    }
+    for (size_t i = 0; i < sizeof residues / sizeof residues[0]; i++)
+        if (!strcmp(residues[i].name, name))
+            return residues[i].srgb;
     return other_residue;
 }
 
@@ -139,10 +138,12 @@ static void fill_atom(const Expansion *e, size_t atom, const StructureOperator *
 {
     const StructureAtom *a = &e->doc->atoms[atom];
     double centre[3];
-    for (int i = 0; i < 3 && op; i++)
-        centre[i] = op->rotation[i][0] * a->position[0] + op->rotation[i][1] * a->position[1] +
-                    op->rotation[i][2] * a->position[2] + op->translation[i];
-    if (!op)
+    if (op)
+        for (int i = 0; i < 3; i++)
+            centre[i] = op->rotation[i][0] * a->position[0] +
+                        op->rotation[i][1] * a->position[1] +
+                        op->rotation[i][2] * a->position[2] + op->translation[i];
+    else
         memcpy(centre, a->position, sizeof centre);
     ptr_builder_fill_sphere(e->builder, e->first + n, centre, e->looks[atom][0], e->material,
                             &e->looks[atom][1]);
