@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Writes a large biological assembly as the PDB archive would, and the same
 spheres as an instanced glTF binary, for bench/assembly.sh: an asymmetric
-unit of ATOMS atoms (default 20,000: 20 chains of a compact random blob of
-C, N, O and S, 150 angstrom from the origin) and an assembly of the 60
+unit of ATOMS atoms (default 20,000 of C, N, O and S at random in a slab 150
+angstrom from the origin, 20 chains) and an assembly of the 60
 rotations of the icosahedral group, "(1-60)" on every chain, as a capsid's
 mmCIF file gives it (ATOMS * 60 spheres after expansion: 1.2 million by
 default). The .glb holds every sphere of the expanded assembly as an
@@ -57,21 +57,33 @@ def icosahedral_group():
 
 
 def unit(atoms, rng):
-    """(element, x, y, z) of atoms atoms, 1.9 angstrom apart on average, in a
-    blob centred 150 angstrom up z."""
-    radius = (atoms * 6.9 * 3 / (4 * math.pi)) ** (1 / 3)
+    """(chain, element, x, y, z) of atoms atoms, 1.9 angstrom apart on
+    average: a slab 150 angstrom from the origin, a sixtieth of the sphere's
+    area (so that the 60 copies tile a shell, as a capsid's proteins do), 20
+    chains its 20 wedges."""
+    radius, chains = 150.0, 20
+    patch = math.sqrt(4 * math.pi * radius ** 2 / 60 / math.pi)
+    thickness = atoms * 6.9 / (math.pi * patch ** 2)
+    normal = [v / math.sqrt(0.3 ** 2 + 0.2 ** 2 + 1) for v in (0.3, 0.2, 1.0)]
+    u = [normal[2], 0.0, -normal[0]]
+    u = [v / math.sqrt(sum(w * w for w in u)) for v in u]
+    w = [normal[1] * u[2] - normal[2] * u[1], normal[2] * u[0] - normal[0] * u[2],
+         normal[0] * u[1] - normal[1] * u[0]]
     out = []
     while len(out) < atoms:
-        p = [rng.uniform(-radius, radius) for _ in range(3)]
-        if sum(v * v for v in p) <= radius * radius:
-            element = rng.choices("CNOS", weights=(63, 17, 19, 1))[0]
-            out.append((element, p[0], p[1], p[2] + 150))
-    return out
+        a, b = rng.uniform(-patch, patch), rng.uniform(-patch, patch)
+        if a * a + b * b > patch * patch:
+            continue
+        h = radius + rng.uniform(-thickness / 2, thickness / 2)
+        chain = int((math.atan2(b, a) + math.pi) / (2 * math.pi) * chains) % chains
+        element = rng.choices("CNOS", weights=(63, 17, 19, 1))[0]
+        out.append((chain, element) + tuple(h * normal[k] + a * u[k] + b * w[k]
+                                            for k in range(3)))
+    return sorted(out, key=lambda atom: atom[0])
 
 
 def write_cif(path, atoms, operators):
     chains = [chr(ord("A") + i) for i in range(20)]
-    per_chain = -(-len(atoms) // len(chains))
     with open(path, "w") as f:
         f.write("data_CAPSID\n_entry.id CAPSID\n\nloop_\n_entity.id\n_entity.type\n"
                 "1 polymer\n\nloop_\n_struct_asym.id\n_struct_asym.entity_id\n")
@@ -97,8 +109,8 @@ def write_cif(path, atoms, operators):
             "label_asym_id", "label_entity_id", "label_seq_id", "Cartn_x", "Cartn_y",
             "Cartn_z", "occupancy", "B_iso_or_equiv", "auth_seq_id", "auth_asym_id",
             "pdbx_PDB_model_num")))
-        for n, (element, x, y, z) in enumerate(atoms):
-            chain, residue = chains[n // per_chain], n // 8 + 1
+        for n, (chain_number, element, x, y, z) in enumerate(atoms):
+            chain, residue = chains[chain_number], n // 8 + 1
             f.write(f"ATOM {n + 1} {element} {element} . ALA {chain} 1 {residue} {x:.3f} "
                     f"{y:.3f} {z:.3f} 1.00 20.00 {residue} {chain} 1\n")
 
@@ -107,7 +119,8 @@ def expanded(atoms, operators):
     """The assembly's spheres as particles_to_glb takes them, in ptr's order:
     each operator's copy of every atom."""
     spheres = []
-    rounded = [(e, float(f"{x:.3f}"), float(f"{y:.3f}"), float(f"{z:.3f}")) for e, x, y, z in atoms]
+    rounded = [(e, float(f"{x:.3f}"), float(f"{y:.3f}"), float(f"{z:.3f}"))
+               for _, e, x, y, z in atoms]
     for m in operators:
         m = [[float(f"{v:.10f}") for v in row] for row in m]
         for element, x, y, z in rounded:
