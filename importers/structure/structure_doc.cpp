@@ -526,15 +526,27 @@ void fill_assembly(const Selection &kept, const Assembly &assembly,
                    std::vector<StructureGenerator> &generators, std::vector<unsigned> &parts,
                    std::vector<StructureOperator> &operators)
 {
+    // The parts of each chain name and of each subchain name, looked up by
+    // the generators' names (a generator a name, not a part at a time: a
+    // file's thousands of generators over thousands of chains stay quick).
+    std::map<std::string, std::vector<unsigned>> of_chain, of_subchain;
+    for (unsigned p = 0; p < kept.parts.size(); p++) {
+        of_chain[kept.parts[p].first].push_back(p);
+        of_subchain[kept.parts[p].second].push_back(p);
+    }
     for (const Generator &g : assembly.generators) {
         StructureGenerator out = { parts.size(), 0, operators.size(), 0, 0 };
-        for (unsigned p = 0; p < kept.parts.size(); p++) {
-            const std::string &name = g.subchains ? kept.parts[p].second : kept.parts[p].first;
-            if (std::find(g.names.begin(), g.names.end(), name) == g.names.end())
-                continue;
-            parts.push_back(p);
-            out.atoms += kept.part_atoms[p];
+        const auto &of_name = g.subchains ? of_subchain : of_chain;
+        for (const std::string &name : g.names) {
+            const auto found = of_name.find(name);
+            if (found != of_name.end())
+                parts.insert(parts.end(), found->second.begin(), found->second.end());
         }
+        // In the file's order, each part once, however often it is named.
+        std::sort(parts.begin() + out.first_part, parts.end());
+        parts.erase(std::unique(parts.begin() + out.first_part, parts.end()), parts.end());
+        for (size_t k = out.first_part; k < parts.size(); k++)
+            out.atoms += kept.part_atoms[parts[k]];
         out.part_count = parts.size() - out.first_part;
         if (!out.atoms || g.operators.empty()) {
             parts.resize(out.first_part);
