@@ -51,6 +51,9 @@ typedef struct PtrImportOptions {
     /* Structures: the biological assembly built (--assembly): its name,
      * "none" for the asymmetric unit; NULL: the file's first, if any. */
     const char *structure_assembly;
+    /* Structures: the model read, 1 the first (a frame of a sequence of
+     * models); 0: the first, with a warning where the file has more. */
+    size_t structure_model;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

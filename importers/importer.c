@@ -89,6 +89,14 @@ PtrResult ptr_import_check_memory(const char *path, uint64_t spheres, PtrError *
                          (double)spheres * PTR_SPHERE_PEAK_BYTES * 1e-9, (double)available * 1e-9);
 }
 
+int ptr_import_is_structure(const char *path)
+{
+    for (size_t i = 0; i < sizeof importers / sizeof importers[0]; i++)
+        if (has_extension(path, importers[i].extension))
+            return importers[i].import == ptr_import_structure;
+    return 0;
+}
+
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
                            PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {

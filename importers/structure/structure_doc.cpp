@@ -190,16 +190,18 @@ void mark_range(const gemmi::Model &model, const gemmi::AtomAddress &start,
     }
 }
 
-// The secondary structure of the residues the file's HELIX and SHEET records
-// (mmCIF: _struct_conf and _struct_sheet_range) name; coil is left out.
-std::map<const gemmi::Residue *, unsigned char> secondary_structure(const gemmi::Structure &st)
+// The secondary structure of the model's residues the file's HELIX and SHEET
+// records (mmCIF: _struct_conf and _struct_sheet_range) name; coil is left
+// out.
+std::map<const gemmi::Residue *, unsigned char> secondary_structure(const gemmi::Structure &st,
+                                                                   const gemmi::Model &model)
 {
     std::map<const gemmi::Residue *, unsigned char> secondary;
     for (const gemmi::Helix &helix : st.helices)
-        mark_range(st.models[0], helix.start, helix.end, STRUCTURE_HELIX, secondary);
+        mark_range(model, helix.start, helix.end, STRUCTURE_HELIX, secondary);
     for (const gemmi::Sheet &sheet : st.sheets)
         for (const gemmi::Sheet::Strand &strand : sheet.strands)
-            mark_range(st.models[0], strand.start, strand.end, STRUCTURE_SHEET, secondary);
+            mark_range(model, strand.start, strand.end, STRUCTURE_SHEET, secondary);
     return secondary;
 }
 
@@ -213,11 +215,11 @@ std::map<std::string, unsigned> entity_numbers(const gemmi::Structure &st)
     return entity_of;
 }
 
-Selection select_atoms(const std::string &path, const gemmi::Structure &st, unsigned select,
-                       int hydrogens)
+Selection select_atoms(const std::string &path, const gemmi::Structure &st,
+                       const gemmi::Model &model, unsigned select, int hydrogens)
 {
-    const gemmi::Model &model = st.models[0];
-    const std::map<const gemmi::Residue *, unsigned char> secondary = secondary_structure(st);
+    const std::map<const gemmi::Residue *, unsigned char> secondary =
+        secondary_structure(st, model);
     const std::map<std::string, unsigned> entity_of = entity_numbers(st);
     std::map<std::string, unsigned> chain_numbers;
     std::map<std::pair<std::string, std::string>, unsigned> part_numbers;
@@ -576,42 +578,54 @@ template <typename T> T *malloc_copy(const std::vector<T> &v)
     return out;
 }
 
+// The file read and parsed, with its assemblies (see Assembly), checked
+// where gemmi reads without checking.
+gemmi::Structure read_structure(const char *path, std::vector<Assembly> &assemblies)
+{
+    gemmi::MaybeGzipped input(path);
+    const gemmi::CoorFormat format = gemmi::coor_format_from_ext(input.basepath());
+    if (format != gemmi::CoorFormat::Pdb && format != gemmi::CoorFormat::Mmcif)
+        throw Fault{ std::string(path) + ": not .pdb, .ent, .cif or .mmcif" };
+    gemmi::CharArray text = gemmi::read_into_buffer(input);
+    check_ascii(path, text.data(), text.size());
+    if (format == gemmi::CoorFormat::Pdb) {
+        check_pdb_numbers(path, text.data(), text.size());
+        const std::string lines = pdb_lines_for_gemmi(text.data(), text.size());
+        text = gemmi::CharArray();
+        gemmi::Structure structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(),
+                                                                 path);
+        assemblies = pdb_assemblies(structure);
+        return structure;
+    }
+    gemmi::cif::Document cif = gemmi::cif::read_memory(text.data(), text.size(), path);
+    text = gemmi::CharArray();
+    if (!cif.blocks.empty()) {
+        check_atom_site_columns(path, cif.blocks[0]);
+        check_whole_numbers(path, cif.blocks[0]);
+        assemblies = mmcif_assemblies(path, cif.blocks[0]);
+    }
+    return gemmi::make_structure(cif);
+}
+
 } // namespace
 
 extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest *request,
                                         StructureDoc *doc, PtrError *err)
 {
     try {
-        gemmi::MaybeGzipped input(path);
-        const gemmi::CoorFormat format = gemmi::coor_format_from_ext(input.basepath());
-        if (format != gemmi::CoorFormat::Pdb && format != gemmi::CoorFormat::Mmcif)
-            return ptr_shim_error(err, PTR_ERR_SCENE_INVALID,
-                                  std::string(path) + ": not .pdb, .ent, .cif or .mmcif");
-        gemmi::CharArray text = gemmi::read_into_buffer(input);
-        check_ascii(path, text.data(), text.size());
-        gemmi::Structure structure;
         std::vector<Assembly> assemblies;
-        if (format == gemmi::CoorFormat::Pdb) {
-            check_pdb_numbers(path, text.data(), text.size());
-            const std::string lines = pdb_lines_for_gemmi(text.data(), text.size());
-            structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(), path);
-            assemblies = pdb_assemblies(structure);
-        } else {
-            gemmi::cif::Document cif = gemmi::cif::read_memory(text.data(), text.size(), path);
-            if (!cif.blocks.empty()) {
-                check_atom_site_columns(path, cif.blocks[0]);
-                check_whole_numbers(path, cif.blocks[0]);
-                assemblies = mmcif_assemblies(path, cif.blocks[0]);
-            }
-            structure = gemmi::make_structure(cif);
-        }
-        text = gemmi::CharArray();
+        gemmi::Structure structure = read_structure(path, assemblies);
         if (structure.models.empty())
             return ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": no atoms");
+        if (request->model >= structure.models.size())
+            return ptr_shim_error(err, PTR_ERR_USAGE,
+                                  std::string(path) + ": no model " +
+                                      std::to_string(request->model + 1) + "; it has " +
+                                      std::to_string(structure.models.size()));
         const Assembly *assembly = chosen_assembly(path, assemblies, request->assembly);
         gemmi::setup_entities(structure);
-        const Selection kept =
-            select_atoms(path, structure, request->select, request->hydrogens);
+        const Selection kept = select_atoms(path, structure, structure.models[request->model],
+                                            request->select, request->hydrogens);
         std::vector<StructureGenerator> generators;
         std::vector<unsigned> parts;
         std::vector<StructureOperator> operators;
@@ -627,6 +641,19 @@ extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest
             structure_doc_free(doc);
             return ptr_shim_error(err, PTR_ERR_NOMEM, std::string(path) + ": out of memory");
         }
+        return PTR_OK;
+    } catch (const Fault &fault) {
+        return ptr_shim_error(err, fault.code, fault.message);
+    } catch (...) {
+        return caught(err, path);
+    }
+}
+
+extern "C" PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err)
+{
+    try {
+        std::vector<Assembly> assemblies;
+        *models = read_structure(path, assemblies).models.size();
         return PTR_OK;
     } catch (const Fault &fault) {
         return ptr_shim_error(err, fault.code, fault.message);

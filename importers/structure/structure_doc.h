@@ -1,5 +1,5 @@
 /* A macromolecular structure (PDB or mmCIF, gzipped or not) as plain C data:
- * the atoms of its first model that a selection keeps, what each belongs to
+ * the atoms of one of its models that a selection keeps, what each belongs to
  * (chain, entity, residue, secondary structure), and the biological assembly
  * asked for as instances of those atoms, read through gemmi. What the atoms
  * become (spheres, colours, values) lives in structure_import.c; this layer
@@ -55,7 +55,7 @@ typedef struct StructureGenerator {
 typedef struct StructureDoc {
     StructureAtom *atoms; /* the asymmetric unit's atoms kept, in the file's order */
     size_t count;
-    size_t models;        /* the models the file has (the first is read) */
+    size_t models;        /* the models the file has */
     /* The assembly asked for: its generators in the file's order; none for
      * the asymmetric unit (none asked for, or the file has none). At most
      * STRUCTURE_MAX_INSTANCES operators in all. */
@@ -69,10 +69,11 @@ typedef struct StructureRequest {
     unsigned select;      /* PTR_STRUCTURE_PROTEIN ...: the residues kept */
     int hydrogens;        /* whether hydrogens (and deuterium) are kept */
     const char *assembly; /* its name; NULL: the file's first, if any; "none": the asymmetric unit */
+    size_t model;         /* the model read: 0 the first */
 } StructureRequest;
 
-/* Reads path (.pdb, .ent, .cif or .mmcif, each optionally .gz): of its first
- * model, the atoms of the residues request->select keeps, hydrogens only
+/* Reads path (.pdb, .ent, .cif or .mmcif, each optionally .gz): of the
+ * model request->model, the atoms of the residues request->select keeps, hydrogens only
  * with request->hydrogens, and of an atom's alternate locations the one of
  * highest occupancy (the first of equals) where the first stood; and the
  * assembly asked for, from an mmCIF's _pdbx_struct_assembly_gen and
@@ -80,10 +81,14 @@ typedef struct StructureRequest {
  * with structure_doc_free) holds them. Fails with PTR_ERR_SCENE_UNREADABLE
  * or PTR_ERR_SCENE_INVALID (a number that is not one, a malformed file, an
  * operator missing, more than STRUCTURE_MAX_INSTANCES instances),
- * PTR_ERR_USAGE (an assembly the file does not have: the message names those
- * it has), PTR_ERR_NOMEM, each with one line naming the file. */
+ * PTR_ERR_USAGE (an assembly or a model the file does not have: the message
+ * names those it has), PTR_ERR_NOMEM, each with one line naming the file. */
 PtrResult structure_doc_read(const char *path, const StructureRequest *request,
                              StructureDoc *doc, PtrError *err);
+
+/* The number of models path has (read and checked as structure_doc_read
+ * reads it), failing as it does. */
+PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err);
 void structure_doc_free(StructureDoc *doc);
 
 #ifdef __cplusplus

@@ -272,6 +272,7 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
                                                        : PTR_STRUCTURE_DEFAULT,
         .hydrogens = !(options && options->drop_hydrogens),
         .assembly = options ? options->structure_assembly : NULL,
+        .model = options && options->structure_model ? options->structure_model - 1 : 0,
     };
     AtomColoring coloring;
     PtrResult res =
@@ -279,9 +280,9 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
     StructureDoc doc = { 0 };
     if (res == PTR_OK)
         res = structure_doc_read(path, &request, &doc, err);
-    if (res == PTR_OK && doc.models > 1)
-        ptr_warn(warnings, "%s: the first of %zu models is read, the others are left out", path,
-                 doc.models);
+    if (res == PTR_OK && doc.models > 1 && !(options && options->structure_model))
+        ptr_warn(warnings, "%s: the first of %zu models is read, the others are left out (# in "
+                 "-o renders each as a frame)", path, doc.models);
     if (res == PTR_OK && doc.count == 0)
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: no atoms%s", path,
                             request.select == PTR_STRUCTURE_ALL ? "" : " of those --select keeps");
@@ -296,6 +297,11 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
     return res;
 }
 
+
+PtrResult ptr_structure_model_count(const char *path, size_t *models, PtrError *err)
+{
+    return structure_doc_models(path, models, err);
+}
 
 PtrResult ptr_structure_select_parse(const char *text, unsigned *parts, PtrError *err)
 {

@@ -476,6 +476,7 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .auto_projection = o->auto_camera,
         .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
         .orbit_degrees = o->orbit_degrees,
+        .structure_model = o->structure_model,
         .dependencies = dependencies,
     };
 }

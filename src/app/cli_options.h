@@ -84,6 +84,7 @@ typedef struct PtrOptions {
     int turntable;          /* frames in a full turn; 0: none */
     int skip_existing;
     double orbit_degrees;   /* the camera's turn in the frame being rendered */
+    size_t structure_model; /* the structure's model the frame renders (1 the first); 0: none */
     int json;
     int quiet;
     int dump_scene;

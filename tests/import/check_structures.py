@@ -9,6 +9,7 @@ gives the converter's first frame; --select and --hydrogens keep what they
 say; bad option values, --color-by a value structures lack and hostile files
 are one-line errors with the README's exit codes.
 Usage: check_structures.py PTR SOURCE_DIR"""
+import json
 import os
 import subprocess
 import sys
@@ -104,6 +105,27 @@ kept = {  # --select and --hydrogens: which of the converter's spheres remain
 }
 for options, indices in kept.items():
     same_spheres(f"mixed.pdb {options}", dump(mixed, *options), [want[i] for i in indices])
+
+# The models as frames: # in -o renders model k as frame k (from 1), each
+# with the spheres of its own model; --frames picks some, a model the file
+# lacks is a usage error.
+def frames(*options):
+    run = subprocess.run([ptr, mixed, "-o", os.path.join(tmp, "m_#.exr"), "--width", "8",
+                          "--samples", "1", "--quiet", "--json", *options], capture_output=True,
+                         text=True)
+    reports = [json.loads(line) for line in run.stdout.splitlines() if line.startswith("{")]
+    return run, [(os.path.basename(r["output"]), r["spheres"]) for r in reports]
+
+
+run, made = frames()
+expect(f"mixed.pdb as frames: {made}, exit {run.returncode}",
+       run.returncode == 0 and made == [("m_1.exr", 5), ("m_2.exr", 1)])
+run, made = frames("--frames", "2:2")
+expect(f"mixed.pdb --frames 2:2: {made}", run.returncode == 0 and made == [("m_2.exr", 1)])
+run, made = frames("--frames", "1:3")
+expect(f"mixed.pdb --frames 1:3: exit {run.returncode}, {run.stderr!r}",
+       run.returncode == 2 and run.stderr == "ptr: --frames: " + mixed +
+       " has no model 3 (frames 1 to 2)\n")
 
 # One-line errors with the README's exit codes (2: usage, 4: the scene).
 for options, code, says in (
