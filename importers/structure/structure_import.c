@@ -131,7 +131,7 @@ typedef struct Expansion {
     size_t first;
     size_t *members;    /* each generator's atoms, one generator after another */
     size_t *slot_start; /* each generator's first slot, then the total */
-    size_t *member_start;
+    size_t *member_start; /* each generator's first in members */
 } Expansion;
 
 static void fill_atom(const Expansion *e, size_t atom, const StructureOperator *op, size_t n)
@@ -227,25 +227,26 @@ static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const Str
                            AtomColoring coloring, PtrError *err)
 {
     Expansion e = { .builder = builder, .doc = doc, .coloring = coloring };
-    size_t spheres = doc->generator_count ? 0 : doc->count;
-    for (size_t g = 0; g < doc->generator_count; g++)
-        spheres += doc->generators[g].atoms * doc->generators[g].operator_count;
-    PtrResult res = ptr_import_check_memory(path, spheres, err);
-    if (res != PTR_OK)
-        return res;
-    double(*looks)[4] = malloc(doc->count * sizeof *looks);
     e.slot_start = malloc((doc->generator_count + 1) * sizeof *e.slot_start);
-    res = looks && e.slot_start ? PTR_OK : PTR_ERR_NOMEM;
+    if (!e.slot_start)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+    e.slot_start[0] = 0;
+    for (size_t g = 0; g < doc->generator_count; g++)
+        e.slot_start[g + 1] =
+            e.slot_start[g] + doc->generators[g].atoms * doc->generators[g].operator_count;
+    const size_t spheres = doc->generator_count ? e.slot_start[doc->generator_count] : doc->count;
+    PtrResult res = ptr_import_check_memory(path, spheres, err);
+    if (res != PTR_OK) {
+        free(e.slot_start);
+        return res;
+    }
+    double(*looks)[4] = malloc(doc->count * sizeof *looks);
+    res = looks ? PTR_OK : PTR_ERR_NOMEM;
     for (size_t i = 0; i < doc->count && res == PTR_OK; i++)
         res = atom_look(path, &doc->atoms[i], coloring, looks[i], err);
     e.looks = (const double(*)[4])looks;
-    if (res == PTR_OK && doc->generator_count) {
-        e.slot_start[0] = 0;
-        for (size_t g = 0; g < doc->generator_count; g++)
-            e.slot_start[g + 1] = e.slot_start[g] +
-                                  doc->generators[g].atoms * doc->generators[g].operator_count;
+    if (res == PTR_OK && doc->generator_count)
         res = list_members(&e);
-    }
     const PtrMaterial white = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(1), .ior = 1.5f };
     const int valued = coloring == BY_BFACTOR || coloring == BY_OCCUPANCY;
     if (res == PTR_ERR_NOMEM ||
