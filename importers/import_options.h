@@ -32,7 +32,8 @@ typedef struct PtrImportOptions {
     int fit_all_objects;     /* OBJ: fit every object, not only those named *sphere* */
     /* glTF: read each sphere's value of this instance or point attribute
      * (--color-by) into PtrSpheres.value; NULL: none. A scene where no
-     * sphere has it is refused. */
+     * sphere has it is refused. Structures: also a colour scheme (element,
+     * chain, ...), which colours the spheres without values. */
     const char *value_attribute;
     /* The automatic camera of a scene that has none: its projection, and the
      * width / height of the image it frames the spheres in (0: the scene's
@@ -47,6 +48,12 @@ typedef struct PtrImportOptions {
      * hydrogens are dropped (--select, --hydrogens). */
     unsigned structure_select;
     int drop_hydrogens;
+    /* Structures: the biological assembly built (--assembly): its name,
+     * "none" for the asymmetric unit; NULL: the file's first, if any. */
+    const char *structure_assembly;
+    /* Structures: the model read, 1 the first (a frame of a sequence of
+     * models); 0: the first, with a warning where the file has more. */
+    size_t structure_model;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

@@ -89,6 +89,14 @@ PtrResult ptr_import_check_memory(const char *path, uint64_t spheres, PtrError *
                          (double)spheres * PTR_SPHERE_PEAK_BYTES * 1e-9, (double)available * 1e-9);
 }
 
+int ptr_import_is_structure(const char *path)
+{
+    for (size_t i = 0; i < sizeof importers / sizeof importers[0]; i++)
+        if (has_extension(path, importers[i].extension))
+            return importers[i].import == ptr_import_structure;
+    return 0;
+}
+
 PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
                            PtrScene *scene, PtrStrings *warnings, PtrError *err)
 {
@@ -110,7 +118,10 @@ PtrResult ptr_import_scene(const char *path, const PtrImportOptions *options,
         if (S_ISREG(st.st_mode) && st.st_size == 0)
             return ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file is empty", path);
         PtrResult r = importers[i].import(path, options, scene, warnings, err);
-        if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value)
+        /* A structure's --color-by may name a colour scheme, which gives
+         * colours, not values (structure_import.c checks its own). */
+        if (r == PTR_OK && options && options->value_attribute && !scene->spheres.value &&
+            importers[i].import != ptr_import_structure)
             r = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                               "%s: no instance or point attribute '%s' (--color-by)", path,
                               options->value_attribute);

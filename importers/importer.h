@@ -24,6 +24,14 @@ extern const char *const ptr_gltf_extensions[];
  * Fails with PTR_ERR_USAGE and "'TEXT' is not ...". */
 PtrResult ptr_structure_select_parse(const char *text, unsigned *parts, PtrError *err);
 
+/* Whether path names a structure (PDB or mmCIF, by its extension), whose
+ * models a sequence's frames can be. */
+int ptr_import_is_structure(const char *path);
+
+/* The number of models the structure path has, failing as its import
+ * does. */
+PtrResult ptr_structure_model_count(const char *path, size_t *models, PtrError *err);
+
 /* Appends a printf-formatted line. */
 void ptr_warn(PtrStrings *lines, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));

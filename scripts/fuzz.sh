@@ -28,7 +28,10 @@ for format in gltf obj structure; do
     structure) find tests/fixtures \( -name '*.pdb' -o -name '*.cif' -o -name '*.gz' \) -size -64k |
         xargs -I{} cp {} "$corpus"/
         head -c 60000 scenes/1tii.pdb >"$corpus"/1tii_head.pdb
-        head -c 60000 tests/fixtures/structures/1tii.cif >"$corpus"/1tii_head.cif ;;
+        head -c 60000 tests/fixtures/structures/1tii.cif >"$corpus"/1tii_head.cif
+        # The assemblies' tables come before the atoms in both; whole lines.
+        head -c 60000 tests/fixtures/structures/assembly.pdb | sed '$d' >"$corpus"/assembly_head.pdb
+        head -c 60000 tests/fixtures/structures/assembly.cif | sed '$d' >"$corpus"/assembly_head.cif ;;
     esac
     echo "== fuzz_$format, $seconds s"
     (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 tests/fuzz/fuzz_$format -max_total_time="$seconds" \

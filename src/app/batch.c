@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 
 #include "app/output.h"
+#include "importer.h"
 
 /* The last run of '#' in text: its offset and width; 0 if there is none. */
 static int find_run(const char *text, size_t *at, int *width)
@@ -165,20 +166,38 @@ static PtrResult set_item(PtrBatchItem *item, const char *scene, const char *out
     return PTR_OK;
 }
 
-/* The items of a sequence: frames of a scene pattern, or of a turntable. */
+/* Whether the options ask for a structure's models as frames: one structure
+ * (not a pattern) and # in -o. */
+static int renders_models(const PtrOptions *o)
+{
+    return o->input_count == 1 && !o->turntable && !ptr_batch_is_pattern(o->inputs[0]) &&
+           ptr_import_is_structure(o->inputs[0]) && ptr_batch_is_pattern(o->output);
+}
+
+/* The items of a sequence: frames of a scene pattern, of a turntable, or a
+ * structure's models (frame k: model k, from 1). */
 static PtrResult plan_frames(const PtrOptions *o, PtrBatchItem **items, int *count,
                              PtrError *err)
 {
     const char *scene = o->inputs[0];
+    const int models = renders_models(o);
     long *frames = NULL;
     int n = 0;
-    PtrResult res = o->has_frames ? listed_frames(o, &frames, &n, err)
-                    : o->turntable ? PTR_OK
-                                   : find_frames(scene, &frames, &n, err);
+    size_t model_count = 0;
+    PtrResult res = models ? ptr_structure_model_count(scene, &model_count, err) : PTR_OK;
+    if (res == PTR_OK)
+        res = o->has_frames ? listed_frames(o, &frames, &n, err)
+              : o->turntable || models ? PTR_OK
+                                       : find_frames(scene, &frames, &n, err);
     if (res != PTR_OK)
         return res;
+    if (models && !o->has_frames && model_count > PTR_MAX_FRAMES)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: %zu models; at most %d frames", scene,
+                             model_count, PTR_MAX_FRAMES);
     if (o->turntable && !o->has_frames)
         n = o->turntable;
+    if (models && !o->has_frames)
+        n = (int)model_count;
     *items = calloc((size_t)n, sizeof **items);
     if (!*items) {
         free(frames);
@@ -187,16 +206,22 @@ static PtrResult plan_frames(const PtrOptions *o, PtrBatchItem **items, int *cou
     *count = n;
     char frame_scene[PTR_PATH_SIZE], output[PTR_PATH_SIZE];
     for (int i = 0; res == PTR_OK && i < n; i++) {
-        long frame = frames ? frames[i] : i;
+        long frame = frames ? frames[i] : models ? i + 1 : i;
         if (o->turntable && frame >= o->turntable) {
             res = ptr_error_set(err, PTR_ERR_USAGE,
                                 "--frames: frame %ld is beyond --turntable %d (frames 0 to %d)",
                                 frame, o->turntable, o->turntable - 1);
             break;
         }
-        if (!o->turntable)
+        if (models && (frame < 1 || (size_t)frame > model_count)) {
+            res = ptr_error_set(err, PTR_ERR_USAGE,
+                                "--frames: %s has no model %ld (frames 1 to %zu)", scene, frame,
+                                model_count);
+            break;
+        }
+        if (!o->turntable && !models)
             res = substitute(scene, frame, frame_scene, err);
-        const char *this_scene = o->turntable ? scene : frame_scene;
+        const char *this_scene = o->turntable || models ? scene : frame_scene;
         if (res == PTR_OK)
             res = ptr_batch_is_pattern(o->output) ? substitute(o->output, frame, output, err)
                                                   : ptr_batch_output(o, this_scene, output, err);
@@ -205,6 +230,7 @@ static PtrResult plan_frames(const PtrOptions *o, PtrBatchItem **items, int *cou
         /* Frame k of N turns the camera k/N of a full turn: frame 0 is the
          * scene's own view. */
         (*items)[i].orbit_degrees = o->turntable ? 360.0 * (double)frame / o->turntable : 0.0;
+        (*items)[i].model = models ? (size_t)frame : 0;
     }
     free(frames);
     return res;
@@ -224,8 +250,9 @@ static const char *sequence_problem(const PtrOptions *o)
         !is_folder(o->output))
         return "a sequence needs # (the frame number), {name} or a folder in -o, "
                "e.g. -o out/f_####.png";
-    if (o->has_frames && !pattern && !o->turntable)
-        return "--frames needs a scene pattern with # or --turntable";
+    if (o->has_frames && !pattern && !o->turntable && !renders_models(o))
+        return "--frames needs a scene pattern with #, --turntable, or a structure with # in "
+               "-o";
     return NULL;
 }
 
@@ -236,7 +263,7 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
     const char *problem = sequence_problem(o);
     if (problem)
         return ptr_error_set(err, PTR_ERR_USAGE, "%s", problem);
-    int sequence = o->turntable || ptr_batch_is_pattern(o->inputs[0]);
+    int sequence = o->turntable || ptr_batch_is_pattern(o->inputs[0]) || renders_models(o);
     PtrResult res = PTR_OK;
     if (sequence) {
         res = plan_frames(o, items, count, err);

@@ -113,6 +113,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         }
         PtrOptions frame = *o;
         frame.orbit_degrees = items[i].orbit_degrees;
+        frame.structure_model = items[i].model;
         ptr_job_render(&frame, items[i].scene, items[i].output, color, NULL, &reports[done]);
         if (o->skip_existing)
             ptr_claim_release(items[i].output);

@@ -297,6 +297,11 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
             return option_error(id, &problem, err);
         break;
     case OPT_hydrogens: return set_switch(id, value, &o->hydrogens, err);
+    case OPT_assembly:
+        if (!*value)
+            return bad_value(id, value, "an assembly's name or none", err);
+        o->structure_assembly = value;
+        break;
     case OPT_color_by:
         if (!*value)
             return bad_value(id, value, "an attribute name", err);
@@ -494,10 +499,12 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .fit_all_objects = o->fit_all_objects,
         .structure_select = o->structure_select,
         .drop_hydrogens = o->hydrogens == PTR_OFF,
+        .structure_assembly = o->structure_assembly,
         .value_attribute = o->color_by,
         .auto_projection = o->auto_camera,
         .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
         .orbit_degrees = o->orbit_degrees,
+        .structure_model = o->structure_model,
         .dependencies = dependencies,
     };
 }

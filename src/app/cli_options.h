@@ -48,6 +48,7 @@ typedef struct PtrOptions {
     int fit_all_objects;
     unsigned structure_select; /* PtrImportOptions.structure_select */
     PtrSwitch hydrogens;
+    const char *structure_assembly; /* PtrImportOptions.structure_assembly */
     const char *color_by;   /* --color-by: the attribute; NULL: none */
     const PtrColormap *colormap;
     int has_color_range;
@@ -88,6 +89,7 @@ typedef struct PtrOptions {
     int turntable;          /* frames in a full turn; 0: none */
     int skip_existing;
     double orbit_degrees;   /* the camera's turn in the frame being rendered */
+    size_t structure_model; /* the structure's model the frame renders (1 the first); 0: none */
     int json;
     int quiet;
     int dump_scene;

@@ -47,6 +47,16 @@ PtrResult ptr_color_by_apply(const PtrOptions *o, const char *scene_path, PtrSce
     if (!o->color_by)
         return PTR_OK;
     const PtrSpheres *s = &scene->spheres;
+    /* Only a structure's colour scheme (chain, entity, ...) gets here
+     * without values: the importer coloured the spheres, and no colormap
+     * takes part. */
+    if (!s->value)
+        return o->colormap || o->has_color_range || o->color_bar
+                   ? ptr_error_set(err, PTR_ERR_USAGE,
+                                   "%s: --color-by %s is a colour scheme, not a quantity: it "
+                                   "takes no --colormap, --color-range or --color-bar",
+                                   scene_path, o->color_by)
+                   : PTR_OK;
     const PtrColormap *map = o->colormap ? o->colormap : &ptr_colormaps[0];
     double lo = INFINITY, hi = -INFINITY;
     size_t valued = 0;

@@ -18,20 +18,11 @@ import tempfile
 ptr, src = sys.argv[1], os.path.abspath(sys.argv[2])
 fixtures = os.path.join(src, "tests", "fixtures", "structures")
 tmp = tempfile.mkdtemp()
-failures, checks = [], 0
+sys.path.insert(0, os.path.join(src, "tests", "support"))
+from dump_checks import Checks  # noqa: E402
 
-
-def expect(what, ok):
-    global checks
-    checks += 1
-    if not ok:
-        failures.append(what)
-
-
-def dump(path, *options):
-    run = subprocess.run([ptr, "--dump-scene", path, *options], capture_output=True, text=True)
-    expect(f"{path} {options}: exit {run.returncode}: {run.stderr}", run.returncode == 0)
-    return json.loads(run.stdout)["spheres"] if run.returncode == 0 else []
+checks = Checks("check_structures", ptr)
+expect, dump = checks.expect, checks.dump
 
 
 def to_glb(source):
@@ -50,7 +41,7 @@ CENTRE_TOLERANCE = 2 * 2.0 ** -23 * 256
 
 def same_spheres(what, got, want, value=False):
     if len(got) != len(want):
-        failures.append(f"{what}: {len(got)} spheres, not {len(want)}")
+        expect(f"{what}: {len(got)} spheres, not {len(want)}", False)
         return
     for i, (g, w) in enumerate(zip(got, want)):
         where = f"{what} sphere {i}"
@@ -115,10 +106,31 @@ kept = {  # --select and --hydrogens: which of the converter's spheres remain
 for options, indices in kept.items():
     same_spheres(f"mixed.pdb {options}", dump(mixed, *options), [want[i] for i in indices])
 
+# The models as frames: # in -o renders model k as frame k (from 1), each
+# with the spheres of its own model; --frames picks some, a model the file
+# lacks is a usage error.
+def frames(*options):
+    run = subprocess.run([ptr, mixed, "-o", os.path.join(tmp, "m_#.exr"), "--width", "8",
+                          "--samples", "1", "--quiet", "--json", *options], capture_output=True,
+                         text=True)
+    reports = [json.loads(line) for line in run.stdout.splitlines() if line.startswith("{")]
+    return run, [(os.path.basename(r["output"]), r["spheres"]) for r in reports]
+
+
+run, made = frames()
+expect(f"mixed.pdb as frames: {made}, exit {run.returncode}",
+       run.returncode == 0 and made == [("m_1.exr", 5), ("m_2.exr", 1)])
+run, made = frames("--frames", "2:2")
+expect(f"mixed.pdb --frames 2:2: {made}", run.returncode == 0 and made == [("m_2.exr", 1)])
+run, made = frames("--frames", "1:3")
+expect(f"mixed.pdb --frames 1:3: exit {run.returncode}, {run.stderr!r}",
+       run.returncode == 2 and run.stderr == "ptr: --frames: " + mixed +
+       " has no model 3 (frames 1 to 2)\n")
+
 # One-line errors with the README's exit codes (2: usage, 4: the scene).
 for options, code, says in (
         (["--select", "proteins"], 2, "--select"), (["--select", "protein,"], 2, "--select"),
-        (["--hydrogens", "no"], 2, "--hydrogens"), (["--color-by", "chain"], 4, "_BFACTOR"),
+        (["--hydrogens", "no"], 2, "--hydrogens"), (["--color-by", "temperature"], 4, "_BFACTOR"),
         (["--select", "water", "--hydrogens", "on"], 0, "")):
     path = os.path.join(fixtures, "1tii.cif")
     run = subprocess.run([ptr, "--dump-scene", path, *options], capture_output=True, text=True)
@@ -153,14 +165,22 @@ for name, says in (
         ("structure_non_ascii_mangled_tag.cif", ":19: not ASCII text, as PDB and mmCIF files are"),
         ("structure_no_atoms.pdb", "no atoms of those --select keeps"),
         ("structure_bomb.pdb.gz", "Cannot determine uncompressed size"),
-        ("structure_not_gzip.cif.gz", "Cannot determine uncompressed size")):
+        ("structure_not_gzip.cif.gz", "Cannot determine uncompressed size"),
+        ("structure_assembly_missing_operator.cif",
+         "assembly 1: operator '7' is not in _pdbx_struct_oper_list"),
+        ("structure_assembly_operator_range.cif",
+         "oper_expression '(1-999999999)' names more operators than ptr builds (100000)"),
+        ("structure_assembly_operator_product.cif",
+         "assembly 1 has more operators than ptr builds (100000)"),
+        ("structure_assembly_operator_expression.cif",
+         "oper_expression '(1-2' is not a list of operators or a product of lists"),
+        ("structure_assembly_operator_not_a_number.cif", "operator 1: 'x' is not a number"),
+        ("structure_assembly_operator_not_a_number.pdb",
+         ":8: an operator's rotation (columns 24-33) '  0.95I057' is not a number")):
     path = os.path.join(hostile, name)
     run = subprocess.run([ptr, "--dump-scene", path], capture_output=True, text=True)
     expect(f"{name}: exit {run.returncode}, {run.stderr!r}",
            run.returncode == 4 and run.stderr.startswith(f"ptr: {path}") and
            says in run.stderr and run.stderr.count("\n") == 1)
 
-print(f"check_structures: {checks} checks, {len(failures)} failed")
-for f in failures[:30]:
-    print("FAIL:", f)
-sys.exit(1 if failures else 0)
+checks.finish()
