@@ -4,12 +4,16 @@
  * has in a TILE x TILE tile (full, half, ... 1/16 resolution), on one thread
  * and on all, at every kernel level this CPU runs, with its share of the
  * peak; last, the seconds the convolutions alone take at those rates for a
- * 500x500 and a 1920x1080 image.
+ * 500x500 and a 1920x1080 image. Times are the threads' CPU clocks (a run
+ * takes its slowest thread's), so that other processes' turns on the cores
+ * do not count.
  *
  *   denoise [TILE]          (default 512)
  *
  * FLOPs count what the kernel computes: 2 a fused multiply-add, channels
  * padded to 16 (the first layer's 9 inputs, the last's 3 outputs). */
+#define _DEFAULT_SOURCE /* getloadavg */
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,28 +47,46 @@ static const Layer layers[] = {
 };
 enum { LAYER_COUNT = sizeof layers / sizeof layers[0] };
 
-/* Seconds on the calling thread's CPU clock for one thread (other
- * processes on the machine then take nothing from the figure), on the wall
- * clock for several. */
-static double seconds(int threads)
+/* Work cut into ranges for the threads, timed on each thread's CPU clock:
+ * a run takes what its slowest thread took, and other processes on the
+ * machine take nothing from the figure. */
+typedef struct Timed {
+    void (*fn)(void *arg, size_t from, size_t to);
+    void *arg;
+    _Atomic uint64_t slowest_ns;
+} Timed;
+
+static uint64_t thread_cpu_ns(void)
 {
     struct timespec ts;
-    clock_gettime(threads == 1 ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
-/* Repeats run(arg) on threads threads until a quarter of a second has
- * passed, three times; the best seconds a run. */
-static double best_seconds(void (*run)(void *), void *arg, int threads)
+static void timed_range(void *arg, size_t from, size_t to)
+{
+    Timed *t = arg;
+    uint64_t start = thread_cpu_ns();
+    t->fn(t->arg, from, to);
+    uint64_t ns = thread_cpu_ns() - start, slowest = atomic_load(&t->slowest_ns);
+    while (ns > slowest && !atomic_compare_exchange_weak(&t->slowest_ns, &slowest, ns))
+        ;
+}
+
+/* Runs fn over 0 .. count - 1 on threads threads until a quarter of a
+ * second has passed, three times; the best seconds a run. */
+static double best_seconds(void (*fn)(void *, size_t, size_t), void *arg, int threads,
+                           size_t count)
 {
     double best = 1e30;
     for (int rep = 0; rep < 3; rep++) {
         int runs = 0;
-        double start = seconds(threads), elapsed;
+        double elapsed = 0;
         do {
-            run(arg);
+            Timed t = { fn, arg, 0 };
+            ptr_parallel_ranges(threads, 0, count, timed_range, &t);
+            elapsed += 1e-9 * (double)atomic_load(&t.slowest_ns);
             runs++;
-            elapsed = seconds(threads) - start;
         } while (elapsed < 0.25);
         if (elapsed / runs < best)
             best = elapsed / runs;
@@ -72,33 +94,22 @@ static double best_seconds(void (*run)(void *), void *arg, int threads)
     return best;
 }
 
-/* The peak: the FMA loop on every thread at once. */
-typedef struct Peak {
-    void (*loop)(uint64_t);
-    int threads;
-} Peak;
-
+/* The peak: the FMA loop once on every thread. */
 enum { PEAK_ITERATIONS = 1 << 22 };
 
 static void peak_range(void *arg, size_t from, size_t to)
 {
-    const Peak *p = arg;
+    void (*loop)(uint64_t) = *(void (**)(uint64_t))arg;
     for (size_t t = from; t < to; t++)
-        p->loop(PEAK_ITERATIONS);
-}
-
-static void run_peak(void *arg)
-{
-    const Peak *p = arg;
-    ptr_parallel_ranges(p->threads, 0, (size_t)p->threads, peak_range, (void *)p);
+        loop(PEAK_ITERATIONS);
 }
 
 static double peak_gflops(PtrCpuLevel level, int threads)
 {
-    Peak p = { level >= PTR_CPU_AVX512 ? ptr_fma_peak_avx512 : ptr_fma_peak_avx2, threads };
+    void (*loop)(uint64_t) = level >= PTR_CPU_AVX512 ? ptr_fma_peak_avx512 : ptr_fma_peak_avx2;
     double lanes = level >= PTR_CPU_AVX512 ? 16 : 8;
     double flops = 12.0 * lanes * 2.0 * PEAK_ITERATIONS * threads;
-    return flops / best_seconds(run_peak, &p, threads) / 1e9;
+    return flops / best_seconds(peak_range, (void *)&loop, threads, (size_t)threads) / 1e9;
 }
 
 /* One layer's buffers at one size, and the kernel to time on them. */
@@ -107,7 +118,6 @@ typedef struct Conv {
     const Layer *layer;
     size_t width, height;
     float *src, *dst, *weights, *bias;
-    int threads;
 } Conv;
 
 static float *floats(size_t count, float value)
@@ -150,12 +160,6 @@ static void conv_rows(void *arg, size_t from, size_t to)
           c->weights, c->bias, c->width, to - from, c->layer->in, c->layer->out, 1);
 }
 
-static void run_conv(void *arg)
-{
-    const Conv *c = arg;
-    ptr_parallel_ranges(c->threads, 0, c->height, conv_rows, (void *)c);
-}
-
 static double layer_flops(const Layer *layer, size_t width, size_t height)
 {
     return 2.0 * 9.0 * (double)layer->in * (double)layer->out * (double)width * (double)height;
@@ -189,10 +193,8 @@ static void bench_level(PtrCpuLevel level, size_t tile, int threads)
         Conv c = { .fn = table.conv3x3 };
         conv_init(&c, &layers[i], tile);
         double flops = layer_flops(&layers[i], c.width, c.height);
-        c.threads = 1;
-        double s1 = best_seconds(run_conv, &c, 1);
-        c.threads = threads;
-        double s_all = best_seconds(run_conv, &c, threads);
+        double s1 = best_seconds(conv_rows, &c, 1, c.height);
+        double s_all = best_seconds(conv_rows, &c, threads, c.height);
         rate1[i] = flops / s1 / 1e9;
         rate_all[i] = flops / s_all / 1e9;
         flops_total += flops;
@@ -225,8 +227,8 @@ int main(int argc, char **argv)
     int threads = ptr_online_cpus();
     ptr_threads_keep(threads);
     PtrCpuLevel top = ptr_cpu_level();
-    /* Other work on the machine lowers the figures on all threads (one
-     * thread's are on its CPU clock). */
+    /* Other work on the machine shares the cores' caches and memory with
+     * the threads timed (not their CPU clocks). */
     double load = 0;
     getloadavg(&load, 1);
     printf("denoise: CPU level %s, %d threads, %zux%zu tile, load average %.2f\n",
