@@ -1,7 +1,8 @@
 /* The denoiser's kernel table (denoise/conv.h): every level's conv3x3
  * against ptr_conv3x3_c, bit for bit, through the checked call, on layers
  * of random shape (1 to 40 pixels wide, 1 to 5 rows, 16 to 160 input and
- * 16 to 112 output channels, ReLU on or off) holding random values of mixed
+ * 16 to 112 output channels; a tenth 41 to 340 wide, of 1 or 2 rows and 16
+ * to 48 channels; ReLU on or off) holding random values of mixed
  * signs, or adversarial ones: NaN, infinities, signed zeros, denormals,
  * values whose products and sums overflow, all-negative sums for the ReLU
  * to zero. The output's border and the memory around the output hold a
@@ -137,6 +138,11 @@ static void make_layer(Layer *l, PtrRng *rng)
     l->rows = 1 + ptr_rng_next(rng) % 5;
     l->in_channels = PTR_CONV_BLOCK * (1 + ptr_rng_next(rng) % 10);
     l->out_channels = PTR_CONV_BLOCK * (1 + ptr_rng_next(rng) % 7);
+    if (ptr_rng_float(rng) < 0.1f) { /* a wide row, kept cheap for the reference */
+        l->width = 41 + ptr_rng_next(rng) % 300;
+        l->rows = 1 + ptr_rng_next(rng) % 2;
+        l->in_channels = l->out_channels = PTR_CONV_BLOCK * (1 + ptr_rng_next(rng) % 3);
+    }
     l->relu = ptr_rng_float(rng) < 0.5f;
     static const float special_shares[] = { 0.001f, 0.005f, 0.03f };
     Draw d = { ptr_rng_float(rng) < 0.5f ? VALUES_RANDOM
