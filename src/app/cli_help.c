@@ -9,6 +9,7 @@
 #include "base/cpu.h"
 #include "base/result.h"
 #include "base/version.h"
+#include "denoise/conv.h"
 #include "importer.h"
 #include "render/render.h"
 
@@ -96,14 +97,17 @@ static void print_version(PtrCpuLevel level)
     printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
 }
 
+/* Each level: the intersectors, the integrator, the denoiser's convolution. */
 static void print_dispatch(PtrCpuLevel level)
 {
     PtrCpuLevel detected = ptr_cpu_detected();
     for (int l = PTR_CPU_NONE; l < PTR_CPU_LEVEL_COUNT; l++) {
         PtrIsectTable table;
+        PtrConvTable conv;
         ptr_isect_init_level(&table, (PtrCpuLevel)l);
-        printf("%-7s %-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
-               ptr_integrator_name(ptr_integrator_for_level((PtrCpuLevel)l)),
+        ptr_conv_init_level(&conv, (PtrCpuLevel)l);
+        printf("%-7s %-7s %-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+               ptr_integrator_name(ptr_integrator_for_level((PtrCpuLevel)l)), conv.name,
                l > (int)detected ? "  (not on this CPU)" : "",
                l == (int)level ? "  <- in use" : "");
     }

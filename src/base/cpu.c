@@ -20,13 +20,17 @@ static PtrCpuLevel detect(void)
     unsigned int a, b, c, d;
     if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & bit_SSE4_1))
         return PTR_CPU_NONE;
+    /* The AVX2 level includes FMA (the denoiser's convolutions are fused
+     * multiply-adds): every AVX2 CPU has it, and a CPU that reports AVX2
+     * without it runs as SSE4.1. */
+    const int has_fma = (c & bit_FMA) != 0;
     /* OSXSAVE and AVX, then XCR0: SSE (bit 1) and AVX (bit 2) state saved. */
     if (!(c & bit_OSXSAVE) || !(c & bit_AVX) || (xgetbv_low() & 0x6) != 0x6)
         return PTR_CPU_SSE41;
     if (__get_cpuid_max(0, NULL) < 7)
         return PTR_CPU_SSE41;
     __cpuid_count(7, 0, a, b, c, d);
-    if (!(b & bit_AVX2))
+    if (!(b & bit_AVX2) || !has_fma)
         return PTR_CPU_SSE41;
     /* AVX-512 F and VL (the tree's traversal runs it on ymm registers), and
      * XCR0 opmask (5), ZMM0-15 upper (6), ZMM16-31 (7) saved. */

@@ -11,7 +11,7 @@
 typedef enum PtrCpuLevel {
     PTR_CPU_NONE,   /* portable C only */
     PTR_CPU_SSE41,
-    PTR_CPU_AVX2,
+    PTR_CPU_AVX2,   /* AVX2 and FMA */
     PTR_CPU_AVX512, /* AVX-512 F */
     PTR_CPU_LEVEL_COUNT,
 } PtrCpuLevel;

@@ -2,6 +2,15 @@
 
 #include <math.h>
 
+#ifndef PTR_HAVE_ASM
+#define PTR_HAVE_ASM 0
+#endif
+
+#if PTR_HAVE_ASM
+PTR_DECL_CONV3X3(ptr_conv3x3_avx2);
+PTR_DECL_CONV3X3(ptr_conv3x3_avx512);
+#endif
+
 PTR_DECL_CONV3X3(ptr_conv3x3_c)
 {
     size_t src_row = (width + 2) * in_channels;
@@ -35,7 +44,20 @@ void ptr_conv_pack(float *packed, const float *oihw, size_t in, size_t out,
 
 void ptr_conv_init_level(PtrConvTable *table, PtrCpuLevel level)
 {
-    (void)level;
     table->conv3x3 = ptr_conv3x3_c;
     table->name = "c";
+#if PTR_HAVE_ASM
+    /* SSE4.1 has no fused multiply-add: the reference's operations start at
+     * AVX2 (which ptr's CPU detection grants only with FMA). */
+    if (level < PTR_CPU_AVX2)
+        return;
+    table->conv3x3 = ptr_conv3x3_avx2;
+    table->name = "avx2";
+    if (level < PTR_CPU_AVX512)
+        return;
+    table->conv3x3 = ptr_conv3x3_avx512;
+    table->name = "avx512";
+#else
+    (void)level;
+#endif
 }

@@ -1,6 +1,7 @@
-/* Checks every assembly intersector the CPU can run against the C reference,
- * bit for bit, on random and adversarial rays and sphere sets; with --bench,
- * times them.
+/* Checks every assembly kernel the CPU can run against the C reference,
+ * bit for bit: the intersectors on random and adversarial rays and sphere
+ * sets, the denoiser's convolutions on random and adversarial layers; with
+ * --bench, times the intersectors.
  *
  *   checkasm [--rays N] [--seed S]     check (default 1000000 rays per level)
  *   checkasm --bench                   nanoseconds per ray at 4..512 spheres,
@@ -133,15 +134,20 @@ static void make_case(Case *c, PtrRng *rng)
     c->count = ptr_rng_float(rng) < 0.8f ? n : (size_t)(ptr_rng_float(rng) * (float)(n + 1)) % (n + 1);
 }
 
+void print_status(const CheckedCallStatus *status)
+{
+    printf("%s%s%s\n", status->failures & 1 ? "; a callee-saved register was clobbered" : "",
+           status->failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
+           status->check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
+}
+
 /* One kernel's line of the result; whether it passed. */
 static int report(const char *kind, const char *name, uint64_t rays, uint64_t hits,
                   uint64_t mismatches, const CheckedCallStatus *status)
 {
-    printf("%s%-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c%s%s%s\n", kind,
-           name, rays, hits, mismatches,
-           status->failures & 1 ? "; a callee-saved register was clobbered" : "",
-           status->failures & 2 ? "; returned with dirty upper YMM state (no vzeroupper)" : "",
-           status->check_xinuse ? "" : " (vzeroupper not checked: no XGETBV(1))");
+    printf("%s%-7s %" PRIu64 " rays (%" PRIu64 " hits): %" PRIu64 " differ from c", kind, name,
+           rays, hits, mismatches);
+    print_status(status);
     return !mismatches && !status->failures;
 }
 
@@ -186,6 +192,7 @@ static int check(uint64_t rays, uint64_t seed)
             report("packet ", tables[l].name, rays, packets.hits, packets.mismatches[l],
                    &packets.status[l]) ? passed++ : failed++;
     failed += check_bvh_closest_hit(seed, &passed);
+    failed += check_conv3x3(seed, &passed);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

@@ -1,7 +1,8 @@
 /* What the checker's parts share. checkasm.c is the harness: the generated
- * cases, the run and the report. Each field of the kernel table
- * (accel/isect.h) is checked in the file named after it: closest_hit.c,
- * closest_hit_packet.c, bvh_closest_hit.c, bvh_closest_hit_packet.c. */
+ * cases, the run and the report. Each field of the kernel tables
+ * (accel/isect.h, denoise/conv.h) is checked in the file named after it:
+ * closest_hit.c, closest_hit_packet.c, bvh_closest_hit.c,
+ * bvh_closest_hit_packet.c, conv3x3.c. */
 #ifndef PTR_CHECKASM_H
 #define PTR_CHECKASM_H
 
@@ -11,6 +12,7 @@
 #include "accel/bvh.h"
 #include "accel/isect.h"
 #include "base/cpu.h"
+#include "denoise/conv.h"
 #include "sampling/rng.h"
 #include "scene/scene.h"
 
@@ -34,8 +36,21 @@ void ptr_checked_call_bvh_packet(PtrBvhClosestHitPacketFn fn, const PtrRayPacket
                                  const PtrBvh *bvh, const PtrSpheres *spheres,
                                  PtrHitPacket *hits, CheckedCallStatus *status);
 
+/* A convolution's nine arguments (PTR_DECL_CONV3X3), in order, for the
+ * checked call to pass on. */
+typedef struct ConvCall {
+    float *dst;
+    const float *src, *weights, *bias;
+    size_t width, rows, in_channels, out_channels;
+    int relu;
+} ConvCall;
+void ptr_checked_call_conv3x3(PtrConv3x3Fn fn, const ConvCall *call, CheckedCallStatus *status);
+
 /* Whether XGETBV(1) can tell a dirty upper YMM state. */
 uint32_t xinuse_supported(void);
+
+/* Ends a kernel's line of the result with what the checked calls saw. */
+void print_status(const CheckedCallStatus *status);
 
 /* A generated case for the brute-force kernels: a ray and the spheres it is
  * tested against. */
@@ -91,5 +106,10 @@ void report_bvh_closest_hit_packet(const PtrIsectTable *tables, PtrCpuLevel top,
                                    uint64_t packets, const Tally *tally, int *passed,
                                    int *failed);
 void bench_bvh_closest_hit(void);
+
+/* conv3x3.c: every level's conv3x3 against ptr_conv3x3_c, bit for bit, with
+ * the output's surroundings guarded; returns the number of levels that
+ * failed. */
+int check_conv3x3(uint64_t seed, int *passed);
 
 #endif
