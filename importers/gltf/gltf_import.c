@@ -360,30 +360,77 @@ static size_t part_vertex(const SurfacePart *p, size_t j)
     return p->first_vertex + (p->has_idx ? index_at(&p->idx, j) : j);
 }
 
-static void mesh_position(const void *user, size_t v, double out[3])
+/* Vertex v of part p (from p's first), as element reads it. */
+static void part_position(const SurfacePart *p, size_t v, double out[3])
 {
-    const SurfacePart *p = part_of(user, v, 0);
     if (p->pos.component_type == GLTF_FLOAT) { /* the common case, read at once */
         float f[3];
-        memcpy(f, p->pos.data + (v - p->first_vertex) * p->pos.stride, sizeof f);
+        memcpy(f, p->pos.data + v * p->pos.stride, sizeof f);
         for (int k = 0; k < 3; k++)
             out[k] = f[k];
         return;
     }
     double e[4];
-    element(&p->pos, v - p->first_vertex, e);
+    element(&p->pos, v, e);
     memcpy(out, e, 3 * sizeof *out);
 }
 
-static void mesh_triangle(const void *user, size_t t, uint32_t out[3])
+/* Triangles j .. j + count - 1 of part p as mesh vertices. */
+static void part_triangles(const SurfacePart *p, size_t j, size_t count, uint32_t (*out)[3])
 {
-    const SurfacePart *p = part_of(user, t, 1);
-    const size_t j = t - p->first_triangle;
-    const size_t at[3] = { p->mode == 4 ? 3 * j : p->mode == 6 ? 0 : j,
-                           p->mode == 4 ? 3 * j + 1 : j + 1,
-                           p->mode == 4 ? 3 * j + 2 : j + 2 };
-    for (int i = 0; i < 3; i++)
-        out[i] = (uint32_t)part_vertex(p, at[i]);
+    const uint32_t base = (uint32_t)p->first_vertex;
+    if (p->mode == 4 && p->has_idx && p->idx.component_type == GLTF_UNSIGNED_INT &&
+        p->idx.stride == 4) { /* the common case of a large mesh, read at once */
+        const unsigned char *at = p->idx.data + 12 * j;
+        for (size_t i = 0; i < count; i++, at += 12) {
+            uint32_t tri[3];
+            memcpy(tri, at, sizeof tri);
+            for (int k = 0; k < 3; k++)
+                out[i][k] = base + tri[k];
+        }
+        return;
+    }
+    for (size_t i = 0; i < count; i++, j++) {
+        const size_t at[3] = { p->mode == 4 ? 3 * j : p->mode == 6 ? 0 : j,
+                               p->mode == 4 ? 3 * j + 1 : j + 1,
+                               p->mode == 4 ? 3 * j + 2 : j + 2 };
+        for (int k = 0; k < 3; k++)
+            out[i][k] = (uint32_t)part_vertex(p, at[k]);
+    }
+}
+
+static void mesh_positions(const void *user, size_t first, size_t count, double (*out)[3])
+{
+    const SurfacePart *p = part_of(user, first, 0);
+    for (size_t i = 0; i < count; p++) {
+        const size_t v = first + i - p->first_vertex;
+        const size_t run = p->pos.count - v < count - i ? p->pos.count - v : count - i;
+        for (size_t k = 0; k < run; k++)
+            part_position(p, v + k, out[i + k]);
+        i += run;
+    }
+}
+
+static void mesh_gather(const void *user, const uint32_t *vertices, size_t count,
+                        double (*out)[3])
+{
+    const SurfacePart *p = part_of(user, vertices[0], 0);
+    for (size_t i = 0; i < count; i++) {
+        if (vertices[i] < p->first_vertex || vertices[i] - p->first_vertex >= p->pos.count)
+            p = part_of(user, vertices[i], 0);
+        part_position(p, vertices[i] - p->first_vertex, out[i]);
+    }
+}
+
+static void mesh_triangles(const void *user, size_t first, size_t count, uint32_t (*out)[3])
+{
+    const SurfacePart *p = part_of(user, first, 1);
+    for (size_t i = 0; i < count; p++) {
+        const size_t j = first + i - p->first_triangle;
+        const size_t run = p->triangles - j < count - i ? p->triangles - j : count - i;
+        part_triangles(p, j, run, out + i);
+        i += run;
+    }
 }
 
 /* The step of a position accessor's storage (mesh_spheres.h). */
@@ -392,6 +439,35 @@ static double position_quantum(const GltfAccessor *a)
     if (a->component_type == GLTF_FLOAT)
         return 0.0;
     return a->normalized ? gltf_component_value(a->component_type, 1, 1.0) : 1.0;
+}
+
+/* Keeps in *failed the least slot that fails: the one a serial import
+ * reports, whichever thread meets it first. */
+static void note_failure(atomic_size_t *failed, size_t slot)
+{
+    size_t seen = atomic_load(failed);
+    while (slot < seen && !atomic_compare_exchange_weak(failed, &seen, slot))
+        ;
+}
+
+/* The indices of a primitive, checked on all cores for a large one: the
+ * first past the primitive's vertices. */
+typedef struct IndexCheck {
+    const GltfAccessor *indices;
+    size_t vertices;
+    atomic_size_t first_past; /* SIZE_MAX: none */
+} IndexCheck;
+
+enum { PARALLEL_INDICES = 1 << 18 };
+
+static void check_indices(void *arg, size_t from, size_t to)
+{
+    IndexCheck *c = arg;
+    for (size_t i = from; i < to; i++)
+        if (index_at(c->indices, i) >= c->vertices) {
+            note_failure(&c->first_past, i);
+            return;
+        }
 }
 
 /* Primitive p of mesh as a surface part, checked: its positions, its
@@ -426,12 +502,16 @@ static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t
                                  "%s: %s: mesh %zu primitive %zu has indices that are not "
                                  "unsigned integers in a buffer", im->path, where, mesh, p);
         n = a->count;
-        for (size_t i = 0; i < n; i++)
-            if (index_at(a, i) >= vertices)
-                return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                     "%s: %s: mesh %zu primitive %zu has index %zu past its "
-                                     "%zu vertices", im->path, where, mesh, p, index_at(a, i),
-                                     vertices);
+        IndexCheck check = { .indices = a, .vertices = vertices };
+        atomic_init(&check.first_past, SIZE_MAX);
+        ptr_parallel_ranges(n >= PARALLEL_INDICES ? ptr_online_cpus() : 1, 0, n, check_indices,
+                            &check);
+        const size_t past = atomic_load(&check.first_past);
+        if (past != SIZE_MAX)
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: %s: mesh %zu primitive %zu has index %zu past its "
+                                 "%zu vertices", im->path, where, mesh, p, index_at(a, past),
+                                 vertices);
     }
     part->triangles = prim->mode == 4 ? n / 3 : (prim->mode == 5 || prim->mode == 6) && n >= 3
                                                     ? n - 2 : 0;
@@ -496,8 +576,8 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
     PtrMeshSphere *found = NULL;
     size_t components = 0;
     const PtrMeshSource source = {
-        .vertex_count = vertices, .triangle_count = triangles, .position = mesh_position,
-        .triangle = mesh_triangle, .user = &s,
+        .vertex_count = vertices, .triangle_count = triangles, .positions = mesh_positions,
+        .gather = mesh_gather, .triangles = mesh_triangles, .user = &s,
     };
     PtrMeshSource quantised = source;
     for (size_t p = 0; p < s.count; p++)
@@ -774,15 +854,6 @@ static Fault instance_spheres(const NodeRun *run, size_t i, const Instance *in, 
             set++, j = 0;
     }
     return NO_FAULT;
-}
-
-/* Keeps in *failed the least slot that fails: the one a serial import
- * reports, whichever thread meets it first. */
-static void note_failure(atomic_size_t *failed, size_t slot)
-{
-    size_t seen = atomic_load(failed);
-    while (slot < seen && !atomic_compare_exchange_weak(failed, &seen, slot))
-        ;
 }
 
 /* Slots begin .. end - 1 of the run (see NodeRun). */
