@@ -93,12 +93,14 @@ static PtrVec3 vec_from(const double v[3])
 }
 
 /* A mesh's surface spheres (docs/scenes.md "Spheres"), found once however
- * many nodes use the mesh. */
+ * many nodes use the mesh, and once for meshes of the same surface. */
 typedef struct SurfaceSpheres {
     int found;
+    const struct SurfaceSpheres *same; /* where the spheres are: itself, or
+                                        * an earlier mesh's; NULL until found */
     size_t count;
     double *spheres;  /* 4 a sphere: the centre and radius in the mesh's frame */
-    int *materials;   /* each one's glTF material, -1 if none */
+    int *primitives;  /* each one's primitive in its mesh (which gives its material) */
     size_t skipped;   /* the parts that are not spheres */
 } SurfaceSpheres;
 
@@ -118,6 +120,8 @@ typedef struct Importer {
     int warned_texture;
     const char *value_name; /* the attribute --color-by asks for, or NULL */
     SurfaceSpheres *surfaces; /* one a mesh */
+    size_t *surface_table;    /* meshes by their surface (surface_key), SIZE_MAX: none */
+    size_t surface_slots;     /* a power of two */
     size_t skipped;           /* mesh parts not drawn, for the one warning */
     char skipped_names[256];  /* where they are, as many as fit */
     int skipped_more;         /* whether more did not fit */
@@ -318,7 +322,7 @@ static void element(const GltfAccessor *a, size_t i, double out[4])
 /* A surface primitive's part of its mesh's vertices and triangles. */
 typedef struct SurfacePart {
     GltfAccessor pos, idx; /* idx read where has_idx says */
-    int has_idx, mode, material;
+    int has_idx, mode, primitive;
     size_t first_vertex, first_triangle, triangles;
 } SurfacePart;
 
@@ -489,7 +493,7 @@ static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t
     if (res != PTR_OK)
         return res;
     part->mode = prim->mode;
-    part->material = prim->material;
+    part->primitive = (int)p;
     part->has_idx = prim->indices >= 0;
     size_t n = vertices;
     if (part->has_idx) {
@@ -536,7 +540,14 @@ static PtrResult bounds_sphere(Importer *im, const Origin *o, size_t mesh_index,
         extent = fmax(extent, mesh->max[k] - mesh->min[k]);
     }
     out->spheres[3] = 0.5 * extent;
-    out->materials[0] = mesh->material;
+    for (size_t p = 0; p < mesh->primitive_count; p++) { /* the first surface primitive's */
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, mesh_index, p, &prim);
+        if (!prim.points) {
+            out->primitives[0] = (int)p;
+            break;
+        }
+    }
     out->count = 1;
     return PTR_OK;
 }
@@ -586,8 +597,8 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
         res = ptr_mesh_spheres(&quantised, im->path, &found, &components, im->err);
     if (res == PTR_OK) {
         out->spheres = malloc((components ? components : 1) * 4 * sizeof *out->spheres);
-        out->materials = malloc((components ? components : 1) * sizeof *out->materials);
-        if (!out->spheres || !out->materials)
+        out->primitives = malloc((components ? components : 1) * sizeof *out->primitives);
+        if (!out->spheres || !out->primitives)
             res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     }
     out->skipped = lines;
@@ -598,11 +609,64 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
         }
         memcpy(&out->spheres[4 * out->count], found[c].centre, sizeof found[c].centre);
         out->spheres[4 * out->count + 3] = found[c].radius;
-        out->materials[out->count++] = part_of(&s, found[c].first_triangle, 1)->material;
+        out->primitives[out->count++] = part_of(&s, found[c].first_triangle, 1)->primitive;
     }
     free(found);
     free(s.parts);
     return res;
+}
+
+/* Whether meshes a and b have the same surface: the same primitives other
+ * than POINTS (accessors and mode), in the same places. */
+static int same_surface(const GltfDoc *doc, size_t a, size_t b)
+{
+    GltfMesh ma, mb;
+    gltf_doc_mesh(doc, a, &ma);
+    gltf_doc_mesh(doc, b, &mb);
+    for (size_t p = 0; p < ma.primitive_count && ma.primitive_count == mb.primitive_count; p++) {
+        GltfPrimitive pa, pb;
+        gltf_doc_primitive(doc, a, p, &pa);
+        gltf_doc_primitive(doc, b, p, &pb);
+        if (pa.points != pb.points ||
+            (!pa.points && (pa.position != pb.position || pa.indices != pb.indices ||
+                            pa.mode != pb.mode || pa.draco != pb.draco)))
+            return 0;
+    }
+    return ma.primitive_count == mb.primitive_count;
+}
+
+/* A hash of what same_surface compares. */
+static uint64_t surface_key(const GltfDoc *doc, size_t mesh_index)
+{
+    GltfMesh mesh;
+    gltf_doc_mesh(doc, mesh_index, &mesh);
+    uint64_t h = 0xcbf29ce484222325u; /* FNV-1a over the numbers */
+    for (size_t p = 0; p < mesh.primitive_count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(doc, mesh_index, p, &prim);
+        const int64_t part[5] = { prim.points, prim.points ? 0 : prim.position,
+                                  prim.points ? 0 : prim.indices, prim.points ? 0 : prim.mode,
+                                  prim.points ? 0 : prim.draco };
+        for (int k = 0; k < 5; k++)
+            h = (h ^ (uint64_t)part[k]) * 0x100000001b3u;
+    }
+    return h;
+}
+
+/* The earlier mesh of the same surface as mesh_index, if one was found,
+ * else mesh_index, entered in the table. */
+static size_t surface_owner(Importer *im, size_t mesh_index)
+{
+    const size_t mask = im->surface_slots - 1;
+    for (size_t slot = surface_key(im->doc, mesh_index) & mask;; slot = (slot + 1) & mask) {
+        const size_t other = im->surface_table[slot];
+        if (other == SIZE_MAX) {
+            im->surface_table[slot] = mesh_index;
+            return mesh_index;
+        }
+        if (same_surface(im->doc, other, mesh_index))
+            return other;
+    }
 }
 
 /* The spheres of mesh_index's surface, found at the first node using it
@@ -611,8 +675,10 @@ static PtrResult surface_spheres(Importer *im, const Origin *o, size_t mesh_inde
                                  const SurfaceSpheres **out)
 {
     SurfaceSpheres *s = &im->surfaces[mesh_index];
-    *out = s;
-    if (s->found)
+    if (!s->same)
+        s->same = &im->surfaces[surface_owner(im, mesh_index)];
+    *out = s->same;
+    if (s->same != s || s->found)
         return PTR_OK;
     s->found = 1;
     GltfMesh mesh;
@@ -631,8 +697,8 @@ static PtrResult surface_spheres(Importer *im, const Origin *o, size_t mesh_inde
     if (!unread)
         return find_surface(im, o, mesh_index, &mesh, s);
     s->spheres = malloc(4 * sizeof *s->spheres);
-    s->materials = malloc(sizeof *s->materials);
-    if (!s->spheres || !s->materials)
+    s->primitives = malloc(sizeof *s->primitives);
+    if (!s->spheres || !s->primitives)
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return bounds_sphere(im, o, mesh_index, &mesh, s);
 }
@@ -1033,9 +1099,20 @@ static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Ins
     PtrResult res = PTR_OK;
     if (run->surface_count && !node->has_radius && first->uneven)
         warn_nonuniform(im, o, warned);
+    int *materials = malloc((mesh->primitive_count ? mesh->primitive_count : 1) *
+                            sizeof *materials); /* each primitive's */
+    if (!materials)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    for (size_t p = 0; p < mesh->primitive_count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        materials[p] = prim.material;
+    }
     for (size_t k = 0; k < run->surface_count && res == PTR_OK; k++)
-        res = map_material(im, node->has_radius ? mesh->material : run->surface->materials[k],
+        res = map_material(im, node->has_radius ? mesh->material
+                                                : materials[run->surface->primitives[k]],
                            &run->surface_materials[k]);
+    free(materials);
     for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
@@ -1425,15 +1502,19 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     size_t materials = gltf_doc_material_count(doc), meshes = gltf_doc_mesh_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     im.surfaces = calloc(meshes ? meshes : 1, sizeof *im.surfaces);
+    for (im.surface_slots = 16; im.surface_slots < 2 * meshes;)
+        im.surface_slots *= 2;
+    im.surface_table = malloc(im.surface_slots * sizeof *im.surface_table);
     PtrResult res = PTR_OK;
     GltfScene gs;
-    if (!im.material_index || !im.surfaces) {
+    if (!im.material_index || !im.surfaces || !im.surface_table) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     } else if (!gltf_doc_scene(doc, &gs)) {
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file has no scene", path);
     } else {
         for (size_t i = 0; i < materials; i++)
             im.material_index[i] = UINT32_MAX;
+        memset(im.surface_table, 0xff, im.surface_slots * sizeof *im.surface_table);
         res = read_scene_extras(&im, &gs);
         uint64_t spheres = 0;
         if (res == PTR_OK)
@@ -1471,9 +1552,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     free(im.material_index);
     for (size_t m = 0; im.surfaces && m < meshes; m++) {
         free(im.surfaces[m].spheres);
-        free(im.surfaces[m].materials);
+        free(im.surfaces[m].primitives);
     }
     free(im.surfaces);
+    free(im.surface_table);
     if (res == PTR_OK)
         res = ptr_import_finish(&im.builder, path, err);
     ptr_builder_free(&im.builder);
