@@ -491,6 +491,27 @@ static void check_vertices(void *arg, size_t from, size_t to)
     }
 }
 
+/* The corners of a block's triangles: where their vertices lie within
+ * 3 * BLOCK of each other (a mesh's triangles mostly use nearby vertices),
+ * those vertices read at once, each once; else each corner read. Returns
+ * the first vertex read at once, or UNSET where each corner was. */
+static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size_t count,
+                             double (*corner)[3])
+{
+    uint32_t lo = UNSET, hi = 0;
+    for (size_t i = 0; i < count; i++)
+        for (int k = 0; k < 3; k++) {
+            lo = tri[i][k] < lo ? tri[i][k] : lo;
+            hi = tri[i][k] > hi ? tri[i][k] : hi;
+        }
+    if (hi - lo < 3 * BLOCK) {
+        mesh->positions(mesh->user, lo, hi - lo + 1, corner);
+        return lo;
+    }
+    mesh->gather(mesh->user, &tri[0][0], 3 * count, corner);
+    return UNSET;
+}
+
 /* Marks the components of triangles from .. to - 1 whose centroid lies too
  * deep inside their sphere (compared at three times the scale: the sum of
  * the corners against three times the centre). */
@@ -503,15 +524,18 @@ static void check_triangles(void *arg, size_t from, size_t to)
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
-        ps->mesh->gather(ps->mesh->user, &tri[0][0], 3 * count, corner);
+        const uint32_t first = read_corners(ps->mesh, tri, count, corner);
         for (size_t i = 0; i < count; i++) {
             const uint32_t c = link_of(ps->parent, tri[i][0]);
             const PtrMeshSphere *s = &ps->spheres[c];
-            double sum[3], centre[3];
-            for (int k = 0; k < 3; k++) {
-                sum[k] = corner[3 * i][k] + corner[3 * i + 1][k] + corner[3 * i + 2][k];
-                centre[k] = 3 * s->centre[k];
+            double sum[3] = { 0, 0, 0 }, centre[3];
+            for (int j = 0; j < 3; j++) {
+                const double *p = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
+                for (int k = 0; k < 3; k++)
+                    sum[k] += p[k];
             }
+            for (int k = 0; k < 3; k++)
+                centre[k] = 3 * s->centre[k];
             if (!(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
                 mark_off(ps, c);
         }
