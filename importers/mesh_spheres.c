@@ -266,18 +266,35 @@ static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed
     return ok;
 }
 
-/* What the passes after the unions share. */
+/* What the passes share. */
 typedef struct Passes {
     const PtrMeshSource *mesh;
-    Link *parent;         /* a vertex's parent; from flatten on, its root; from
-                           * relabel on, its component, UNSET if no triangle
-                           * uses it */
-    atomic_size_t *first; /* a root's first triangle, SIZE_MAX if none; from
-                           * relabel on, its component */
+    Link *parent; /* a vertex's parent; from flatten on, its root; from relabel
+                   * on, its component, UNSET if no triangle uses it */
+    Link *label;  /* UNSET, or USED for a triangle's first corner and, from
+                   * flatten on, for the root of its set; from number_roots
+                   * on, a root's component */
     PtrMeshSphere *spheres;
+    atomic_size_t *first;   /* a component's first triangle */
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
     atomic_uchar *off;      /* whether a component lies off its sphere */
 } Passes;
+
+enum { USED = UNSET - 1 };
+
+static void start_sets(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        atomic_init(&ps->parent[v], (uint32_t)v);
+}
+
+static void clear_labels(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        atomic_init(&ps->label[v], UNSET);
+}
 
 static void unite_triangles(void *arg, size_t from, size_t to)
 {
@@ -289,97 +306,42 @@ static void unite_triangles(void *arg, size_t from, size_t to)
         for (size_t i = 0; i < count; i++) {
             unite(ps->parent, tri[i][0], tri[i][1]);
             unite(ps->parent, tri[i][0], tri[i][2]);
+            atomic_store_explicit(&ps->label[tri[i][0]], USED, memory_order_relaxed);
         }
     }
 }
 
-/* Each vertex its root; no root a first triangle yet. */
+/* Each vertex its root, and a root USED if a vertex of its set is. */
 static void flatten(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++) {
-        atomic_store_explicit(&ps->parent[v], find(ps->parent, (uint32_t)v),
-                              memory_order_relaxed);
-        atomic_init(&ps->first[v], SIZE_MAX);
+        const uint32_t root = find(ps->parent, (uint32_t)v);
+        atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
+        if (root != v && link_of(ps->label, (uint32_t)v) == USED)
+            atomic_store_explicit(&ps->label[root], USED, memory_order_relaxed);
     }
 }
 
-/* Each root's first triangle, the least of the threads'. */
-static void find_firsts(void *arg, size_t from, size_t to)
+/* The roots of sets that have triangles, numbered in order (each set's root
+ * is its lowest vertex): how many. */
+static size_t number_roots(const Passes *ps)
 {
-    const Passes *ps = arg;
-    uint32_t tri[BLOCK][3], last = UNSET;
-    for (size_t t = from; t < to; t += BLOCK) {
-        const size_t count = to - t < BLOCK ? to - t : BLOCK;
-        ps->mesh->triangles(ps->mesh->user, t, count, tri);
-        for (size_t i = 0; i < count; i++) {
-            const uint32_t root = link_of(ps->parent, tri[i][0]);
-            if (root == last) /* a later triangle of the same component */
-                continue;
-            last = root;
-            atomic_size_t *first = &ps->first[root];
-            size_t seen = atomic_load_explicit(first, memory_order_relaxed);
-            while (t + i < seen && !atomic_compare_exchange_weak_explicit(
-                                       first, &seen, t + i, memory_order_relaxed,
-                                       memory_order_relaxed))
-                ;
-        }
-    }
+    size_t n = 0;
+    for (size_t v = 0; v < ps->mesh->vertex_count; v++)
+        if (link_of(ps->parent, (uint32_t)v) == v && link_of(ps->label, (uint32_t)v) == USED)
+            atomic_store_explicit(&ps->label[v], (uint32_t)n++, memory_order_relaxed);
+    return n;
 }
 
-/* A component's root and first triangle. */
-typedef struct Root {
-    size_t first;
-    uint32_t vertex;
-} Root;
-
-static int by_first(const void *a, const void *b)
-{
-    const size_t x = ((const Root *)a)->first, y = ((const Root *)b)->first;
-    return (x > y) - (x < y);
-}
-
-/* The roots that have triangles, in the order of their first triangles,
- * into *out (malloc'd) and *count. */
-static int list_roots(const Passes *ps, Root **out, size_t *count)
-{
-    size_t room = 16, n = 0;
-    int sorted = 1;
-    Root *roots = malloc(room * sizeof *roots);
-    for (size_t v = 0; roots && v < ps->mesh->vertex_count; v++) {
-        if (link_of(ps->parent, (uint32_t)v) != v)
-            continue;
-        const size_t first = atomic_load_explicit(&ps->first[v], memory_order_relaxed);
-        if (first == SIZE_MAX)
-            continue;
-        if (n == room) {
-            Root *more = realloc(roots, 2 * room * sizeof *roots);
-            if (!more) {
-                free(roots);
-                return 0;
-            }
-            roots = more, room *= 2;
-        }
-        sorted = sorted && (n == 0 || roots[n - 1].first < first);
-        roots[n++] = (Root){ first, (uint32_t)v };
-    }
-    if (roots && !sorted)
-        qsort(roots, n, sizeof *roots, by_first);
-    *out = roots;
-    *count = n;
-    return roots != NULL;
-}
-
-/* Each vertex its component, from its root's (in first). */
+/* Each vertex its component, from its root's label. */
 static void relabel(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
-    for (size_t v = from; v < to; v++) {
-        const size_t c = atomic_load_explicit(&ps->first[link_of(ps->parent, (uint32_t)v)],
-                                              memory_order_relaxed);
-        atomic_store_explicit(&ps->parent[v], c == SIZE_MAX ? UNSET : (uint32_t)c,
+    for (size_t v = from; v < to; v++)
+        atomic_store_explicit(&ps->parent[v],
+                              link_of(ps->label, link_of(ps->parent, (uint32_t)v)),
                               memory_order_relaxed);
-    }
 }
 
 static void lower_to(_Atomic double *bound, double x)
@@ -514,12 +476,13 @@ static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size
 
 /* Marks the components of triangles from .. to - 1 whose centroid lies too
  * deep inside their sphere (compared at three times the scale: the sum of
- * the corners against three times the centre). */
+ * the corners against three times the centre), and finds each component's
+ * first triangle. */
 static void check_triangles(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     const double slack = 2 * ps->mesh->quantum;
-    uint32_t tri[BLOCK][3];
+    uint32_t tri[BLOCK][3], last = UNSET;
     double corner[3 * BLOCK][3];
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
@@ -527,6 +490,14 @@ static void check_triangles(void *arg, size_t from, size_t to)
         const uint32_t first = read_corners(ps->mesh, tri, count, corner);
         for (size_t i = 0; i < count; i++) {
             const uint32_t c = link_of(ps->parent, tri[i][0]);
+            if (c != last) { /* this thread's first triangle of c: the least of the threads' */
+                last = c;
+                size_t seen = atomic_load_explicit(&ps->first[c], memory_order_relaxed);
+                while (t + i < seen && !atomic_compare_exchange_weak_explicit(
+                                           &ps->first[c], &seen, t + i, memory_order_relaxed,
+                                           memory_order_relaxed))
+                    ;
+            }
             const PtrMeshSphere *s = &ps->spheres[c];
             double sum[3] = { 0, 0, 0 }, centre[3];
             for (int j = 0; j < 3; j++) {
@@ -542,66 +513,77 @@ static void check_triangles(void *arg, size_t from, size_t to)
     }
 }
 
-/* The components numbered in the order of their first triangles, fitted
- * and checked, into ps->spheres (malloc'd, count of them). */
+static int by_first_triangle(const void *a, const void *b)
+{
+    const size_t x = ((const PtrMeshSphere *)a)->first_triangle;
+    const size_t y = ((const PtrMeshSphere *)b)->first_triangle;
+    return (x > y) - (x < y);
+}
+
+/* The components, numbered by their roots, fitted and checked into
+ * ps->spheres (malloc'd, count of them), then put in the order of their
+ * first triangles. */
 static int fit_components(Passes *ps, size_t *count)
 {
     const PtrMeshSource *mesh = ps->mesh;
     const int threads = threads_for(mesh);
     const size_t n = mesh->vertex_count;
     ptr_parallel_ranges(threads, 0, n, flatten, ps);
-    ptr_parallel_ranges(threads, 0, mesh->triangle_count, find_firsts, ps);
-    Root *roots = NULL;
-    size_t components = 0;
-    if (!list_roots(ps, &roots, &components))
-        return 0;
-    const size_t room = components ? components : 1;
+    const size_t components = number_roots(ps), room = components ? components : 1;
     ps->spheres = malloc(room * sizeof *ps->spheres);
+    ps->first = malloc(room * sizeof *ps->first);
     ps->bounds = malloc(6 * room * sizeof *ps->bounds);
     ps->off = malloc(room * sizeof *ps->off);
-    const int ok = ps->spheres && ps->bounds && ps->off;
-    for (size_t c = 0; ok && c < components; c++) {
-        ps->spheres[c].first_triangle = roots[c].first;
-        atomic_store_explicit(&ps->first[roots[c].vertex], c, memory_order_relaxed);
+    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off)
+        return 0;
+    for (size_t c = 0; c < components; c++) {
+        atomic_init(&ps->first[c], SIZE_MAX);
         for (int k = 0; k < 3; k++) {
             atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
             atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
         }
         atomic_init(&ps->off[c], 0);
     }
-    free(roots);
-    if (ok) {
-        ptr_parallel_ranges(threads, 0, n, relabel, ps);
-        ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
-        fit(ps, components);
-        ptr_parallel_ranges(threads, 0, n, check_vertices, ps);
-        ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
-        for (size_t c = 0; c < components; c++)
-            ps->spheres[c].is_sphere = ps->spheres[c].is_sphere && !atomic_load(&ps->off[c]);
+    ptr_parallel_ranges(threads, 0, n, relabel, ps);
+    ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
+    fit(ps, components);
+    ptr_parallel_ranges(threads, 0, n, check_vertices, ps);
+    ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
+    int sorted = 1;
+    for (size_t c = 0; c < components; c++) {
+        PtrMeshSphere *s = &ps->spheres[c];
+        s->is_sphere = s->is_sphere && !atomic_load(&ps->off[c]);
+        s->first_triangle = atomic_load(&ps->first[c]);
+        sorted = sorted && (c == 0 || s[-1].first_triangle < s->first_triangle);
     }
+    if (!sorted)
+        qsort(ps->spheres, components, sizeof *ps->spheres, by_first_triangle);
     *count = components;
-    return ok;
+    return 1;
 }
 
 PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
                            size_t *count, PtrError *err)
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
-    Link *parent = malloc(n * sizeof *parent);
-    /* One a vertex: the positions' keys, then the roots' first triangles. */
-    void *scratch = malloc(n * (sizeof(Keyed) > sizeof(atomic_size_t) ? sizeof(Keyed)
-                                                                         : sizeof(atomic_size_t)));
-    Passes ps = { .mesh = mesh, .parent = parent, .first = scratch };
+    const int threads = threads_for(mesh);
+    /* One a vertex: the positions' keys, then the labels. */
+    Keyed *scratch = malloc(n * sizeof *scratch);
+    Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
+                  .label = (Link *)scratch };
     size_t components = 0;
-    int ok = parent && scratch;
-    for (size_t v = 0; ok && v < mesh->vertex_count; v++)
-        atomic_init(&parent[v], (uint32_t)v);
-    ok = ok && unite_positions(mesh, parent, scratch);
+    int ok = ps.parent && scratch;
     if (ok)
-        ptr_parallel_ranges(threads_for(mesh), 0, mesh->triangle_count, unite_triangles, &ps);
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
+    ok = ok && unite_positions(mesh, ps.parent, scratch);
+    if (ok) {
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
+        ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
+    }
     ok = ok && fit_components(&ps, &components);
-    free(parent);
+    free(ps.parent);
     free(scratch);
+    free(ps.first);
     free(ps.bounds);
     free(ps.off);
     if (!ok) {
