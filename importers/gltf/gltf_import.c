@@ -364,14 +364,19 @@ static size_t part_vertex(const SurfacePart *p, size_t j)
     return p->first_vertex + (p->has_idx ? index_at(&p->idx, j) : j);
 }
 
+static void float_position(const unsigned char *at, double out[3])
+{
+    float f[3];
+    memcpy(f, at, sizeof f);
+    for (int k = 0; k < 3; k++)
+        out[k] = f[k];
+}
+
 /* Vertex v of part p (from p's first), as element reads it. */
 static void part_position(const SurfacePart *p, size_t v, double out[3])
 {
     if (p->pos.component_type == GLTF_FLOAT) { /* the common case, read at once */
-        float f[3];
-        memcpy(f, p->pos.data + v * p->pos.stride, sizeof f);
-        for (int k = 0; k < 3; k++)
-            out[k] = f[k];
+        float_position(p->pos.data + v * p->pos.stride, out);
         return;
     }
     double e[4];
@@ -409,8 +414,12 @@ static void mesh_positions(const void *user, size_t first, size_t count, double 
     for (size_t i = 0; i < count; p++) {
         const size_t v = first + i - p->first_vertex;
         const size_t run = p->pos.count - v < count - i ? p->pos.count - v : count - i;
-        for (size_t k = 0; k < run; k++)
-            part_position(p, v + k, out[i + k]);
+        if (p->pos.component_type == GLTF_FLOAT) /* the common case, its type asked once */
+            for (size_t k = 0; k < run; k++)
+                float_position(p->pos.data + (v + k) * p->pos.stride, out[i + k]);
+        else
+            for (size_t k = 0; k < run; k++)
+                part_position(p, v + k, out[i + k]);
         i += run;
     }
 }
@@ -467,8 +476,20 @@ enum { PARALLEL_INDICES = 1 << 18 };
 static void check_indices(void *arg, size_t from, size_t to)
 {
     IndexCheck *c = arg;
+    const GltfAccessor *a = c->indices;
+    /* 32-bit indices, the common case of a large mesh: the largest of each
+     * chunk first, the chunk searched only if it is past the vertices. */
+    for (; a->component_type == GLTF_UNSIGNED_INT && a->stride == 4 && to - from >= 4096;
+         from += 4096) {
+        uint32_t chunk[4096], largest = 0;
+        memcpy(chunk, a->data + 4 * from, sizeof chunk);
+        for (size_t i = 0; i < 4096; i++)
+            largest = chunk[i] > largest ? chunk[i] : largest;
+        if (largest >= c->vertices)
+            break;
+    }
     for (size_t i = from; i < to; i++)
-        if (index_at(c->indices, i) >= c->vertices) {
+        if (index_at(a, i) >= c->vertices) {
             note_failure(&c->first_past, i);
             return;
         }
