@@ -369,36 +369,55 @@ static void merge_bounds(const Passes *ps, uint32_t c, const double lo[3], const
     }
 }
 
-/* The bounds of vertices from .. to - 1's components, gathered over each
- * run of vertices of one component (a mesh's components mostly lie in runs),
- * a position that is not a number left out. */
-static void bound_vertices(void *arg, size_t from, size_t to)
+/* A pass's step at a vertex of component c, at position p. */
+typedef void (*VertexStep)(const Passes *ps, uint32_t c, const double p[3], void *state);
+
+/* The step at each vertex from .. to - 1 that belongs to a component, the
+ * positions read a block at a time. */
+static void each_vertex(const Passes *ps, size_t from, size_t to, VertexStep step, void *state)
 {
-    const Passes *ps = arg;
-    double p[BLOCK][3], lo[3] = { 0, 0, 0 }, hi[3] = { 0, 0, 0 };
-    uint32_t run = UNSET;
+    double p[BLOCK][3];
     for (size_t v = from; v < to; v += BLOCK) {
         const size_t count = to - v < BLOCK ? to - v : BLOCK;
         ps->mesh->positions(ps->mesh->user, v, count, p);
         for (size_t i = 0; i < count; i++) {
             const uint32_t c = link_of(ps->parent, (uint32_t)(v + i));
-            if (c == UNSET)
-                continue;
-            if (c != run) {
-                if (run != UNSET)
-                    merge_bounds(ps, run, lo, hi);
-                run = c;
-                for (int k = 0; k < 3; k++)
-                    lo[k] = HUGE_VAL, hi[k] = -HUGE_VAL;
-            }
-            for (int k = 0; k < 3; k++) {
-                lo[k] = p[i][k] < lo[k] ? p[i][k] : lo[k];
-                hi[k] = p[i][k] > hi[k] ? p[i][k] : hi[k];
-            }
+            if (c != UNSET)
+                step(ps, c, p[i], state);
         }
     }
-    if (run != UNSET)
-        merge_bounds(ps, run, lo, hi);
+}
+
+/* The bounds of a run of vertices of one component (a mesh's components
+ * mostly lie in runs), merged into the component's at the run's end. */
+typedef struct Run {
+    uint32_t component; /* UNSET before the first */
+    double lo[3], hi[3];
+} Run;
+
+/* A position that is not a number is left out. */
+static void bound_vertex(const Passes *ps, uint32_t c, const double p[3], void *state)
+{
+    Run *run = state;
+    if (c != run->component) {
+        if (run->component != UNSET)
+            merge_bounds(ps, run->component, run->lo, run->hi);
+        run->component = c;
+        for (int k = 0; k < 3; k++)
+            run->lo[k] = HUGE_VAL, run->hi[k] = -HUGE_VAL;
+    }
+    for (int k = 0; k < 3; k++) {
+        run->lo[k] = p[k] < run->lo[k] ? p[k] : run->lo[k];
+        run->hi[k] = p[k] > run->hi[k] ? p[k] : run->hi[k];
+    }
+}
+
+static void bound_vertices(void *arg, size_t from, size_t to)
+{
+    Run run = { .component = UNSET };
+    each_vertex(arg, from, to, bound_vertex, &run);
+    if (run.component != UNSET)
+        merge_bounds(arg, run.component, run.lo, run.hi);
 }
 
 /* The fit of each component to its bounds. */
@@ -432,25 +451,20 @@ static void mark_off(const Passes *ps, uint32_t c)
     atomic_store_explicit(&ps->off[c], 1, memory_order_relaxed);
 }
 
-/* Marks the components of vertices from .. to - 1 that lie off their sphere. */
+/* Marks c if the vertex at p lies off its sphere. */
+static void check_vertex(const Passes *ps, uint32_t c, const double p[3], void *state)
+{
+    (void)state;
+    const PtrMeshSphere *s = &ps->spheres[c];
+    const double slack = 2 * ps->mesh->quantum;
+    if (!(fabs(distance(p, s->centre) - s->radius) <=
+          PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
+        mark_off(ps, c);
+}
+
 static void check_vertices(void *arg, size_t from, size_t to)
 {
-    const Passes *ps = arg;
-    const double slack = 2 * ps->mesh->quantum;
-    double p[BLOCK][3];
-    for (size_t v = from; v < to; v += BLOCK) {
-        const size_t count = to - v < BLOCK ? to - v : BLOCK;
-        ps->mesh->positions(ps->mesh->user, v, count, p);
-        for (size_t i = 0; i < count; i++) {
-            const uint32_t c = link_of(ps->parent, (uint32_t)(v + i));
-            if (c == UNSET)
-                continue;
-            const PtrMeshSphere *s = &ps->spheres[c];
-            if (!(fabs(distance(p[i], s->centre) - s->radius) <=
-                  PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
-                mark_off(ps, c);
-        }
-    }
+    each_vertex(arg, from, to, check_vertex, NULL);
 }
 
 /* The corners of a block's triangles: where their vertices lie within
