@@ -24,9 +24,10 @@ enum {
 
 /* A vertex's parent in the union-find forest. Threads unite at once without
  * locks: a root links only to a lower root, by compare-and-swap, so parents
- * only ever point lower, and a find halves paths by storing an ancestor,
- * which stays one whatever other threads do. Each set's root is then its
- * lowest vertex, as serial unions leave it. */
+ * only ever point lower, and a find halves paths by swapping in an ancestor
+ * for the parent it read (swapping, so that it never undoes a root stored
+ * by flatten since). Each set's root is then its lowest vertex, as serial
+ * unions leave it. */
 typedef _Atomic uint32_t Link;
 
 static uint32_t link_of(Link *parent, uint32_t v)
@@ -39,7 +40,8 @@ static uint32_t find(Link *parent, uint32_t v)
     for (uint32_t up; (up = link_of(parent, v)) != v;) {
         const uint32_t above = link_of(parent, up);
         if (above != up)
-            atomic_store_explicit(&parent[v], above, memory_order_relaxed);
+            atomic_compare_exchange_strong_explicit(&parent[v], &up, above, memory_order_relaxed,
+                                                    memory_order_relaxed);
         v = above;
     }
     return v;
