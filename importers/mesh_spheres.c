@@ -371,23 +371,15 @@ static void merge_bounds(const Passes *ps, uint32_t c, const double lo[3], const
     }
 }
 
-/* A pass's step at a vertex of component c, at position p. */
-typedef void (*VertexStep)(const Passes *ps, uint32_t c, const double p[3], void *state);
-
-/* The step at each vertex from .. to - 1 that belongs to a component, the
- * positions read a block at a time. */
-static void each_vertex(const Passes *ps, size_t from, size_t to, VertexStep step, void *state)
+/* Vertices v .. to - 1, at most a block of them: their positions into p and
+ * their components into c. Returns how many. */
+static size_t vertex_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
 {
-    double p[BLOCK][3];
-    for (size_t v = from; v < to; v += BLOCK) {
-        const size_t count = to - v < BLOCK ? to - v : BLOCK;
-        ps->mesh->positions(ps->mesh->user, v, count, p);
-        for (size_t i = 0; i < count; i++) {
-            const uint32_t c = link_of(ps->parent, (uint32_t)(v + i));
-            if (c != UNSET)
-                step(ps, c, p[i], state);
-        }
-    }
+    const size_t count = to - v < BLOCK ? to - v : BLOCK;
+    ps->mesh->positions(ps->mesh->user, v, count, p);
+    for (size_t i = 0; i < count; i++)
+        c[i] = link_of(ps->parent, (uint32_t)(v + i));
+    return count;
 }
 
 /* The bounds of a run of vertices of one component (a mesh's components
@@ -398,9 +390,8 @@ typedef struct Run {
 } Run;
 
 /* A position that is not a number is left out. */
-static void bound_vertex(const Passes *ps, uint32_t c, const double p[3], void *state)
+static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[3])
 {
-    Run *run = state;
     if (c != run->component) {
         if (run->component != UNSET)
             merge_bounds(ps, run->component, run->lo, run->hi);
@@ -416,10 +407,16 @@ static void bound_vertex(const Passes *ps, uint32_t c, const double p[3], void *
 
 static void bound_vertices(void *arg, size_t from, size_t to)
 {
+    const Passes *ps = arg;
     Run run = { .component = UNSET };
-    each_vertex(arg, from, to, bound_vertex, &run);
+    double p[BLOCK][3];
+    uint32_t c[BLOCK];
+    for (size_t v = from; v < to; v += BLOCK)
+        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++)
+            if (c[i] != UNSET)
+                bound_vertex(ps, &run, c[i], p[i]);
     if (run.component != UNSET)
-        merge_bounds(arg, run.component, run.lo, run.hi);
+        merge_bounds(ps, run.component, run.lo, run.hi);
 }
 
 /* The fit of each component to its bounds. */
@@ -453,20 +450,22 @@ static void mark_off(const Passes *ps, uint32_t c)
     atomic_store_explicit(&ps->off[c], 1, memory_order_relaxed);
 }
 
-/* Marks c if the vertex at p lies off its sphere. */
-static void check_vertex(const Passes *ps, uint32_t c, const double p[3], void *state)
-{
-    (void)state;
-    const PtrMeshSphere *s = &ps->spheres[c];
-    const double slack = 2 * ps->mesh->quantum;
-    if (!(fabs(distance(p, s->centre) - s->radius) <=
-          PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
-        mark_off(ps, c);
-}
-
+/* Marks the components of vertices from .. to - 1 that lie off their sphere. */
 static void check_vertices(void *arg, size_t from, size_t to)
 {
-    each_vertex(arg, from, to, check_vertex, NULL);
+    const Passes *ps = arg;
+    const double slack = 2 * ps->mesh->quantum;
+    double p[BLOCK][3];
+    uint32_t c[BLOCK];
+    for (size_t v = from; v < to; v += BLOCK)
+        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++) {
+            if (c[i] == UNSET)
+                continue;
+            const PtrMeshSphere *s = &ps->spheres[c[i]];
+            if (!(fabs(distance(p[i], s->centre) - s->radius) <=
+                  PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
+                mark_off(ps, c[i]);
+        }
 }
 
 /* The corners of a block's triangles: where their vertices lie within
