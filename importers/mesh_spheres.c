@@ -1,7 +1,9 @@
 /* Connected components by union-find over the triangles' vertex indices and
- * a hash of the vertices' positions (unwelded exports: every triangle its
- * own vertices), each fitted and checked; linear in the mesh's size. The
- * mesh's callbacks are called from several threads at once. */
+ * the vertices' positions (unwelded exports: every triangle its own
+ * vertices), each fitted and checked. Every pass is linear in the mesh's
+ * size, reads it a block at a time through the mesh's callbacks, and runs on
+ * all cores for a large mesh; what it finds does not depend on how the
+ * passes are cut among threads. */
 #include "mesh_spheres.h"
 
 #include <math.h>
@@ -12,33 +14,65 @@
 #include "base/cpu.h"
 #include "base/threads.h"
 
-enum { UNSET = UINT32_MAX };
+enum {
+    UNSET = UINT32_MAX,
+    BLOCK = 256,                 /* vertices or triangles read at once */
+    PARALLEL_SIZE = 1 << 16,     /* vertices and triangles: a mesh this large on all cores */
+    PARTITION_VERTICES = 4096,   /* about the vertices of one table of positions */
+    MAX_PARTITION_BITS = 10,
+};
 
-/* The root of v's set, halving the path on the way. */
-static uint32_t find(uint32_t *parent, uint32_t v)
+/* A vertex's parent in the union-find forest. Threads unite at once without
+ * locks: a root links only to a lower root, by compare-and-swap, so parents
+ * only ever point lower, and a find halves paths by swapping in an ancestor
+ * for the parent it read (swapping, so that it never undoes a root stored
+ * by flatten since). Each set's root is then its lowest vertex, as serial
+ * unions leave it. */
+typedef _Atomic uint32_t Link;
+
+static uint32_t link_of(Link *parent, uint32_t v)
 {
-    while (parent[v] != v) {
-        parent[v] = parent[parent[v]];
-        v = parent[v];
+    return atomic_load_explicit(&parent[v], memory_order_relaxed);
+}
+
+static uint32_t find(Link *parent, uint32_t v)
+{
+    for (uint32_t up; (up = link_of(parent, v)) != v;) {
+        const uint32_t above = link_of(parent, up);
+        if (above != up)
+            atomic_compare_exchange_strong_explicit(&parent[v], &up, above, memory_order_relaxed,
+                                                    memory_order_relaxed);
+        v = above;
     }
     return v;
 }
 
-/* The lower root becomes the root, so the sets do not depend on the order
- * of the unions. */
-static void unite(uint32_t *parent, uint32_t a, uint32_t b)
+static void unite(Link *parent, uint32_t a, uint32_t b)
 {
-    a = find(parent, a);
-    b = find(parent, b);
-    if (a < b)
-        parent[b] = a;
-    else if (b < a)
-        parent[a] = b;
+    if (link_of(parent, a) == link_of(parent, b)) /* most often, once paths are short */
+        return;
+    for (;;) {
+        a = find(parent, a);
+        b = find(parent, b);
+        if (a == b)
+            return;
+        uint32_t high = a > b ? a : b;
+        const uint32_t low = a > b ? b : a;
+        if (atomic_compare_exchange_weak_explicit(&parent[high], &high, low,
+                                                  memory_order_relaxed, memory_order_relaxed))
+            return;
+    }
+}
+
+static int threads_for(const PtrMeshSource *mesh)
+{
+    return mesh->vertex_count + mesh->triangle_count >= PARALLEL_SIZE ? ptr_online_cpus() : 1;
 }
 
 /* A hash of a position's bits: each coordinate multiplied apart, then
- * MurmurHash3's finaliser, so that the low bits the table uses depend on
- * every bit (positions often differ only in their high bits). */
+ * MurmurHash3's finaliser, so that the low bits the tables use and the high
+ * bits the partitions use depend on every bit (positions often differ only
+ * in their high bits). */
 static uint64_t position_hash(const double p[3])
 {
     static const uint64_t odd[3] = { 0x9e3779b97f4a7c15u, 0xc2b2ae3d27d4eb4fu,
@@ -58,40 +92,107 @@ static uint64_t position_hash(const double p[3])
     return h ^ (h >> 33);
 }
 
-/* Vertices of equal positions are found partition by partition (the top
- * bits of their hash), each partition's table small enough for the cache,
- * the partitions on all cores for a mesh this large or larger. */
-enum { PARTITION_BITS = 10, PARTITIONS = 1 << PARTITION_BITS, PARALLEL_VERTICES = 1 << 16 };
+/* A vertex and the low bits of its position's hash. */
+typedef struct Keyed {
+    uint32_t key, vertex;
+} Keyed;
 
+/* Vertices of equal positions are found partition by partition (the top
+ * bits of their hash), each partition's table small enough for the cache.
+ * The vertices are cut into slices, one a thread, each counting its
+ * vertices of each partition and then placing them, so that a partition
+ * holds its vertices in order. */
 typedef struct PositionMatch {
     const PtrMeshSource *mesh;
-    uint64_t *hash;   /* a vertex */
-    uint32_t *order;  /* the vertices, partition after partition, each in order */
-    size_t start[PARTITIONS + 1]; /* partition p: order[start[p] .. start[p + 1] - 1] */
-    uint32_t *match;  /* an earlier vertex of the same position, or UNSET */
+    Link *parent;
+    Keyed *keyed;   /* the vertices, partition after partition */
+    size_t *start;  /* partition p: keyed[start[p] .. start[p + 1] - 1] */
+    size_t *next;   /* slice s, partition p at [s * partitions + p]: first the
+                     * slice's count, then where it places its next vertex */
+    size_t slices, partitions;
+    int bits;       /* partitions = 2^bits */
     atomic_int failed; /* a table could not be allocated */
 } PositionMatch;
 
-static void hash_positions(void *arg, size_t from, size_t to)
+static size_t slice_start(const PositionMatch *pm, size_t s)
+{
+    return pm->mesh->vertex_count * s / pm->slices;
+}
+
+static size_t partition_of(const PositionMatch *pm, uint64_t hash)
+{
+    return pm->bits ? (size_t)(hash >> (64 - pm->bits)) : 0;
+}
+
+/* The hashes of vertices v .. end - 1, at most a block of them: how many. */
+static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t *hash)
+{
+    double p[BLOCK][3];
+    const size_t count = end - v < BLOCK ? end - v : BLOCK;
+    pm->mesh->positions(pm->mesh->user, v, count, p);
+    for (size_t i = 0; i < count; i++)
+        hash[i] = position_hash(p[i]);
+    return count;
+}
+
+static void count_slices(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
-    for (size_t v = from; v < to; v++) {
-        double p[3];
-        pm->mesh->position(pm->mesh->user, v, p);
-        pm->hash[v] = position_hash(p);
+    uint64_t hash[BLOCK];
+    for (size_t s = from; s < to; s++) {
+        size_t *count = &pm->next[s * pm->partitions];
+        for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
+            for (size_t i = 0, n = hash_block(pm, v, end, hash); i < n; i++)
+                count[partition_of(pm, hash[i])]++;
     }
 }
 
-static int same_position(const PtrMeshSource *mesh, size_t v, size_t w)
+/* The keyed vertices a partition's buffer holds until they are written out
+ * together (a cache line): written one by one, each vertex to its own
+ * partition's place, they would miss the cache and the TLB each time. */
+enum { LINE = 8 };
+
+static void place_slices(void *arg, size_t from, size_t to)
 {
-    double p[3], q[3];
-    mesh->position(mesh->user, v, p);
-    mesh->position(mesh->user, w, q);
-    return p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+    PositionMatch *pm = arg;
+    Keyed (*line)[LINE] = malloc(pm->partitions * sizeof *line);
+    unsigned char *held = calloc(pm->partitions, 1);
+    uint64_t hash[BLOCK];
+    for (size_t s = from; line && held && s < to; s++) {
+        size_t *next = &pm->next[s * pm->partitions];
+        for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
+            for (size_t i = 0, n = hash_block(pm, v, end, hash); i < n; i++) {
+                const size_t p = partition_of(pm, hash[i]);
+                line[p][held[p]++] = (Keyed){ (uint32_t)hash[i], (uint32_t)(v + i) };
+                if (held[p] == LINE) {
+                    memcpy(&pm->keyed[next[p]], line[p], sizeof line[p]);
+                    next[p] += LINE;
+                    held[p] = 0;
+                }
+            }
+        for (size_t p = 0; p < pm->partitions; p++) {
+            memcpy(&pm->keyed[next[p]], line[p], held[p] * sizeof line[p][0]);
+            next[p] += held[p];
+            held[p] = 0;
+        }
+    }
+    if (!line || !held)
+        atomic_store(&pm->failed, 1);
+    free(line);
+    free(held);
 }
 
-/* Partitions from .. to - 1, through an open-addressed table of twice as
- * many slots as the largest has vertices. */
+static int same_position(const PtrMeshSource *mesh, uint32_t v, uint32_t w)
+{
+    const uint32_t both[2] = { v, w };
+    double p[2][3];
+    mesh->gather(mesh->user, both, 2, p);
+    return p[0][0] == p[1][0] && p[0][1] == p[1][1] && p[0][2] == p[1][2];
+}
+
+/* Partitions from .. to - 1, each through an open-addressed table of twice
+ * as many slots as it has vertices: a vertex is united with the first of
+ * its position. */
 static void match_partitions(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
@@ -108,64 +209,234 @@ static void match_partitions(void *arg, size_t from, size_t to)
         return;
     }
     for (size_t p = from; p < to; p++) {
-        memset(table, 0xff, size * sizeof *table);
-        for (size_t i = pm->start[p]; i < pm->start[p + 1]; i++) {
-            const uint32_t v = pm->order[i];
-            for (size_t slot = pm->hash[v] & (size - 1);; slot = (slot + 1) & (size - 1)) {
-                const uint32_t w = table[slot];
-                if (w == UNSET) {
-                    table[slot] = v;
+        const Keyed *k = &pm->keyed[pm->start[p]];
+        const size_t count = pm->start[p + 1] - pm->start[p];
+        size_t mask = 15;
+        while (mask + 1 < 2 * count)
+            mask = 2 * mask + 1;
+        memset(table, 0xff, (mask + 1) * sizeof *table);
+        for (uint32_t i = 0; i < count; i++)
+            for (size_t slot = k[i].key & mask;; slot = (slot + 1) & mask) {
+                const uint32_t j = table[slot];
+                if (j == UNSET) {
+                    table[slot] = i;
                     break;
                 }
-                if (pm->hash[w] == pm->hash[v] && same_position(pm->mesh, v, w)) {
-                    pm->match[v] = w;
+                if (k[j].key == k[i].key && same_position(pm->mesh, k[i].vertex, k[j].vertex)) {
+                    unite(pm->parent, k[i].vertex, k[j].vertex);
                     break;
                 }
             }
-        }
     }
     free(table);
 }
 
-/* Joins the vertices of equal positions. */
-static int unite_positions(const PtrMeshSource *mesh, uint32_t *parent)
+/* Joins the vertices of equal positions, keyed (one a vertex) as scratch. */
+static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed)
 {
-    const size_t n = mesh->vertex_count;
-    PositionMatch *pm = malloc(sizeof *pm);
-    if (!pm)
-        return 0;
-    pm->mesh = mesh;
-    pm->hash = malloc((n ? n : 1) * sizeof *pm->hash);
-    pm->order = malloc((n ? n : 1) * sizeof *pm->order);
-    pm->match = malloc((n ? n : 1) * sizeof *pm->match);
-    atomic_init(&pm->failed, 0);
-    int ok = pm->hash && pm->order && pm->match;
+    PositionMatch pm = { .mesh = mesh, .parent = parent, .keyed = keyed,
+                         .slices = (size_t)threads_for(mesh) };
+    while (pm.bits < MAX_PARTITION_BITS &&
+           ((size_t)PARTITION_VERTICES << pm.bits) < mesh->vertex_count)
+        pm.bits++;
+    pm.partitions = (size_t)1 << pm.bits;
+    pm.start = malloc((pm.partitions + 1) * sizeof *pm.start);
+    pm.next = calloc(pm.slices * pm.partitions, sizeof *pm.next);
+    atomic_init(&pm.failed, 0);
+    int ok = pm.start && pm.next;
     if (ok) {
-        const int threads = n >= PARALLEL_VERTICES ? ptr_online_cpus() : 1;
-        ptr_parallel_ranges(threads, 0, n, hash_positions, pm);
-        size_t fill[PARTITIONS] = { 0 };
-        for (size_t v = 0; v < n; v++)
-            fill[pm->hash[v] >> (64 - PARTITION_BITS)]++;
-        pm->start[0] = 0;
-        for (size_t p = 0; p < PARTITIONS; p++) {
-            pm->start[p + 1] = pm->start[p] + fill[p];
-            fill[p] = pm->start[p];
+        const int threads = (int)pm.slices;
+        ptr_parallel_ranges(threads, 0, pm.slices, count_slices, &pm);
+        size_t at = 0;
+        for (size_t p = 0; p < pm.partitions; p++) {
+            pm.start[p] = at;
+            for (size_t s = 0; s < pm.slices; s++) {
+                size_t *next = &pm.next[s * pm.partitions + p];
+                const size_t count = *next;
+                *next = at;
+                at += count;
+            }
         }
-        for (size_t v = 0; v < n; v++) {
-            pm->order[fill[pm->hash[v] >> (64 - PARTITION_BITS)]++] = (uint32_t)v;
-            pm->match[v] = UNSET;
-        }
-        ptr_parallel_ranges(threads, 0, PARTITIONS, match_partitions, pm);
-        ok = !atomic_load(&pm->failed);
-        for (size_t v = 0; ok && v < n; v++)
-            if (pm->match[v] != UNSET)
-                unite(parent, (uint32_t)v, pm->match[v]);
+        pm.start[pm.partitions] = at;
+        ptr_parallel_ranges(threads, 0, pm.slices, place_slices, &pm);
+        if (!atomic_load(&pm.failed))
+            ptr_parallel_ranges(threads, 0, pm.partitions, match_partitions, &pm);
+        ok = !atomic_load(&pm.failed);
     }
-    free(pm->hash);
-    free(pm->order);
-    free(pm->match);
-    free(pm);
+    free(pm.start);
+    free(pm.next);
     return ok;
+}
+
+/* What the passes share. */
+typedef struct Passes {
+    const PtrMeshSource *mesh;
+    Link *parent; /* a vertex's parent; from flatten on, its root; from relabel
+                   * on, its component, UNSET if no triangle uses it */
+    Link *label;  /* UNSET, or USED for a triangle's first corner and, from
+                   * flatten on, for the root of its set; from number_roots
+                   * on, a root's component */
+    PtrMeshSphere *spheres;
+    atomic_size_t *first;   /* a component's first triangle */
+    _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
+    atomic_uchar *off;      /* whether a component lies off its sphere */
+} Passes;
+
+enum { USED = UNSET - 1 };
+
+static void start_sets(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        atomic_init(&ps->parent[v], (uint32_t)v);
+}
+
+static void clear_labels(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        atomic_init(&ps->label[v], UNSET);
+}
+
+static void unite_triangles(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    uint32_t tri[BLOCK][3];
+    for (size_t t = from; t < to; t += BLOCK) {
+        const size_t count = to - t < BLOCK ? to - t : BLOCK;
+        ps->mesh->triangles(ps->mesh->user, t, count, tri);
+        for (size_t i = 0; i < count; i++) {
+            unite(ps->parent, tri[i][0], tri[i][1]);
+            unite(ps->parent, tri[i][0], tri[i][2]);
+            atomic_store_explicit(&ps->label[tri[i][0]], USED, memory_order_relaxed);
+        }
+    }
+}
+
+/* Each vertex its root, and a root USED if a vertex of its set is. */
+static void flatten(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++) {
+        const uint32_t root = find(ps->parent, (uint32_t)v);
+        atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
+        if (root != v && link_of(ps->label, (uint32_t)v) == USED)
+            atomic_store_explicit(&ps->label[root], USED, memory_order_relaxed);
+    }
+}
+
+/* The roots of sets that have triangles, numbered in order (each set's root
+ * is its lowest vertex): how many. */
+static size_t number_roots(const Passes *ps)
+{
+    size_t n = 0;
+    for (size_t v = 0; v < ps->mesh->vertex_count; v++)
+        if (link_of(ps->parent, (uint32_t)v) == v && link_of(ps->label, (uint32_t)v) == USED)
+            atomic_store_explicit(&ps->label[v], (uint32_t)n++, memory_order_relaxed);
+    return n;
+}
+
+/* Each vertex its component, from its root's label. */
+static void relabel(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        atomic_store_explicit(&ps->parent[v],
+                              link_of(ps->label, link_of(ps->parent, (uint32_t)v)),
+                              memory_order_relaxed);
+}
+
+static void lower_to(_Atomic double *bound, double x)
+{
+    double seen = atomic_load_explicit(bound, memory_order_relaxed);
+    while (x < seen && !atomic_compare_exchange_weak_explicit(bound, &seen, x, memory_order_relaxed,
+                                                              memory_order_relaxed))
+        ;
+}
+
+static void raise_to(_Atomic double *bound, double x)
+{
+    double seen = atomic_load_explicit(bound, memory_order_relaxed);
+    while (x > seen && !atomic_compare_exchange_weak_explicit(bound, &seen, x, memory_order_relaxed,
+                                                              memory_order_relaxed))
+        ;
+}
+
+/* Adds a run of one component's vertices' bounds to the component's. */
+static void merge_bounds(const Passes *ps, uint32_t c, const double lo[3], const double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lower_to(&ps->bounds[6 * c + k], lo[k]);
+        raise_to(&ps->bounds[6 * c + 3 + k], hi[k]);
+    }
+}
+
+/* Vertices v .. to - 1, at most a block of them: their positions into p and
+ * their components into c. Returns how many. */
+static size_t vertex_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
+{
+    const size_t count = to - v < BLOCK ? to - v : BLOCK;
+    ps->mesh->positions(ps->mesh->user, v, count, p);
+    for (size_t i = 0; i < count; i++)
+        c[i] = link_of(ps->parent, (uint32_t)(v + i));
+    return count;
+}
+
+/* The bounds of a run of vertices of one component (a mesh's components
+ * mostly lie in runs), merged into the component's at the run's end. */
+typedef struct Run {
+    uint32_t component; /* UNSET before the first */
+    double lo[3], hi[3];
+} Run;
+
+/* A position that is not a number is left out. */
+static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[3])
+{
+    if (c != run->component) {
+        if (run->component != UNSET)
+            merge_bounds(ps, run->component, run->lo, run->hi);
+        run->component = c;
+        for (int k = 0; k < 3; k++)
+            run->lo[k] = HUGE_VAL, run->hi[k] = -HUGE_VAL;
+    }
+    for (int k = 0; k < 3; k++) {
+        run->lo[k] = p[k] < run->lo[k] ? p[k] : run->lo[k];
+        run->hi[k] = p[k] > run->hi[k] ? p[k] : run->hi[k];
+    }
+}
+
+static void bound_vertices(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    Run run = { .component = UNSET };
+    double p[BLOCK][3];
+    uint32_t c[BLOCK];
+    for (size_t v = from; v < to; v += BLOCK)
+        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++)
+            if (c[i] != UNSET)
+                bound_vertex(ps, &run, c[i], p[i]);
+    if (run.component != UNSET)
+        merge_bounds(ps, run.component, run.lo, run.hi);
+}
+
+/* The fit of each component to its bounds. */
+static void fit(const Passes *ps, size_t count)
+{
+    for (size_t c = 0; c < count; c++) {
+        double extent = 0.0, smallest = HUGE_VAL;
+        for (int k = 0; k < 3; k++) {
+            const double lo = atomic_load_explicit(&ps->bounds[6 * c + k], memory_order_relaxed);
+            const double hi =
+                atomic_load_explicit(&ps->bounds[6 * c + 3 + k], memory_order_relaxed);
+            ps->spheres[c].centre[k] = 0.5 * (lo + hi);
+            extent = fmax(extent, hi - lo);
+            smallest = fmin(smallest, hi - lo);
+        }
+        ps->spheres[c].radius = 0.5 * extent;
+        ps->spheres[c].is_sphere =
+            extent > 0.0 && isfinite(extent) &&
+            smallest + 2 * ps->mesh->quantum >= PTR_SPHERE_EXTENT_RATIO * extent;
+    }
 }
 
 static double distance(const double a[3], const double b[3])
@@ -174,187 +445,167 @@ static double distance(const double a[3], const double b[3])
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/* The bounds of each component (lo, hi: 3 a component), then the fit. */
-static void fit(const PtrMeshSource *mesh, const uint32_t *label, PtrMeshSphere *spheres,
-                size_t count, double *lo, double *hi)
+static void mark_off(const Passes *ps, uint32_t c)
 {
-    for (size_t c = 0; c < 3 * count; c++) {
-        lo[c] = HUGE_VAL;
-        hi[c] = -HUGE_VAL;
-    }
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        if (label[v] == UNSET)
-            continue;
-        double p[3];
-        mesh->position(mesh->user, v, p);
-        for (int k = 0; k < 3; k++) {
-            lo[3 * label[v] + k] = fmin(lo[3 * label[v] + k], p[k]);
-            hi[3 * label[v] + k] = fmax(hi[3 * label[v] + k], p[k]);
-        }
-    }
-    for (size_t c = 0; c < count; c++) {
-        double extent = 0.0, smallest = HUGE_VAL;
-        for (int k = 0; k < 3; k++) {
-            const double e = hi[3 * c + k] - lo[3 * c + k];
-            spheres[c].centre[k] = 0.5 * (lo[3 * c + k] + hi[3 * c + k]);
-            extent = fmax(extent, e);
-            smallest = fmin(smallest, e);
-        }
-        spheres[c].radius = 0.5 * extent;
-        spheres[c].is_sphere = extent > 0.0 && isfinite(extent) &&
-                               smallest + 2 * mesh->quantum >= PTR_SPHERE_EXTENT_RATIO * extent;
-    }
+    atomic_store_explicit(&ps->off[c], 1, memory_order_relaxed);
 }
-
-/* The check of a mesh's components, on all cores for a large mesh: a
- * thread that finds a component off its sphere marks it in `off`. */
-typedef struct Check {
-    const PtrMeshSource *mesh;
-    const uint32_t *label; /* a vertex's component, UNSET if no triangle uses it */
-    const PtrMeshSphere *spheres;
-    atomic_uchar *off;
-} Check;
 
 /* Marks the components of vertices from .. to - 1 that lie off their sphere. */
 static void check_vertices(void *arg, size_t from, size_t to)
 {
-    const Check *c = arg;
-    const double slack = 2 * c->mesh->quantum;
-    for (size_t v = from; v < to; v++) {
-        if (c->label[v] == UNSET)
-            continue;
-        const PtrMeshSphere *s = &c->spheres[c->label[v]];
-        double p[3];
-        c->mesh->position(c->mesh->user, v, p);
-        if (!(fabs(distance(p, s->centre) - s->radius) <=
-              PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
-            atomic_store_explicit(&c->off[c->label[v]], 1, memory_order_relaxed);
+    const Passes *ps = arg;
+    const double slack = 2 * ps->mesh->quantum;
+    double p[BLOCK][3];
+    uint32_t c[BLOCK];
+    for (size_t v = from; v < to; v += BLOCK)
+        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++) {
+            if (c[i] == UNSET)
+                continue;
+            const PtrMeshSphere *s = &ps->spheres[c[i]];
+            if (!(fabs(distance(p[i], s->centre) - s->radius) <=
+                  PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
+                mark_off(ps, c[i]);
+        }
+}
+
+/* The corners of a block's triangles: where their vertices lie within
+ * 3 * BLOCK of each other (a mesh's triangles mostly use nearby vertices),
+ * those vertices read at once, each once; else each corner read. Returns
+ * the first vertex read at once, or UNSET where each corner was. */
+static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size_t count,
+                             double (*corner)[3])
+{
+    uint32_t lo = UNSET, hi = 0;
+    for (size_t i = 0; i < count; i++)
+        for (int k = 0; k < 3; k++) {
+            lo = tri[i][k] < lo ? tri[i][k] : lo;
+            hi = tri[i][k] > hi ? tri[i][k] : hi;
+        }
+    if (hi - lo < 3 * BLOCK) {
+        mesh->positions(mesh->user, lo, hi - lo + 1, corner);
+        return lo;
     }
+    mesh->gather(mesh->user, &tri[0][0], 3 * count, corner);
+    return UNSET;
 }
 
 /* Marks the components of triangles from .. to - 1 whose centroid lies too
  * deep inside their sphere (compared at three times the scale: the sum of
- * the corners against three times the centre). */
+ * the corners against three times the centre), and finds each component's
+ * first triangle. */
 static void check_triangles(void *arg, size_t from, size_t to)
 {
-    const Check *c = arg;
-    const double slack = 2 * c->mesh->quantum;
-    for (size_t t = from; t < to; t++) {
-        uint32_t tri[3];
-        double sum[3] = { 0, 0, 0 }, p[3], centre[3];
-        c->mesh->triangle(c->mesh->user, t, tri);
-        for (int i = 0; i < 3; i++) {
-            c->mesh->position(c->mesh->user, tri[i], p);
-            for (int k = 0; k < 3; k++)
-                sum[k] += p[k];
-        }
-        const PtrMeshSphere *s = &c->spheres[c->label[tri[0]]];
-        for (int k = 0; k < 3; k++)
-            centre[k] = 3 * s->centre[k];
-        if (!(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
-            atomic_store_explicit(&c->off[c->label[tri[0]]], 1, memory_order_relaxed);
-    }
-}
-
-/* Clears is_sphere of a component with a vertex off its sphere or a
- * triangle's centroid too deep inside it. */
-static int check(const PtrMeshSource *mesh, const uint32_t *label, PtrMeshSphere *spheres,
-                 size_t count)
-{
-    Check c = { mesh, label, spheres, malloc((count ? count : 1) * sizeof *c.off) };
-    if (!c.off)
-        return 0;
-    for (size_t k = 0; k < count; k++)
-        atomic_init(&c.off[k], 0);
-    const int threads = mesh->vertex_count >= PARALLEL_VERTICES ? ptr_online_cpus() : 1;
-    ptr_parallel_ranges(threads, 0, mesh->vertex_count, check_vertices, &c);
-    ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, &c);
-    for (size_t k = 0; k < count; k++)
-        spheres[k].is_sphere = spheres[k].is_sphere && !atomic_load(&c.off[k]);
-    free(c.off);
-    return 1;
-}
-
-/* Numbers each root's component in the order of first triangles (label:
- * a root's number), with the first triangle of each into *first (malloc'd). */
-static int number_components(const PtrMeshSource *mesh, uint32_t *parent, uint32_t *label,
-                             size_t **first, size_t *count)
-{
-    size_t room = 16, n = 0;
-    size_t *firsts = malloc(room * sizeof *firsts);
-    for (size_t t = 0; firsts && t < mesh->triangle_count; t++) {
-        uint32_t tri[3];
-        mesh->triangle(mesh->user, t, tri);
-        const uint32_t root = find(parent, tri[0]);
-        if (label[root] != UNSET)
-            continue;
-        if (n == room) {
-            size_t *more = realloc(firsts, 2 * room * sizeof *firsts);
-            if (!more) {
-                free(firsts);
-                return 0;
+    const Passes *ps = arg;
+    const double slack = 2 * ps->mesh->quantum;
+    uint32_t tri[BLOCK][3], last = UNSET;
+    double corner[3 * BLOCK][3];
+    for (size_t t = from; t < to; t += BLOCK) {
+        const size_t count = to - t < BLOCK ? to - t : BLOCK;
+        ps->mesh->triangles(ps->mesh->user, t, count, tri);
+        const uint32_t first = read_corners(ps->mesh, tri, count, corner);
+        for (size_t i = 0; i < count; i++) {
+            const uint32_t c = link_of(ps->parent, tri[i][0]);
+            if (c != last) { /* this thread's first triangle of c: the least of the threads' */
+                last = c;
+                size_t seen = atomic_load_explicit(&ps->first[c], memory_order_relaxed);
+                while (t + i < seen && !atomic_compare_exchange_weak_explicit(
+                                           &ps->first[c], &seen, t + i, memory_order_relaxed,
+                                           memory_order_relaxed))
+                    ;
             }
-            firsts = more, room *= 2;
+            const PtrMeshSphere *s = &ps->spheres[c];
+            double sum[3] = { 0, 0, 0 }, centre[3];
+            for (int j = 0; j < 3; j++) {
+                const double *p = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
+                for (int k = 0; k < 3; k++)
+                    sum[k] += p[k];
+            }
+            for (int k = 0; k < 3; k++)
+                centre[k] = 3 * s->centre[k];
+            if (!(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
+                mark_off(ps, c);
         }
-        label[root] = (uint32_t)n;
-        firsts[n++] = t;
     }
-    *first = firsts;
-    *count = n;
-    return firsts != NULL;
+}
+
+static int by_first_triangle(const void *a, const void *b)
+{
+    const size_t x = ((const PtrMeshSphere *)a)->first_triangle;
+    const size_t y = ((const PtrMeshSphere *)b)->first_triangle;
+    return (x > y) - (x < y);
+}
+
+/* The components, numbered by their roots, fitted and checked into
+ * ps->spheres (malloc'd, count of them), then put in the order of their
+ * first triangles. */
+static int fit_components(Passes *ps, size_t *count)
+{
+    const PtrMeshSource *mesh = ps->mesh;
+    const int threads = threads_for(mesh);
+    const size_t n = mesh->vertex_count;
+    ptr_parallel_ranges(threads, 0, n, flatten, ps);
+    const size_t components = number_roots(ps), room = components ? components : 1;
+    ps->spheres = malloc(room * sizeof *ps->spheres);
+    ps->first = malloc(room * sizeof *ps->first);
+    ps->bounds = malloc(6 * room * sizeof *ps->bounds);
+    ps->off = malloc(room * sizeof *ps->off);
+    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off)
+        return 0;
+    for (size_t c = 0; c < components; c++) {
+        atomic_init(&ps->first[c], SIZE_MAX);
+        for (int k = 0; k < 3; k++) {
+            atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
+            atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
+        }
+        atomic_init(&ps->off[c], 0);
+    }
+    ptr_parallel_ranges(threads, 0, n, relabel, ps);
+    ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
+    fit(ps, components);
+    ptr_parallel_ranges(threads, 0, n, check_vertices, ps);
+    ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
+    int sorted = 1;
+    for (size_t c = 0; c < components; c++) {
+        PtrMeshSphere *s = &ps->spheres[c];
+        s->is_sphere = s->is_sphere && !atomic_load(&ps->off[c]);
+        s->first_triangle = atomic_load(&ps->first[c]);
+        sorted = sorted && (c == 0 || s[-1].first_triangle < s->first_triangle);
+    }
+    if (!sorted)
+        qsort(ps->spheres, components, sizeof *ps->spheres, by_first_triangle);
+    *count = components;
+    return 1;
 }
 
 PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
                            size_t *count, PtrError *err)
 {
-    const size_t n = mesh->vertex_count;
-    uint32_t *parent = malloc((n ? n : 1) * sizeof *parent);
-    PtrMeshSphere *spheres = NULL;
-    double *bounds = NULL;
+    const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
+    const int threads = threads_for(mesh);
+    /* One a vertex: the positions' keys, then the labels. */
+    Keyed *scratch = malloc(n * sizeof *scratch);
+    Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
+                  .label = (Link *)scratch };
     size_t components = 0;
-    int ok = parent != NULL;
-    for (size_t v = 0; ok && v < n; v++)
-        parent[v] = (uint32_t)v;
-    ok = ok && unite_positions(mesh, parent);
-    for (size_t t = 0; ok && t < mesh->triangle_count; t++) {
-        uint32_t tri[3];
-        mesh->triangle(mesh->user, t, tri);
-        unite(parent, tri[0], tri[1]);
-        unite(parent, tri[0], tri[2]);
-    }
-    /* Each root's component, numbered in the order of first triangles;
-     * the labels go into parent once every vertex knows its root. */
-    uint32_t *label = ok ? malloc((n ? n : 1) * sizeof *label) : NULL;
-    size_t *first = NULL;
-    ok = ok && label;
+    int ok = ps.parent && scratch;
+    if (ok)
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
+    ok = ok && unite_positions(mesh, ps.parent, scratch);
     if (ok) {
-        memset(label, 0xff, (n ? n : 1) * sizeof *label);
-        ok = number_components(mesh, parent, label, &first, &components);
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
+        ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
     }
-    if (ok) {
-        spheres = malloc((components ? components : 1) * sizeof *spheres);
-        bounds = malloc((components ? components : 1) * 6 * sizeof *bounds);
-        ok = spheres && bounds;
-    }
-    if (ok) {
-        for (size_t v = 0; v < n; v++) /* roots stay roots: each vertex its root */
-            parent[v] = find(parent, (uint32_t)v);
-        for (size_t v = 0; v < n; v++)
-            parent[v] = label[parent[v]];
-        for (size_t c = 0; c < components; c++)
-            spheres[c].first_triangle = first[c];
-        fit(mesh, parent, spheres, components, bounds, bounds + 3 * components);
-        ok = check(mesh, parent, spheres, components);
-    }
-    free(first);
-    free(parent);
-    free(label);
-    free(bounds);
+    ok = ok && fit_components(&ps, &components);
+    free(ps.parent);
+    free(scratch);
+    free(ps.first);
+    free(ps.bounds);
+    free(ps.off);
     if (!ok) {
-        free(spheres);
+        free(ps.spheres);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     }
-    *out = spheres;
+    *out = ps.spheres;
     *count = components;
     return PTR_OK;
 }

@@ -8,12 +8,18 @@
 
 #include "base/result.h"
 
-/* A mesh as its reader sees it: vertex v's position, triangle t's three
- * vertices (each below vertex_count: the reader has checked them). */
+/* A mesh as its reader sees it, read a block at a time (from several
+ * threads at once): positions of vertices by range or by list, triangles'
+ * three vertices by range (each below vertex_count: the reader has checked
+ * them). */
 typedef struct PtrMeshSource {
     size_t vertex_count, triangle_count;
-    void (*position)(const void *user, size_t v, double out[3]);
-    void (*triangle)(const void *user, size_t t, uint32_t out[3]);
+    /* Vertices first .. first + count - 1. */
+    void (*positions)(const void *user, size_t first, size_t count, double (*out)[3]);
+    /* The count vertices listed. */
+    void (*gather)(const void *user, const uint32_t *vertices, size_t count, double (*out)[3]);
+    /* Triangles first .. first + count - 1. */
+    void (*triangles)(const void *user, size_t first, size_t count, uint32_t (*out)[3]);
     const void *user;
     /* The step of the positions' storage (1 for integers, 1/255 for
      * normalised bytes, ...; 0 for floats): the check allows two of it. */

@@ -93,12 +93,14 @@ static PtrVec3 vec_from(const double v[3])
 }
 
 /* A mesh's surface spheres (docs/scenes.md "Spheres"), found once however
- * many nodes use the mesh. */
+ * many nodes use the mesh, and once for meshes of the same surface. */
 typedef struct SurfaceSpheres {
     int found;
+    const struct SurfaceSpheres *same; /* where the spheres are: itself, or
+                                        * an earlier mesh's; NULL until found */
     size_t count;
     double *spheres;  /* 4 a sphere: the centre and radius in the mesh's frame */
-    int *materials;   /* each one's glTF material, -1 if none */
+    int *primitives;  /* each one's primitive in its mesh (which gives its material) */
     size_t skipped;   /* the parts that are not spheres */
 } SurfaceSpheres;
 
@@ -118,6 +120,8 @@ typedef struct Importer {
     int warned_texture;
     const char *value_name; /* the attribute --color-by asks for, or NULL */
     SurfaceSpheres *surfaces; /* one a mesh */
+    size_t *surface_table;    /* meshes by their surface (surface_key), SIZE_MAX: none */
+    size_t surface_slots;     /* a power of two */
     size_t skipped;           /* mesh parts not drawn, for the one warning */
     char skipped_names[256];  /* where they are, as many as fit */
     int skipped_more;         /* whether more did not fit */
@@ -318,7 +322,7 @@ static void element(const GltfAccessor *a, size_t i, double out[4])
 /* A surface primitive's part of its mesh's vertices and triangles. */
 typedef struct SurfacePart {
     GltfAccessor pos, idx; /* idx read where has_idx says */
-    int has_idx, mode, material;
+    int has_idx, mode, primitive;
     size_t first_vertex, first_triangle, triangles;
 } SurfacePart;
 
@@ -360,30 +364,86 @@ static size_t part_vertex(const SurfacePart *p, size_t j)
     return p->first_vertex + (p->has_idx ? index_at(&p->idx, j) : j);
 }
 
-static void mesh_position(const void *user, size_t v, double out[3])
+static void float_position(const unsigned char *at, double out[3])
 {
-    const SurfacePart *p = part_of(user, v, 0);
+    float f[3];
+    memcpy(f, at, sizeof f);
+    for (int k = 0; k < 3; k++)
+        out[k] = f[k];
+}
+
+/* Vertex v of part p (from p's first), as element reads it. */
+static void part_position(const SurfacePart *p, size_t v, double out[3])
+{
     if (p->pos.component_type == GLTF_FLOAT) { /* the common case, read at once */
-        float f[3];
-        memcpy(f, p->pos.data + (v - p->first_vertex) * p->pos.stride, sizeof f);
-        for (int k = 0; k < 3; k++)
-            out[k] = f[k];
+        float_position(p->pos.data + v * p->pos.stride, out);
         return;
     }
     double e[4];
-    element(&p->pos, v - p->first_vertex, e);
+    element(&p->pos, v, e);
     memcpy(out, e, 3 * sizeof *out);
 }
 
-static void mesh_triangle(const void *user, size_t t, uint32_t out[3])
+/* Triangles j .. j + count - 1 of part p as mesh vertices. */
+static void part_triangles(const SurfacePart *p, size_t j, size_t count, uint32_t (*out)[3])
 {
-    const SurfacePart *p = part_of(user, t, 1);
-    const size_t j = t - p->first_triangle;
-    const size_t at[3] = { p->mode == 4 ? 3 * j : p->mode == 6 ? 0 : j,
-                           p->mode == 4 ? 3 * j + 1 : j + 1,
-                           p->mode == 4 ? 3 * j + 2 : j + 2 };
-    for (int i = 0; i < 3; i++)
-        out[i] = (uint32_t)part_vertex(p, at[i]);
+    const uint32_t base = (uint32_t)p->first_vertex;
+    if (p->mode == 4 && p->has_idx && p->idx.component_type == GLTF_UNSIGNED_INT &&
+        p->idx.stride == 4) { /* the common case of a large mesh, read at once */
+        const unsigned char *at = p->idx.data + 12 * j;
+        for (size_t i = 0; i < count; i++, at += 12) {
+            uint32_t tri[3];
+            memcpy(tri, at, sizeof tri);
+            for (int k = 0; k < 3; k++)
+                out[i][k] = base + tri[k];
+        }
+        return;
+    }
+    for (size_t i = 0; i < count; i++, j++) {
+        const size_t at[3] = { p->mode == 4 ? 3 * j : p->mode == 6 ? 0 : j,
+                               p->mode == 4 ? 3 * j + 1 : j + 1,
+                               p->mode == 4 ? 3 * j + 2 : j + 2 };
+        for (int k = 0; k < 3; k++)
+            out[i][k] = (uint32_t)part_vertex(p, at[k]);
+    }
+}
+
+static void mesh_positions(const void *user, size_t first, size_t count, double (*out)[3])
+{
+    const SurfacePart *p = part_of(user, first, 0);
+    for (size_t i = 0; i < count; p++) {
+        const size_t v = first + i - p->first_vertex;
+        const size_t run = p->pos.count - v < count - i ? p->pos.count - v : count - i;
+        if (p->pos.component_type == GLTF_FLOAT) /* the common case, its type asked once */
+            for (size_t k = 0; k < run; k++)
+                float_position(p->pos.data + (v + k) * p->pos.stride, out[i + k]);
+        else
+            for (size_t k = 0; k < run; k++)
+                part_position(p, v + k, out[i + k]);
+        i += run;
+    }
+}
+
+static void mesh_gather(const void *user, const uint32_t *vertices, size_t count,
+                        double (*out)[3])
+{
+    const SurfacePart *p = part_of(user, vertices[0], 0);
+    for (size_t i = 0; i < count; i++) {
+        if (vertices[i] < p->first_vertex || vertices[i] - p->first_vertex >= p->pos.count)
+            p = part_of(user, vertices[i], 0);
+        part_position(p, vertices[i] - p->first_vertex, out[i]);
+    }
+}
+
+static void mesh_triangles(const void *user, size_t first, size_t count, uint32_t (*out)[3])
+{
+    const SurfacePart *p = part_of(user, first, 1);
+    for (size_t i = 0; i < count; p++) {
+        const size_t j = first + i - p->first_triangle;
+        const size_t run = p->triangles - j < count - i ? p->triangles - j : count - i;
+        part_triangles(p, j, run, out + i);
+        i += run;
+    }
 }
 
 /* The step of a position accessor's storage (mesh_spheres.h). */
@@ -392,6 +452,47 @@ static double position_quantum(const GltfAccessor *a)
     if (a->component_type == GLTF_FLOAT)
         return 0.0;
     return a->normalized ? gltf_component_value(a->component_type, 1, 1.0) : 1.0;
+}
+
+/* Keeps in *failed the least slot that fails: the one a serial import
+ * reports, whichever thread meets it first. */
+static void note_failure(atomic_size_t *failed, size_t slot)
+{
+    size_t seen = atomic_load(failed);
+    while (slot < seen && !atomic_compare_exchange_weak(failed, &seen, slot))
+        ;
+}
+
+/* The indices of a primitive, checked on all cores for a large one: the
+ * first past the primitive's vertices. */
+typedef struct IndexCheck {
+    const GltfAccessor *indices;
+    size_t vertices;
+    atomic_size_t first_past; /* SIZE_MAX: none */
+} IndexCheck;
+
+enum { PARALLEL_INDICES = 1 << 18 };
+
+static void check_indices(void *arg, size_t from, size_t to)
+{
+    IndexCheck *c = arg;
+    const GltfAccessor *a = c->indices;
+    /* 32-bit indices, the common case of a large mesh: the largest of each
+     * chunk first, the chunk searched only if it is past the vertices. */
+    for (; a->component_type == GLTF_UNSIGNED_INT && a->stride == 4 && to - from >= 4096;
+         from += 4096) {
+        uint32_t chunk[4096], largest = 0;
+        memcpy(chunk, a->data + 4 * from, sizeof chunk);
+        for (size_t i = 0; i < 4096; i++)
+            largest = chunk[i] > largest ? chunk[i] : largest;
+        if (largest >= c->vertices)
+            break;
+    }
+    for (size_t i = from; i < to; i++)
+        if (index_at(a, i) >= c->vertices) {
+            note_failure(&c->first_past, i);
+            return;
+        }
 }
 
 /* Primitive p of mesh as a surface part, checked: its positions, its
@@ -413,7 +514,7 @@ static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t
     if (res != PTR_OK)
         return res;
     part->mode = prim->mode;
-    part->material = prim->material;
+    part->primitive = (int)p;
     part->has_idx = prim->indices >= 0;
     size_t n = vertices;
     if (part->has_idx) {
@@ -426,12 +527,16 @@ static PtrResult surface_part(Importer *im, const Origin *o, size_t mesh, size_t
                                  "%s: %s: mesh %zu primitive %zu has indices that are not "
                                  "unsigned integers in a buffer", im->path, where, mesh, p);
         n = a->count;
-        for (size_t i = 0; i < n; i++)
-            if (index_at(a, i) >= vertices)
-                return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                     "%s: %s: mesh %zu primitive %zu has index %zu past its "
-                                     "%zu vertices", im->path, where, mesh, p, index_at(a, i),
-                                     vertices);
+        IndexCheck check = { .indices = a, .vertices = vertices };
+        atomic_init(&check.first_past, SIZE_MAX);
+        ptr_parallel_ranges(n >= PARALLEL_INDICES ? ptr_online_cpus() : 1, 0, n, check_indices,
+                            &check);
+        const size_t past = atomic_load(&check.first_past);
+        if (past != SIZE_MAX)
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: %s: mesh %zu primitive %zu has index %zu past its "
+                                 "%zu vertices", im->path, where, mesh, p, index_at(a, past),
+                                 vertices);
     }
     part->triangles = prim->mode == 4 ? n / 3 : (prim->mode == 5 || prim->mode == 6) && n >= 3
                                                     ? n - 2 : 0;
@@ -456,7 +561,14 @@ static PtrResult bounds_sphere(Importer *im, const Origin *o, size_t mesh_index,
         extent = fmax(extent, mesh->max[k] - mesh->min[k]);
     }
     out->spheres[3] = 0.5 * extent;
-    out->materials[0] = mesh->material;
+    for (size_t p = 0; p < mesh->primitive_count; p++) { /* the first surface primitive's */
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, mesh_index, p, &prim);
+        if (!prim.points) {
+            out->primitives[0] = (int)p;
+            break;
+        }
+    }
     out->count = 1;
     return PTR_OK;
 }
@@ -496,8 +608,8 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
     PtrMeshSphere *found = NULL;
     size_t components = 0;
     const PtrMeshSource source = {
-        .vertex_count = vertices, .triangle_count = triangles, .position = mesh_position,
-        .triangle = mesh_triangle, .user = &s,
+        .vertex_count = vertices, .triangle_count = triangles, .positions = mesh_positions,
+        .gather = mesh_gather, .triangles = mesh_triangles, .user = &s,
     };
     PtrMeshSource quantised = source;
     for (size_t p = 0; p < s.count; p++)
@@ -506,8 +618,8 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
         res = ptr_mesh_spheres(&quantised, im->path, &found, &components, im->err);
     if (res == PTR_OK) {
         out->spheres = malloc((components ? components : 1) * 4 * sizeof *out->spheres);
-        out->materials = malloc((components ? components : 1) * sizeof *out->materials);
-        if (!out->spheres || !out->materials)
+        out->primitives = malloc((components ? components : 1) * sizeof *out->primitives);
+        if (!out->spheres || !out->primitives)
             res = ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     }
     out->skipped = lines;
@@ -518,11 +630,64 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
         }
         memcpy(&out->spheres[4 * out->count], found[c].centre, sizeof found[c].centre);
         out->spheres[4 * out->count + 3] = found[c].radius;
-        out->materials[out->count++] = part_of(&s, found[c].first_triangle, 1)->material;
+        out->primitives[out->count++] = part_of(&s, found[c].first_triangle, 1)->primitive;
     }
     free(found);
     free(s.parts);
     return res;
+}
+
+/* Whether meshes a and b have the same surface: the same primitives other
+ * than POINTS (accessors and mode), in the same places. */
+static int same_surface(const GltfDoc *doc, size_t a, size_t b)
+{
+    GltfMesh ma, mb;
+    gltf_doc_mesh(doc, a, &ma);
+    gltf_doc_mesh(doc, b, &mb);
+    for (size_t p = 0; p < ma.primitive_count && ma.primitive_count == mb.primitive_count; p++) {
+        GltfPrimitive pa, pb;
+        gltf_doc_primitive(doc, a, p, &pa);
+        gltf_doc_primitive(doc, b, p, &pb);
+        if (pa.points != pb.points ||
+            (!pa.points && (pa.position != pb.position || pa.indices != pb.indices ||
+                            pa.mode != pb.mode || pa.draco != pb.draco)))
+            return 0;
+    }
+    return ma.primitive_count == mb.primitive_count;
+}
+
+/* A hash of what same_surface compares. */
+static uint64_t surface_key(const GltfDoc *doc, size_t mesh_index)
+{
+    GltfMesh mesh;
+    gltf_doc_mesh(doc, mesh_index, &mesh);
+    uint64_t h = 0xcbf29ce484222325u; /* FNV-1a over the numbers */
+    for (size_t p = 0; p < mesh.primitive_count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(doc, mesh_index, p, &prim);
+        const int64_t part[5] = { prim.points, prim.points ? 0 : prim.position,
+                                  prim.points ? 0 : prim.indices, prim.points ? 0 : prim.mode,
+                                  prim.points ? 0 : prim.draco };
+        for (int k = 0; k < 5; k++)
+            h = (h ^ (uint64_t)part[k]) * 0x100000001b3u;
+    }
+    return h;
+}
+
+/* The earlier mesh of the same surface as mesh_index, if one was found,
+ * else mesh_index, entered in the table. */
+static size_t surface_owner(Importer *im, size_t mesh_index)
+{
+    const size_t mask = im->surface_slots - 1;
+    for (size_t slot = surface_key(im->doc, mesh_index) & mask;; slot = (slot + 1) & mask) {
+        const size_t other = im->surface_table[slot];
+        if (other == SIZE_MAX) {
+            im->surface_table[slot] = mesh_index;
+            return mesh_index;
+        }
+        if (same_surface(im->doc, other, mesh_index))
+            return other;
+    }
 }
 
 /* The spheres of mesh_index's surface, found at the first node using it
@@ -531,8 +696,10 @@ static PtrResult surface_spheres(Importer *im, const Origin *o, size_t mesh_inde
                                  const SurfaceSpheres **out)
 {
     SurfaceSpheres *s = &im->surfaces[mesh_index];
-    *out = s;
-    if (s->found)
+    if (!s->same)
+        s->same = &im->surfaces[surface_owner(im, mesh_index)];
+    *out = s->same;
+    if (s->same != s || s->found)
         return PTR_OK;
     s->found = 1;
     GltfMesh mesh;
@@ -551,8 +718,8 @@ static PtrResult surface_spheres(Importer *im, const Origin *o, size_t mesh_inde
     if (!unread)
         return find_surface(im, o, mesh_index, &mesh, s);
     s->spheres = malloc(4 * sizeof *s->spheres);
-    s->materials = malloc(sizeof *s->materials);
-    if (!s->spheres || !s->materials)
+    s->primitives = malloc(sizeof *s->primitives);
+    if (!s->spheres || !s->primitives)
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return bounds_sphere(im, o, mesh_index, &mesh, s);
 }
@@ -776,15 +943,6 @@ static Fault instance_spheres(const NodeRun *run, size_t i, const Instance *in, 
     return NO_FAULT;
 }
 
-/* Keeps in *failed the least slot that fails: the one a serial import
- * reports, whichever thread meets it first. */
-static void note_failure(atomic_size_t *failed, size_t slot)
-{
-    size_t seen = atomic_load(failed);
-    while (slot < seen && !atomic_compare_exchange_weak(failed, &seen, slot))
-        ;
-}
-
 /* Slots begin .. end - 1 of the run (see NodeRun). */
 static void convert_slots(void *arg, size_t begin, size_t end)
 {
@@ -962,9 +1120,20 @@ static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Ins
     PtrResult res = PTR_OK;
     if (run->surface_count && !node->has_radius && first->uneven)
         warn_nonuniform(im, o, warned);
+    int *materials = malloc((mesh->primitive_count ? mesh->primitive_count : 1) *
+                            sizeof *materials); /* each primitive's */
+    if (!materials)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    for (size_t p = 0; p < mesh->primitive_count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
+        materials[p] = prim.material;
+    }
     for (size_t k = 0; k < run->surface_count && res == PTR_OK; k++)
-        res = map_material(im, node->has_radius ? mesh->material : run->surface->materials[k],
+        res = map_material(im, node->has_radius ? mesh->material
+                                                : materials[run->surface->primitives[k]],
                            &run->surface_materials[k]);
+    free(materials);
     for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
         GltfPrimitive prim;
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
@@ -1354,15 +1523,19 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     size_t materials = gltf_doc_material_count(doc), meshes = gltf_doc_mesh_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     im.surfaces = calloc(meshes ? meshes : 1, sizeof *im.surfaces);
+    for (im.surface_slots = 16; im.surface_slots < 2 * meshes;)
+        im.surface_slots *= 2;
+    im.surface_table = malloc(im.surface_slots * sizeof *im.surface_table);
     PtrResult res = PTR_OK;
     GltfScene gs;
-    if (!im.material_index || !im.surfaces) {
+    if (!im.material_index || !im.surfaces || !im.surface_table) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     } else if (!gltf_doc_scene(doc, &gs)) {
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file has no scene", path);
     } else {
         for (size_t i = 0; i < materials; i++)
             im.material_index[i] = UINT32_MAX;
+        memset(im.surface_table, 0xff, im.surface_slots * sizeof *im.surface_table);
         res = read_scene_extras(&im, &gs);
         uint64_t spheres = 0;
         if (res == PTR_OK)
@@ -1400,9 +1573,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     free(im.material_index);
     for (size_t m = 0; im.surfaces && m < meshes; m++) {
         free(im.surfaces[m].spheres);
-        free(im.surfaces[m].materials);
+        free(im.surfaces[m].primitives);
     }
     free(im.surfaces);
+    free(im.surface_table);
     if (res == PTR_OK)
         res = ptr_import_finish(&im.builder, path, err);
     ptr_builder_free(&im.builder);

@@ -431,16 +431,25 @@ typedef struct PartMesh {
     const uint32_t *tris;
 } PartMesh;
 
-static void part_position(const void *user, size_t k, double out[3])
+static void part_positions(const void *user, size_t first, size_t count, double (*out)[3])
 {
     const PartMesh *m = user;
-    memcpy(out, &m->v[3 * (size_t)m->global[k]], 3 * sizeof *out);
+    for (size_t i = 0; i < count; i++)
+        memcpy(out[i], &m->v[3 * (size_t)m->global[first + i]], sizeof out[i]);
 }
 
-static void part_triangle(const void *user, size_t t, uint32_t out[3])
+static void part_gather(const void *user, const uint32_t *vertices, size_t count,
+                        double (*out)[3])
 {
     const PartMesh *m = user;
-    memcpy(out, &m->tris[3 * t], 3 * sizeof *out);
+    for (size_t i = 0; i < count; i++)
+        memcpy(out[i], &m->v[3 * (size_t)m->global[vertices[i]]], sizeof out[i]);
+}
+
+static void part_triangles(const void *user, size_t first, size_t count, uint32_t (*out)[3])
+{
+    const PartMesh *m = user;
+    memcpy(out, &m->tris[3 * first], count * sizeof *out);
 }
 
 /* The spheres of part p (docs/scenes.md): its components, checked; local_of
@@ -468,7 +477,8 @@ static PtrResult part_spheres(Reader *r, const Part *p, uint32_t *local_of,
         local_of[global[k]] = UINT32_MAX;
     const PartMesh mesh = { r->v, global, tris };
     const PtrMeshSource source = { .vertex_count = n, .triangle_count = p->ntris,
-                                   .position = part_position, .triangle = part_triangle,
+                                   .positions = part_positions, .gather = part_gather,
+                                   .triangles = part_triangles,
                                    .user = &mesh };
     if (res == PTR_OK)
         res = ptr_mesh_spheres(&source, r->path, &spheres, &count, r->err);

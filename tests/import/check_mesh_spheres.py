@@ -7,6 +7,8 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - joined: spheres in one primitive (welded, one turned so its bounds are not
   its sphere's), and two more in a second primitive of another material;
 - unwelded: every triangle its own vertices (components by position);
+- many: 300 unwelded spheres and two cubes over two primitives, one sphere
+  split across them, enough for the components to be found on all cores;
 - quantised: normalised 16-bit and plain 8-bit positions, scaled back by the
   node, within the tolerance;
 - cube, torus, plane, cylinder, each alone: no sphere, the warning;
@@ -103,6 +105,27 @@ def main():
         path = os.path.join(folder, "unwelded.glb")
         w.write(path)
         expect(path, [((1, 2, 3), 1.5, 0), ((6, 2, 3), 0.5, 0)], 0)
+
+        # Many: enough vertices and triangles that the components are found
+        # on all cores; unwelded, over two primitives, with a cube among the
+        # spheres of each and a sphere split across them (joined by position,
+        # of the material of its first triangle's primitive).
+        many = [((3 * (i % 20), 3 * (i // 20), 0), 0.5 + 0.001 * i) for i in range(300)]
+        split = mf.uv_sphere((0, -5, 0), 1)
+        half = len(split[1]) // 2
+        parts = []
+        for spheres, piece, at in ((many[:150], split[1][:half], 151),
+                                   (many[150:], split[1][half:], 0)):
+            shapes = [mf.uv_sphere(c, r) for c, r in spheres]
+            shapes.insert(75, mf.cube((at, 100, 0), 1))
+            shapes.insert(at, (split[0], piece))
+            parts.append(mf.unweld(mf.combine(*shapes)))
+        w = mf.Writer()
+        w.node("Many", w.mesh("ManyMesh", [(parts[0], 1), (parts[1], 2)]))
+        path = os.path.join(folder, "many.glb")
+        w.write(path)
+        expect(path, [(c, r, 1) for c, r in many[:150]] + [((0, -5, 0), 1, 1)] +
+               [(c, r, 2) for c, r in many[150:]], 2, ["node 'Many' (mesh 'ManyMesh')"])
 
         # Quantised: 16-bit normalised over [0, 1], and 8-bit integers; the
         # node's scale and translation map them back to (10, 0, 0) radius 2.
