@@ -95,7 +95,15 @@ PtrResult ptr_image_read(PtrImageLoader *loader, const char *path, PtrImage **ou
         return ptr_exr_read(path, out, err);
     const PtrImageModule *m;
     PtrResult loaded = ptr_oiio_module(loader, path, &m, err);
-    return loaded == PTR_OK ? m->read(path, out, err) : loaded;
+    return loaded == PTR_OK ? m->read(path, NULL, 0, out, err) : loaded;
+}
+
+PtrResult ptr_image_decode(PtrImageLoader *loader, const char *name, const unsigned char *bytes,
+                           size_t size, PtrImage **out, PtrError *err)
+{
+    const PtrImageModule *m;
+    PtrResult loaded = ptr_oiio_module(loader, name, &m, err);
+    return loaded == PTR_OK ? m->read(name, bytes, size, out, err) : loaded;
 }
 
 void ptr_image_free(PtrImage *image)

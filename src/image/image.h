@@ -119,6 +119,11 @@ typedef struct PtrImage PtrImage;
  * says. */
 PtrResult ptr_image_read(PtrImageLoader *loader, const char *path, PtrImage **out,
                          PtrError *err);
+/* An image file's size bytes, held in memory (a texture a glTF embeds),
+ * decoded through the module in the format name's extension gives (PNG,
+ * JPEG, WebP, ...), into *out; errors as ptr_image_read's, naming name. */
+PtrResult ptr_image_decode(PtrImageLoader *loader, const char *name, const unsigned char *bytes,
+                           size_t size, PtrImage **out, PtrError *err);
 void ptr_image_free(PtrImage *image);
 int ptr_image_width(const PtrImage *image);
 int ptr_image_height(const PtrImage *image);

@@ -108,7 +108,10 @@ typedef struct PtrImageModule {
     PtrResult (*write)(const char *file, const char *name, const PtrImageLayout *layout,
                        const float *rgb, const float *alpha, PtrPixelFormat format,
                        const PtrImageAttr *attrs, size_t attr_count, PtrError *err);
-    PtrResult (*read)(const char *path, PtrImage **out, PtrError *err);
+    /* Reads the file path, or, where bytes is not NULL, the size bytes
+     * given, in the format path's extension names. */
+    PtrResult (*read)(const char *path, const unsigned char *bytes, size_t size, PtrImage **out,
+                      PtrError *err);
 } PtrImageModule;
 
 /* The loader's module into *out, loaded now if its thread has not (see

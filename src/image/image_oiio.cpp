@@ -4,8 +4,14 @@
 #include "base/version.h"
 #include "image/image_backend.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
@@ -78,16 +84,72 @@ PtrResult write_image(const char *file, const char *name, const PtrImageLayout *
     }
 }
 
-PtrResult read_image(const char *path, PtrImage **out, PtrError *err)
+// Standard error sent to /dev/null while it lives. libpng prints "libpng
+// error: ..." itself before it hands OpenImageIO the message (its default
+// handler runs after OpenImageIO's returns), and ptr says what failed in
+// one line of its own: so while a texture (bytes in memory) decodes, which
+// an import does before any render thread starts, stderr is quiet.
+class QuietStderr {
+public:
+    QuietStderr()
+    {
+        std::fflush(stderr);
+        saved_ = dup(STDERR_FILENO);
+        const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
+        if (null >= 0) {
+            dup2(null, STDERR_FILENO);
+            close(null);
+        }
+    }
+    ~QuietStderr()
+    {
+        if (saved_ < 0)
+            return;
+        std::fflush(stderr);
+        dup2(saved_, STDERR_FILENO);
+        close(saved_);
+    }
+    QuietStderr(const QuietStderr &) = delete;
+    QuietStderr &operator=(const QuietStderr &) = delete;
+
+private:
+    int saved_;
+};
+
+// The reader of path's format opened on the bytes memory holds, which must
+// outlive it, or null with *fault. ImageInput::open with a proxy looks for
+// the file itself first and fails without one: the reader is made, then
+// given the bytes.
+OIIO::ImageInput::unique_ptr open_memory(const char *path, OIIO::Filesystem::IOProxy *memory,
+                                         const OIIO::ImageSpec &config, std::string *fault)
+{
+    auto in = OIIO::ImageInput::create(path, false, &config, memory);
+    OIIO::ImageSpec spec;
+    if (!in)
+        *fault = OIIO::geterror();
+    else if (!in->set_ioproxy(memory) || !in->open(path, spec, config))
+        *fault = in->geterror();
+    else
+        return in;
+    return nullptr;
+}
+
+PtrResult read_image(const char *path, const unsigned char *bytes, size_t size, PtrImage **out,
+                     PtrError *err)
 {
     PtrImage *image = nullptr;
     try {
         // Colour as stored, not premultiplied by alpha on the way in.
         OIIO::ImageSpec config;
         config.attribute("oiio:UnassociatedAlpha", 1);
-        auto in = OIIO::ImageInput::open(path, &config);
+        OIIO::Filesystem::IOMemReader memory(bytes, bytes ? size : 0);
+        std::unique_ptr<QuietStderr> quiet(bytes ? new QuietStderr : nullptr);
+        std::string fault;
+        auto in = bytes ? open_memory(path, &memory, config, &fault)
+                        : OIIO::ImageInput::open(path, &config);
         if (!in)
-            return ptr_shim_error(err, PTR_ERR_USAGE, std::string(path) + ": " + OIIO::geterror());
+            return ptr_shim_error(err, PTR_ERR_USAGE,
+                                  std::string(path) + ": " + (bytes ? fault : OIIO::geterror()));
         const OIIO::ImageSpec &spec = in->spec();
         std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
         if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
