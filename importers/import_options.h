@@ -7,6 +7,7 @@
 
 #include <stddef.h>
 
+#include "base/result.h"
 #include "scene/scene.h"
 #include "structure/structure_parts.h"
 
@@ -25,6 +26,24 @@ typedef struct PtrCameraSpec {
     double aperture;       /* lens diameter; 0: a pinhole */
     double focus_distance; /* 0: the distance from lookfrom to lookat */
 } PtrCameraSpec;
+
+/* A texture's texels as stored (8-bit values over 255: no transfer function
+ * undone): width x height RGBA floats, rows top to bottom. */
+typedef struct PtrTexels {
+    int width, height;
+    float *rgba; /* malloc'd: the importer frees it */
+} PtrTexels;
+
+/* Decodes an image file held in memory, size bytes (a texture a glTF
+ * embeds or names), in the format name's extension gives (PNG, JPEG, WebP),
+ * into *out. name is also what messages give. Importers stand below the
+ * image layer: whoever runs the import, which owns the image module's
+ * loader, hands them this (the app's reads through src/image). */
+typedef struct PtrTextureDecoder {
+    PtrResult (*decode)(void *context, const char *name, const unsigned char *bytes, size_t size,
+                        PtrTexels *out, PtrError *err);
+    void *context;
+} PtrTextureDecoder;
 
 typedef struct PtrImportOptions {
     const char *camera_name; /* glTF: use the camera (node or camera name); NULL: the first */
@@ -57,6 +76,9 @@ typedef struct PtrImportOptions {
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;
+    /* glTF: reads the textures that colour spheres; decode NULL: they are
+     * not read (a warning names the first material that has one). */
+    PtrTextureDecoder textures;
 } PtrImportOptions;
 
 #endif /* PTR_IMPORT_OPTIONS_H */

@@ -280,6 +280,8 @@ typedef struct Passes {
     atomic_size_t *first;   /* a component's first triangle */
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
     atomic_uchar *off;      /* whether a component lies off its sphere */
+    uint32_t *order;        /* a component's place among the sorted spheres */
+    uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
 } Passes;
 
 enum { USED = UNSET - 1 };
@@ -528,6 +530,32 @@ static void check_triangles(void *arg, size_t from, size_t to)
     }
 }
 
+/* Each vertex's place among the sorted spheres, from its component. */
+static void label_vertices(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++) {
+        const uint32_t c = link_of(ps->parent, (uint32_t)v);
+        ps->vertex_spheres[v] = c == UNSET ? UNSET : ps->order[c];
+    }
+}
+
+/* ps->vertex_spheres filled, once the spheres are sorted: a sphere's first
+ * triangle's corner gives the component it was numbered as. */
+static int sort_labels(Passes *ps, size_t components)
+{
+    ps->order = malloc((components ? components : 1) * sizeof *ps->order);
+    if (!ps->order)
+        return 0;
+    for (size_t i = 0; i < components; i++) {
+        uint32_t tri[1][3];
+        ps->mesh->triangles(ps->mesh->user, ps->spheres[i].first_triangle, 1, tri);
+        ps->order[link_of(ps->parent, tri[0][0])] = (uint32_t)i;
+    }
+    ptr_parallel_ranges(threads_for(ps->mesh), 0, ps->mesh->vertex_count, label_vertices, ps);
+    return 1;
+}
+
 static int by_first_triangle(const void *a, const void *b)
 {
     const size_t x = ((const PtrMeshSphere *)a)->first_triangle;
@@ -574,20 +602,21 @@ static int fit_components(Passes *ps, size_t *count)
     if (!sorted)
         qsort(ps->spheres, components, sizeof *ps->spheres, by_first_triangle);
     *count = components;
-    return 1;
+    return !ps->vertex_spheres || sort_labels(ps, components);
 }
 
 PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
-                           size_t *count, PtrError *err)
+                           size_t *count, uint32_t **vertex_spheres, PtrError *err)
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
     const int threads = threads_for(mesh);
     /* One a vertex: the positions' keys, then the labels. */
     Keyed *scratch = malloc(n * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
-                  .label = (Link *)scratch };
+                  .label = (Link *)scratch,
+                  .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL };
     size_t components = 0;
-    int ok = ps.parent && scratch;
+    int ok = ps.parent && scratch && (!vertex_spheres || ps.vertex_spheres);
     if (ok)
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
     ok = ok && unite_positions(mesh, ps.parent, scratch);
@@ -601,10 +630,14 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
     free(ps.first);
     free(ps.bounds);
     free(ps.off);
+    free(ps.order);
     if (!ok) {
         free(ps.spheres);
+        free(ps.vertex_spheres);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     }
+    if (vertex_spheres)
+        *vertex_spheres = ps.vertex_spheres;
     *out = ps.spheres;
     *count = components;
     return PTR_OK;

@@ -46,8 +46,11 @@ typedef struct PtrMeshSphere {
 /* The mesh's components (triangles sharing a vertex, by index or by equal
  * position), in the order of their first triangles, into *out (malloc'd,
  * the caller frees it) and *count. Vertices no triangle uses are ignored.
- * Fails only for memory (PTR_ERR_NOMEM, naming path). */
+ * Where vertex_spheres is not NULL, *vertex_spheres receives each vertex's
+ * component, as its index in *out (UINT32_MAX for a vertex no triangle
+ * uses), malloc'd too: what a reader of per-vertex colours needs. Fails
+ * only for memory (PTR_ERR_NOMEM, naming path). */
 PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
-                           size_t *count, PtrError *err);
+                           size_t *count, uint32_t **vertex_spheres, PtrError *err);
 
 #endif /* PTR_MESH_SPHERES_H */

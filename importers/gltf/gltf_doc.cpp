@@ -100,14 +100,20 @@ struct GltfDoc {
     int scene = -1;
     std::vector<std::string> files;
     std::map<int, std::vector<unsigned char>> decoded; /* buffer views, decompressed */
+    std::map<int, std::vector<unsigned char>> image_files; /* images by URI, as read */
+    std::vector<std::string> image_names; /* each image's, see GltfTexture */
 };
 
 namespace {
 
-// ptr never looks at textures: skip decoding every embedded image.
-bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
-                const unsigned char *, int, void *)
+// Images are decoded by the importer, only those a sphere reads: here the
+// bytes of those a URI names (a file, or data: text) are kept as read.
+bool keep_image(tinygltf::Image *image, const int index, std::string *, std::string *, int, int,
+                const unsigned char *bytes, int size, void *user)
 {
+    if (image->bufferView < 0) /* those in a buffer view are read there */
+        (*static_cast<std::map<int, std::vector<unsigned char>> *>(user))[index]
+            .assign(bytes, bytes + size);
     return true;
 }
 
@@ -134,6 +140,20 @@ bool read_regular_file(std::vector<unsigned char> *out, std::string *error,
 }
 
 bool in_range(int index, size_t count) { return index >= 0 && size_t(index) < count; }
+
+// The extension of image's format, for the image module: by its MIME type
+// (a buffer view's, or a data: URI's), else its file's; PNG without either.
+std::string image_extension(const tinygltf::Image &image)
+{
+    const std::string &uri = image.uri;
+    if (image.mimeType.compare(0, 6, "image/") == 0)
+        return image.mimeType.substr(6);
+    if (uri.compare(0, 11, "data:image/") == 0)
+        return uri.substr(11, uri.find(';') - 11);
+    const size_t dot = uri.rfind('.');
+    return dot == std::string::npos || uri.compare(0, 5, "data:") == 0 ? "png"
+                                                                       : uri.substr(dot + 1);
+}
 
 const char *const instancing_extension = "EXT_mesh_gpu_instancing";
 
@@ -524,6 +544,32 @@ bool extension_number(const tinygltf::ExtensionMap &extensions, const char *exte
     return it != extensions.end() && number_member(it->second, key, out);
 }
 
+// object[key] as two numbers into out, if it is an array of two numbers.
+void pair_member(const tinygltf::Value &object, const char *key, double out[2])
+{
+    const tinygltf::Value *v = object_member(object, key);
+    if (v && v->IsArray() && v->ArrayLen() == 2 && v->Get(0).IsNumber() && v->Get(1).IsNumber())
+        for (int k = 0; k < 2; k++)
+            out[k] = v->Get(k).GetNumberAsDouble();
+}
+
+// A textureInfo's texture and TEXCOORD_n, with its KHR_texture_transform.
+void texture_ref(int index, int texcoord, const tinygltf::ExtensionMap &extensions,
+                 GltfTextureRef *out)
+{
+    *out = GltfTextureRef{ index, texcoord, { 0, 0 }, 0, { 1, 1 } };
+    auto it = extensions.find("KHR_texture_transform");
+    if (it == extensions.end())
+        return;
+    const tinygltf::Value &t = it->second;
+    double n;
+    if (number_member(t, "texCoord", &n) && n >= 0 && n < 16)
+        out->texcoord = int(n);
+    number_member(t, "rotation", &out->rotation);
+    pair_member(t, "offset", out->offset);
+    pair_member(t, "scale", out->scale);
+}
+
 template <size_t N>
 void copy_or(double (&dst)[N], const std::vector<double> &src, const double (&fallback)[N])
 {
@@ -536,7 +582,7 @@ void copy_or(double (&dst)[N], const std::vector<double> &src, const double (&fa
 extern "C" const char *const ptr_gltf_extensions[] = {
     "EXT_mesh_gpu_instancing", "EXT_meshopt_compression", "KHR_draco_mesh_compression",
     "KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_transmission",
-    "KHR_mesh_quantization", nullptr,
+    "KHR_mesh_quantization", "KHR_texture_transform", nullptr,
 };
 
 extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
@@ -555,7 +601,7 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         const size_t slash = scene_path.rfind('/');
         const std::string dir = slash == std::string::npos ? "" : scene_path.substr(0, slash + 1);
         tinygltf::TinyGLTF loader;
-        loader.SetImageLoader(skip_image, nullptr);
+        loader.SetImageLoader(keep_image, &doc->image_files);
         loader.SetFsCallbacks({ regular_file_exists, tinygltf::ExpandFilePath, read_regular_file,
                                 tinygltf::WriteWholeFile, nullptr });
         std::string error;
@@ -625,6 +671,9 @@ extern "C" GltfDoc *gltf_doc_load(const char *path, PtrError *err)
         }
         const tinygltf::Model &m = doc->model;
         doc->scene = m.defaultScene != -1 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
+        for (size_t i = 0; i < m.images.size(); i++) /* "FILE image 3.png" */
+            doc->image_names.push_back(std::string(path) + " image " + std::to_string(i) + "." +
+                                       image_extension(m.images[i]));
         for (size_t b = 0; b < m.buffers.size(); b++) {
             const std::string &uri = b < external.uri.size() && !external.uri[b].empty()
                                          ? external.uri[b] : m.buffers[b].uri;
@@ -645,6 +694,7 @@ extern "C" const char *gltf_doc_file(const GltfDoc *d, size_t i) { return d->fil
 extern "C" size_t gltf_doc_node_count(const GltfDoc *d) { return d->model.nodes.size(); }
 extern "C" size_t gltf_doc_mesh_count(const GltfDoc *d) { return d->model.meshes.size(); }
 extern "C" size_t gltf_doc_material_count(const GltfDoc *d) { return d->model.materials.size(); }
+extern "C" size_t gltf_doc_texture_count(const GltfDoc *d) { return d->model.textures.size(); }
 
 extern "C" void gltf_doc_node(const GltfDoc *doc, size_t index, GltfNode *out)
 {
@@ -835,10 +885,53 @@ extern "C" void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial
                      &out->transmission);
     out->ior = 1.5;
     extension_number(m.extensions, "KHR_materials_ior", "ior", &out->ior);
-    out->has_texture = pbr.baseColorTexture.index >= 0 ||
-                       pbr.metallicRoughnessTexture.index >= 0 ||
-                       m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0 ||
-                       m.emissiveTexture.index >= 0;
+    texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                pbr.baseColorTexture.extensions, &out->base_texture);
+    texture_ref(m.emissiveTexture.index, m.emissiveTexture.texCoord, m.emissiveTexture.extensions,
+                &out->emissive_texture);
+    texture_ref(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                pbr.metallicRoughnessTexture.extensions, &out->metal_rough_texture);
+}
+
+extern "C" void gltf_doc_texture(const GltfDoc *doc, int index, GltfTexture *out)
+{
+    const tinygltf::Model &m = doc->model;
+    *out = GltfTexture{};
+    out->wrap_s = out->wrap_t = GLTF_REPEAT;
+    if (!in_range(index, m.textures.size())) {
+        out->fault = "does not exist";
+        return;
+    }
+    const tinygltf::Texture &t = m.textures[size_t(index)];
+    if (in_range(t.sampler, m.samplers.size())) {
+        out->wrap_s = m.samplers[size_t(t.sampler)].wrapS;
+        out->wrap_t = m.samplers[size_t(t.sampler)].wrapT;
+    }
+    if (t.source < 0 && t.extensions.count("KHR_texture_basisu")) {
+        out->fault = "is KTX2 (KHR_texture_basisu), which ptr does not read";
+        return;
+    }
+    if (!in_range(t.source, m.images.size())) {
+        out->fault = "refers to an image that does not exist";
+        return;
+    }
+    const tinygltf::Image &image = m.images[size_t(t.source)];
+    out->name = doc->image_names[size_t(t.source)].c_str();
+    if (image.mimeType == "image/ktx2") {
+        out->fault = "is KTX2 (KHR_texture_basisu), which ptr does not read";
+        return;
+    }
+    auto file = doc->image_files.find(t.source);
+    if (file != doc->image_files.end()) {
+        out->bytes = file->second.data();
+        out->size = file->second.size();
+    } else if (in_range(image.bufferView, m.bufferViews.size())) {
+        const tinygltf::BufferView &v = m.bufferViews[size_t(image.bufferView)];
+        out->bytes = doc->buffers[size_t(v.buffer)].data + v.byteOffset; /* checked at load */
+        out->size = v.byteLength;
+    } else {
+        out->fault = "has an image with no bytes ptr can read";
+    }
 }
 
 extern "C" void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *out)

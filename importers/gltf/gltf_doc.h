@@ -93,6 +93,26 @@ typedef struct GltfMesh {
     size_t point_primitives; /* of them, POINTS (spheres of their own) */
 } GltfMesh;
 
+/* A material's reference to a texture (glTF's textureInfo), with its
+ * KHR_texture_transform: uv' = offset + R(rotation) * (scale * uv). */
+typedef struct GltfTextureRef {
+    int texture;  /* -1 if none; may be out of range (gltf_doc_texture says) */
+    int texcoord; /* n of TEXCOORD_n: the transform's texCoord where it gives one */
+    double offset[2], rotation, scale[2];
+} GltfTextureRef;
+
+/* glTF's sampler wrap modes. */
+enum { GLTF_CLAMP = 33071, GLTF_MIRRORED_REPEAT = 33648, GLTF_REPEAT = 10497 };
+
+/* A texture's image, as the file stores it. */
+typedef struct GltfTexture {
+    const unsigned char *bytes; /* NULL with fault set */
+    size_t size;
+    const char *name;  /* for the image module: ends in the format's extension */
+    int wrap_s, wrap_t;
+    const char *fault; /* why the image cannot be read, or NULL */
+} GltfTexture;
+
 typedef struct GltfMaterial {
     const char *name;
     double base_color[4];
@@ -101,7 +121,7 @@ typedef struct GltfMaterial {
     double emissive_strength;   /* KHR_materials_emissive_strength, default 1 */
     double transmission;        /* KHR_materials_transmission, default 0 */
     double ior;                 /* KHR_materials_ior, default 1.5 */
-    int has_texture;
+    GltfTextureRef base_texture, emissive_texture, metal_rough_texture;
 } GltfMaterial;
 
 typedef struct GltfCamera {
@@ -142,6 +162,7 @@ const char *gltf_doc_file(const GltfDoc *doc, size_t index);
 size_t gltf_doc_node_count(const GltfDoc *doc);
 size_t gltf_doc_mesh_count(const GltfDoc *doc);
 size_t gltf_doc_material_count(const GltfDoc *doc);
+size_t gltf_doc_texture_count(const GltfDoc *doc);
 
 /* Index arguments must be below the matching count; every index the
  * structures hold has been checked to be in range when the file loaded. */
@@ -151,6 +172,9 @@ void gltf_doc_material(const GltfDoc *doc, size_t index, GltfMaterial *material)
 void gltf_doc_camera(const GltfDoc *doc, size_t index, GltfCamera *camera);
 void gltf_doc_primitive(const GltfDoc *doc, size_t mesh, size_t index, GltfPrimitive *primitive);
 void gltf_doc_accessor(const GltfDoc *doc, size_t index, GltfAccessor *accessor);
+/* Texture index's image and sampler; out->fault says what is wrong with
+ * either (an index out of range, an image in no buffer, KTX2). */
+void gltf_doc_texture(const GltfDoc *doc, int index, GltfTexture *out);
 
 /* Gives back the memory of elements first .. end - 1 of an accessor, which
  * the importer has read and will not read again soon: where they lie in a

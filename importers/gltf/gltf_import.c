@@ -10,6 +10,7 @@
 #include "base/threads.h"
 #include "builder.h"
 #include "gltf_doc.h"
+#include "gltf_textures.h"
 #include "importer_internal.h"
 #include "mesh_spheres.h"
 
@@ -101,6 +102,8 @@ typedef struct SurfaceSpheres {
     size_t count;
     double *spheres;  /* 4 a sphere: the centre and radius in the mesh's frame */
     int *primitives;  /* each one's primitive in its mesh (which gives its material) */
+    uint32_t *materials; /* each one's scene material, where textures or vertex
+                          * colours give it one of its own; else NULL */
     size_t skipped;   /* the parts that are not spheres */
 } SurfaceSpheres;
 
@@ -118,6 +121,11 @@ typedef struct Importer {
     uint32_t *material_index; /* glTF material -> scene material, UINT32_MAX unset */
     uint32_t default_material;
     int warned_texture;
+    GltfTextures *textures;   /* NULL where the import reads none */
+    uint32_t *made;           /* the materials textures gave, by value
+                               * (made_slots, a power of two), UINT32_MAX: none */
+    size_t made_slots, made_count;
+    size_t varying;           /* spheres a texture or COLOR_0 varies over */
     const char *value_name; /* the attribute --color-by asks for, or NULL */
     SurfaceSpheres *surfaces; /* one a mesh */
     size_t *surface_table;    /* meshes by their surface (surface_key), SIZE_MAX: none */
@@ -132,6 +140,59 @@ static const char *label(const char *name, const char *fallback)
     return name && *name ? name : fallback;
 }
 
+/* Whether a material takes a value from a texture. */
+static int has_color_texture(const GltfMaterial *g)
+{
+    return g->base_texture.texture >= 0 || g->emissive_texture.texture >= 0 ||
+           g->metal_rough_texture.texture >= 0;
+}
+
+/* What a sphere reads of its material where textures and vertex colours
+ * may change it: the factors times their means (docs/scenes.md). */
+typedef struct MaterialValues {
+    double base[3], emission[3], metallic, roughness;
+} MaterialValues;
+
+static MaterialValues factor_values(const GltfMaterial *g)
+{
+    MaterialValues v = { .metallic = g->metallic, .roughness = g->roughness };
+    for (int k = 0; k < 3; k++) {
+        v.base[k] = g->base_color[k];
+        v.emission[k] = g->emissive[k] * g->emissive_strength;
+    }
+    return v;
+}
+
+/* glTF material gltf_index (its values v) as ptr's (docs/scenes.md). */
+static PtrResult convert_material(Importer *im, int gltf_index, const GltfMaterial *g,
+                                  const MaterialValues *v, PtrMaterial *m)
+{
+    if (!all_finite(g->base_color, 4) || !all_finite(v->base, 3) ||
+        !all_finite(v->emission, 3) || !isfinite(g->ior) || !isfinite(v->roughness) ||
+        !isfinite(v->metallic) || !isfinite(g->transmission) || !(g->ior > 0.0) ||
+        v->emission[0] < 0 || v->emission[1] < 0 || v->emission[2] < 0)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                             "%s: material %d ('%s') has a value out of range", im->path,
+                             gltf_index, label(g->name, "unnamed"));
+    *m = (PtrMaterial){ .kind = PTR_MATERIAL_DIFFUSE, .albedo = vec_from(v->base),
+                        .emission = vec_from(v->emission), .ior = 1.5f };
+    if (g->transmission > 0.0) {
+        m->kind = PTR_MATERIAL_DIELECTRIC;
+        m->ior = (float)g->ior;
+    } else if (v->metallic >= 0.5) {
+        m->kind = PTR_MATERIAL_METAL;
+        m->fuzz = (float)v->roughness;
+    }
+    return PTR_OK;
+}
+
+static PtrResult add_material(Importer *im, const PtrMaterial *m, uint32_t *out)
+{
+    if (ptr_scene_add_material(im->scene, m, out, NULL) != PTR_OK)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    return PTR_OK;
+}
+
 static PtrResult map_material(Importer *im, int gltf_index, uint32_t *out)
 {
     uint32_t *slot = gltf_index < 0 ? &im->default_material : &im->material_index[gltf_index];
@@ -143,34 +204,65 @@ static PtrResult map_material(Importer *im, int gltf_index, uint32_t *out)
     if (gltf_index >= 0) {
         GltfMaterial g;
         gltf_doc_material(im->doc, (size_t)gltf_index, &g);
-        if (g.has_texture && !im->warned_texture) {
+        if (has_color_texture(&g) && !im->warned_texture) {
             im->warned_texture = 1;
-            ptr_warn(im->warnings, "%s: textures are ignored (first seen on material '%s')",
-                     im->path, label(g.name, "unnamed"));
+            ptr_warn(im->warnings, "%s: textures are ignored without an image reader or "
+                     "vertices to read them at (first seen on material '%s')", im->path,
+                     label(g.name, "unnamed"));
         }
-        double emission[3] = { g.emissive[0] * g.emissive_strength,
-                               g.emissive[1] * g.emissive_strength,
-                               g.emissive[2] * g.emissive_strength };
-        if (!all_finite(g.base_color, 4) || !all_finite(emission, 3) || !isfinite(g.ior) ||
-            !isfinite(g.roughness) || !isfinite(g.metallic) || !isfinite(g.transmission) ||
-            !(g.ior > 0.0) || emission[0] < 0 || emission[1] < 0 || emission[2] < 0)
-            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
-                                 "%s: material %d ('%s') has a value out of range", im->path,
-                                 gltf_index, label(g.name, "unnamed"));
-        m.albedo = vec_from(g.base_color);
-        m.emission = vec_from(emission);
-        if (g.transmission > 0.0) {
-            m.kind = PTR_MATERIAL_DIELECTRIC;
-            m.ior = (float)g.ior;
-        } else if (g.metallic >= 0.5) {
-            m.kind = PTR_MATERIAL_METAL;
-            m.fuzz = (float)g.roughness;
-        }
+        const MaterialValues v = factor_values(&g);
+        PtrResult res = convert_material(im, gltf_index, &g, &v, &m);
+        if (res != PTR_OK)
+            return res;
     }
-    if (ptr_scene_add_material(im->scene, &m, slot, NULL) != PTR_OK)
-        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    PtrResult res = add_material(im, &m, slot);
     *out = *slot;
-    return PTR_OK;
+    return res;
+}
+
+/* FNV-1a over a material's bytes (floats and an enum: no padding). */
+static size_t material_hash(const PtrMaterial *m)
+{
+    const unsigned char *b = (const unsigned char *)m;
+    uint64_t h = 0xcbf29ce484222325u;
+    for (size_t i = 0; i < sizeof *m; i++)
+        h = (h ^ b[i]) * 0x100000001b3u;
+    return (size_t)h;
+}
+
+/* The scene material of value m, made once however many spheres have it:
+ * a million spheres of a palette of a hundred colours make a hundred. */
+static PtrResult made_material(Importer *im, const PtrMaterial *m, uint32_t *out)
+{
+    if (2 * (im->made_count + 1) > im->made_slots) { /* grown, the table made again */
+        const size_t slots = im->made_slots ? 2 * im->made_slots : 64;
+        uint32_t *table = malloc(slots * sizeof *table);
+        if (!table)
+            return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+        memset(table, 0xff, slots * sizeof *table);
+        for (size_t i = 0; i < im->made_slots; i++) {
+            if (im->made[i] == UINT32_MAX)
+                continue;
+            size_t at = material_hash(&im->scene->materials[im->made[i]]) & (slots - 1);
+            while (table[at] != UINT32_MAX)
+                at = (at + 1) & (slots - 1);
+            table[at] = im->made[i];
+        }
+        free(im->made);
+        im->made = table;
+        im->made_slots = slots;
+    }
+    const size_t mask = im->made_slots - 1;
+    size_t at = material_hash(m) & mask;
+    for (; im->made[at] != UINT32_MAX; at = (at + 1) & mask)
+        if (!memcmp(&im->scene->materials[im->made[at]], m, sizeof *m)) {
+            *out = im->made[at];
+            return PTR_OK;
+        }
+    PtrResult res = add_material(im, m, &im->made[at]);
+    im->made_count += res == PTR_OK;
+    *out = im->made[at];
+    return res;
 }
 
 /* What a sphere is made for, for messages: "node 3 ('Cloud')", with
@@ -573,6 +665,197 @@ static PtrResult bounds_sphere(Importer *im, const Origin *o, size_t mesh_index,
     return PTR_OK;
 }
 
+/* A primitive's material, or glTF's stand-in for none: ptr's default grey
+ * (docs/scenes.md). */
+static void primitive_material(const Importer *im, const GltfPrimitive *prim, GltfMaterial *g)
+{
+    if (prim->material >= 0) {
+        gltf_doc_material(im->doc, (size_t)prim->material, g);
+        return;
+    }
+    *g = (GltfMaterial){ .base_color = { 0.8, 0.8, 0.8, 1 }, .roughness = 1,
+                         .emissive_strength = 1, .ior = 1.5,
+                         .base_texture.texture = -1, .emissive_texture.texture = -1,
+                         .metal_rough_texture.texture = -1 };
+}
+
+/* Whether a primitive's spheres take their colours from its vertices: its
+ * material's textures (where the import reads them) or its COLOR_0. */
+static int colored_by_vertices(const Importer *im, const GltfPrimitive *prim)
+{
+    GltfMaterial g;
+    primitive_material(im, prim, &g);
+    return prim->color >= 0 || (im->textures && has_color_texture(&g));
+}
+
+/* What the vertices of one component read: each value's sum over them, the
+ * first vertex's values and whether another differs. */
+enum { VALUES = 8 }; /* base r g b, emission r g b, metallic, roughness */
+typedef struct ColorSum {
+    double sum[VALUES];
+    float first[VALUES];
+    size_t vertices;
+    int varies;
+} ColorSum;
+
+/* The texture references of a material, the TEXCOORD accessors they read
+ * (one a reference, checked) and the part's COLOR_0. */
+typedef struct VertexColors {
+    const GltfTextureRef *refs[3]; /* base, emissive, metallic-roughness; NULL: none */
+    GltfAccessor uv[3], color;
+    int has_color;
+} VertexColors;
+
+static PtrResult vertex_colors(Importer *im, const Origin *o, size_t mesh_index,
+                               const SurfacePart *part, const GltfPrimitive *prim,
+                               const GltfMaterial *g, VertexColors *vc)
+{
+    const GltfTextureRef *refs[3] = { &g->base_texture, &g->emissive_texture,
+                                      &g->metal_rough_texture };
+    PtrResult res = PTR_OK;
+    size_t count = part->pos.count;
+    for (int r = 0; r < 3 && res == PTR_OK; r++) {
+        vc->refs[r] = im->textures && refs[r]->texture >= 0 ? refs[r] : NULL;
+        if (!vc->refs[r])
+            continue;
+        char name[32];
+        snprintf(name, sizeof name, "TEXCOORD_%d", refs[r]->texcoord);
+        const int index = gltf_doc_primitive_attribute(im->doc, mesh_index,
+                                                       (size_t)part->primitive, name);
+        if (index < 0)
+            return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
+                                 "%s: mesh %zu primitive %d: its material's texture %d reads %s, "
+                                 "which the primitive does not have", im->path, mesh_index,
+                                 part->primitive, refs[r]->texture, name);
+        res = attribute_accessor(im, o, name, index, 2, 2, QUANTIZED, &count, &vc->uv[r]);
+    }
+    vc->has_color = prim->color >= 0;
+    if (res == PTR_OK && vc->has_color)
+        res = attribute_accessor(im, o, "COLOR_0", prim->color, 3, 4, FLOATS_OR_UNSIGNED, &count,
+                                 &vc->color);
+    return res;
+}
+
+/* Vertex v's values (see ColorSum): COLOR_0 times the linear base colour
+ * texel, the linear emissive texel, the metallic-roughness texel's B and G;
+ * 1 where there is none. */
+static PtrResult vertex_values(Importer *im, const VertexColors *vc, size_t v,
+                               float out[VALUES])
+{
+    for (int k = 0; k < VALUES; k++)
+        out[k] = 1.0f;
+    double e[4];
+    if (vc->has_color) {
+        element(&vc->color, v, e);
+        for (int k = 0; k < 3; k++)
+            out[k] = (float)e[k];
+    }
+    for (int r = 0; r < 3; r++) {
+        if (!vc->refs[r])
+            continue;
+        float texel[4];
+        element(&vc->uv[r], v, e);
+        PtrResult res = gltf_textures_sample(im->textures, vc->refs[r], e, texel, im->err);
+        if (res != PTR_OK)
+            return res;
+        if (r == 2) {
+            out[6] = texel[2];
+            out[7] = texel[1];
+        } else {
+            for (int k = 0; k < 3; k++)
+                out[3 * r + k] *= (float)gltf_srgb_to_linear(texel[k]);
+        }
+    }
+    return PTR_OK;
+}
+
+/* Adds the part's vertices to the sums of the components they belong to,
+ * those whose material is the part's (their first triangle in it). */
+static PtrResult add_part_colors(Importer *im, const Origin *o, size_t mesh_index,
+                                 const SurfaceParts *s, const SurfacePart *part,
+                                 const PtrMeshSphere *found, const uint32_t *labels,
+                                 ColorSum *sums)
+{
+    GltfPrimitive prim;
+    GltfMaterial g;
+    gltf_doc_primitive(im->doc, mesh_index, (size_t)part->primitive, &prim);
+    if (!colored_by_vertices(im, &prim))
+        return PTR_OK;
+    primitive_material(im, &prim, &g);
+    VertexColors vc;
+    PtrResult res = vertex_colors(im, o, mesh_index, part, &prim, &g, &vc);
+    for (size_t v = 0; v < part->pos.count && res == PTR_OK; v++) {
+        const uint32_t c = labels[part->first_vertex + v];
+        if (c == UINT32_MAX || !found[c].is_sphere ||
+            part_of(s, found[c].first_triangle, 1) != part)
+            continue;
+        float values[VALUES];
+        res = vertex_values(im, &vc, v, values);
+        ColorSum *sum = &sums[c];
+        for (int k = 0; k < VALUES && res == PTR_OK; k++) {
+            if (!sum->vertices)
+                sum->first[k] = values[k];
+            sum->varies |= fabsf(values[k] - sum->first[k]) > 1e-6f;
+            sum->sum[k] += values[k];
+        }
+        sum->vertices++;
+    }
+    return res;
+}
+
+/* Component c's material, from the sums over its vertices: the factors
+ * times the means (docs/scenes.md, "Textures"). */
+static PtrResult component_material(Importer *im, size_t mesh_index, const SurfaceParts *s,
+                                    const PtrMeshSphere *found, size_t c, const ColorSum *sum,
+                                    uint32_t *out)
+{
+    GltfPrimitive prim;
+    GltfMaterial g;
+    gltf_doc_primitive(im->doc, mesh_index,
+                       (size_t)part_of(s, found[c].first_triangle, 1)->primitive, &prim);
+    primitive_material(im, &prim, &g);
+    MaterialValues v = factor_values(&g);
+    const double n = (double)sum->vertices;
+    for (int k = 0; k < 3; k++) {
+        v.base[k] *= sum->sum[k] / n;
+        v.emission[k] *= sum->sum[3 + k] / n;
+    }
+    v.metallic *= sum->sum[6] / n;
+    v.roughness *= sum->sum[7] / n;
+    im->varying += sum->varies;
+    PtrMaterial m;
+    PtrResult res = convert_material(im, prim.material, &g, &v, &m);
+    return res == PTR_OK ? made_material(im, &m, out) : res;
+}
+
+/* Each sphere's own material (out->materials) where its vertices colour it:
+ * labels give each vertex's component among found. */
+static PtrResult surface_colors(Importer *im, const Origin *o, size_t mesh_index,
+                                const SurfaceParts *s, const PtrMeshSphere *found,
+                                size_t components, const uint32_t *labels, SurfaceSpheres *out)
+{
+    ColorSum *sums = calloc(components ? components : 1, sizeof *sums);
+    out->materials = malloc((out->count ? out->count : 1) * sizeof *out->materials);
+    if (!sums || !out->materials) {
+        free(sums);
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    }
+    PtrResult res = PTR_OK;
+    for (size_t p = 0; p < s->count && res == PTR_OK; p++)
+        res = add_part_colors(im, o, mesh_index, s, &s->parts[p], found, labels, sums);
+    for (size_t c = 0, k = 0; c < components && res == PTR_OK; c++) {
+        if (!found[c].is_sphere)
+            continue;
+        out->materials[k] = UINT32_MAX;
+        if (sums[c].vertices)
+            res = component_material(im, mesh_index, s, found, c, &sums[c],
+                                     &out->materials[k]);
+        k++;
+    }
+    free(sums);
+    return res;
+}
+
 /* The components of a mesh's surface primitives, as o first meets them. */
 static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
                               const GltfMesh *mesh, SurfaceSpheres *out)
@@ -606,7 +889,14 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
                             "%s: mesh %zu has more vertices than ptr reads (%zu)", im->path,
                             mesh_index, vertices);
     PtrMeshSphere *found = NULL;
+    uint32_t *labels = NULL;
     size_t components = 0;
+    int colored = 0;
+    for (size_t p = 0; p < s.count; p++) {
+        GltfPrimitive prim;
+        gltf_doc_primitive(im->doc, mesh_index, (size_t)s.parts[p].primitive, &prim);
+        colored |= colored_by_vertices(im, &prim);
+    }
     const PtrMeshSource source = {
         .vertex_count = vertices, .triangle_count = triangles, .positions = mesh_positions,
         .gather = mesh_gather, .triangles = mesh_triangles, .user = &s,
@@ -615,7 +905,8 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
     for (size_t p = 0; p < s.count; p++)
         quantised.quantum = fmax(quantised.quantum, position_quantum(&s.parts[p].pos));
     if (res == PTR_OK)
-        res = ptr_mesh_spheres(&quantised, im->path, &found, &components, im->err);
+        res = ptr_mesh_spheres(&quantised, im->path, &found, &components,
+                               colored ? &labels : NULL, im->err);
     if (res == PTR_OK) {
         out->spheres = malloc((components ? components : 1) * 4 * sizeof *out->spheres);
         out->primitives = malloc((components ? components : 1) * sizeof *out->primitives);
@@ -632,43 +923,66 @@ static PtrResult find_surface(Importer *im, const Origin *o, size_t mesh_index,
         out->spheres[4 * out->count + 3] = found[c].radius;
         out->primitives[out->count++] = part_of(&s, found[c].first_triangle, 1)->primitive;
     }
+    if (res == PTR_OK && colored)
+        res = surface_colors(im, o, mesh_index, &s, found, components, labels, out);
+    free(labels);
     free(found);
     free(s.parts);
     return res;
 }
 
+/* What the spheres of primitive p of a mesh depend on: whether it is POINTS,
+ * else its accessors and mode, and where its vertices colour the spheres,
+ * its material, COLOR_0 and first two TEXCOORDs. */
+enum { SURFACE_NUMBERS = 9 };
+static void surface_numbers(const Importer *im, size_t mesh_index, size_t p,
+                            int64_t out[SURFACE_NUMBERS])
+{
+    GltfPrimitive prim;
+    gltf_doc_primitive(im->doc, mesh_index, p, &prim);
+    memset(out, 0, SURFACE_NUMBERS * sizeof *out);
+    out[0] = prim.points;
+    if (prim.points)
+        return;
+    out[1] = prim.position;
+    out[2] = prim.indices;
+    out[3] = prim.mode;
+    out[4] = prim.draco;
+    if (!colored_by_vertices(im, &prim))
+        return;
+    out[5] = prim.material;
+    out[6] = prim.color;
+    out[7] = gltf_doc_primitive_attribute(im->doc, mesh_index, p, "TEXCOORD_0");
+    out[8] = gltf_doc_primitive_attribute(im->doc, mesh_index, p, "TEXCOORD_1");
+}
+
 /* Whether meshes a and b have the same surface: the same primitives other
- * than POINTS (accessors and mode), in the same places. */
-static int same_surface(const GltfDoc *doc, size_t a, size_t b)
+ * than POINTS (see surface_numbers), in the same places. */
+static int same_surface(const Importer *im, size_t a, size_t b)
 {
     GltfMesh ma, mb;
-    gltf_doc_mesh(doc, a, &ma);
-    gltf_doc_mesh(doc, b, &mb);
+    gltf_doc_mesh(im->doc, a, &ma);
+    gltf_doc_mesh(im->doc, b, &mb);
     for (size_t p = 0; p < ma.primitive_count && ma.primitive_count == mb.primitive_count; p++) {
-        GltfPrimitive pa, pb;
-        gltf_doc_primitive(doc, a, p, &pa);
-        gltf_doc_primitive(doc, b, p, &pb);
-        if (pa.points != pb.points ||
-            (!pa.points && (pa.position != pb.position || pa.indices != pb.indices ||
-                            pa.mode != pb.mode || pa.draco != pb.draco)))
+        int64_t na[SURFACE_NUMBERS], nb[SURFACE_NUMBERS];
+        surface_numbers(im, a, p, na);
+        surface_numbers(im, b, p, nb);
+        if (memcmp(na, nb, sizeof na))
             return 0;
     }
     return ma.primitive_count == mb.primitive_count;
 }
 
 /* A hash of what same_surface compares. */
-static uint64_t surface_key(const GltfDoc *doc, size_t mesh_index)
+static uint64_t surface_key(const Importer *im, size_t mesh_index)
 {
     GltfMesh mesh;
-    gltf_doc_mesh(doc, mesh_index, &mesh);
+    gltf_doc_mesh(im->doc, mesh_index, &mesh);
     uint64_t h = 0xcbf29ce484222325u; /* FNV-1a over the numbers */
     for (size_t p = 0; p < mesh.primitive_count; p++) {
-        GltfPrimitive prim;
-        gltf_doc_primitive(doc, mesh_index, p, &prim);
-        const int64_t part[5] = { prim.points, prim.points ? 0 : prim.position,
-                                  prim.points ? 0 : prim.indices, prim.points ? 0 : prim.mode,
-                                  prim.points ? 0 : prim.draco };
-        for (int k = 0; k < 5; k++)
+        int64_t part[SURFACE_NUMBERS];
+        surface_numbers(im, mesh_index, p, part);
+        for (int k = 0; k < SURFACE_NUMBERS; k++)
             h = (h ^ (uint64_t)part[k]) * 0x100000001b3u;
     }
     return h;
@@ -679,13 +993,13 @@ static uint64_t surface_key(const GltfDoc *doc, size_t mesh_index)
 static size_t surface_owner(Importer *im, size_t mesh_index)
 {
     const size_t mask = im->surface_slots - 1;
-    for (size_t slot = surface_key(im->doc, mesh_index) & mask;; slot = (slot + 1) & mask) {
+    for (size_t slot = surface_key(im, mesh_index) & mask;; slot = (slot + 1) & mask) {
         const size_t other = im->surface_table[slot];
         if (other == SIZE_MAX) {
             im->surface_table[slot] = mesh_index;
             return mesh_index;
         }
-        if (same_surface(im->doc, other, mesh_index))
+        if (same_surface(im, other, mesh_index))
             return other;
     }
 }
@@ -1129,10 +1443,15 @@ static PtrResult run_mesh(Importer *im, const Origin *o, NodeRun *run, const Ins
         gltf_doc_primitive(im->doc, (size_t)node->mesh, p, &prim);
         materials[p] = prim.material;
     }
-    for (size_t k = 0; k < run->surface_count && res == PTR_OK; k++)
-        res = map_material(im, node->has_radius ? mesh->material
-                                                : materials[run->surface->primitives[k]],
-                           &run->surface_materials[k]);
+    const uint32_t *own = node->has_radius ? NULL : run->surface->materials;
+    for (size_t k = 0; k < run->surface_count && res == PTR_OK; k++) {
+        if (own && own[k] != UINT32_MAX)
+            run->surface_materials[k] = own[k];
+        else
+            res = map_material(im, node->has_radius ? mesh->material
+                                                    : materials[run->surface->primitives[k]],
+                               &run->surface_materials[k]);
+    }
     free(materials);
     for (size_t p = 0; p < mesh->primitive_count && res == PTR_OK; p++) {
         GltfPrimitive prim;
@@ -1520,19 +1839,21 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         .value_name = options ? options->value_attribute : NULL,
     };
     ptr_builder_init(&im.builder, scene, options);
+    PtrResult res = options && options->textures.decode
+                        ? gltf_textures_new(doc, path, &options->textures, &im.textures, err)
+                        : PTR_OK;
     size_t materials = gltf_doc_material_count(doc), meshes = gltf_doc_mesh_count(doc);
     im.material_index = malloc((materials ? materials : 1) * sizeof *im.material_index);
     im.surfaces = calloc(meshes ? meshes : 1, sizeof *im.surfaces);
     for (im.surface_slots = 16; im.surface_slots < 2 * meshes;)
         im.surface_slots *= 2;
     im.surface_table = malloc(im.surface_slots * sizeof *im.surface_table);
-    PtrResult res = PTR_OK;
     GltfScene gs;
-    if (!im.material_index || !im.surfaces || !im.surface_table) {
+    if (res == PTR_OK && (!im.material_index || !im.surfaces || !im.surface_table)) {
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
-    } else if (!gltf_doc_scene(doc, &gs)) {
+    } else if (res == PTR_OK && !gltf_doc_scene(doc, &gs)) {
         res = ptr_error_set(err, PTR_ERR_SCENE_INVALID, "%s: the file has no scene", path);
-    } else {
+    } else if (res == PTR_OK) {
         for (size_t i = 0; i < materials; i++)
             im.material_index[i] = UINT32_MAX;
         memset(im.surface_table, 0xff, im.surface_slots * sizeof *im.surface_table);
@@ -1566,6 +1887,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
                  "\"Spheres\"): %s%s", path, im.skipped, im.skipped == 1 ? "" : "s",
                  im.skipped == 1 ? "it is" : "they are", im.skipped_names,
                  im.skipped_more ? ", ..." : "");
+    if (res == PTR_OK && im.varying)
+        ptr_warn(warnings, "%s: %zu sphere%s textures or vertex colours that vary over %s: "
+                 "each takes their mean", path, im.varying,
+                 im.varying == 1 ? " has" : "s have", im.varying == 1 ? "it" : "them");
     for (size_t i = 0; options && options->dependencies && i < gltf_doc_file_count(doc); i++)
         ptr_warn(options->dependencies, "%s", gltf_doc_file(doc, i));
     /* The file's buffers go before the scene's arrays are filled. */
@@ -1574,7 +1899,10 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
     for (size_t m = 0; im.surfaces && m < meshes; m++) {
         free(im.surfaces[m].spheres);
         free(im.surfaces[m].primitives);
+        free(im.surfaces[m].materials);
     }
+    free(im.made);
+    gltf_textures_free(im.textures);
     free(im.surfaces);
     free(im.surface_table);
     if (res == PTR_OK)

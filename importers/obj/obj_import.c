@@ -481,7 +481,7 @@ static PtrResult part_spheres(Reader *r, const Part *p, uint32_t *local_of,
                                    .triangles = part_triangles,
                                    .user = &mesh };
     if (res == PTR_OK)
-        res = ptr_mesh_spheres(&source, r->path, &spheres, &count, r->err);
+        res = ptr_mesh_spheres(&source, r->path, &spheres, &count, NULL, r->err);
     for (size_t c = 0; res == PTR_OK && c < count; c++) {
         if (!spheres[c].is_sphere)
             ++*skipped;

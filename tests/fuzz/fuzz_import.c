@@ -28,6 +28,27 @@ static void write_file(const char *path, const uint8_t *data, size_t size)
     fclose(f);
 }
 
+/* A stand-in for the image module's decoder, so that the fuzzer reaches
+ * texture sampling (glTF) without OpenImageIO: an image's first two bytes
+ * give its size (1 to 16 texels a side), the bytes after them its texels,
+ * cycled; fewer than 3 bytes is a broken image. */
+static PtrResult decode_texels(void *context, const char *name, const unsigned char *bytes,
+                               size_t size, PtrTexels *out, PtrError *err)
+{
+    (void)context;
+    if (size < 3)
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: not an image", name);
+    out->width = 1 + bytes[0] % 16;
+    out->height = 1 + bytes[1] % 16;
+    const size_t values = 4 * (size_t)out->width * (size_t)out->height;
+    out->rgba = malloc(values * sizeof *out->rgba);
+    if (!out->rgba)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", name);
+    for (size_t i = 0; i < values; i++)
+        out->rgba[i] = bytes[2 + i % (size - 2)] / 255.0f;
+    return PTR_OK;
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (!dir[0]) {
@@ -58,11 +79,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Half the inputs also read a value per sphere (--color-by): COLOR_0
      * names both the points' COLOR_0 and the instances' _COLOR_0, which the
      * seed files have; a structure's B-factor. Structures are read with
-     * waters or without, hydrogens or without. */
+     * waters or without, hydrogens or without. Half the glTF files have
+     * their textures read. */
     PtrImportOptions options = {
         .dependencies = &dependencies, .fit_all_objects = size & 1,
         .value_attribute = size & 2 ? (FUZZ_FORMAT == 3 ? "bfactor" : "color_0") : NULL,
-        .structure_select = size & 4 ? PTR_STRUCTURE_ALL : 0, .drop_hydrogens = size & 8 };
+        .structure_select = size & 4 ? PTR_STRUCTURE_ALL : 0, .drop_hydrogens = size & 8,
+        .textures = { size & 16 ? decode_texels : NULL, NULL } };
     PtrResult r = ptr_import_scene(path, &options, &scene, &warnings, &err);
     /* A refusal is one line that names the file. */
     if (r != PTR_OK && (strchr(err.message, '\n') || strncmp(err.message, path, strlen(dir))))

@@ -1,0 +1,126 @@
+/* Textures read at texture coordinates, decoded lazily (gltf_textures.h). */
+#include "gltf_textures.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* A texture as decoded, or why it cannot be. */
+typedef struct Decoded {
+    int state; /* UNREAD, READ or FAILED */
+    GltfTexture info;
+    PtrTexels texels;
+    PtrError error; /* FAILED: the message, given again at each sample */
+} Decoded;
+
+enum { UNREAD, READ, FAILED };
+
+struct GltfTextures {
+    const GltfDoc *doc;
+    const char *path;
+    PtrTextureDecoder decoder;
+    Decoded *textures; /* one a texture of the file */
+    size_t count;
+};
+
+PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
+                            const PtrTextureDecoder *decoder, GltfTextures **out, PtrError *err)
+{
+    GltfTextures *t = calloc(1, sizeof *t);
+    const size_t count = gltf_doc_texture_count(doc);
+    Decoded *textures = t ? calloc(count ? count : 1, sizeof *textures) : NULL;
+    if (!textures) {
+        free(t);
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+    }
+    *t = (GltfTextures){ doc, path, *decoder, textures, count };
+    *out = t;
+    return PTR_OK;
+}
+
+void gltf_textures_free(GltfTextures *textures)
+{
+    if (!textures)
+        return;
+    for (size_t i = 0; i < textures->count; i++)
+        free(textures->textures[i].texels.rgba);
+    free(textures->textures);
+    free(textures);
+}
+
+/* Texture index decoded, at its first use. */
+static PtrResult decode(GltfTextures *t, int index, const Decoded **out, PtrError *err)
+{
+    if (index < 0 || (size_t)index >= t->count)
+        return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                             "%s: a material refers to texture %d, which does not exist",
+                             t->path, index);
+    Decoded *d = &t->textures[index];
+    if (d->state == UNREAD) {
+        gltf_doc_texture(t->doc, index, &d->info);
+        PtrError inner = { 0 };
+        PtrResult res = PTR_OK;
+        if (d->info.fault)
+            res = ptr_error_set(&d->error, PTR_ERR_SCENE_INVALID, "%s: texture %d %s", t->path,
+                                index, d->info.fault);
+        else if ((res = t->decoder.decode(t->decoder.context, d->info.name, d->info.bytes,
+                                          d->info.size, &d->texels, &inner)) != PTR_OK)
+            res = ptr_error_set(&d->error, res == PTR_ERR_NOMEM ? res : PTR_ERR_SCENE_INVALID,
+                                "%s (texture %d)", inner.message, index);
+        else if (d->texels.width <= 0 || d->texels.height <= 0)
+            res = ptr_error_set(&d->error, PTR_ERR_SCENE_INVALID, "%s: texture %d is empty",
+                                t->path, index);
+        d->state = res == PTR_OK ? READ : FAILED;
+    }
+    if (d->state == FAILED)
+        return ptr_error_set(err, d->error.code, "%s", d->error.message);
+    *out = d;
+    return PTR_OK;
+}
+
+/* A coordinate wrapped into [0, 1] as the sampler's mode says. */
+static double wrap(double x, int mode)
+{
+    if (mode == GLTF_CLAMP)
+        return x < 0.0 ? 0.0 : x > 1.0 ? 1.0 : x;
+    if (mode == GLTF_MIRRORED_REPEAT) {
+        const double t = x - 2.0 * floor(0.5 * x);
+        return t > 1.0 ? 2.0 - t : t;
+    }
+    return x - floor(x);
+}
+
+/* The texel of a wrapped coordinate among n (the last for 1.0). */
+static int texel_of(double x, int n)
+{
+    const int i = (int)(x * n);
+    return i < n ? i : n - 1;
+}
+
+PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
+                               const double uv[2], float rgba[4], PtrError *err)
+{
+    const Decoded *d;
+    PtrResult res = decode(textures, ref->texture, &d, err);
+    if (res != PTR_OK)
+        return res;
+    /* KHR_texture_transform: offset + rotation * (scale * uv), the
+     * rotation counter-clockwise in the image as glTF's matrix has it. */
+    const double c = cos(ref->rotation), s = sin(ref->rotation);
+    const double su = ref->scale[0] * uv[0], sv = ref->scale[1] * uv[1];
+    const double u = ref->offset[0] + c * su + s * sv, v = ref->offset[1] - s * su + c * sv;
+    if (!isfinite(u) || !isfinite(v))
+        return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
+                             "%s: texture %d is read at a texture coordinate that is not finite",
+                             textures->path, ref->texture);
+    const PtrTexels *t = &d->texels;
+    const size_t x = (size_t)texel_of(wrap(u, d->info.wrap_s), t->width);
+    const size_t y = (size_t)texel_of(wrap(v, d->info.wrap_t), t->height);
+    for (int k = 0; k < 4; k++)
+        rgba[k] = t->rgba[4 * (y * (size_t)t->width + x) + (size_t)k];
+    return PTR_OK;
+}
+
+double gltf_srgb_to_linear(double encoded)
+{
+    return encoded <= 0.04045 ? encoded / 12.92 : pow((encoded + 0.055) / 1.055, 2.4);
+}
