@@ -158,8 +158,8 @@ def add_instances(buffer, spheres, name):
     return {"name": name, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attributes}}}
 
 
-def build(desc, instanced=False):
-    verts, tris = unit_sphere()
+def build(desc, instanced=False, segments=SEGMENTS, rings=RINGS):
+    verts, tris = unit_sphere(segments, rings)
     buffer = Buffer()
     buffer.add(b"".join(struct.pack("<3f", *v) for v in verts), 5126, len(verts), "VEC3", 34962,
                min=[-1.0, -1.0, -1.0], max=[1.0, 1.0, 1.0])

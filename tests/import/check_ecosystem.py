@@ -7,9 +7,12 @@ as the scenes they were made from, and render.
   three_instanced.json, the centres, radii and colours the script used.
 - instance, quantize, meshopt, draco, optimize, instance_meshopt, gltfpack,
   join and join_meshopt (.glb) against nodes.glb, the node-per-sphere scene
-  they were made from (which itself must match nodes.json exactly): join
-  merges the 60 spheres into one mesh of 4 primitives, one a material, and
-  ptr finds each sphere again as a connected component.
+  they were made from (which itself must match nodes.json exactly); and
+  palette_optimize and palette_join against palette.glb (which must match
+  palette.json): join merges the spheres into one mesh of a primitive a
+  material, optimize first merges the materials into a few with palette
+  textures (make_nodes.py says when), and ptr finds each sphere again as a
+  connected component, with its own texels for its material.
   Compared: the number of spheres; each reference sphere is paired with the
   nearest one imported (instancing reorders them); centre components and
   radius within TOL(r) = 2 * r / (2^14 - 1) + 1e-6 * SIZE: 14 bits is the
@@ -20,11 +23,20 @@ as the scenes they were made from, and render.
   join_meshopt is quantised over the joined mesh's bounds, the whole scene:
   its step is SPAN / (2^14 - 1), SPAN the largest extent of the spheres'
   bounds.
+  optimize and palette_optimize are also simplified, with gltf-transform's
+  default error, 1e-4 of the mesh's extent (here the joined mesh's, SPAN):
+  meshoptimizer's error is a distance to the surface's planes, not to its
+  bounds, which move by up to 2.5 times it here: their tolerance adds 3 times
+  it.
   Files without quantisation (three_instanced, instance) get 1e-6 * SIZE only.
   Materials: the same kind, fuzz and ior within 1e-6, and the colour (the
-  material's albedo times the sphere's own colour, where it has one) within
-  1/255 (colours are not quantised by these tools unless instanced, where
-  8-bit colour is their default).
+  material's albedo times the sphere's own colour, where it has one) and
+  the emission within 1/255 (colours are not quantised by these tools unless
+  instanced, where 8-bit colour is their default). In the files with palette
+  textures (PALETTE) colours are 8-bit sRGB texels and metallic and roughness
+  8-bit: there the colour and the emission (over the brightest of the
+  reference's, the emissive strength) are compared sRGB-encoded, within 1/255
+  of each other, and fuzz within 1/255.
 - Each file renders: ptr FILE -o out.exr --samples 1 --width 16, exit 0.
 - ortho.gltf (three.js, an OrthographicCamera xmag 6, ymag 4, znear 0.5,
   zfar 50 at (0, 2, 10) looking down -Z) shows in --dump-scene as an
@@ -42,11 +54,19 @@ import tempfile
 
 ptr, folder = sys.argv[1], sys.argv[2]
 POSITION_BITS = 14
-GLTF_TRANSFORM = ["instance", "quantize", "meshopt", "draco", "optimize", "instance_meshopt",
-                  "gltfpack", "join", "join_meshopt"]
+# The tools' files and the source each was made from.
+GLTF_TRANSFORM = {"instance": "nodes", "quantize": "nodes", "meshopt": "nodes", "draco": "nodes",
+                  "optimize": "nodes", "instance_meshopt": "nodes", "gltfpack": "nodes",
+                  "join": "nodes", "join_meshopt": "nodes", "palette_optimize": "palette",
+                  "palette_join": "palette"}
 # Quantised over each sphere's mesh, or over one mesh holding them all.
-QUANTISED = {"quantize", "meshopt", "draco", "optimize", "instance_meshopt", "gltfpack"}
-QUANTISED_JOINED = {"join_meshopt"}
+QUANTISED = {"quantize", "meshopt", "draco", "instance_meshopt", "gltfpack"}
+QUANTISED_JOINED = {"join_meshopt", "optimize", "palette_optimize"}
+PALETTE = {"optimize", "palette_optimize"}
+# Simplified by optimize, with its default error: 1e-4 of the mesh's extent,
+# 3 times it for the bounds (see the docstring).
+SIMPLIFIED = {"optimize", "palette_optimize"}
+SIMPLIFY_ERROR = 1e-4 * 3
 
 
 class Failure(Exception):
@@ -81,9 +101,29 @@ def flatten(scene):
     return out
 
 
-def compare(got, want, quantised, joined=False):
+def srgb(x):
+    """A linear value sRGB-encoded, as an 8-bit texel stores it (over 255)."""
+    x = min(max(x, 0.0), 1.0)
+    return 12.92 * x if x <= 0.0031308 else 1.055 * x ** (1 / 2.4) - 0.055
+
+
+def colour_error(g, w, palette):
+    """The largest difference of colour and emission, sRGB-encoded in a
+    palette (the emission over the reference's brightest)."""
+    if not palette:
+        return max(abs(a - b) for a, b in zip(g["colour"] + g["emission"],
+                                              w["colour"] + w["emission"]))
+    strength = max(max(w["emission"]), 1.0)
+    return max([abs(srgb(a) - srgb(b)) for a, b in zip(g["colour"], w["colour"])] +
+               [abs(srgb(a / strength) - srgb(b / strength))
+                for a, b in zip(g["emission"], w["emission"])])
+
+
+def compare(got, want, quantised, joined=False, palette=False, simplified=False):
     """Problems of `got` against `want` (lists from flatten), at most a few;
-    quantised over each sphere's bounds, or (joined) over all of them."""
+    quantised over each sphere's bounds, or (joined) over all of them;
+    colours from palette textures, vertices moved by simplify (see the
+    docstring)."""
     if len(got) != len(want):
         return [f"{len(got)} spheres, not {len(want)}"]
     size = max(abs(x) for s in want for x in s["center"])
@@ -96,7 +136,8 @@ def compare(got, want, quantised, joined=False):
         free.remove(j)
         g = got[j]
         extent = span if joined else 2 * w["radius"]
-        tol = 1e-6 * size + (extent / (2 ** POSITION_BITS - 1) if quantised else 0)
+        tol = (1e-6 * size + (extent / (2 ** POSITION_BITS - 1) if quantised else 0) +
+               (SIMPLIFY_ERROR * extent if simplified else 0))
         err = max(abs(a - b) for a, b in zip(g["center"], w["center"]))
         if err > tol:
             problems.append(f"sphere {i}: centre {g['center']}, not {w['center']} "
@@ -106,22 +147,25 @@ def compare(got, want, quantised, joined=False):
                             f"{tol:.3g})")
         if g["kind"] != w["kind"]:
             problems.append(f"sphere {i}: material {g['kind']}, not {w['kind']}")
-        elif abs(g["fuzz"] - w["fuzz"]) > 1e-6 or abs(g["ior"] - w["ior"]) > 1e-6:
+        elif (abs(g["fuzz"] - w["fuzz"]) > (1.0 / 255 if palette else 1e-6) or
+              abs(g["ior"] - w["ior"]) > 1e-6):
             problems.append(f"sphere {i}: fuzz/ior {g['fuzz']}/{g['ior']}, not "
                             f"{w['fuzz']}/{w['ior']}")
-        if max(abs(a - b) for a, b in zip(g["colour"] + g["emission"],
-                                          w["colour"] + w["emission"])) > 1.0 / 255:
-            problems.append(f"sphere {i}: colour {g['colour']}, not {w['colour']}")
+        if colour_error(g, w, palette) > 1.0 / 255:
+            problems.append(f"sphere {i}: colour {g['colour']} emission {g['emission']}, not "
+                            f"{w['colour']} {w['emission']}")
     return problems
 
 
-def reference_nodes():
-    with open(os.path.join(folder, "nodes.json")) as f:
+def reference(stem):
+    """The spheres of the description stem.json (make_nodes.py)."""
+    with open(os.path.join(folder, stem + ".json")) as f:
         desc = json.load(f)
     kinds = {"lambertian": "diffuse", "metal": "metal", "dielectric": "dielectric"}
     return [{"center": s["center"], "radius": s["radius"], "kind": kinds[s["material"]],
              "colour": s.get("albedo", [1, 1, 1]), "fuzz": s.get("fuzz", 0),
-             "ior": s.get("ior", 0), "emission": [0, 0, 0]} for s in desc["spheres"]]
+             "ior": s.get("ior", 0), "emission": s.get("emission", [0, 0, 0])}
+            for s in desc["spheres"]]
 
 
 def reference_three():
@@ -164,24 +208,25 @@ def main():
                 problems = [f"{type(e).__name__}: {e}"]
             results[name] = problems
 
-        nodes = None
+        sources = {}
 
-        def check_nodes():
-            nonlocal nodes
-            nodes = flatten(dump("nodes.glb"))
-            return compare(nodes, reference_nodes(), False)
+        def check_source(stem):
+            sources[stem] = flatten(dump(stem + ".glb"))
+            return compare(sources[stem], reference(stem), False)
 
-        check("nodes.glb", check_nodes)
+        for stem in ("nodes", "palette"):
+            check(stem + ".glb", lambda: check_source(stem))
         check("three_instanced.glb",
               lambda: compare(flatten(dump("three_instanced.glb")), reference_three(), False))
-        for stem in GLTF_TRANSFORM:
+        for stem, source in GLTF_TRANSFORM.items():
             name = stem + ".glb"
-            if nodes is None:
-                results[name] = ["nodes.glb, the reference, did not import"]
+            if source not in sources:
+                results[name] = [f"{source}.glb, the reference, did not import"]
                 continue
-            check(name, lambda: compare(flatten(dump(name)), nodes,
+            check(name, lambda: compare(flatten(dump(name)), sources[source],
                                         stem in QUANTISED | QUANTISED_JOINED,
-                                        stem in QUANTISED_JOINED))
+                                        stem in QUANTISED_JOINED, stem in PALETTE,
+                                        stem in SIMPLIFIED))
         check("ortho.gltf", lambda: check_ortho(dump("ortho.gltf")))
 
     failed = 0
