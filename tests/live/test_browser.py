@@ -18,7 +18,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from live_client import Ptr, samples as samples_for  # noqa: E402
+from live_client import Ptr, read_ppm, samples as samples_for  # noqa: E402
 
 SKIP = 77
 ptr, src = sys.argv[1], sys.argv[2]
@@ -95,14 +95,6 @@ def try_exposure(web, p, before):
             result = "render ended first"
     web.execute_script(SET_STOPS, 0)
     return result
-
-
-def read_ppm(path):
-    data = open(path, "rb").read()
-    parts = data.split(maxsplit=4)
-    if parts[0] != b"P6" or parts[3] != b"255":
-        raise ValueError(path + ": not an 8-bit PPM")
-    return int(parts[1]), int(parts[2]), parts[4]
 
 
 def main():
