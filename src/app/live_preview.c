@@ -149,8 +149,13 @@ static void *preview_loop(void *arg)
     setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), PREVIEW_NICE);
     Work w = { 0 };
     pthread_mutex_lock(&p->lock);
-    while (!p->stopping) {
-        if (!p->pending.number || !p->wanted(p->user)) {
+    for (;;) {
+        /* Stopping, the newest frame is still denoised if wanted: the
+         * render's last image. */
+        int ready = p->pending.number && p->wanted(p->user);
+        if (!ready && p->stopping)
+            break;
+        if (!ready) {
             struct timespec t;
             clock_gettime(CLOCK_MONOTONIC, &t);
             t.tv_nsec += poll_nanoseconds;

@@ -32,7 +32,8 @@ typedef void (*PtrLivePreviewDone)(void *user, uint64_t frame, const float *rgb)
 PtrResult ptr_live_preview_new(PtrCpuLevel level, int (*wanted)(void *user),
                                PtrLivePreviewDone done, void *user, PtrLivePreview **out,
                                PtrError *err);
-/* Waits for the frame under way, then stops the thread. */
+/* Denoises the newest frame if it is wanted and not denoised yet, then
+ * stops the thread. */
 void ptr_live_preview_free(PtrLivePreview *preview);
 
 /* A render starts: what its passes are rendered from if its film has none.
