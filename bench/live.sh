@@ -13,9 +13,9 @@
 # machine (its drawing competes with the render too; Chromium stays open on
 # an empty page during the renders without --live: it costs a core 5% idle).
 # With --preview, the page has its denoised preview on (/denoise?on=1)
-# before the render's first pass: the ratios then say what the preview
-# costs on top of the live view (its thread, ptr-live-denoise, counts among
-# the live view's), and each run says how many denoised frames the page got.
+# before the render's first pass: the ratios then say what the live view
+# costs with its preview (whose thread, ptr-live-oidn, counts among the live
+# view's), and each run says how many denoised frames the page got.
 # Usage: bench/live.sh PTR [RUNS] [--browser] [--preview] [-- RENDER OPTIONS]
 #   (from the source folder; default RUNS 7 and options
 #    scenes/seed.gltf --width 500 --height 500 --samples 400)

@@ -1,6 +1,7 @@
 #define _GNU_SOURCE /* pthread_setname_np */
 #include "app/live_preview.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,8 +17,13 @@
  * their antialiasing, at a few percent of a render of hundreds. The
  * niceness is the live encoder's: a frame waits rather than the render. */
 enum { GUIDE_SAMPLES = 4, PREVIEW_NICE = 10 };
-/* How often an idle preview asks whether it is wanted. */
-static const long poll_nanoseconds = 250000000L;
+/* The share of the machine's cores the preview takes at most, over time:
+ * a niceness alone bounds it only against the render's threads, not when
+ * they wait (between passes, for the last tiles) or compete with other
+ * processes, where the preview took a quarter of ptr's CPU time. After a
+ * frame that cost it c seconds of CPU, it rests until c is this share of
+ * the cores' time since the frame began. */
+static const double cpu_share = 0.05;
 
 /* A frame handed over: colour, then albedo, then normal, 3 floats a pixel
  * each, in one buffer that moves between its owners whole. */
@@ -32,7 +38,6 @@ typedef struct Frame {
 
 struct PtrLivePreview {
     PtrDenoiser *denoiser;
-    int (*wanted)(void *user);
     PtrLivePreviewDone done;
     void *user;
     pthread_t thread;
@@ -52,8 +57,9 @@ struct PtrLivePreview {
 };
 
 /* The preview's thread's own: the frame it denoises, the passes it
- * rendered, and the result. */
+ * rendered, the result, and the CPU time they took. */
 typedef struct Work {
+    double cpu_seconds;
     Frame frame;
     float *guides;     /* albedo, then normal, of guides_render */
     size_t guides_capacity; /* floats */
@@ -90,8 +96,10 @@ static int render_guides(Work *w, const PtrScene *scene, const PtrAccel *accel,
         ptr_accum_free(film, pixels, PTR_ACCUM_STRIDE_PASSES);
         return 0;
     }
-    int ok = ptr_render_samples(scene, accel, &settings, first, samples, film, NULL, NULL, NULL,
-                                NULL) == PTR_OK;
+    PtrRenderStats stats;
+    int ok = ptr_render_samples(scene, accel, &settings, first, samples, film, NULL, NULL,
+                                &stats, NULL) == PTR_OK;
+    w->cpu_seconds += ok ? stats.seconds : 0; /* one thread, busy throughout */
     if (ok)
         ptr_accum_resolve_passes(film, pixels, w->guides, w->guides + 3 * pixels);
     ptr_accum_free(film, pixels, PTR_ACCUM_STRIDE_PASSES);
@@ -142,39 +150,52 @@ static void denoise_frame(PtrLivePreview *p, Work *w, const float *guides)
         p->done(p->user, f->number, w->out);
 }
 
+static double thread_cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Waits until seconds after start on the monotonic clock, or stopping
+ * (the lock held). */
+static void rest_until(PtrLivePreview *p, double until)
+{
+    struct timespec t;
+    double whole = floor(until);
+    t.tv_sec = (time_t)whole;
+    t.tv_nsec = (long)((until - whole) * 1e9);
+    while (!p->stopping && ptr_now_seconds() < until)
+        pthread_cond_timedwait(&p->changed, &p->lock, &t);
+}
+
 static void *preview_loop(void *arg)
 {
     PtrLivePreview *p = arg;
-    pthread_setname_np(pthread_self(), "ptr-live-denoise");
+    pthread_setname_np(pthread_self(), "ptr-live-oidn");
     setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), PREVIEW_NICE);
+    const double cores = ptr_online_cpus();
     Work w = { 0 };
     pthread_mutex_lock(&p->lock);
-    for (;;) {
-        /* Stopping, the newest frame is still denoised if wanted: the
-         * render's last image. */
-        int ready = p->pending.number && p->wanted(p->user);
-        if (!ready && p->stopping)
-            break;
-        if (!ready) {
-            struct timespec t;
-            clock_gettime(CLOCK_MONOTONIC, &t);
-            t.tv_nsec += poll_nanoseconds;
-            if (t.tv_nsec >= 1000000000L) {
-                t.tv_sec++;
-                t.tv_nsec -= 1000000000L;
-            }
-            pthread_cond_timedwait(&p->changed, &p->lock, &t);
+    /* Stopping, a frame still waiting is denoised: the render's last. */
+    while (!p->stopping || p->pending.number) {
+        if (!p->pending.number) {
+            pthread_cond_wait(&p->changed, &p->lock);
             continue;
         }
         Frame taken = p->pending;
         p->pending = w.frame;
         p->pending.number = 0;
         w.frame = taken;
+        double start = ptr_now_seconds(), cpu_start = thread_cpu_seconds();
+        w.cpu_seconds = 0;
         const float *guides = guides_for(p, &w);
         pthread_mutex_unlock(&p->lock);
         if (guides)
             denoise_frame(p, &w, guides);
+        w.cpu_seconds += thread_cpu_seconds() - cpu_start;
         pthread_mutex_lock(&p->lock);
+        rest_until(p, start + w.cpu_seconds / (cpu_share * cores));
     }
     pthread_mutex_unlock(&p->lock);
     free(w.frame.data);
@@ -183,9 +204,8 @@ static void *preview_loop(void *arg)
     return NULL;
 }
 
-PtrResult ptr_live_preview_new(PtrCpuLevel level, int (*wanted)(void *user),
-                               PtrLivePreviewDone done, void *user, PtrLivePreview **out,
-                               PtrError *err)
+PtrResult ptr_live_preview_new(PtrCpuLevel level, PtrLivePreviewDone done, void *user,
+                               PtrLivePreview **out, PtrError *err)
 {
     PtrLivePreview *p = calloc(1, sizeof *p);
     if (!p)
@@ -195,10 +215,10 @@ PtrResult ptr_live_preview_new(PtrCpuLevel level, int (*wanted)(void *user),
         free(p);
         return res;
     }
-    p->wanted = wanted;
     p->done = done;
     p->user = user;
     pthread_mutex_init(&p->lock, NULL);
+    /* Timed waits on the clock ptr_now_seconds reads. */
     pthread_condattr_t attr;
     pthread_condattr_init(&attr);
     pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);

@@ -1,15 +1,16 @@
-/* The live view's denoised preview: every pass's frame is handed over, and
- * while a page (or tev) wants it denoised, a thread of its own, at a low
- * priority, denoises the newest one with the small network on one core,
- * dropping those that arrive while it works; the last frame of a render
- * stays, so that a preview turned on later gets it. The render copies a
- * frame and takes a lock for a swap of pointers, nothing more.
+/* The live view's denoised preview: the frames a page (or tev) wants
+ * denoised are handed over after their pass, and a thread of its own, at a
+ * low priority and within a share of the cores, denoises the newest one
+ * with the small network on one core, dropping those that arrive
+ * meanwhile. The render copies a frame and takes a lock for a swap of
+ * pointers, nothing more.
  *
  * The denoiser needs the albedo and normal passes. A film that records them
  * (--passes, --denoise) gives its own; otherwise, the first time a frame of
  * a render is to be denoised, the preview renders them itself, once, from a
  * few samples of the same scene: recording them in the render's film would
- * cost every render with --live about 13% (docs/architecture.md). */
+ * cost every render with --live 7 to 13% of its instructions (README, Live
+ * view). */
 #ifndef PTR_LIVE_PREVIEW_H
 #define PTR_LIVE_PREVIEW_H
 
@@ -26,14 +27,12 @@ typedef struct PtrLivePreview PtrLivePreview;
 typedef void (*PtrLivePreviewDone)(void *user, uint64_t frame, const float *rgb);
 
 /* Loads the small network's weights for this CPU level and starts the
- * thread, which asks wanted(user) (a few times a second while idle)
- * whether to denoise: PTR_ERR_INSTALL (a missing weight file),
- * PTR_ERR_NOMEM, PTR_ERR_INTERNAL. */
-PtrResult ptr_live_preview_new(PtrCpuLevel level, int (*wanted)(void *user),
-                               PtrLivePreviewDone done, void *user, PtrLivePreview **out,
-                               PtrError *err);
-/* Denoises the newest frame if it is wanted and not denoised yet, then
- * stops the thread. */
+ * thread: PTR_ERR_INSTALL (a missing weight file), PTR_ERR_NOMEM,
+ * PTR_ERR_INTERNAL. */
+PtrResult ptr_live_preview_new(PtrCpuLevel level, PtrLivePreviewDone done, void *user,
+                               PtrLivePreview **out, PtrError *err);
+/* Denoises the frame handed over last if it is not yet, then stops the
+ * thread. */
 void ptr_live_preview_free(PtrLivePreview *preview);
 
 /* A render starts: what its passes are rendered from if its film has none.

@@ -28,12 +28,6 @@ static int apply_view(void *user, float *rgb, size_t pixels, float stops)
     return ptr_color_apply(user, rgb, pixels, &err) == PTR_OK ? 0 : -1;
 }
 
-static int denoise_wanted(void *user)
-{
-    (void)user;
-    return module->denoise_wanted(session);
-}
-
 static void hand_denoised(void *user, uint64_t frame, const float *rgb)
 {
     (void)user;
@@ -60,8 +54,7 @@ PtrResult ptr_live_view_open(const PtrOptions *o, const PtrColor *color, PtrErro
      * preview only, said once. */
     PtrError why;
     if ((o->live || options.tev_denoised) &&
-        ptr_live_preview_new(o->cpu_level, denoise_wanted, hand_denoised, NULL, &preview,
-                             &why) != PTR_OK)
+        ptr_live_preview_new(o->cpu_level, hand_denoised, NULL, &preview, &why) != PTR_OK)
         fprintf(stderr, "ptr: warning: the live view has no denoised preview: %s\n",
                 why.message);
     return PTR_OK;
@@ -99,7 +92,9 @@ static void pass_done(void *user, const double *film, size_t pixels, size_t stri
         .state = PTR_LIVE_RENDERING,
     };
     uint64_t frame = module->frame(session, scratch, &last);
-    if (preview)
+    /* Only while wanted: the copy, and the reading of the film's passes,
+     * take place while the render's threads wait. */
+    if (preview && module->denoise_wanted(session))
         ptr_live_preview_frame(preview, frame, scratch, film, pixels, stride);
 }
 
