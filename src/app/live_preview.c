@@ -157,8 +157,8 @@ static double thread_cpu_seconds(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Waits until seconds after start on the monotonic clock, or stopping
- * (the lock held). */
+/* Waits until ptr_now_seconds() reaches until, or stopping (the lock
+ * held). */
 static void rest_until(PtrLivePreview *p, double until)
 {
     struct timespec t;
