@@ -158,7 +158,8 @@ static int send_tile(LiveTev *t, int x0, int y0, int w, int h)
         put_u32(&wr, (uint32_t)h);
         for (int y = y0; y < y0 + h; y++)
             for (int x = x0; x < x0 + w; x++)
-                put_float(&wr, t->current[((size_t)y * (size_t)t->width + (size_t)x) * channels + c]);
+                put_float(&wr,
+                          t->current[((size_t)y * (size_t)t->width + (size_t)x) * channels + c]);
         if (!send_all(t->fd, m, size))
             return 0;
     }

@@ -110,7 +110,8 @@ def try_preview(web, p, url):
         if p.process.poll() is not None:
             result = "render ended first"
             break
-        if not heard or web.execute_script("return document.getElementById('denoise').checked") != on:
+        checked = web.execute_script("return document.getElementById('denoise').checked")
+        if not heard or checked != on:
             result = "the toggle %s did not reach ptr or the page" % ("on" if on else "off")
             break
     listener.close()

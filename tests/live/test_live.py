@@ -103,7 +103,8 @@ def roughness(d, png):
         f.write(png)
     subprocess.run(["oiiotool", path, "-o", path + ".ppm"], check=True)
     w, h, rgb = read_ppm(path + ".ppm")
-    steps = [abs(rgb[i] - rgb[i + 3]) for y in range(h) for i in range(3 * w * y, 3 * w * (y + 1) - 3)]
+    steps = [abs(rgb[i] - rgb[i + 3])
+             for y in range(h) for i in range(3 * w * y, 3 * w * (y + 1) - 3)]
     return sum(steps) / len(steps)
 
 
