@@ -12,7 +12,11 @@
 # or with --browser, the page itself in headless Chromium on the same
 # machine (its drawing competes with the render too; Chromium stays open on
 # an empty page during the renders without --live: it costs a core 5% idle).
-# Usage: bench/live.sh PTR [RUNS] [--browser] [-- RENDER OPTIONS]
+# With --preview, the page has its denoised preview on (/denoise?on=1)
+# before the render's first pass: the ratios then say what the live view
+# costs with its preview (whose thread, ptr-live-oidn, counts among the live
+# view's), and each run says how many denoised frames the page got.
+# Usage: bench/live.sh PTR [RUNS] [--browser] [--preview] [-- RENDER OPTIONS]
 #   (from the source folder; default RUNS 7 and options
 #    scenes/seed.gltf --width 500 --height 500 --samples 400)
 set -eu
@@ -20,9 +24,11 @@ ptr=$1
 shift
 runs=7
 browser=0
+preview=0
 while [ $# -gt 0 ]; do
     case $1 in
         --browser) browser=1 ;;
+        --preview) preview=1 ;;
         --) shift; break ;;
         *) runs=$1 ;;
     esac
@@ -32,12 +38,13 @@ done
 python=python3
 # Debian's python3-selenium is for Debian's python3.
 [ $browser = 0 ] || [ ! -x /usr/bin/python3 ] || python=/usr/bin/python3
-exec $python - "$ptr" "$runs" "$browser" "$@" <<'PY'
+exec $python - "$ptr" "$runs" "$browser" "$preview" "$@" <<'PY'
 import glob, json, os, resource, statistics, sys, tempfile, threading, time
 sys.path.insert(0, "tests/support")
-from live_client import Ptr, Page
+from live_client import Ptr, Page, get
 
-ptr, runs, browser, args = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1", sys.argv[4:]
+ptr, runs, browser, preview = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1", sys.argv[4] == "1"
+args = sys.argv[5:]
 web = None
 if browser:
     sys.path.insert(0, "tests/live")
@@ -77,12 +84,14 @@ def run(live, out):
     before = cpu()
     p = Ptr([ptr, *args, "-o", out, "--json", "--quiet"] + (["--live", "0"] if live else []))
     page = None
-    frames = 0
+    frames = denoised = 0
     seen = {}
     poller = threading.Thread(target=thread_cpu, args=(p.process.pid, seen), daemon=True)
     poller.start()
     if live:
         url = p.url()
+        if preview:
+            get(url, "/denoise?on=1")
         if web:
             web.get(url)
         else:
@@ -97,10 +106,13 @@ def run(live, out):
     if page:
         page.close()
         frames = len(page.frames)
+        denoised = sum(1 for f in page.frames if f[2])
     if web:
         frames = web.execute_script("const e = document.getElementById('image');"
                                     "return e ? Number(e.dataset.frame) : 0")
-    return json.loads(p.stdout.splitlines()[-1])["rays_per_second"], frames, seconds, share
+    rays = json.loads(p.stdout.splitlines()[-1])["rays_per_second"]
+    shown = "%d frames" % frames + (", %d denoised" % denoised if page and preview else "")
+    return rays, shown, seconds, share
 
 
 with tempfile.TemporaryDirectory() as d:
@@ -112,13 +124,14 @@ with tempfile.TemporaryDirectory() as d:
         cpu_ratio.append(c0 / c1)
         shares.append(share)
         print("run %d: %.2f Mrays/s and %.2f CPU s without --live, %.2f Mrays/s and %.2f CPU s "
-              "with a page open (%d frames, %.1f%% of the CPU time in the live view's threads): "
+              "with a page open (%s, %.1f%% of the CPU time in the live view's threads): "
               "ratios %.3f, %.3f" % (i + 1, r0 / 1e6, c0, r1 / 1e6, c1, f, 100 * share,
                                      speed[-1], cpu_ratio[-1]), flush=True)
 if web:
     web.quit()
-print("median of %d pairs, with a page open%s over without --live: rays per second %.3f, "
+print("median of %d pairs, with a page open%s%s over without --live: rays per second %.3f, "
       "CPU time (inverse) %.3f; the live view's threads took %.1f%% of ptr's CPU time"
-      % (runs, " in Chromium" if browser else "", statistics.median(speed),
+      % (runs, " in Chromium" if browser else "", ", its preview on," if preview else "",
+         statistics.median(speed),
          statistics.median(cpu_ratio), 100 * statistics.median(shares)))
 PY

@@ -78,7 +78,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
-    ptr_live_view_begin(report->scene, report->output, layout.width, layout.height, &passes);
+    ptr_live_view_begin(report->scene, report->output, scene, accel, &settings, &passes);
     size_t pixels = (size_t)layout.width * (size_t)layout.height;
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;

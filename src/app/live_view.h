@@ -17,11 +17,14 @@ PtrResult ptr_live_view_open(const PtrOptions *options, const PtrColor *color, P
 /* Lets open pages fetch the last image, then stops. */
 void ptr_live_view_close(void);
 
-/* A render starts: sets passes->pass_done so that each pass reaches the
- * view (nothing when there is no view). */
-void ptr_live_view_begin(const char *scene, const char *output, int width, int height,
+/* A render of settings' region starts: sets passes->pass_done so that each
+ * pass reaches the view (nothing when there is no view). scene and accel
+ * (from which the denoised preview may render passes) must stay until
+ * ptr_live_view_end. */
+void ptr_live_view_begin(const char *scene_path, const char *output, const PtrScene *scene,
+                         const PtrAccel *accel, const PtrRenderSettings *settings,
                          PtrProgressiveOptions *passes);
-/* The render ended: ok or not. */
+/* The render ended, ok or not: nothing reads its scene any more. */
 void ptr_live_view_end(int ok);
 
 #endif /* PTR_LIVE_VIEW_H */

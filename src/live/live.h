@@ -8,7 +8,10 @@
  * The renderer hands each pass's image (scene-linear RGB) to frame(), which
  * copies it under a lock and returns: everything else (the view transform,
  * PNG encoding, sending) happens on the module's own threads, and only while
- * a page is open or tev is connected. */
+ * a page is open or tev is connected. While a page has its denoised preview
+ * on (or tev is to get a denoised layer), the renderer denoises frames on a
+ * thread of its own and hands the results to denoised(): the module holds
+ * no denoiser. */
 #ifndef PTR_LIVE_H
 #define PTR_LIVE_H
 
@@ -43,6 +46,9 @@ typedef struct PtrLiveOptions {
      * Returns 0 on success. */
     int (*view)(void *user, float *rgb, size_t pixels, float stops);
     void *view_user;
+    /* Whether tev gets the denoised image as a layer "denoised" beside the
+     * noisy RGB (the render denoises its output). */
+    int tev_denoised;
 } PtrLiveOptions;
 
 #define PTR_LIVE_MODULE_SYMBOL "ptr_live_module_table"
@@ -63,8 +69,16 @@ typedef struct PtrLiveModule {
     void (*begin)(PtrLiveSession *session, const char *scene, const char *output, int width,
                   int height);
     /* The image after a pass (width x height RGB of begin, scene-linear):
-     * copied, never kept. */
-    void (*frame)(PtrLiveSession *session, const float *rgb, const PtrLiveStatus *status);
+     * copied, never kept. Returns its number, which names its denoised
+     * image. */
+    uint64_t (*frame)(PtrLiveSession *session, const float *rgb, const PtrLiveStatus *status);
+    /* Whether a denoised image of the frames is wanted now: a page is open
+     * with its preview on, or tev_denoised. */
+    int (*denoise_wanted)(PtrLiveSession *session);
+    /* The denoised image of the frame numbered frame (the RGB of frame(),
+     * denoised): copied, never kept; ignored if it is of an earlier render
+     * or older than the denoised image the module has. */
+    void (*denoised)(PtrLiveSession *session, uint64_t frame, const float *rgb);
     /* The render ended (status->state says how); the page keeps its image. */
     void (*end)(PtrLiveSession *session, const PtrLiveStatus *status);
     /* Lets open pages fetch the last image (a second or two at most), stops the

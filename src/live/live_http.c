@@ -6,7 +6,8 @@
  *   GET /                the page (page.html)
  *   GET /events          Server-Sent Events: the state as JSON at each change
  *   GET /frame.png       the latest image, as the output's view shows it
- *   GET /exposure?stops=X  the page's exposure, on top of the output's */
+ *   GET /exposure?stops=X  the page's exposure, on top of the output's
+ *   GET /denoise?on=1|0  the page's denoised preview, on or off */
 #include "live/live_module.h"
 
 #include <errno.h>
@@ -202,11 +203,12 @@ static int format_event(const PtrLiveSession *s, char *buf, size_t size)
                     "data: {\"render\":%llu,\"scene\":\"%s\",\"output\":\"%s\",\"width\":%d,"
                     "\"height\":%d,\"frame\":%llu,\"samples\":%u,\"total\":%u,"
                     "\"elapsed\":%.2f,\"remaining\":%.2f,\"mrays\":%.2f,\"state\":\"%s\","
-                    "\"stops\":%g}\n\n",
+                    "\"stops\":%g,\"preview\":%s,\"denoised\":%s}\n\n",
                     (unsigned long long)s->render, scene, output, s->width, s->height,
                     (unsigned long long)s->png_id, st->samples_done, st->samples_total,
                     st->elapsed, st->remaining, st->mrays_per_second, state_name(st->state),
-                    (double)s->stops);
+                    (double)s->stops, s->preview_denoised ? "true" : "false",
+                    s->png_denoised ? "true" : "false");
 }
 
 static ssize_t read_events(void *cls, uint64_t pos, char *buf, size_t max)
@@ -279,6 +281,13 @@ static enum MHD_Result send_text(struct MHD_Connection *connection, unsigned sta
                          "text/plain; charset=utf-8");
 }
 
+/* A setting taken: no content. */
+static enum MHD_Result send_done(struct MHD_Connection *connection)
+{
+    return send_response(connection, MHD_HTTP_NO_CONTENT,
+                         MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT), NULL);
+}
+
 static enum MHD_Result serve_page(struct MHD_Connection *connection)
 {
     struct MHD_Response *r = MHD_create_response_from_buffer(
@@ -320,6 +329,7 @@ typedef struct FrameResponse {
     PtrLiveSession *session;
     unsigned char *png;
     size_t size;
+    int denoised;
 } FrameResponse;
 
 static ssize_t read_frame(void *cls, uint64_t pos, char *buf, size_t max)
@@ -357,17 +367,19 @@ static enum MHD_Result serve_frame(PtrLiveSession *s, struct MHD_Connection *con
         s->frames_sending++;
         pthread_cond_broadcast(&s->changed);
     }
-    int none = !s->png;
+    int none = !s->png, denoised = s->png_denoised;
     pthread_mutex_unlock(&s->lock);
     if (!copy) {
         free(f);
         return none ? send_text(connection, MHD_HTTP_NOT_FOUND, "no image yet\n") : MHD_NO;
     }
-    *f = (FrameResponse){ s, copy, size };
+    *f = (FrameResponse){ s, copy, size, denoised };
     struct MHD_Response *r =
         MHD_create_response_from_callback(size, FRAME_BLOCK, read_frame, f, release_frame);
     if (!r)
         release_frame(f);
+    else
+        MHD_add_response_header(r, "X-Ptr-Denoised", denoised ? "1" : "0");
     return send_response(connection, MHD_HTTP_OK, r, "image/png");
 }
 
@@ -386,8 +398,23 @@ static enum MHD_Result set_exposure(PtrLiveSession *s, struct MHD_Connection *co
         pthread_cond_broadcast(&s->changed);
     }
     pthread_mutex_unlock(&s->lock);
-    return send_response(connection, MHD_HTTP_NO_CONTENT,
-                         MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT), NULL);
+    return send_done(connection);
+}
+
+static enum MHD_Result set_preview(PtrLiveSession *s, struct MHD_Connection *connection)
+{
+    const char *text = MHD_lookup_connection_value(connection, MHD_GET_ARGUMENT_KIND, "on");
+    if (!text || (strcmp(text, "0") && strcmp(text, "1")))
+        return send_text(connection, MHD_HTTP_BAD_REQUEST, "on: 1 or 0\n");
+    pthread_mutex_lock(&s->lock);
+    int on = text[0] == '1';
+    if (on != s->preview_denoised) {
+        s->preview_denoised = on;
+        s->event++;
+        pthread_cond_broadcast(&s->changed);
+    }
+    pthread_mutex_unlock(&s->lock);
+    return send_done(connection);
 }
 
 static enum MHD_Result handle(void *cls, struct MHD_Connection *connection, const char *url,
@@ -417,6 +444,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *connection, cons
         return serve_frame(s, connection);
     if (!strcmp(url, "/exposure"))
         return set_exposure(s, connection);
+    if (!strcmp(url, "/denoise"))
+        return set_preview(s, connection);
     return send_text(connection, MHD_HTTP_NOT_FOUND, "not found\n");
 }
 

@@ -96,10 +96,24 @@ static unsigned char *view_to_bytes(PtrLiveSession *s, float *rgb, size_t pixels
     return bytes;
 }
 
+/* The image a page is to see (the lock held): the newest denoised frame
+ * while the preview is on and there is one of this render, else the newest
+ * frame; *frame is its number, *denoised whether it is denoised. */
+static const float *shown(const PtrLiveSession *s, uint64_t *frame, int *denoised)
+{
+    *denoised = s->preview_denoised && s->denoised_frame > 0;
+    *frame = *denoised ? s->denoised_frame : s->frame_version;
+    return *denoised ? s->denoised : s->frame;
+}
+
 static int encoding_wanted(const PtrLiveSession *s)
 {
+    uint64_t frame;
+    int denoised;
+    shown(s, &frame, &denoised);
     return s->pages > 0 && s->frame && s->frame_version > 0 &&
-           (s->png_frame != s->frame_version || s->png_stops != s->stops_version);
+           (s->png_frame != frame || s->png_denoised != denoised ||
+            s->png_stops != s->stops_version);
 }
 
 static void *encode_loop(void *arg)
@@ -133,9 +147,11 @@ static void *encode_loop(void *arg)
                 continue;
             }
         }
-        memcpy(work, s->frame, floats * sizeof *work);
+        uint64_t frame;
+        int denoised;
+        memcpy(work, shown(s, &frame, &denoised), floats * sizeof *work);
         int width = s->width, height = s->height;
-        uint64_t frame = s->frame_version, stops_version = s->stops_version;
+        uint64_t stops_version = s->stops_version;
         float stops = s->stops;
         pthread_mutex_unlock(&s->lock);
 
@@ -148,6 +164,7 @@ static void *encode_loop(void *arg)
         pthread_mutex_lock(&s->lock);
         /* A failure marks the frame as done: the next frame tries again. */
         s->png_frame = frame;
+        s->png_denoised = denoised;
         s->png_stops = stops_version;
         if (png) {
             free(s->png);
@@ -168,6 +185,7 @@ static void session_free(PtrLiveSession *s)
     pthread_cond_destroy(&s->changed);
     pthread_mutex_destroy(&s->lock);
     free(s->frame);
+    free(s->denoised);
     free(s->png);
     free(s);
 }
@@ -254,22 +272,53 @@ static void session_begin(PtrLiveSession *s, const char *scene, const char *outp
     s->width = width;
     s->height = height;
     s->render++;
+    s->render_frames = s->frame_version;
+    s->denoised_frame = 0;
     s->status = (PtrLiveStatus){ .remaining = -1, .state = PTR_LIVE_RENDERING };
     s->event++;
     pthread_cond_broadcast(&s->changed);
     pthread_mutex_unlock(&s->lock);
 }
 
-static void session_frame(PtrLiveSession *s, const float *rgb, const PtrLiveStatus *status)
+static uint64_t session_frame(PtrLiveSession *s, const float *rgb, const PtrLiveStatus *status)
 {
     pthread_mutex_lock(&s->lock);
     if (s->frame) {
         memcpy(s->frame, rgb, (size_t)s->width * (size_t)s->height * 3 * sizeof *rgb);
         s->frame_version++;
     }
+    uint64_t frame = s->frame_version;
     s->status = *status;
     s->event++;
     pthread_cond_broadcast(&s->changed);
+    pthread_mutex_unlock(&s->lock);
+    return frame;
+}
+
+static int session_denoise_wanted(PtrLiveSession *s)
+{
+    pthread_mutex_lock(&s->lock);
+    int wanted = (s->pages > 0 && s->preview_denoised) || (s->tev && s->options.tev_denoised);
+    pthread_mutex_unlock(&s->lock);
+    return wanted;
+}
+
+static void session_denoised(PtrLiveSession *s, uint64_t frame, const float *rgb)
+{
+    pthread_mutex_lock(&s->lock);
+    size_t floats = (size_t)s->width * (size_t)s->height * 3;
+    if (frame > s->render_frames && frame <= s->frame_version && frame > s->denoised_frame) {
+        if (floats > s->denoised_capacity) {
+            free(s->denoised);
+            s->denoised = malloc(floats * sizeof *s->denoised);
+            s->denoised_capacity = s->denoised ? floats : 0;
+        }
+        if (s->denoised) {
+            memcpy(s->denoised, rgb, floats * sizeof *rgb);
+            s->denoised_frame = frame;
+            pthread_cond_broadcast(&s->changed);
+        }
+    }
     pthread_mutex_unlock(&s->lock);
 }
 
@@ -289,6 +338,8 @@ __attribute__((visibility("default"))) const PtrLiveModule ptr_live_module_table
     .url = session_url,
     .begin = session_begin,
     .frame = session_frame,
+    .denoise_wanted = session_denoise_wanted,
+    .denoised = session_denoised,
     .end = session_end,
     .stop = session_stop,
 };

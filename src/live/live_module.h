@@ -28,18 +28,25 @@ struct PtrLiveSession {
     float *frame;           /* width x height RGB, scene-linear; NULL before a frame */
     size_t frame_capacity;  /* floats */
     uint64_t frame_version; /* frame() calls so far, over all renders */
+    uint64_t render_frames; /* frame_version when the render began: its frames are above */
+    float *denoised;        /* the newest denoised frame of this render, width x height RGB */
+    size_t denoised_capacity; /* floats */
+    uint64_t denoised_frame; /* the frame it is of; 0: none of this render */
     PtrLiveStatus status;
     uint64_t event;         /* changes a page should hear about */
 
-    /* The page: open event streams, its exposure, and the PNG of the view. */
+    /* The page: open event streams, its exposure, its denoised preview
+     * (on or off), and the PNG of the view. */
     int pages;
     void *streams;          /* live_http.c's list of them */
     float stops;
     uint64_t stops_version;
+    int preview_denoised;   /* the page's toggle: show denoised frames when there are */
     unsigned char *png;
     size_t png_size;
     uint64_t png_id;        /* encodings so far: the page asks for /frame.png?id */
     uint64_t png_frame, png_stops; /* the frame_version and stops_version it shows */
+    int png_denoised;       /* it shows the denoised image of png_frame */
     uint64_t served_frame;  /* the newest frame_version a page has fetched */
     int frames_sending;     /* /frame.png responses not yet sent in full */
     pthread_t encoder;

@@ -4,10 +4,12 @@
  * little-endian, strings ending in a zero byte. CreateImage (type 4) names
  * the image and its channels; UpdateImage (type 3) sends one channel of a
  * tile as floats. After each pass (at most every 250 ms) only the tiles
- * that changed are sent, linear RGB. A failed send closes the connection;
- * the next frame reconnects (at most once a second), creating the image
- * again, so a tev that restarts gets the whole image. The render never
- * waits for any of it. */
+ * that changed are sent, linear RGB; with tev_denoised, the newest denoised
+ * frame too, as channels denoised.R/G/B (tev's layer "denoised"), once
+ * there is one (the image is created again with them). A failed send
+ * closes the connection; the next frame reconnects (at most once a
+ * second), creating the image again, so a tev that restarts gets the whole
+ * image. The render never waits for any of it. */
 #define _GNU_SOURCE /* pthread_setname_np */
 #include "live/live_module.h"
 
@@ -30,15 +32,22 @@ enum {
 };
 static const double send_interval = 0.25, reconnect_interval = 1.0;
 
+/* The channels of the image, in the order of current's floats. */
+static const char *const channel_names[] = { "R", "G", "B", "denoised.R", "denoised.G",
+                                             "denoised.B" };
+
 struct LiveTev {
     char host[256], port[16];
     pthread_t thread;
     int fd;
     uint64_t sent_frame;  /* frame_version last sent */
+    uint64_t sent_denoised; /* denoised_frame last sent */
     uint64_t created;     /* the render whose image tev has */
     float *current, *previous; /* what this frame is, what tev has (NULL: nothing) */
     size_t capacity;
     int width, height;
+    int channels;         /* 3, or 6 with the denoised frame */
+    int created_channels; /* those of the image tev has */
     char name[256];
     unsigned char *message;
     size_t message_capacity;
@@ -115,8 +124,9 @@ static void put_header(Writer *w, const LiveTev *t, size_t size, unsigned char t
 
 static int send_create(LiveTev *t)
 {
-    static const char *const channels[] = { "R", "G", "B" };
-    size_t size = header_size(t) + 4 * 3 + 3 * 2;
+    size_t size = header_size(t) + 4 * 3;
+    for (int c = 0; c < t->channels; c++)
+        size += strlen(channel_names[c]) + 1;
     unsigned char *m = message_buffer(t, size);
     if (!m)
         return 0;
@@ -124,30 +134,32 @@ static int send_create(LiveTev *t)
     put_header(&w, t, size, TYPE_CREATE_IMAGE, 1);
     put_u32(&w, (uint32_t)t->width);
     put_u32(&w, (uint32_t)t->height);
-    put_u32(&w, 3);
-    for (int c = 0; c < 3; c++)
-        put_string(&w, channels[c]);
+    put_u32(&w, (uint32_t)t->channels);
+    for (int c = 0; c < t->channels; c++)
+        put_string(&w, channel_names[c]);
     return send_all(t->fd, m, size);
 }
 
 static int send_tile(LiveTev *t, int x0, int y0, int w, int h)
 {
-    static const char *const channels[] = { "R", "G", "B" };
-    for (int c = 0; c < 3; c++) {
-        size_t size = header_size(t) + 2 + 4 * 4 + 4 * (size_t)w * (size_t)h;
+    const size_t channels = (size_t)t->channels;
+    for (size_t c = 0; c < channels; c++) {
+        size_t size = header_size(t) + strlen(channel_names[c]) + 1 + 4 * 4 +
+                      4 * (size_t)w * (size_t)h;
         unsigned char *m = message_buffer(t, size);
         if (!m)
             return 0;
         Writer wr = { m };
         put_header(&wr, t, size, TYPE_UPDATE_IMAGE, 0);
-        put_string(&wr, channels[c]);
+        put_string(&wr, channel_names[c]);
         put_u32(&wr, (uint32_t)x0);
         put_u32(&wr, (uint32_t)y0);
         put_u32(&wr, (uint32_t)w);
         put_u32(&wr, (uint32_t)h);
         for (int y = y0; y < y0 + h; y++)
             for (int x = x0; x < x0 + w; x++)
-                put_float(&wr, t->current[((size_t)y * (size_t)t->width + (size_t)x) * 3 + (size_t)c]);
+                put_float(&wr,
+                          t->current[((size_t)y * (size_t)t->width + (size_t)x) * channels + c]);
         if (!send_all(t->fd, m, size))
             return 0;
     }
@@ -159,8 +171,9 @@ static int tile_changed(const LiveTev *t, int x0, int y0, int w, int h)
     if (!t->previous)
         return 1;
     for (int y = y0; y < y0 + h; y++) {
-        size_t at = ((size_t)y * (size_t)t->width + (size_t)x0) * 3;
-        if (memcmp(t->current + at, t->previous + at, (size_t)w * 3 * sizeof(float)))
+        size_t at = ((size_t)y * (size_t)t->width + (size_t)x0) * (size_t)t->channels;
+        if (memcmp(t->current + at, t->previous + at,
+                   (size_t)w * (size_t)t->channels * sizeof(float)))
             return 1;
     }
     return 0;
@@ -220,10 +233,12 @@ static int connect_to(const char *host, const char *port)
     return fd;
 }
 
-/* Copies the session's image into current (the lock held): 0 if none. */
+/* Copies the session's image, and its denoised frame if tev is to get it,
+ * into current (the lock held): 0 if none. */
 static int take_frame(PtrLiveSession *s, LiveTev *t)
 {
-    size_t floats = (size_t)s->width * (size_t)s->height * 3;
+    int channels = s->options.tev_denoised && s->denoised_frame > 0 ? 6 : 3;
+    size_t pixels = (size_t)s->width * (size_t)s->height, floats = pixels * (size_t)channels;
     if (!s->frame || s->frame_version == 0 || floats == 0)
         return 0;
     if (floats > t->capacity) {
@@ -236,11 +251,20 @@ static int take_frame(PtrLiveSession *s, LiveTev *t)
             return 0;
         t->created = 0;
     }
-    memcpy(t->current, s->frame, floats * sizeof(float));
-    if (t->created != s->render || t->width != s->width || t->height != s->height)
+    if (channels == 3) {
+        memcpy(t->current, s->frame, floats * sizeof(float));
+    } else {
+        for (size_t i = 0; i < pixels; i++) {
+            memcpy(t->current + 6 * i, s->frame + 3 * i, 3 * sizeof(float));
+            memcpy(t->current + 6 * i + 3, s->denoised + 3 * i, 3 * sizeof(float));
+        }
+    }
+    if (t->created != s->render || t->width != s->width || t->height != s->height ||
+        t->created_channels != channels)
         t->created = 0; /* a new image for tev */
     t->width = s->width;
     t->height = s->height;
+    t->channels = channels;
     const char *base = strrchr(s->output, '/');
     snprintf(t->name, sizeof t->name, "%s", base ? base + 1 : s->output);
     return 1;
@@ -254,7 +278,8 @@ static void *send_loop(void *arg)
     double last_send = -1e9, last_attempt = -1e9;
     pthread_mutex_lock(&s->lock);
     for (;;) {
-        int pending = s->frame_version != t->sent_frame && s->frame_version > 0;
+        int pending = (s->frame_version != t->sent_frame && s->frame_version > 0) ||
+                      (s->denoised_frame > 0 && s->denoised_frame != t->sent_denoised);
         if (s->stopping && (!pending || t->fd < 0))
             break; /* the last frame is sent, or there is no tev to send it to */
         double now = ptr_live_now();
@@ -265,9 +290,10 @@ static void *send_loop(void *arg)
             ptr_live_wait(s, wait);
             continue;
         }
-        uint64_t render = s->render, frame = s->frame_version;
+        uint64_t render = s->render, frame = s->frame_version, denoised = s->denoised_frame;
         if (!take_frame(s, t)) {
             t->sent_frame = frame;
+            t->sent_denoised = denoised;
             continue;
         }
         pthread_mutex_unlock(&s->lock);
@@ -280,6 +306,7 @@ static void *send_loop(void *arg)
         if (ok && !t->created) {
             ok = send_create(t);
             t->created = ok ? render : 0;
+            t->created_channels = t->channels;
             /* tev has nothing of this image yet */
             float *keep = t->previous;
             if (ok) {
@@ -300,9 +327,10 @@ static void *send_loop(void *arg)
         }
 
         pthread_mutex_lock(&s->lock);
-        if (ok)
+        if (ok) {
             t->sent_frame = frame;
-        else if (s->stopping)
+            t->sent_denoised = denoised;
+        } else if (s->stopping)
             break;
     }
     pthread_mutex_unlock(&s->lock);

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The page in a real browser: headless Chromium (through Selenium and
 chromedriver) opens --live's page while ptr renders, sees the image change
-as passes land and the progress advance, and at the end holds on its canvas
+as passes land and the progress advance, its exposure control brighten the
+image and its denoised preview's box reach ptr (on, then off: the image
+drawn last is as rendered), and at the end holds on its canvas
 the PNG ptr wrote (the same view), within 1/255. Exits 77 (skipped) only
 where Chromium, chromedriver or Selenium is missing, saying which.
 
@@ -18,7 +20,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from live_client import Ptr, samples as samples_for  # noqa: E402
+from live_client import Page, Ptr, read_ppm, samples as samples_for, wait_for  # noqa: E402
 
 SKIP = 77
 ptr, src = sys.argv[1], sys.argv[2]
@@ -97,12 +99,23 @@ def try_exposure(web, p, before):
     return result
 
 
-def read_ppm(path):
-    data = open(path, "rb").read()
-    parts = data.split(maxsplit=4)
-    if parts[0] != b"P6" or parts[3] != b"255":
-        raise ValueError(path + ": not an 8-bit PPM")
-    return int(parts[1]), int(parts[2]), parts[4]
+def try_preview(web, p, url):
+    """The denoised preview's toggle, on then off: ptr hears each (the state
+    it sends says so), and the page's box follows the state."""
+    listener = Page(url)
+    result = "on and off"
+    for on in (True, False):
+        web.execute_script("document.getElementById('denoise').click()")
+        heard = wait_for(lambda: any(s["preview"] == on for s in listener.states[-1:]), 10)
+        if p.process.poll() is not None:
+            result = "render ended first"
+            break
+        checked = web.execute_script("return document.getElementById('denoise').checked")
+        if not heard or checked != on:
+            result = "the toggle %s did not reach ptr or the page" % ("on" if on else "off")
+            break
+    listener.close()
+    return result
 
 
 def main():
@@ -132,7 +145,7 @@ def main():
                 print("FAIL: ptr printed no address: " + p.stderr, file=sys.stderr)
                 return 1
             web.get(url)
-            seen, samples, exposure = {}, [], "not tried"
+            seen, samples, exposure, preview = {}, [], "not tried", "not tried"
             while p.process.poll() is None:
                 w, h, frame, state, done, pixels = web.execute_script(CANVAS)
                 if w > 1:
@@ -143,9 +156,14 @@ def main():
                     screenshot = None
                 if exposure == "not tried" and len(seen) >= 2:
                     exposure = try_exposure(web, p, mean(pixels))
+                elif preview == "not tried" and exposure != "not tried":
+                    preview = try_preview(web, p, url)
                 time.sleep(0.2)
             check(exposure in ("brighter", "render ended first"),
                   "the exposure control: %s" % exposure)
+            check(preview in ("on and off", "render ended first") or
+                  (preview == "not tried" and exposure == "render ended first"),
+                  "the preview's toggle: %s" % preview)
             code = p.wait()
             check(code == 0, "ptr: exit %d: %s" % (code, p.stderr))
             # The page keeps the last image: wait for it to be drawn.
@@ -174,8 +192,9 @@ def main():
             worst = max(abs(rgba[4 * i + c] - reference[3 * i + c])
                         for i in range(w * h) for c in range(3))
             check(worst <= 1, "the canvas differs from the PNG by %d/255" % worst)
-            print("browser: %d images shown during the render; exposure +2: %s; the canvas is "
-                  "the PNG within %d/255" % (len(seen), exposure, worst))
+            print("browser: %d images shown during the render; exposure +2: %s; the preview's "
+                  "toggle: %s; the canvas is the PNG within %d/255"
+                  % (len(seen), exposure, preview, worst))
     if failures:
         return 1
     print("browser: passed")

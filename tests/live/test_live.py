@@ -1,22 +1,25 @@
 #!/usr/bin/env python3
 """--live: the server's routes, the address rules (loopback by default, a
 warning for any other, a port in use is one line and exit 2), images
-byte-identical with and without a page open, the page following a batch and
---watch, a slow request cut off, and a flood of malformed and slow requests
-during a render that neither crashes ptr nor stalls it.
+byte-identical with and without a page open, the denoised preview (its
+toggle, its frames, the image written unchanged by it), the page following a
+batch and --watch, a slow request cut off, and a flood of malformed and slow
+requests during a render that neither crashes ptr nor stalls it.
 
 Usage: test_live.py PTR SOURCE_DIR [SANITIZED]"""
 import os
 import random
 import shutil
 import socket
+import subprocess
 import sys
 import tempfile
 import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from live_client import Ptr, Page, get, same_image_bytes, samples, wait_for  # noqa: E402
+from live_client import (Ptr, Page, get, read_ppm, same_image_bytes, samples,  # noqa: E402
+                         wait_for)
 
 ptr, src = sys.argv[1], sys.argv[2]
 scene = os.path.join(src, "scenes", "seed.gltf")
@@ -92,6 +95,63 @@ def identical_with_page(d):
                             (last, b)) == 0, "the page's last frame is not the written PNG")
 
 
+def roughness(d, png):
+    """The mean difference between horizontal neighbours over a frame's
+    channels, from 0 to 255: what noise raises and denoising lowers."""
+    path = os.path.join(d, "roughness.png")
+    with open(path, "wb") as f:
+        f.write(png)
+    subprocess.run(["oiiotool", path, "-o", path + ".ppm"], check=True)
+    w, h, rgb = read_ppm(path + ".ppm")
+    steps = [abs(rgb[i] - rgb[i + 3])
+             for y in range(h) for i in range(3 * w * y, 3 * w * (y + 1) - 3)]
+    return sum(steps) / len(steps)
+
+
+def denoised_preview(d):
+    """With the page's toggle on, the frames become the denoised image of a
+    pass (the header X-Ptr-Denoised and the state say so, and they are
+    smoother than the noisy frames); off, noisy again. The image written is
+    the same bytes with the preview on. /denoise takes on=1 or on=0, nothing
+    else. With --watch, ptr serves after the render, so the last pass's
+    denoised image arrives with nothing left to wait for."""
+    a, b = os.path.join(d, "plain_preview.exr"), os.path.join(d, "preview.exr")
+    # Few samples, for a frame that is clearly noisy, on more pixels, for a
+    # render that lasts beyond its first pass.
+    plain(a, n=48, size=320)
+    p = Ptr(render(b, ["--live", "0", "--watch"], n=48, size=320))
+    url = p.url()
+    if not check(url, "--live --watch: no address: %s" % p.stderr):
+        p.process.kill()
+        return
+    for query in ["on=2", "on=", "", "on=true", "on=1x", "on=%00", "off=1", "on=" + "1" * 3000]:
+        status = get(url, "/denoise?" + query)[0]
+        check(status in (400, 414), "GET /denoise?%s: %d, not 400" % (query[:20], status))
+    check(get(url, "/denoise?on=1")[0] == 204, "GET /denoise?on=1: not 204")
+    page = Page(url)
+    denoised = lambda: [f for f in page.frames if f[2]]  # noqa: E731
+    check(wait_for(lambda: denoised() and any(s["state"] == "done" for s in page.states), 120),
+          "no denoised frame within 120 s: %d frames, stderr %s" % (len(page.frames), p.stderr))
+    check(same_image_bytes(a, b), "the image written with the preview on differs")
+    check(any(s["preview"] and s["denoised"] for s in page.states),
+          "no state said the frame shown is denoised")
+    check(get(url, "/denoise?on=0")[0] == 204, "GET /denoise?on=0: not 204")
+    # Off, the page gets the last pass as rendered: the same samples as the
+    # last denoised frame.
+    if check(wait_for(lambda: page.frames and not page.frames[-1][2], 30),
+             "the preview off: the last frame shown is still denoised") and denoised():
+        smooth, rough = roughness(d, denoised()[-1][1]), roughness(d, page.frames[-1][1])
+        check(smooth < 0.85 * rough, "the denoised frame is not smoother: %.2f against the "
+              "noisy frame's %.2f" % (smooth, rough))
+        print("preview: %d denoised frames of %d; roughness %.2f denoised, %.2f as rendered"
+              % (len(denoised()), len(page.frames), smooth, rough))
+    p.process.send_signal(2)
+    code = p.wait(30)
+    page.close()
+    check(code == 0 and "warning" not in p.stderr, "--watch stopped by SIGINT: exit %d: %s"
+          % (code, p.stderr))
+
+
 def addresses(d):
     out = os.path.join(d, "a.exr")
     # A port in use: one line, exit 2, and no render.
@@ -156,7 +216,9 @@ class Flood:
                    b"GET / HTTP/1.1\r\nHost: x\r\nContent-Length: -5\r\n\r\n",
                    b"GET / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\nzz\r\n",
                    b"GET /events HTTP/1.1\r\nHost: x\r\nRange: bytes=99999-\r\n\r\n",
-                   b"GET /frame.png?id=\xff\xfe HTTP/1.1\r\n\r\n"]
+                   b"GET /frame.png?id=\xff\xfe HTTP/1.1\r\n\r\n",
+                   b"GET /denoise?on=1 HTTP/1.1\r\n\r\n", b"GET /denoise?on=\x01 HTTP/1.1\r\n\r\n",
+                   b"GET /denoise?on=0&on=1&" + b"x=y&" * 3000 + b" HTTP/1.1\r\n\r\n"]
         while not self.stop:
             data = rng.choice(samples) if rng.random() < 0.7 else rng.randbytes(rng.randrange(1, 3000))
             self.attempt(lambda s: (s.sendall(data), s.recv(1024)))
@@ -318,6 +380,7 @@ def request_deadline(d):
 def main():
     with tempfile.TemporaryDirectory() as d:
         identical_with_page(d)
+        denoised_preview(d)
         addresses(d)
         follows(d)
         request_deadline(d)

@@ -8,6 +8,9 @@ rebuilds the image, which must be the EXR ptr writes, float for float.
 The stand-in drops the first connection after a few messages, as a tev
 that quits and restarts: ptr reconnects and sends the whole image again.
 Without any tev listening, the render is the same and takes no longer.
+With --denoise, tev gets the layer "denoised" beside the noisy RGB: at the
+end, the RGB is the EXR's noisy layer and the layer its denoised colour
+(--denoise fast: the preview's network; the same bits on any thread count).
 
 Usage: test_tev.py PTR SOURCE_DIR [SANITIZED]"""
 import os
@@ -155,17 +158,18 @@ class StandIn:
                                 (len(payload) - r.at, kind))
         self.messages[kind] += 1
 
-    def write_pfm(self, name, path):
+    def write_pfm(self, name, path, layer=""):
         image = self.images[name]
         width, height = image["size"]
         c = image["channels"]
+        r, g, b = (c[layer + n] for n in "RGB")
         with open(path, "wb") as f:
             f.write(b"PF\n%d %d\n-1.0\n" % (width, height))
             for y in reversed(range(height)):  # PFM rows run bottom to top
                 row = []
                 for x in range(width):
                     i = y * width + x
-                    row += [c["R"][i], c["G"][i], c["B"][i]]
+                    row += [r[i], g[i], b[i]]
                 f.write(struct.pack("<%df" % len(row), *row))
 
     def close(self):
@@ -175,6 +179,38 @@ class StandIn:
 def render(out, extra):
     return [ptr, scene, "-o", out, "--width", str(WIDTH), "--height", str(HEIGHT),
             "--samples", str(samples(400)), "--threads", "2", *extra]
+
+
+def same_pixels(a, b):
+    """Whether two images hold the same floats (idiff, no tolerance)."""
+    r = subprocess.run(["idiff", "-q", "-fail", "0", "-failpercent", "0", "-warn", "0", a, b],
+                       capture_output=True, text=True)
+    return r.returncode == 0, r.stdout
+
+
+def denoised_layer(d):
+    tev = StandIn()
+    out = os.path.join(d, "denoised.exr")
+    p = Ptr(render(out, ["--tev", "127.0.0.1:%d" % tev.port, "--denoise", "fast"]))
+    code = p.wait()
+    time.sleep(0.3)
+    tev.close()
+    check(code == 0 and not tev.errors, "--tev --denoise: exit %d, %s: %s"
+          % (code, tev.errors, p.stderr))
+    image = tev.images.get("denoised.exr", {"channels": {}})
+    names = list(image["channels"])
+    if not check(names == ["R", "G", "B", "denoised.R", "denoised.G", "denoised.B"],
+                 "--tev --denoise: channels %s" % names):
+        return
+    # tev's layer against the EXR's, each alone: idiff compares every channel.
+    for tev_layer, exr_channels, what in [
+            ("denoised.", "R,G,B", "tev's denoised layer is not the EXR's denoised colour"),
+            ("", "R=noisy.R,G=noisy.G,B=noisy.B", "tev's RGB is not the EXR's noisy layer")]:
+        got, written = os.path.join(d, "tev.pfm"), os.path.join(d, "layer.exr")
+        subprocess.run(["oiiotool", out, "--ch", exr_channels, "-o", written], check=True)
+        tev.write_pfm("denoised.exr", got, tev_layer)
+        same, why = same_pixels(got, written)
+        check(same, "%s: %s" % (what, why))
 
 
 def main():
@@ -196,9 +232,8 @@ def main():
         if "tev.exr" in tev.images:
             rebuilt = os.path.join(d, "rebuilt.pfm")
             tev.write_pfm("tev.exr", rebuilt)
-            r = subprocess.run(["idiff", "-q", "-fail", "0", "-failpercent", "0", "-warn", "0",
-                                rebuilt, out], capture_output=True, text=True)
-            check(r.returncode == 0, "the image tev got is not the EXR: %s" % r.stdout)
+            same, why = same_pixels(rebuilt, out)
+            check(same, "the image tev got is not the EXR: %s" % why)
 
         # No tev listening: the same image, no slower than the render above by much.
         closed = socket.socket()
@@ -215,6 +250,7 @@ def main():
         print("tev: %d connections, %d CreateImage and %d UpdateImage messages; render %.1f s "
               "streaming, %.1f s with no tev" % (tev.connections, tev.messages[4],
                                                  tev.messages[3], took, took_alone))
+        denoised_layer(d)
     if failures:
         return 1
     print("tev: passed")

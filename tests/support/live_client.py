@@ -77,7 +77,7 @@ def get(url, path, timeout=10):
 class Page:
     """What the page does, as a script: follows /events, and fetches
     /frame.png whenever the state names a new frame. states and frames
-    (id, PNG bytes) collect what it saw."""
+    (id, PNG bytes, whether ptr said it is denoised) collect what it saw."""
 
     def __init__(self, url):
         self.url = url
@@ -104,10 +104,10 @@ class Page:
                 state = json.loads(line[6:])
                 self.states.append(state)
                 if state["frame"] and state["frame"] != shown:
-                    status, _, body = get(self.url, "/frame.png?id=%d" % state["frame"])
+                    status, headers, body = get(self.url, "/frame.png?id=%d" % state["frame"])
                     if status == 200:
                         shown = state["frame"]
-                        self.frames.append((shown, body))
+                        self.frames.append((shown, body, headers.get("X-Ptr-Denoised") == "1"))
             c.close()
         except (OSError, http.client.HTTPException, ValueError) as e:
             if not self._stop:
@@ -156,3 +156,12 @@ def same_image_bytes(a, b):
     if a.endswith(".exr"):
         return exr_without_timings(a) == exr_without_timings(b)
     return open(a, "rb").read() == open(b, "rb").read()
+
+
+def read_ppm(path):
+    """(width, height, RGB bytes) of an 8-bit binary PPM (oiiotool's)."""
+    data = open(path, "rb").read()
+    parts = data.split(maxsplit=4)
+    if parts[0] != b"P6" or parts[3] != b"255":
+        raise ValueError(path + ": not an 8-bit PPM")
+    return int(parts[1]), int(parts[2]), parts[4]
