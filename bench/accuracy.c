@@ -261,7 +261,8 @@ static int denoise_curves(FILE *csv, const Bench *bench, const PtrScene *scene,
 }
 
 /* final.gltf and the molecule, at sizes whose 16,384-spp references take
- * 5 to 7 CPU-minutes each (under 15 minutes on 2 cores shared with others). */
+ * about 2 CPU-minutes each (8 minutes on 2 cores shared with heavy other
+ * work). */
 static int denoise_chart(FILE *csv, uint32_t max_spp, uint32_t ref_spp, const char *dir,
                          const char *only)
 {

@@ -14,8 +14,8 @@ set key bottom left
 methods = "raw fast balanced high"
 do for [scene in "final 1tii"] {
     set title scene eq "final" ? "final.gltf (486 spheres, 160x90)" : "1tii.pdb (5469 atoms, 96x72)"
-    plot for [m in methods] data using \
-        (strcol(1) eq scene && strcol(2) eq m ? $4 : NaN):(strcol(1) eq scene && strcol(2) eq m ? $6 : NaN) \
+    # Each curve's rows apart: the CSV interleaves the methods at each spp.
+    plot for [m in methods] sprintf("< grep '^%s,%s,' %s", scene, m, data) using 4:6 \
         with linespoints pointtype 7 pointsize 0.8 title m
 }
 unset multiplot
