@@ -12,7 +12,7 @@
  *       wanders by tens of per cent at low sample counts
  *   accuracy denoise OUT.csv [MAX_SPP] [REFERENCE_SPP] [REFERENCE_DIR] [SCENE]
  *       the raw render against its denoised image at each quality (the
- *       default estimator and intersector, the tree, as the CLI renders);
+ *       default estimator, intersector and structure, as the CLI renders);
  *       a row's seconds are the render's and the denoiser's together, the
  *       denoiser's also apart; the reference, which takes minutes, is kept
  *       in REFERENCE_DIR (raw floats, read back when its size matches);
