@@ -12,19 +12,11 @@ import subprocess
 import sys
 import tempfile
 
-SYSTEM_PYTHON = "/usr/bin/python3"
-try:
-    import numpy as np
-except ImportError:
-    # scripts/install-deps.sh installs Debian's python3-numpy, which only
-    # Debian's own python3 imports, not one that comes first in PATH (pyenv).
-    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
-        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
-    print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
-    sys.exit(77)
-
+# The reference first: without NumPy it runs this script again under
+# Debian's python3, or skips it.
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import denoise_reference  # noqa: E402
+import numpy as np  # noqa: E402
 
 # Each quality's networks: the colour's, then those filtering albedo and normal.
 WEIGHTS = {"balanced": ["rt_hdr_alb_nrm.tza"], "fast": ["rt_hdr_alb_nrm_small.tza"],

@@ -9,10 +9,21 @@ Denoise's description (docs/denoise.md), sharing no code with ptr's.
 
 COLOR, ALBEDO and NORMAL are raw little-endian float32 RGB, row by row; OUT
 is written the same way (float64 rounded to float32)."""
+import os
 import struct
 import sys
 
-import numpy as np
+SYSTEM_PYTHON = "/usr/bin/python3"
+try:
+    import numpy as np
+except ImportError:
+    # scripts/install-deps.sh installs Debian's python3-numpy, which only
+    # Debian's own python3 imports, not one that comes first in PATH (pyenv):
+    # the script run (this one or a check importing it) starts again there.
+    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
+    print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
+    sys.exit(77)
 
 
 def read_tza(path):
