@@ -6,13 +6,18 @@
  * peak; last, the seconds the convolutions alone take at those rates for a
  * 500x500 and a 1920x1080 image. Times are the threads' CPU clocks (a run
  * takes its slowest thread's), so that other processes' turns on the cores
- * do not count.
+ * do not count. Then the whole denoiser (ptr_denoise: pre- and
+ * post-processing, tiles, every layer) at each quality on synthetic images
+ * of those sizes: its wall-clock seconds and the CPU seconds of all its
+ * threads, from which the seconds on an otherwise idle machine follow
+ * (CPU seconds over threads, when the threads are kept busy).
  *
  *   denoise [TILE]          (default 512)
  *
  * FLOPs count what the kernel computes: 2 a fused multiply-add, channels
  * padded to 16 (the first layer's 9 inputs, the last's 3 outputs). */
 #define _DEFAULT_SOURCE /* getloadavg */
+#include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -23,6 +28,7 @@
 #include "base/cpu.h"
 #include "base/threads.h"
 #include "denoise/conv.h"
+#include "denoise/denoise.h"
 
 void ptr_fma_peak_avx2(uint64_t iterations);
 void ptr_fma_peak_avx512(uint64_t iterations);
@@ -217,6 +223,78 @@ static void bench_level(PtrCpuLevel level, size_t tile, int threads)
            image_seconds(rate_all, 500, 500), image_seconds(rate_all, 1920, 1080), threads);
 }
 
+static double clock_seconds(clockid_t clock)
+{
+    struct timespec ts;
+    clock_gettime(clock, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* A rendered image's look, without a renderer: colour with noise and a few
+ * fireflies, albedo in blocks, normals that turn across the image. */
+static void synthetic_image(float *color, float *albedo, float *normal, size_t width,
+                            size_t height)
+{
+    uint32_t state = 12345;
+    for (size_t y = 0; y < height; y++)
+        for (size_t x = 0; x < width; x++) {
+            size_t i = (y * width + x) * 3;
+            for (int c = 0; c < 3; c++) {
+                state = state * 1664525u + 1013904223u;
+                float noise = (float)(state >> 8) / 16777216.0f;
+                albedo[i + c] = 0.2f + 0.6f * (float)(((x / 32 + y / 32 + (size_t)c) % 3)) / 2;
+                color[i + c] = albedo[i + c] * 2.0f * noise * noise;
+            }
+            if (state % 997 == 0)
+                color[i] = color[i + 1] = color[i + 2] = 100.0f;
+            float nx = (float)x / (float)width - 0.5f, ny = (float)y / (float)height - 0.5f;
+            float nz = sqrtf(1.0f - nx * nx - ny * ny);
+            normal[i] = nx, normal[i + 1] = ny, normal[i + 2] = nz;
+        }
+}
+
+/* The whole denoiser at each quality and size: one run each, as a render
+ * calls it (weights loaded before). */
+static void bench_denoiser(int threads)
+{
+    static const char *const names[] = { "fast", "balanced", "high" };
+    static const size_t sizes[][2] = { { 500, 500 }, { 1920, 1080 } };
+    printf("\nthe whole denoiser (ptr_denoise), %d threads: wall seconds (CPU seconds of all "
+           "threads)\n%-9s", threads, "quality");
+    for (size_t s = 0; s < 2; s++)
+        printf(" %26zux%zu", sizes[s][0], sizes[s][1]);
+    printf("\n");
+    for (int q = PTR_DENOISE_FAST; q <= PTR_DENOISE_HIGH; q++) {
+        PtrDenoiser *denoiser;
+        PtrError err;
+        if (ptr_denoiser_new((PtrDenoiseQuality)q, NULL, ptr_cpu_level(), &denoiser, &err) !=
+            PTR_OK) {
+            printf("%-9s %s\n", names[q], err.message);
+            continue;
+        }
+        printf("%-9s", names[q]);
+        for (size_t s = 0; s < 2; s++) {
+            size_t width = sizes[s][0], height = sizes[s][1], n = width * height * 3;
+            float *color = floats(n, 0), *albedo = floats(n, 0), *normal = floats(n, 0);
+            synthetic_image(color, albedo, normal, width, height);
+            PtrDenoiseInput input = { color, albedo, normal, 3, 3, 3, width, height };
+            double wall = clock_seconds(CLOCK_MONOTONIC),
+                   cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
+            if (ptr_denoise(denoiser, &input, threads, color, 3, &err) != PTR_OK) {
+                fprintf(stderr, "denoise: %s\n", err.message);
+                exit(2);
+            }
+            wall = clock_seconds(CLOCK_MONOTONIC) - wall;
+            cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu;
+            printf(" %16.3f s (%6.3f s)", wall, cpu);
+            fflush(stdout);
+            free(color), free(albedo), free(normal);
+        }
+        printf("\n");
+        ptr_denoiser_free(denoiser);
+    }
+}
+
 int main(int argc, char **argv)
 {
     size_t tile = argc > 1 ? strtoul(argv[1], NULL, 10) : 512;
@@ -239,5 +317,6 @@ int main(int argc, char **argv)
     }
     for (int level = PTR_CPU_AVX2; level <= (int)top; level++)
         bench_level((PtrCpuLevel)level, tile, threads);
+    bench_denoiser(threads);
     return 0;
 }

@@ -12,19 +12,11 @@ import subprocess
 import sys
 import tempfile
 
-SYSTEM_PYTHON = "/usr/bin/python3"
-try:
-    import numpy as np
-except ImportError:
-    # scripts/install-deps.sh installs Debian's python3-numpy, which only
-    # Debian's own python3 imports, not one that comes first in PATH (pyenv).
-    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
-        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
-    print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
-    sys.exit(77)
-
+# The reference first: without NumPy it runs this script again under
+# Debian's python3, or skips it.
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import denoise_reference  # noqa: E402
+import numpy as np  # noqa: E402
 
 # Each quality's networks: the colour's, then those filtering albedo and normal.
 WEIGHTS = {"balanced": ["rt_hdr_alb_nrm.tza"], "fast": ["rt_hdr_alb_nrm_small.tza"],
@@ -40,20 +32,6 @@ if not all(os.path.isfile(os.path.join(weights_dir, f)) for fs in WEIGHTS.values
 
 failures = []
 work = tempfile.mkdtemp(prefix="ptr_denoise_")
-
-
-def scene(width, height, seed):
-    """Noisy HDR colour with a few very bright pixels, albedo in [0, 1],
-    unit normals (and one pixel that hit nothing), as float32."""
-    rng = np.random.default_rng(seed)
-    color = rng.gamma(0.8, 0.6, (height, width, 3))
-    for _ in range(3):
-        color[rng.integers(height), rng.integers(width)] = rng.uniform(1e2, 3e4, 3)
-    albedo = rng.uniform(0.0, 1.0, (height, width, 3))
-    normal = rng.normal(size=(height, width, 3))
-    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
-    normal[0, 0] = 0.0
-    return [a.astype("<f4") for a in (color, albedo, normal)]
 
 
 def run_ptr(quality, images, threads=1, tile=0, level=None):
@@ -75,7 +53,7 @@ def run_ptr(quality, images, threads=1, tile=0, level=None):
 
 
 def compare_with_reference(quality, width, height, seed):
-    images = scene(width, height, seed)
+    images = denoise_reference.test_images(width, height, seed)
     color_net, *guide_nets = [denoise_reference.read_tza(os.path.join(weights_dir, f))
                               for f in WEIGHTS[quality]]
     expected = denoise_reference.denoise(color_net, *(a.astype(np.float64) for a in images),
@@ -105,7 +83,7 @@ compare_with_reference("high", 40, 24, 5)
 
 levels = [os.environ["PTR_CPUMASK"]] if os.environ.get("PTR_CPUMASK") else ["none", "sse41",
                                                                             "avx2"]
-images = scene(40, 24, 1)
+images = denoise_reference.test_images(40, 24, 1)
 check_same("levels and threads",
            [(f"{level} with {threads} thread(s)", run_ptr("balanced", images, threads, 0, level))
             for level in levels for threads in (1, 2)])
@@ -113,7 +91,7 @@ check_same("levels and threads",
 # Tiles of 240 pixels (the smallest: 16 beyond twice the overlap) across a
 # 256-pixel side make two; each pixel is the untiled image's, bit for bit.
 for width, height in ((256, 24), (24, 256)):
-    images = scene(width, height, 4)
+    images = denoise_reference.test_images(width, height, 4)
     check_same(f"tiles of {width}x{height}",
                [("one tile", run_ptr("fast", images)),
                 ("tiles of 240", run_ptr("fast", images, 1, 240)),

@@ -9,10 +9,21 @@ Denoise's description (docs/denoise.md), sharing no code with ptr's.
 
 COLOR, ALBEDO and NORMAL are raw little-endian float32 RGB, row by row; OUT
 is written the same way (float64 rounded to float32)."""
+import os
 import struct
 import sys
 
-import numpy as np
+SYSTEM_PYTHON = "/usr/bin/python3"
+try:
+    import numpy as np
+except ImportError:
+    # scripts/install-deps.sh installs Debian's python3-numpy, which only
+    # Debian's own python3 imports, not one that comes first in PATH (pyenv):
+    # the script run (this one or a check importing it) starts again there.
+    if os.path.exists(SYSTEM_PYTHON) and not os.path.samefile(sys.executable, SYSTEM_PYTHON):
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
+    print("skipped: NumPy is not installed (scripts/install-deps.sh installs python3-numpy)")
+    sys.exit(77)
 
 
 def read_tza(path):
@@ -141,14 +152,21 @@ def srgb_inverse(x):
     return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))
 
 
-def run(tensors, planes):
-    """The network on the planes (H x W x C), padded with zeros at the right
-    and the bottom to a multiple of 16, so that every pooling halves exactly;
-    its 3 output channels, H x W x 3, negatives as 0."""
+def padded(planes):
+    """The planes (H x W x C) padded with zeros at the right and the bottom to
+    a multiple of 16, so that every pooling halves exactly."""
     h, w, c = planes.shape
-    x = np.zeros((c, -(-h // 16) * 16, -(-w // 16) * 16))
-    x[:, :h, :w] = planes.transpose(2, 0, 1)
-    return np.maximum(unet(tensors, x)[:3, :h, :w].transpose(1, 2, 0), 0.0)
+    x = np.zeros((-(-h // 16) * 16, -(-w // 16) * 16, c))
+    x[:h, :w] = planes
+    return x
+
+
+def run(tensors, planes):
+    """The network on the planes (H x W x C): its 3 output channels,
+    H x W x 3, negatives as 0."""
+    h, w, _ = planes.shape
+    out = unet(tensors, padded(planes).transpose(2, 0, 1))
+    return np.maximum(out[:3, :h, :w].transpose(1, 2, 0), 0.0)
 
 
 def denoise(tensors, color, albedo, normal, guide_filters=None):
@@ -160,11 +178,38 @@ def denoise(tensors, color, albedo, normal, guide_filters=None):
         albedo = np.minimum(srgb_inverse(run(albedo_net, srgb_forward(np.clip(albedo, 0, 1)))),
                             1.0)
         normal = np.clip(run(normal_net, np.clip(normal, -1, 1) * 0.5 + 0.5) * 2 - 1, -1, 1)
+    planes, scale = color_planes(color, albedo, normal)
+    return color_output(run(tensors, planes), scale)
+
+
+def color_planes(color, albedo, normal):
+    """The colour network's input, H x W x 9, and the exposure that scaled
+    the colour."""
     scale = autoexposure(np.maximum(np.nan_to_num(color, nan=0.0), 0.0))
     colour_in = pu_forward(np.maximum(np.nan_to_num(color, nan=0.0) * scale, 0.0)) * PU_NORM
     planes = np.concatenate([colour_in, np.clip(albedo, 0.0, 1.0),
                              np.clip(normal, -1.0, 1.0) * 0.5 + 0.5], axis=2)
-    return pu_inverse(run(tensors, planes) / PU_NORM) / scale
+    return planes, scale
+
+
+def color_output(out, scale):
+    """The colour network's output (H x W x 3, negatives as 0) back to linear
+    HDR colour."""
+    return pu_inverse(out / PU_NORM) / scale
+
+
+def test_images(width, height, seed):
+    """Noisy HDR colour with a few very bright pixels, albedo in [0, 1],
+    unit normals (and one pixel that hit nothing), as float32."""
+    rng = np.random.default_rng(seed)
+    color = rng.gamma(0.8, 0.6, (height, width, 3))
+    for _ in range(3):
+        color[rng.integers(height), rng.integers(width)] = rng.uniform(1e2, 3e4, 3)
+    albedo = rng.uniform(0.0, 1.0, (height, width, 3))
+    normal = rng.normal(size=(height, width, 3))
+    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+    normal[0, 0] = 0.0
+    return [a.astype("<f4") for a in (color, albedo, normal)]
 
 
 def main():
