@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "base/cpu.h"
+#include "base/threads.h"
 #include "gltf_accessors.h"
 #include "gltf_materials.h"
 
@@ -65,8 +67,8 @@ static PtrResult vertex_colors(Importer *im, const Origin *o, size_t mesh_index,
 /* Vertex v's values (see ColorSum): COLOR_0 times the linear base colour
  * texel, the linear emissive texel, the metallic-roughness texel's B and G;
  * 1 where there is none. */
-static PtrResult vertex_values(Importer *im, const VertexColors *vc, size_t v,
-                               float out[VALUES])
+static PtrResult vertex_values(GltfTextures *textures, const VertexColors *vc, size_t v,
+                               float out[VALUES], PtrError *err)
 {
     for (int k = 0; k < VALUES; k++)
         out[k] = 1.0f;
@@ -81,7 +83,7 @@ static PtrResult vertex_values(Importer *im, const VertexColors *vc, size_t v,
             continue;
         float texel[4];
         gltf_element(&vc->uv[r], v, e);
-        PtrResult res = gltf_textures_sample(im->textures, vc->refs[r], e, texel, im->err);
+        PtrResult res = gltf_textures_sample(textures, vc->refs[r], e, texel, err);
         if (res != PTR_OK)
             return res;
         if (r == 2) {
@@ -95,37 +97,108 @@ static PtrResult vertex_values(Importer *im, const VertexColors *vc, size_t v,
     return PTR_OK;
 }
 
-/* Adds the part's vertices to the sums of the components they belong to,
- * those whose material is the part's (their first triangle in it). */
+/* The part's vertices whose values are summed: those of sphere components
+ * whose material is the part's (their first triangle in it). */
+typedef struct PartVertices {
+    const SurfaceParts *s;
+    const SurfacePart *part;
+    const PtrMeshSphere *found;
+    const uint32_t *labels;
+} PartVertices;
+
+/* Vertex v's component (v from the part's first), or UINT32_MAX where its
+ * values are not summed. */
+static uint32_t summed_component(const PartVertices *pv, size_t v)
+{
+    const uint32_t c = pv->labels[pv->part->first_vertex + v];
+    if (c == UINT32_MAX || !pv->found[c].is_sphere ||
+        gltf_part_of(pv->s, pv->found[c].first_triangle, 1) != pv->part)
+        return UINT32_MAX;
+    return c;
+}
+
+static void add_values(ColorSum *sum, const float values[VALUES])
+{
+    for (int k = 0; k < VALUES; k++) {
+        if (!sum->vertices)
+            sum->first[k] = values[k];
+        sum->varies |= fabsf(values[k] - sum->first[k]) > 1e-6f;
+        sum->sum[k] += values[k];
+    }
+    sum->vertices++;
+}
+
+/* A part of this many vertices or more has its values read on all cores,
+ * COLOR_BLOCK vertices at a time; they are then added in the vertices'
+ * order, so that the sums do not depend on how many threads read them. */
+enum { PARALLEL_COLORS = 1 << 15, COLOR_BLOCK = 1 << 18 };
+
+/* The values of a block of a part's vertices, read on all cores. */
+typedef struct BlockValues {
+    const PartVertices *vertices;
+    GltfTextures *textures;
+    const VertexColors *vc;
+    size_t first;            /* the block's first vertex */
+    float (*values)[VALUES]; /* each summed vertex's, from the block's first */
+    atomic_size_t failed;    /* the least vertex whose values fail; SIZE_MAX: none */
+} BlockValues;
+
+/* Reads the values of vertices from .. to - 1 of the block; the textures
+ * they sample are decoded already, so that threads only read them. */
+static void read_values(void *arg, size_t from, size_t to)
+{
+    BlockValues *b = arg;
+    for (size_t v = from; v < to; v++)
+        if (summed_component(b->vertices, v) != UINT32_MAX &&
+            vertex_values(b->textures, b->vc, v, b->values[v - b->first], NULL) != PTR_OK) {
+            gltf_note_failure(&b->failed, v);
+            return;
+        }
+}
+
+/* Adds the part's summed vertices to the sums of their components. */
 static PtrResult add_part_colors(Importer *im, const Origin *o, size_t mesh_index,
-                                 const SurfaceParts *s, const SurfacePart *part,
-                                 const PtrMeshSphere *found, const uint32_t *labels,
-                                 ColorSum *sums)
+                                 const PartVertices *pv, ColorSum *sums)
 {
     GltfPrimitive prim;
     GltfMaterial g;
-    gltf_doc_primitive(im->doc, mesh_index, (size_t)part->primitive, &prim);
+    gltf_doc_primitive(im->doc, mesh_index, (size_t)pv->part->primitive, &prim);
     if (!gltf_colored_by_vertices(im, &prim))
         return PTR_OK;
     gltf_primitive_material(im, &prim, &g);
     VertexColors vc;
-    PtrResult res = vertex_colors(im, o, mesh_index, part, &prim, &g, &vc);
-    for (size_t v = 0; v < part->pos.count && res == PTR_OK; v++) {
-        const uint32_t c = labels[part->first_vertex + v];
-        if (c == UINT32_MAX || !found[c].is_sphere ||
-            gltf_part_of(s, found[c].first_triangle, 1) != part)
-            continue;
-        float values[VALUES];
-        res = vertex_values(im, &vc, v, values);
-        ColorSum *sum = &sums[c];
-        for (int k = 0; k < VALUES && res == PTR_OK; k++) {
-            if (!sum->vertices)
-                sum->first[k] = values[k];
-            sum->varies |= fabsf(values[k] - sum->first[k]) > 1e-6f;
-            sum->sum[k] += values[k];
+    PtrResult res = vertex_colors(im, o, mesh_index, pv->part, &prim, &g, &vc);
+    const size_t count = pv->part->pos.count;
+    size_t v = 0;
+    while (v < count && summed_component(pv, v) == UINT32_MAX)
+        v++;
+    /* The first summed vertex read here decodes the textures the part
+     * reads, or fails as a serial read does. */
+    float values[VALUES];
+    if (res != PTR_OK || v == count ||
+        (res = vertex_values(im->textures, &vc, v, values, im->err)) != PTR_OK)
+        return res;
+    BlockValues b = { .vertices = pv, .textures = im->textures, .vc = &vc,
+                      .values = malloc((count - v < COLOR_BLOCK ? count - v : COLOR_BLOCK) *
+                                       sizeof *b.values) };
+    if (!b.values)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+    const int threads = count >= PARALLEL_COLORS ? ptr_online_cpus() : 1;
+    for (; v < count && res == PTR_OK; v = b.first + COLOR_BLOCK) {
+        b.first = v;
+        const size_t end = count - v > COLOR_BLOCK ? v + COLOR_BLOCK : count;
+        atomic_init(&b.failed, SIZE_MAX);
+        ptr_parallel_ranges(threads, v, end, read_values, &b);
+        const size_t failed = atomic_load(&b.failed);
+        for (size_t u = v; u < end && res == PTR_OK; u++) {
+            const uint32_t c = summed_component(pv, u);
+            if (u == failed) /* read again for its message */
+                res = vertex_values(im->textures, &vc, u, values, im->err);
+            else if (c != UINT32_MAX)
+                add_values(&sums[c], b.values[u - v]);
         }
-        sum->vertices++;
     }
+    free(b.values);
     return res;
 }
 
@@ -165,8 +238,10 @@ PtrResult gltf_surface_colors(Importer *im, const Origin *o, size_t mesh_index,
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     }
     PtrResult res = PTR_OK;
-    for (size_t p = 0; p < s->count && res == PTR_OK; p++)
-        res = add_part_colors(im, o, mesh_index, s, &s->parts[p], found, labels, sums);
+    for (size_t p = 0; p < s->count && res == PTR_OK; p++) {
+        const PartVertices pv = { s, &s->parts[p], found, labels };
+        res = add_part_colors(im, o, mesh_index, &pv, sums);
+    }
     for (size_t c = 0, k = 0; c < components && res == PTR_OK; c++) {
         if (!found[c].is_sphere)
             continue;
