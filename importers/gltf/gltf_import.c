@@ -1,6 +1,5 @@
 /* glTF nodes to spheres, following docs/scenes.md: the default scene's
  * nodes walked, its cameras and extras read. */
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 

@@ -1,7 +1,6 @@
 /* A node's spheres (gltf_instances.h). */
 #include "gltf_instances.h"
 
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 

@@ -1,7 +1,6 @@
 /* Surface primitives as one mesh (gltf_parts.h). */
 #include "gltf_parts.h"
 
-#include <stdio.h>
 #include <string.h>
 
 #include "base/cpu.h"
