@@ -187,7 +187,7 @@ static PtrResult add_part_colors(Importer *im, const Origin *o, size_t mesh_inde
     for (; v < count && res == PTR_OK; v = b.first + COLOR_BLOCK) {
         b.first = v;
         const size_t end = count - v > COLOR_BLOCK ? v + COLOR_BLOCK : count;
-        atomic_init(&b.failed, SIZE_MAX);
+        atomic_store(&b.failed, SIZE_MAX);
         ptr_parallel_ranges(threads, v, end, read_values, &b);
         const size_t failed = atomic_load(&b.failed);
         for (size_t u = v; u < end && res == PTR_OK; u++) {
