@@ -21,7 +21,9 @@ void gltf_textures_free(GltfTextures *textures);
  * stored (RGBA, 8-bit values over 255), which a palette's texture
  * coordinates hit exactly. Fails with PTR_ERR_SCENE_INVALID, naming the
  * texture, for one that does not exist or cannot be decoded (KTX2, broken
- * bytes) and for coordinates that are not finite; PTR_ERR_NOMEM. */
+ * bytes) and for coordinates that are not finite; PTR_ERR_NOMEM. A texture
+ * is decoded at its first sample: threads may sample at once only textures
+ * sampled before (err NULL or their own). */
 PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
                                const double uv[2], float rgba[4], PtrError *err);
 
