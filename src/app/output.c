@@ -172,6 +172,9 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
     const float *noisy = NULL;
     float *denoised = NULL;
     if (info->denoiser) {
+        if (!info->albedo || !info->normal)
+            return ptr_error_set(err, PTR_ERR_INTERNAL, "%s: a denoiser without the passes",
+                                 path);
         PtrResult res = denoise(path, layout, rgb, info, &denoised, err);
         if (res != PTR_OK)
             return res;
