@@ -10,6 +10,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "app/signals.h"
+#include "denoise/conv.h"
 #include "denoise/denoise.h"
 #include "render/film.h"
 
@@ -177,8 +179,9 @@ static void *preview_loop(void *arg)
     const double cores = ptr_online_cpus();
     Work w = { 0 };
     pthread_mutex_lock(&p->lock);
-    /* Stopping, a frame still waiting is denoised: the render's last. */
-    while (!p->stopping || p->pending.number) {
+    /* Stopping, a frame still waiting is denoised (the render's last),
+     * unless the process was asked to stop. */
+    while (!p->stopping || (p->pending.number && !ptr_stop_requested)) {
         if (!p->pending.number) {
             pthread_cond_wait(&p->changed, &p->lock);
             continue;
@@ -207,6 +210,14 @@ static void *preview_loop(void *arg)
 PtrResult ptr_live_preview_new(PtrCpuLevel level, PtrLivePreviewDone done, void *user,
                                PtrLivePreview **out, PtrError *err)
 {
+    /* The C reference runs the network at a fraction of a GFLOP/s: minutes
+     * a frame, and a stop that waits for the frame under way. */
+    PtrConvTable conv;
+    ptr_conv_init_level(&conv, level);
+    if (conv.conv3x3 == ptr_conv3x3_c)
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "no vector convolution at CPU level '%s' (AVX2 and up)",
+                             ptr_cpu_level_name(level));
     PtrLivePreview *p = calloc(1, sizeof *p);
     if (!p)
         return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoised preview");

@@ -27,12 +27,12 @@ typedef struct PtrLivePreview PtrLivePreview;
 typedef void (*PtrLivePreviewDone)(void *user, uint64_t frame, const float *rgb);
 
 /* Loads the small network's weights for this CPU level and starts the
- * thread: PTR_ERR_INSTALL (a missing weight file), PTR_ERR_NOMEM,
- * PTR_ERR_INTERNAL. */
+ * thread: PTR_ERR_USAGE at a level whose convolution is the C reference,
+ * PTR_ERR_INSTALL (a missing weight file), PTR_ERR_NOMEM, PTR_ERR_INTERNAL. */
 PtrResult ptr_live_preview_new(PtrCpuLevel level, PtrLivePreviewDone done, void *user,
                                PtrLivePreview **out, PtrError *err);
-/* Denoises the frame handed over last if it is not yet, then stops the
- * thread. */
+/* Denoises the frame handed over last if it is not yet (unless a signal
+ * asked the process to stop), then stops the thread. */
 void ptr_live_preview_free(PtrLivePreview *preview);
 
 /* A render starts: what its passes are rendered from if its film has none.

@@ -51,12 +51,16 @@ PtrResult ptr_live_view_open(const PtrOptions *o, const PtrColor *color, PtrErro
     if (o->live)
         fprintf(stderr, "ptr: live view at %s\n", module->url(session));
     /* The live view works without it: a missing weight file costs the
-     * preview only, said once. */
+     * preview only, said once as the broken installation it is; a CPU level
+     * without the vector convolution, said once as a fact. */
     PtrError why;
-    if ((o->live || options.tev_denoised) &&
-        ptr_live_preview_new(o->cpu_level, hand_denoised, NULL, &preview, &why) != PTR_OK)
-        fprintf(stderr, "ptr: warning: the live view has no denoised preview: %s\n",
-                why.message);
+    PtrResult without = o->live || options.tev_denoised
+                            ? ptr_live_preview_new(o->cpu_level, hand_denoised, NULL,
+                                                   &preview, &why)
+                            : PTR_OK;
+    if (without != PTR_OK)
+        fprintf(stderr, "ptr: %sthe live view has no denoised preview: %s\n",
+                without == PTR_ERR_USAGE ? "" : "warning: ", why.message);
     return PTR_OK;
 }
 

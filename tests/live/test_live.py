@@ -19,7 +19,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
 from live_client import (Ptr, Page, get, read_ppm, same_image_bytes, samples,  # noqa: E402
-                         wait_for)
+                         vector_convolution, wait_for)
 
 ptr, src = sys.argv[1], sys.argv[2]
 scene = os.path.join(src, "scenes", "seed.gltf")
@@ -116,6 +116,13 @@ def denoised_preview(d):
     else. With --watch, ptr serves after the render, so the last pass's
     denoised image arrives with nothing left to wait for."""
     a, b = os.path.join(d, "plain_preview.exr"), os.path.join(d, "preview.exr")
+    if not vector_convolution(ptr):
+        p = Ptr(render(b, ["--live", "0"], n=4))
+        code = p.wait()
+        check(code == 0 and "no denoised preview: no vector convolution" in p.stderr,
+              "--live below AVX2: exit %d, no line saying there is no preview: %s"
+              % (code, p.stderr))
+        return
     # Few samples, for a frame that is clearly noisy, on more pixels, for a
     # render that lasts beyond its first pass.
     plain(a, n=48, size=320)

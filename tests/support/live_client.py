@@ -165,3 +165,12 @@ def read_ppm(path):
     if parts[0] != b"P6" or parts[3] != b"255":
         raise ValueError(path + ": not an 8-bit PPM")
     return int(parts[1]), int(parts[2]), parts[4]
+
+
+def vector_convolution(ptr):
+    """Whether the CPU level in use has the denoiser's vector convolution
+    (the fourth column of --print-dispatch's row "<- in use"): below it the
+    live view has no denoised preview."""
+    out = subprocess.run([ptr, "--print-dispatch"], capture_output=True, text=True).stdout
+    row = next(line.split() for line in out.splitlines() if "<- in use" in line)
+    return row[3] != "c"
