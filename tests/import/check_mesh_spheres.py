@@ -14,6 +14,10 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - cube, torus, plane, cylinder, each alone: no sphere, the warning;
 - mixed: spheres, a cube and a torus joined, with a degenerate triangle of
   its own: the spheres, and one warning counting 3 parts and naming the node;
+- nan: a sphere and 200,001 vertices whose positions are NaN, unwelded in
+  one primitive: the sphere, and each NaN triangle a part not drawn (a NaN
+  position equals nothing, so matching positions stays linear: kept, they
+  would all probe one chain of the table, minutes of import);
 - a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
   ", ..." to fit the line;
 - OBJ: an object of two joined spheres and a cube named like a sphere: the
@@ -155,6 +159,20 @@ def main():
         path = os.path.join(folder, "mixed.glb")
         w.write(path)
         expect(path, [((0, 0, 0), 1, 0), ((8, 0, 0), 1, 0)], 3, ["node 'Mixed' (mesh 'MixedMesh')"])
+
+        # NaN positions, unwelded: each triangle its own part, not drawn.
+        nan = float("nan")
+        count = 66667
+        bad = ([[nan] * 3] * (3 * count), [(3 * k, 3 * k + 1, 3 * k + 2) for k in range(count)])
+        w = mf.Writer()
+        w.node("Nan", w.mesh("NanMesh", [(mf.combine(mf.unweld(mf.uv_sphere((1, 2, 3), 1.5)),
+                                                     bad), 0)]))
+        positions = w.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+        for bound in ("min", "max"):  # NaN is not JSON
+            del w.doc["accessors"][positions][bound]
+        path = os.path.join(folder, "nan.glb")
+        w.write(path)
+        expect(path, [((1, 2, 3), 1.5, 0)], count, ["node 'Nan' (mesh 'NanMesh')"])
 
         # One mesh, a cube, under 40 nodes: 40 parts, the names cut with "...".
         w = mf.Writer()
