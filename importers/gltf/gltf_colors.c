@@ -6,6 +6,7 @@
 
 #include "base/cpu.h"
 #include "base/threads.h"
+#include "scene/colormap.h"
 #include "gltf_accessors.h"
 #include "gltf_materials.h"
 
@@ -91,7 +92,7 @@ static PtrResult vertex_values(GltfTextures *textures, const VertexColors *vc, s
             out[7] = texel[1];
         } else {
             for (int k = 0; k < 3; k++)
-                out[3 * r + k] *= (float)gltf_srgb_to_linear(texel[k]);
+                out[3 * r + k] *= ptr_srgb_to_linear(texel[k]);
         }
     }
     return PTR_OK;

@@ -119,8 +119,3 @@ PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref
         rgba[k] = t->rgba[4 * (y * (size_t)t->width + x) + (size_t)k];
     return PTR_OK;
 }
-
-double gltf_srgb_to_linear(double encoded)
-{
-    return encoded <= 0.04045 ? encoded / 12.92 : pow((encoded + 0.055) / 1.055, 2.4);
-}
