@@ -6,7 +6,8 @@ that counts and names it, never drawn as its bounding sphere.
 Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - joined: spheres in one primitive (welded, one turned so its bounds are not
   its sphere's), and two more in a second primitive of another material;
-- unwelded: every triangle its own vertices (components by position);
+- unwelded: every triangle its own vertices (components by position), and
+  a sphere whose hemispheres meet at y = +0 on one side, -0 on the other;
 - many: 300 unwelded spheres and two cubes over two primitives, one sphere
   split across them, enough for the components to be found on all cores;
 - quantised: normalised 16-bit and plain 8-bit positions, scaled back by the
@@ -109,6 +110,21 @@ def main():
         path = os.path.join(folder, "unwelded.glb")
         w.write(path)
         expect(path, [((1, 2, 3), 1.5, 0), ((6, 2, 3), 0.5, 0)], 0)
+
+        # Unwelded with signed zeros: -0 and +0 are one position (they
+        # compare equal). The hemispheres meet only at the equator, y = +0
+        # in the northern's triangles and -0 in the southern's: one sphere.
+        verts, tris = mf.unweld(mf.uv_sphere((0, 0, 0), 1))
+        verts = [[x, 0.0 if abs(y) < 1e-9 else y, z] for x, y, z in verts]
+        for t in range(0, len(verts), 3):
+            if min(v[1] for v in verts[t:t + 3]) < 0:
+                for v in verts[t:t + 3]:
+                    v[1] = -0.0 if v[1] == 0 else v[1]
+        w = mf.Writer()
+        w.node("zeros", w.mesh("zeros", [((verts, tris), 0)]))
+        path = os.path.join(folder, "signed_zeros.glb")
+        w.write(path)
+        expect(path, [((0, 0, 0), 1, 0)], 0)
 
         # Many: enough vertices and triangles that the components are found
         # on all cores; unwelded, over two primitives, with a cube among the
