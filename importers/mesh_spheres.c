@@ -124,25 +124,34 @@ static size_t partition_of(const PositionMatch *pm, uint64_t hash)
     return pm->bits ? (size_t)(hash >> (64 - pm->bits)) : 0;
 }
 
-/* The hashes of vertices v .. end - 1, at most a block of them: how many. */
-static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t *hash)
+/* The vertices among v .. end - 1 (at most a block of them) that can equal
+ * another, with their hashes: how many. A position with a NaN equals
+ * nothing, so it is left out: kept, all NaNs of one bit pattern would
+ * share a hash and every one would probe past all the earlier ones. */
+static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t *hash,
+                         uint32_t *vertex)
 {
     double p[BLOCK][3];
     const size_t count = end - v < BLOCK ? end - v : BLOCK;
     pm->mesh->positions(pm->mesh->user, v, count, p);
+    size_t kept = 0;
     for (size_t i = 0; i < count; i++)
-        hash[i] = position_hash(p[i]);
-    return count;
+        if (!isnan(p[i][0]) && !isnan(p[i][1]) && !isnan(p[i][2])) {
+            hash[kept] = position_hash(p[i]);
+            vertex[kept++] = (uint32_t)(v + i);
+        }
+    return kept;
 }
 
 static void count_slices(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
     uint64_t hash[BLOCK];
+    uint32_t vertex[BLOCK];
     for (size_t s = from; s < to; s++) {
         size_t *count = &pm->next[s * pm->partitions];
         for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
-            for (size_t i = 0, n = hash_block(pm, v, end, hash); i < n; i++)
+            for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++)
                 count[partition_of(pm, hash[i])]++;
     }
 }
@@ -158,12 +167,13 @@ static void place_slices(void *arg, size_t from, size_t to)
     Keyed (*line)[LINE] = malloc(pm->partitions * sizeof *line);
     unsigned char *held = calloc(pm->partitions, 1);
     uint64_t hash[BLOCK];
+    uint32_t vertex[BLOCK];
     for (size_t s = from; line && held && s < to; s++) {
         size_t *next = &pm->next[s * pm->partitions];
         for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
-            for (size_t i = 0, n = hash_block(pm, v, end, hash); i < n; i++) {
+            for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++) {
                 const size_t p = partition_of(pm, hash[i]);
-                line[p][held[p]++] = (Keyed){ (uint32_t)hash[i], (uint32_t)(v + i) };
+                line[p][held[p]++] = (Keyed){ (uint32_t)hash[i], vertex[i] };
                 if (held[p] == LINE) {
                     memcpy(&pm->keyed[next[p]], line[p], sizeof line[p]);
                     next[p] += LINE;

@@ -91,7 +91,7 @@ static PtrResult vertex_values(GltfTextures *textures, const VertexColors *vc, s
             out[7] = texel[1];
         } else {
             for (int k = 0; k < 3; k++)
-                out[3 * r + k] *= (float)gltf_srgb_to_linear(texel[k]);
+                out[3 * r + k] *= gltf_textures_srgb_to_linear(textures, texel[k]);
         }
     }
     return PTR_OK;

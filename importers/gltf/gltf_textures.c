@@ -4,6 +4,8 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "scene/colormap.h"
+
 /* A texture as decoded, or why it cannot be. */
 typedef struct Decoded {
     int state; /* UNREAD, READ or FAILED */
@@ -14,12 +16,20 @@ typedef struct Decoded {
 
 enum { UNREAD, READ, FAILED };
 
+/* 8-bit texels: the 256 values n / 255, in both of the forms a decoder
+ * may give them (divided by 255, or times 1 / 255, which differ in the last
+ * bit for 126 of them), and the sRGB decoding of each, so that a texel of
+ * an 8-bit texture (palettes' are) is decoded once, not through pow at
+ * every vertex. */
+enum { BYTE_VALUES = 256, BYTE_FORMS = 2 };
+
 struct GltfTextures {
     const GltfDoc *doc;
     const char *path;
     PtrTextureDecoder decoder;
     Decoded *textures; /* one a texture of the file */
     size_t count;
+    float byte_value[BYTE_FORMS][BYTE_VALUES], byte_linear[BYTE_FORMS][BYTE_VALUES];
 };
 
 PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
@@ -32,7 +42,14 @@ PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
         free(t);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     }
-    *t = (GltfTextures){ doc, path, *decoder, textures, count };
+    *t = (GltfTextures){ doc, path, *decoder, textures, count, { { 0 } }, { { 0 } } };
+    const volatile float reciprocal = 1.0f / 255.0f; /* not folded into a division */
+    for (int n = 0; n < BYTE_VALUES; n++) {
+        t->byte_value[0][n] = (float)n / 255.0f;
+        t->byte_value[1][n] = (float)n * reciprocal;
+        for (int f = 0; f < BYTE_FORMS; f++)
+            t->byte_linear[f][n] = ptr_srgb_to_linear(t->byte_value[f][n]);
+    }
     *out = t;
     return PTR_OK;
 }
@@ -120,7 +137,14 @@ PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref
     return PTR_OK;
 }
 
-double gltf_srgb_to_linear(double encoded)
+float gltf_textures_srgb_to_linear(const GltfTextures *textures, float encoded)
 {
-    return encoded <= 0.04045 ? encoded / 12.92 : pow((encoded + 0.055) / 1.055, 2.4);
+    const float scaled = encoded * 255.0f;
+    if (scaled >= 0.0f && scaled <= 255.0f) { /* not NaN */
+        const int n = (int)(scaled + 0.5f);
+        for (int f = 0; f < BYTE_FORMS; f++)
+            if (textures->byte_value[f][n] == encoded)
+                return textures->byte_linear[f][n];
+    }
+    return ptr_srgb_to_linear(encoded);
 }

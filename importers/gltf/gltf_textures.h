@@ -27,7 +27,8 @@ void gltf_textures_free(GltfTextures *textures);
 PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
                                const double uv[2], float rgba[4], PtrError *err);
 
-/* An sRGB-encoded value (base colour and emissive textures) made linear. */
-double gltf_srgb_to_linear(double encoded);
+/* An sRGB-encoded texel value (base colour and emissive textures) made
+ * linear: ptr_srgb_to_linear's value, from a table for 8-bit values. */
+float gltf_textures_srgb_to_linear(const GltfTextures *textures, float encoded);
 
 #endif /* PTR_GLTF_TEXTURES_H */

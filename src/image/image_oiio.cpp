@@ -88,13 +88,18 @@ PtrResult write_image(const char *file, const char *name, const PtrImageLayout *
 // error: ..." itself before it hands OpenImageIO the message (its default
 // handler runs after OpenImageIO's returns), and ptr says what failed in
 // one line of its own: so while a texture (bytes in memory) decodes, which
-// an import does before any render thread starts, stderr is quiet.
+// an import does before any render thread starts, stderr is quiet. No
+// option of OpenImageIO 2.4 keeps libpng quiet (libpng's png_error calls
+// the default handler whenever the reader's returns). If stderr cannot be
+// saved, it is left as it is: a stray line beats losing it for good.
 class QuietStderr {
 public:
     QuietStderr()
     {
         std::fflush(stderr);
         saved_ = dup(STDERR_FILENO);
+        if (saved_ < 0)
+            return;
         const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
         if (null >= 0) {
             dup2(null, STDERR_FILENO);

@@ -23,7 +23,10 @@ PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, doubl
 
 float ptr_srgb_to_linear(float c)
 {
-    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+    /* In double, rounded once at the end: the float result nearest the
+     * standard's, which powf's own rounding and the float constants miss by
+     * a last bit for some inputs. */
+    return (float)(c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4));
 }
 
 PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, double hi)

@@ -6,7 +6,8 @@ that counts and names it, never drawn as its bounding sphere.
 Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - joined: spheres in one primitive (welded, one turned so its bounds are not
   its sphere's), and two more in a second primitive of another material;
-- unwelded: every triangle its own vertices (components by position);
+- unwelded: every triangle its own vertices (components by position), and
+  a sphere whose hemispheres meet at y = +0 on one side, -0 on the other;
 - many: 300 unwelded spheres and two cubes over two primitives, one sphere
   split across them, enough for the components to be found on all cores;
 - quantised: normalised 16-bit and plain 8-bit positions, scaled back by the
@@ -14,6 +15,10 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - cube, torus, plane, cylinder, each alone: no sphere, the warning;
 - mixed: spheres, a cube and a torus joined, with a degenerate triangle of
   its own: the spheres, and one warning counting 3 parts and naming the node;
+- nan: a sphere and 200,001 vertices whose positions are NaN, unwelded in
+  one primitive: the sphere, and each NaN triangle a part not drawn (a NaN
+  position equals nothing, so matching positions stays linear: kept, they
+  would all probe one chain of the table, minutes of import);
 - a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
   ", ..." to fit the line;
 - OBJ: an object of two joined spheres and a cube named like a sphere: the
@@ -106,6 +111,21 @@ def main():
         w.write(path)
         expect(path, [((1, 2, 3), 1.5, 0), ((6, 2, 3), 0.5, 0)], 0)
 
+        # Unwelded with signed zeros: -0 and +0 are one position (they
+        # compare equal). The hemispheres meet only at the equator, y = +0
+        # in the northern's triangles and -0 in the southern's: one sphere.
+        verts, tris = mf.unweld(mf.uv_sphere((0, 0, 0), 1))
+        verts = [[x, 0.0 if abs(y) < 1e-9 else y, z] for x, y, z in verts]
+        for t in range(0, len(verts), 3):
+            if min(v[1] for v in verts[t:t + 3]) < 0:
+                for v in verts[t:t + 3]:
+                    v[1] = -0.0 if v[1] == 0 else v[1]
+        w = mf.Writer()
+        w.node("zeros", w.mesh("zeros", [((verts, tris), 0)]))
+        path = os.path.join(folder, "signed_zeros.glb")
+        w.write(path)
+        expect(path, [((0, 0, 0), 1, 0)], 0)
+
         # Many: enough vertices and triangles that the components are found
         # on all cores; unwelded, over two primitives, with a cube among the
         # spheres of each and a sphere split across them (joined by position,
@@ -155,6 +175,20 @@ def main():
         path = os.path.join(folder, "mixed.glb")
         w.write(path)
         expect(path, [((0, 0, 0), 1, 0), ((8, 0, 0), 1, 0)], 3, ["node 'Mixed' (mesh 'MixedMesh')"])
+
+        # NaN positions, unwelded: each triangle its own part, not drawn.
+        nan = float("nan")
+        count = 66667
+        bad = ([[nan] * 3] * (3 * count), [(3 * k, 3 * k + 1, 3 * k + 2) for k in range(count)])
+        w = mf.Writer()
+        w.node("Nan", w.mesh("NanMesh", [(mf.combine(mf.unweld(mf.uv_sphere((1, 2, 3), 1.5)),
+                                                     bad), 0)]))
+        positions = w.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+        for bound in ("min", "max"):  # NaN is not JSON
+            del w.doc["accessors"][positions][bound]
+        path = os.path.join(folder, "nan.glb")
+        w.write(path)
+        expect(path, [((1, 2, 3), 1.5, 0)], count, ["node 'Nan' (mesh 'NanMesh')"])
 
         # One mesh, a cube, under 40 nodes: 40 parts, the names cut with "...".
         w = mf.Writer()
