@@ -156,8 +156,13 @@ unsigned residue_kind(const gemmi::Residue &residue)
     return PTR_STRUCTURE_LIGAND;
 }
 
-// One atom in several places: chain, residue number, insertion code, name.
-using AtomKey = std::tuple<std::string, int, char, std::string>;
+// One atom in several places: chain, subchain, residue number, insertion
+// code, name. An atom's alternate locations are within one residue of one
+// subchain (mmCIF label_asym_id); two subchains of one chain may number
+// residues alike, and their atoms are not alternates of each other. An atom
+// and the one it replaces thus share their part, whose count of atoms stays
+// right.
+using AtomKey = std::tuple<std::string, std::string, int, char, std::string>;
 
 // The atoms kept, and the parts they belong to (StructureAtom.part): for
 // each, its chain's name, its subchain's (which an assembly's generators
@@ -259,7 +264,7 @@ Selection select_atoms(const std::string &path, const gemmi::Structure &st,
                     part.first->second };
                 residue.name.copy(atom.residue, sizeof atom.residue - 1);
                 if (a.altloc) {
-                    const AtomKey key{ chain.name, residue.seqid.num.value,
+                    const AtomKey key{ chain.name, residue.subchain, residue.seqid.num.value,
                                        residue.seqid.icode, a.name };
                     const auto found = first_of.find(key);
                     if (found != first_of.end()) {
