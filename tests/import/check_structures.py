@@ -159,6 +159,12 @@ for name, atoms in (("structure_altloc_across_subchains_winner.cif",
     expect(f"{name}: {got}, not {want}", len(got) == len(want) and all(
         math.dist(g, w) < 1e-4 for g, w in zip(got, want)))
 
+# An assembly not asked for is not expanded: the asymmetric unit of a file
+# whose only assembly asks for too many operators.
+got = dump(os.path.join(hostile, "structure_assembly_many_rows.cif"), "--assembly", "none")
+expect(f"structure_assembly_many_rows.cif --assembly none: {len(got)} spheres, not 2",
+       len(got) == 2)
+
 # Hostile files (tests/fixtures/hostile; test_hostile.sh runs them under time
 # and memory bounds): exit 4 and the problem named, in one line that names
 # the file, within seconds (an assembly's operators are counted as they are
