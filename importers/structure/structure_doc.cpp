@@ -156,8 +156,13 @@ unsigned residue_kind(const gemmi::Residue &residue)
     return PTR_STRUCTURE_LIGAND;
 }
 
-// One atom in several places: chain, residue number, insertion code, name.
-using AtomKey = std::tuple<std::string, int, char, std::string>;
+// One atom in several places: chain, subchain, residue number, insertion
+// code, name. An atom's alternate locations are within one residue of one
+// subchain (mmCIF label_asym_id); two subchains of one chain may number
+// residues alike, and their atoms are not alternates of each other. An atom
+// and the one it replaces thus share their part, whose count of atoms stays
+// right.
+using AtomKey = std::tuple<std::string, std::string, int, char, std::string>;
 
 // The atoms kept, and the parts they belong to (StructureAtom.part): for
 // each, its chain's name, its subchain's (which an assembly's generators
@@ -259,7 +264,7 @@ Selection select_atoms(const std::string &path, const gemmi::Structure &st,
                     part.first->second };
                 residue.name.copy(atom.residue, sizeof atom.residue - 1);
                 if (a.altloc) {
-                    const AtomKey key{ chain.name, residue.seqid.num.value,
+                    const AtomKey key{ chain.name, residue.subchain, residue.seqid.num.value,
                                        residue.seqid.icode, a.name };
                     const auto found = first_of.find(key);
                     if (found != first_of.end()) {
@@ -395,14 +400,17 @@ std::vector<std::vector<std::string>> operator_lists(const std::string &path,
 }
 
 // A generator's operators: the product of its lists, the last applied
-// first, as the mmCIF dictionary defines it.
+// first, as the mmCIF dictionary defines it; refused before any is made if
+// they are more than room, what STRUCTURE_MAX_INSTANCES leaves of its
+// assembly.
 std::vector<gemmi::Transform> operator_product(const std::string &path, const std::string &assembly,
                                                const std::vector<std::vector<std::string>> &lists,
-                                               const std::map<std::string, gemmi::Transform> &known)
+                                               const std::map<std::string, gemmi::Transform> &known,
+                                               size_t room)
 {
     size_t count = 1;
     for (const std::vector<std::string> &list : lists)
-        if ((count *= list.size()) > STRUCTURE_MAX_INSTANCES)
+        if ((count *= list.size()) > room)
             throw Fault{ path + ": assembly " + assembly +
                          " has more operators than ptr builds (100000)" };
     std::vector<gemmi::Transform> product(1);
@@ -423,7 +431,12 @@ std::vector<gemmi::Transform> operator_product(const std::string &path, const st
 
 // An mmCIF file's assemblies, read here rather than by gemmi, which leaves
 // out an operator the list lacks and reads only the first list of a product.
-std::vector<Assembly> mmcif_assemblies(const std::string &path, gemmi::cif::Block &block)
+// Only the one asked for (see StructureRequest) gets its generators: a file
+// of thousands of generators would otherwise have each expanded, however
+// many operators they ask for in all; its operators are counted as they are
+// made, and refused once they pass STRUCTURE_MAX_INSTANCES.
+std::vector<Assembly> mmcif_assemblies(const std::string &path, gemmi::cif::Block &block,
+                                       const char *asked)
 {
     std::vector<std::string> tags = gemmi::impl::transform_tags("matrix", "vector");
     tags.emplace_back("id");
@@ -450,13 +463,27 @@ std::vector<Assembly> mmcif_assemblies(const std::string &path, gemmi::cif::Bloc
     };
     for (const std::string &id : block.find_values("_pdbx_struct_assembly.id"))
         named(gemmi::cif::as_string(id));
-    for (const auto row : block.find("_pdbx_struct_assembly_gen.",
-                                     { "assembly_id", "oper_expression", "asym_id_list" })) {
-        Assembly &a = named(row.str(0));
-        Generator g{ {}, true, operator_product(path, a.name, operator_lists(path, row.str(1)),
-                                                known) };
+    gemmi::cif::Table rows = block.find("_pdbx_struct_assembly_gen.",
+                                        { "assembly_id", "oper_expression", "asym_id_list" });
+    for (const auto row : rows)
+        named(row.str(0));
+    const auto chosen = std::find_if(assemblies.begin(), assemblies.end(),
+                                     [asked, &assemblies](const Assembly &a) {
+                                         return asked ? a.name == asked
+                                                      : &a == &assemblies.front();
+                                     });
+    if (chosen == assemblies.end())
+        return assemblies;
+    size_t instances = 0;
+    for (const auto row : rows) {
+        if (row.str(0) != chosen->name)
+            continue;
+        Generator g{ {}, true, operator_product(path, chosen->name,
+                                                operator_lists(path, row.str(1)), known,
+                                                STRUCTURE_MAX_INSTANCES - instances) };
+        instances += g.operators.size();
         gemmi::split_str_into(row.str(2), ',', g.names);
-        a.generators.push_back(g);
+        chosen->generators.push_back(g);
     }
     return assemblies;
 }
@@ -477,27 +504,28 @@ std::vector<Assembly> pdb_assemblies(const gemmi::Structure &st)
     return assemblies;
 }
 
-// The assembly asked for (see StructureRequest), or none; every assembly
-// the file has is checked against STRUCTURE_MAX_INSTANCES.
+// The assembly asked for (see StructureRequest), or none; checked against
+// STRUCTURE_MAX_INSTANCES (a PDB file's, which gemmi made as it read them).
 const Assembly *chosen_assembly(const std::string &path, const std::vector<Assembly> &assemblies,
                                 const char *asked)
 {
-    for (const Assembly &a : assemblies) {
+    const auto checked = [&path](const Assembly &a) {
         size_t operators = 0;
         for (const Generator &g : a.generators)
             operators += g.operators.size();
         if (operators > STRUCTURE_MAX_INSTANCES)
             throw Fault{ path + ": assembly " + a.name +
                          " has more operators than ptr builds (100000)" };
-    }
+        return &a;
+    };
     if (asked && !std::strcmp(asked, "none"))
         return nullptr;
     if (!asked)
-        return assemblies.empty() ? nullptr : &assemblies[0];
+        return assemblies.empty() ? nullptr : checked(assemblies[0]);
     std::string names;
     for (const Assembly &a : assemblies) {
         if (a.name == asked)
-            return &a;
+            return checked(a);
         if (names.size() < 60)
             names += (names.empty() ? "" : ", ") + a.name;
         else if (names.back() != '.')
@@ -578,9 +606,11 @@ template <typename T> T *malloc_copy(const std::vector<T> &v)
     return out;
 }
 
-// The file read and parsed, with its assemblies (see Assembly), checked
-// where gemmi reads without checking.
-gemmi::Structure read_structure(const char *path, std::vector<Assembly> &assemblies)
+// The file read and parsed, checked where gemmi reads without checking;
+// with its assemblies (see Assembly, and mmcif_assemblies for asked) where
+// assemblies is not null.
+gemmi::Structure read_structure(const char *path, const char *asked,
+                                std::vector<Assembly> *assemblies)
 {
     gemmi::MaybeGzipped input(path);
     const gemmi::CoorFormat format = gemmi::coor_format_from_ext(input.basepath());
@@ -594,7 +624,8 @@ gemmi::Structure read_structure(const char *path, std::vector<Assembly> &assembl
         text = gemmi::CharArray();
         gemmi::Structure structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(),
                                                                  path);
-        assemblies = pdb_assemblies(structure);
+        if (assemblies)
+            *assemblies = pdb_assemblies(structure);
         return structure;
     }
     gemmi::cif::Document cif = gemmi::cif::read_memory(text.data(), text.size(), path);
@@ -602,7 +633,8 @@ gemmi::Structure read_structure(const char *path, std::vector<Assembly> &assembl
     if (!cif.blocks.empty()) {
         check_atom_site_columns(path, cif.blocks[0]);
         check_whole_numbers(path, cif.blocks[0]);
-        assemblies = mmcif_assemblies(path, cif.blocks[0]);
+        if (assemblies)
+            *assemblies = mmcif_assemblies(path, cif.blocks[0], asked);
     }
     return gemmi::make_structure(cif);
 }
@@ -614,7 +646,7 @@ extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest
 {
     try {
         std::vector<Assembly> assemblies;
-        gemmi::Structure structure = read_structure(path, assemblies);
+        gemmi::Structure structure = read_structure(path, request->assembly, &assemblies);
         if (structure.models.empty())
             return ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": no atoms");
         if (request->model >= structure.models.size())
@@ -652,8 +684,7 @@ extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest
 extern "C" PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err)
 {
     try {
-        std::vector<Assembly> assemblies;
-        *models = read_structure(path, assemblies).models.size();
+        *models = read_structure(path, nullptr, nullptr).models.size();
         return PTR_OK;
     } catch (const Fault &fault) {
         return ptr_shim_error(err, fault.code, fault.message);

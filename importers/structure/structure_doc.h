@@ -20,8 +20,10 @@ extern "C" {
 enum { STRUCTURE_COIL, STRUCTURE_HELIX, STRUCTURE_SHEET };
 
 /* The most instances an assembly may have: the largest in the PDB archive
- * have a few thousand operators; a file asking for more is refused before
- * any is made. */
+ * have a few thousand operators. Of an mmCIF file only the assembly asked
+ * for is expanded, and refused as soon as its operators would pass this,
+ * before they are made; a PDB file's are those of its REMARK 350 lines,
+ * which gemmi reads whole. */
 enum { STRUCTURE_MAX_INSTANCES = 100000 };
 
 typedef struct StructureAtom {
@@ -87,7 +89,7 @@ PtrResult structure_doc_read(const char *path, const StructureRequest *request,
                              StructureDoc *doc, PtrError *err);
 
 /* The number of models path has (read and checked as structure_doc_read
- * reads it), failing as it does. */
+ * reads its atoms; its assemblies are not read), failing as it does. */
 PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err);
 void structure_doc_free(StructureDoc *doc);
 

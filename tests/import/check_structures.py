@@ -10,6 +10,7 @@ say; bad option values, --color-by a value structures lack and hostile files
 are one-line errors with the README's exit codes.
 Usage: check_structures.py PTR SOURCE_DIR"""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -145,10 +146,29 @@ run = subprocess.run([ptr, pdb, "-o", image, "--width", "32", "--samples", "1", 
 expect(f"ptr 1tii.pdb -o 1tii.png: exit {run.returncode}, {run.stderr!r}",
        run.returncode == 0 and os.path.getsize(image) > 0)
 
+hostile = os.path.join(src, "tests", "fixtures", "hostile")
+
+# Alternate locations in two subchains of one chain, at one residue number,
+# are not alternates of one atom: both are kept, each in its own subchain,
+# whichever the assembly names (its two operators: x, y, z and -x, -y, z).
+for name, atoms in (("structure_altloc_across_subchains_winner.cif",
+                     [(42.704, -10.253, 18.851), (43.104, -10.953, 19.851)]),
+                    ("structure_altloc_across_subchains_loser.cif", [(42.053, -9.336, 17.867)])):
+    got = [tuple(sphere["center"]) for sphere in dump(os.path.join(hostile, name))]
+    want = atoms + [(-x, -y, z) for x, y, z in atoms]
+    expect(f"{name}: {got}, not {want}", len(got) == len(want) and all(
+        math.dist(g, w) < 1e-4 for g, w in zip(got, want)))
+
+# An assembly not asked for is not expanded: the asymmetric unit of a file
+# whose only assembly asks for too many operators.
+got = dump(os.path.join(hostile, "structure_assembly_many_rows.cif"), "--assembly", "none")
+expect(f"structure_assembly_many_rows.cif --assembly none: {len(got)} spheres, not 2",
+       len(got) == 2)
+
 # Hostile files (tests/fixtures/hostile; test_hostile.sh runs them under time
 # and memory bounds): exit 4 and the problem named, in one line that names
-# the file.
-hostile = os.path.join(src, "tests", "fixtures", "hostile")
+# the file, within seconds (an assembly's operators are counted as they are
+# made, not after all are).
 for name, says in (
         ("structure_truncated.pdb", ":23: an atom line of 40 columns, short of its coordinates (31-54)"),
         ("structure_truncated.cif", "structure_truncated.cif:820:1: Wrong number of values"),
@@ -172,13 +192,20 @@ for name, says in (
          "oper_expression '(1-999999999)' names more operators than ptr builds (100000)"),
         ("structure_assembly_operator_product.cif",
          "assembly 1 has more operators than ptr builds (100000)"),
+        ("structure_assembly_many_rows.cif",
+         "assembly 1 has more operators than ptr builds (100000)"),
         ("structure_assembly_operator_expression.cif",
          "oper_expression '(1-2' is not a list of operators or a product of lists"),
         ("structure_assembly_operator_not_a_number.cif", "operator 1: 'x' is not a number"),
         ("structure_assembly_operator_not_a_number.pdb",
          ":8: an operator's rotation (columns 24-33) '  0.95I057' is not a number")):
     path = os.path.join(hostile, name)
-    run = subprocess.run([ptr, "--dump-scene", path], capture_output=True, text=True)
+    try:
+        run = subprocess.run([ptr, "--dump-scene", path], capture_output=True, text=True,
+                             timeout=10)
+    except subprocess.TimeoutExpired:
+        expect(f"{name}: still running after 10 s", False)
+        continue
     expect(f"{name}: exit {run.returncode}, {run.stderr!r}",
            run.returncode == 4 and run.stderr.startswith(f"ptr: {path}") and
            says in run.stderr and run.stderr.count("\n") == 1)
