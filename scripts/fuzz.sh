@@ -34,7 +34,7 @@ for format in gltf obj structure; do
         head -c 60000 tests/fixtures/structures/assembly.cif | sed '$d' >"$corpus"/assembly_head.cif ;;
     esac
     echo "== fuzz_$format, $seconds s"
-    (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 tests/fuzz/fuzz_$format -max_total_time="$seconds" \
+    (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1:intercept_tls_get_addr=0 tests/fuzz/fuzz_$format -max_total_time="$seconds" \
         -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
         "corpus-$format" \
         2>"fuzz_$format.log") || { tail -40 "build-fuzz/fuzz_$format.log"; exit 1; }
