@@ -21,12 +21,22 @@
 
 enum { MAX_LINE = 64 << 20 }; /* longer lines are not OBJ */
 
+/* A part's faces from first_triangle on (up to the next run's) were read
+ * under one usemtl: a joined object (Blender's Join, exported) holds spheres
+ * of several materials, each run of faces its own. */
+typedef struct MaterialRun {
+    size_t first_triangle;
+    char *material;       /* NULL: no usemtl yet */
+    uint32_t scene_index; /* once a sphere uses it, else UINT32_MAX */
+} MaterialRun;
+
 typedef struct Part { /* an object (o) or a group (g) */
     char *name;       /* NULL: faces before any o or g */
     long line;
     double lo[3], hi[3];
     size_t faces;
-    char *material;   /* usemtl in force at its first face */
+    MaterialRun *runs; /* in the order of their faces; the first at face 0 */
+    size_t nruns, runs_capacity;
     uint32_t *tris;   /* its faces as triangles (fans), 3 vertex indices each */
     size_t ntris, tris_capacity;
 } Part;
@@ -155,6 +165,12 @@ static PtrResult start_part(Reader *r, Parts *parts, const char *name, long line
     return PTR_OK;
 }
 
+/* Whether two names, either NULL (none), are the same. */
+static int same_name(const char *a, const char *b)
+{
+    return a && b ? !strcmp(a, b) : a == b;
+}
+
 static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int first_corner)
 {
     if (parts->current < 0 && start_part(r, parts, NULL, line) != PTR_OK)
@@ -165,8 +181,19 @@ static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int
         part->hi[k] = fmax(part->hi[k], p[k]);
     }
     if (first_corner) {
-        if (!part->faces && r->material)
-            part->material = copy(r->material);
+        const MaterialRun *last = part->nruns ? &part->runs[part->nruns - 1] : NULL;
+        if (!last || !same_name(last->material, r->material)) {
+            if (grow((void **)&part->runs, &part->runs_capacity, part->nruns + 1,
+                     sizeof *part->runs))
+                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+            MaterialRun *run = &part->runs[part->nruns];
+            *run = (MaterialRun){ .first_triangle = part->ntris,
+                                  .material = r->material ? copy(r->material) : NULL,
+                                  .scene_index = UINT32_MAX };
+            if (r->material && !run->material)
+                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+            part->nruns++;
+        }
         part->faces++;
     }
     return PTR_OK;
@@ -452,11 +479,27 @@ static void part_triangles(const void *user, size_t first, size_t count, uint32_
     memcpy(out, &m->tris[3 * first], count * sizeof *out);
 }
 
-/* The spheres of part p (docs/scenes.md): its components, checked; local_of
- * (one a vertex of the file, UNSET) is left as it was found. Adds the
- * components that are not spheres to *skipped. */
-static PtrResult part_spheres(Reader *r, const Part *p, uint32_t *local_of,
-                              PtrSceneBuilder *builder, uint32_t material, size_t *skipped)
+/* The run of faces triangle t of part p was read in: the last that starts at
+ * or before it (runs of faces with no surface start where the next does). */
+static MaterialRun *run_at(const Part *p, size_t t)
+{
+    size_t lo = 0, hi = p->nruns;
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (p->runs[mid].first_triangle <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return &p->runs[lo];
+}
+
+/* The spheres of part p (docs/scenes.md): its components, checked, each with
+ * the material of its first face; local_of (one a vertex of the file, UNSET)
+ * is left as it was found. Adds the components that are not spheres to
+ * *skipped. */
+static PtrResult part_spheres(Reader *r, Part *p, uint32_t *local_of, PtrSceneBuilder *builder,
+                              PtrScene *scene, uint32_t *grey, size_t *skipped)
 {
     const size_t corners = 3 * p->ntris;
     uint32_t *global = malloc((corners ? corners : 1) * sizeof *global);
@@ -483,10 +526,15 @@ static PtrResult part_spheres(Reader *r, const Part *p, uint32_t *local_of,
     if (res == PTR_OK)
         res = ptr_mesh_spheres(&source, r->path, &spheres, &count, NULL, r->err);
     for (size_t c = 0; res == PTR_OK && c < count; c++) {
-        if (!spheres[c].is_sphere)
+        if (!spheres[c].is_sphere) {
             ++*skipped;
-        else if (ptr_builder_add_sphere(builder, spheres[c].centre, spheres[c].radius, material,
-                                        NULL))
+            continue;
+        }
+        MaterialRun *run = run_at(p, spheres[c].first_triangle);
+        if (run->scene_index == UINT32_MAX)
+            res = material_for(r, run->material, scene, &run->scene_index, grey);
+        if (res == PTR_OK && ptr_builder_add_sphere(builder, spheres[c].centre, spheres[c].radius,
+                                                    run->scene_index, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     }
     free(spheres);
@@ -514,7 +562,7 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
     if (local_of)
         memset(local_of, 0xff, (r->nv ? r->nv : 1) * sizeof *local_of);
     for (size_t i = 0; res == PTR_OK && i < parts->count; i++) {
-        const Part *p = &parts->items[i];
+        Part *p = &parts->items[i];
         const char *name = p->name ? p->name : base;
         if (!p->faces)
             continue;
@@ -534,12 +582,11 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
                                 p->line, name);
             break;
         }
-        uint32_t material;
-        res = material_for(r, p->material, scene, &material, &grey);
         const size_t before = skipped;
-        if (res == PTR_OK && !fit_all)
-            res = part_spheres(r, p, local_of, &builder, material, &skipped);
-        else if (res == PTR_OK &&
+        uint32_t material; /* --fit-all-objects: the object's first face's */
+        if (!fit_all)
+            res = part_spheres(r, p, local_of, &builder, scene, &grey, &skipped);
+        else if ((res = material_for(r, p->runs[0].material, scene, &material, &grey)) == PTR_OK &&
                  ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         if (skipped > before) {
@@ -573,7 +620,9 @@ static void free_parts(Parts *parts)
 {
     for (size_t i = 0; i < parts->count; i++) {
         free(parts->items[i].name);
-        free(parts->items[i].material);
+        for (size_t k = 0; k < parts->items[i].nruns; k++)
+            free(parts->items[i].runs[k].material);
+        free(parts->items[i].runs);
         free(parts->items[i].tris);
     }
     free(parts->items);

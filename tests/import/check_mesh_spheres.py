@@ -21,9 +21,10 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
   would all probe one chain of the table, minutes of import);
 - a cube mesh under 40 nodes beside a sphere: 40 parts, the names cut with
   ", ..." to fit the line;
-- OBJ: an object of two joined spheres and a cube named like a sphere: the
-  two spheres and the warning; with --fit-all-objects one sphere an object,
-  unchecked, no warning.
+- OBJ: an object of two joined spheres, each under its own usemtl, and a
+  cube named like a sphere: the two spheres, each with its material, and the
+  warning; with --fit-all-objects one sphere an object, unchecked, no
+  warning.
 Usage: check_mesh_spheres.py PTR"""
 import json
 import os
@@ -200,20 +201,28 @@ def main():
         w.write(path)
         expect(path, [((0, -5, 0), 1, 0)], 40, ["node 'Cube0' (mesh 'Box')", ", ..."])
 
-        # OBJ, under its naming rule: an object of two joined spheres, a cube
-        # named like a sphere; --fit-all-objects fits each object, unchecked.
-        verts, tris = mf.combine(mf.uv_sphere((0, 0, 0), 1), mf.uv_sphere((5, 0, 0), 2))
+        # OBJ, under its naming rule: an object of two joined spheres of
+        # materials 0 and 1 (usemtl is state: the second holds for the cube),
+        # a cube named like a sphere; --fit-all-objects fits each object,
+        # unchecked.
+        first = mf.uv_sphere((0, 0, 0), 1)
+        verts, tris = mf.combine(first, mf.uv_sphere((5, 0, 0), 2))
         cube_verts, cube_tris = mf.cube((0, 9, 0), 1)
+        with open(os.path.join(folder, "joined.mtl"), "w") as f:
+            f.write("newmtl M0\nKd 0.25 0.25 0.25\nnewmtl M1\nKd 0.5 0.5 0.5\n")
         path = os.path.join(folder, "joined.obj")
         with open(path, "w") as f:
-            f.write("o TwoSpheres\n")
+            f.write("mtllib joined.mtl\no TwoSpheres\n")
             f.writelines(f"v {x} {y} {z}\n" for x, y, z in verts)
-            f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tris)
+            for t, (a, b, c) in enumerate(tris):
+                if t in (0, len(first[1])):
+                    f.write(f"usemtl M{0 if t == 0 else 1}\n")
+                f.write(f"f {a + 1} {b + 1} {c + 1}\n")
             f.write("o CubeSphere\n")
             f.writelines(f"v {x} {y} {z}\n" for x, y, z in cube_verts)
             f.writelines(f"f {a + 1 + len(verts)} {b + 1 + len(verts)} {c + 1 + len(verts)}\n"
                          for a, b, c in cube_tris)
-        expect(path, [((0, 0, 0), 1, -1), ((5, 0, 0), 2, -1)], 1, ["object 'CubeSphere' (line"])
+        expect(path, [((0, 0, 0), 1, 0), ((5, 0, 0), 2, 1)], 1, ["object 'CubeSphere' (line"])
         run = subprocess.run([ptr, "--dump-scene", "--fit-all-objects", path], capture_output=True,
                              text=True, timeout=60)
         fitted = [(s["center"], s["radius"]) for s in json.loads(run.stdout)["spheres"]]
