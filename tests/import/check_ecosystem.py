@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The files of tests/fixtures/ecosystem/, written by three.js, the glTF
-Transform CLI and gltfpack (tests/fixtures/ecosystem/make_fixtures.sh), import
-as the scenes they were made from, and render.
+Transform CLI and gltfpack (tests/fixtures/ecosystem/make_fixtures.sh) and by
+Blender (make_blender.py), import as the scenes they were made from, and
+render.
 
 - three_instanced.glb (three.js GLTFExporter, an InstancedMesh) against
   three_instanced.json, the centres, radii and colours the script used.
@@ -37,6 +38,20 @@ as the scenes they were made from, and render.
   8-bit: there the colour and the emission (over the brightest of the
   reference's, the emissive strength) are compared sRGB-encoded, within 1/255
   of each other, and fuzz within 1/255.
+- blender_join.glb and blender_join.obj (make_blender.py: Blender's Join of
+  three UV spheres, two ico spheres and a cube, exported with the glTF and
+  the OBJ exporters' defaults) against blender_join.json, the spheres as set
+  in Blender: the same comparison, unquantised (float32 in the .glb, 6
+  decimals in the OBJ, both within 1e-6 * SIZE: a UV sphere's and an ico
+  sphere's vertices lie on their sphere and reach it along each axis, so
+  centre and radius come out all but exact), each sphere with its own
+  material; and one warning, that 1 mesh part (the cube) is not drawn,
+  naming the node or the object. Blender's OBJ exporter without its PBR
+  extensions (its default) writes no transmission: there the glass sphere
+  is a diffuse one of its base colour. blender_join.obj with
+  --fit-all-objects is one sphere, the bounds of all the joined object
+  holds, the cube's included, in its first face's material (the first
+  sphere's), and no warning.
 - Each file renders: ptr FILE -o out.exr --samples 1 --width 16, exit 0.
 - ortho.gltf (three.js, an OrthographicCamera xmag 6, ymag 4, znear 0.5,
   zfar 50 at (0, 2, 10) looking down -Z) shows in --dump-scene as an
@@ -73,9 +88,9 @@ class Failure(Exception):
     pass
 
 
-def dump(name):
-    run = subprocess.run([ptr, "--dump-scene", os.path.join(folder, name)], capture_output=True,
-                         text=True, timeout=60)
+def dump(name, *options):
+    run = subprocess.run([ptr, "--dump-scene", *options, os.path.join(folder, name)],
+                         capture_output=True, text=True, timeout=60)
     if run.returncode != 0:
         raise Failure(f"--dump-scene exit {run.returncode}: {run.stderr.strip()[:300]}")
     return json.loads(run.stdout)
@@ -176,6 +191,41 @@ def reference_three():
             for s in desc["spheres"]]
 
 
+def blender_reference(obj):
+    """The spheres of blender_join.json; in the OBJ, whose .mtl has no
+    transmission, the glass sphere is diffuse (see the docstring)."""
+    want = reference("blender_join")
+    if obj:
+        want = [dict(w, kind="diffuse", ior=0) if w["kind"] == "dielectric" else w for w in want]
+    return want
+
+
+def check_blender(name, part):
+    """Blender's Join: the spheres, and the cube skipped with the warning
+    naming part."""
+    scene = dump(name)
+    problems = compare(flatten(scene), blender_reference(name.endswith(".obj")), False)
+    skipped = f'1 mesh part not drawn: it is not a sphere (docs/scenes.md, "Spheres"): {part}'
+    if len(scene["warnings"]) != 1 or not scene["warnings"][0].endswith(skipped):
+        problems.append(f"warnings {scene['warnings']}, not one ending in: {skipped}")
+    return problems
+
+
+def check_blender_fit_all():
+    """--fit-all-objects: the joined object is one sphere, its bounds'."""
+    scene = dump("blender_join.obj", "--fit-all-objects")
+    with open(os.path.join(folder, "blender_join.json")) as f:
+        desc = json.load(f)
+    balls = ([(s["center"], s["radius"]) for s in desc["spheres"]] +
+             [(c["center"], c["size"] / 2) for c in desc["cubes"]])
+    lo = [min(c[k] - r for c, r in balls) for k in range(3)]
+    hi = [max(c[k] + r for c, r in balls) for k in range(3)]
+    bounds = dict(blender_reference(True)[0], center=[(a + b) / 2 for a, b in zip(lo, hi)],
+                  radius=max(b - a for a, b in zip(lo, hi)) / 2)
+    problems = compare(flatten(scene), [bounds], False)
+    return problems + [f"warning: {w}" for w in scene["warnings"]]
+
+
 def check_ortho(scene):
     problems = []
     cam = scene["camera"]
@@ -198,7 +248,7 @@ def check_ortho(scene):
 def main():
     results = {}
     with tempfile.TemporaryDirectory() as scratch:
-        def check(name, test):
+        def check(name, test, label=None):
             try:
                 problems = test()
                 render(name, scratch)
@@ -206,7 +256,7 @@ def main():
                 problems = [str(e)]
             except Exception as e:  # a dump that is not the JSON expected
                 problems = [f"{type(e).__name__}: {e}"]
-            results[name] = problems
+            results[label or name] = problems
 
         sources = {}
 
@@ -228,6 +278,11 @@ def main():
                                         stem in QUANTISED_JOINED, stem in PALETTE,
                                         stem in SIMPLIFIED))
         check("ortho.gltf", lambda: check_ortho(dump("ortho.gltf")))
+        check("blender_join.glb", lambda: check_blender("blender_join.glb",
+                                                        "node 'Sphere' (mesh 'Sphere')"))
+        check("blender_join.obj", lambda: check_blender("blender_join.obj",
+                                                        "object 'Sphere' (line 4)"))
+        check("blender_join.obj", check_blender_fit_all, "blender_join.obj --fit-all-objects")
 
     failed = 0
     for name, problems in results.items():
