@@ -7,36 +7,20 @@ Run through scripts/make-blender-fixtures.sh, or:
     blender -b --factory-startup --python scripts/blender_fixtures.py -- OUT_DIR
 """
 import math
+import os
 import sys
 
 import bpy
 from mathutils import Vector
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_scene import blender_xyz, principled  # noqa: E402
 
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 scene.render.resolution_x = 320
 scene.render.resolution_y = 240
-
-
-def blender_xyz(x, y, z):
-    """glTF and OBJ (as exported) are +Y up; Blender is +Z up."""
-    return (x, -z, y)
-
-
-def material(name, base, metallic=0.0, roughness=0.5, transmission=0.0, ior=1.45,
-             emission=(0, 0, 0), strength=0.0):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.inputs["Base Color"].default_value = (*base, 1.0)
-    p.inputs["Metallic"].default_value = metallic
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Transmission"].default_value = transmission
-    p.inputs["IOR"].default_value = ior
-    p.inputs["Emission"].default_value = (*emission, 1.0)
-    p.inputs["Emission Strength"].default_value = strength
-    return m
 
 
 def sphere(name, centre, radius, mat):
@@ -49,14 +33,14 @@ def sphere(name, centre, radius, mat):
 
 
 # name, centre (+Y up), radius, material: the values the test checks.
-sphere("GroundSphere", (0, -100, 0), 100, material("Ground", (0.5, 0.5, 0.5), roughness=1.0))
-sphere("DiffuseSphere", (0, 1, 0), 1, material("Clay", (0.8, 0.2, 0.1)))
-sphere("MetalSphere", (2.5, 1, 0), 1, material("Brass", (0.9, 0.8, 0.6), metallic=1.0,
-                                                   roughness=0.25))
-sphere("GlassSphere", (-2.5, 1, 0), 1, material("Glass", (1, 1, 1), roughness=0.0,
-                                                    transmission=1.0, ior=1.45))
-sphere("LampSphere", (0, 3.5, -2), 0.5, material("Lamp", (0.1, 0.1, 0.1),
-                                                    emission=(1.0, 0.9, 0.8), strength=4.0))
+sphere("GroundSphere", (0, -100, 0), 100, principled("Ground", (0.5, 0.5, 0.5), roughness=1.0))
+sphere("DiffuseSphere", (0, 1, 0), 1, principled("Clay", (0.8, 0.2, 0.1)))
+sphere("MetalSphere", (2.5, 1, 0), 1, principled("Brass", (0.9, 0.8, 0.6), metallic=1.0,
+                                                     roughness=0.25))
+sphere("GlassSphere", (-2.5, 1, 0), 1, principled("Glass", (1, 1, 1), roughness=0.0,
+                                                      transmission=1.0, ior=1.45))
+sphere("LampSphere", (0, 3.5, -2), 0.5, principled("Lamp", (0.1, 0.1, 0.1),
+                                                      emission=(1.0, 0.9, 0.8), strength=4.0))
 
 camera_data = bpy.data.cameras.new("Camera")
 camera_data.sensor_fit = "VERTICAL"
