@@ -180,7 +180,7 @@ static int run(const PtrOptions *o)
      * no thread can start while the load runs. */
     char first_output[PTR_PATH_SIZE];
     if (!o->list_views) {
-        int threads = o->threads > 0 ? o->threads : ptr_online_cpus();
+        int threads = ptr_thread_count(o->threads);
         ptr_threads_keep(threads);
         if (o->skip_existing && ptr_claim_keeper_start(&err) != PTR_OK)
             return fail(&err);
