@@ -219,12 +219,14 @@ static int run(const PtrOptions *o)
                           ptr_integrator_name(o->integrator), ptr_cpu_level_name(o->cpu_level),
                           built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
-        } else if (ptr_live_view_open(o, color, &err) != PTR_OK) {
-            code = fail(&err);
         } else {
-            code = o->watch ? watch_scene(o, color) : render_all(o, color);
+            PtrOptions rendering = *o;
+            if (ptr_live_view_open(o, color, &rendering.live_view, &err) != PTR_OK)
+                code = fail(&err);
+            else
+                code = o->watch ? watch_scene(&rendering, color) : render_all(&rendering, color);
+            ptr_live_view_close(rendering.live_view);
         }
-        ptr_live_view_close();
     }
     ptr_color_close(color);
     ptr_claim_keeper_stop();

@@ -35,6 +35,9 @@ typedef enum PtrPrintRequest {
     PTR_PRINT_DISPATCH,
 } PtrPrintRequest;
 
+/* The live view (app/live_view.h). */
+typedef struct PtrLiveView PtrLiveView;
+
 typedef struct PtrOptions {
     char **inputs;          /* scenes; for `ptr merge`, the parts */
     int input_count;
@@ -101,6 +104,9 @@ typedef struct PtrOptions {
     /* Not an option either: the denoiser of the run, with --denoise, which
      * ptr_cli_main owns too (NULL from ptr_options_parse). */
     PtrDenoiser *denoiser;
+    /* Not an option either: the live view of the renders, with --live or
+     * --tev, which the run that renders owns (NULL otherwise). */
+    PtrLiveView *live_view;
 } PtrOptions;
 
 /* What the importers need of the options. */
