@@ -95,11 +95,13 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
     PtrError err = { 0 };
     PtrBatchItem *items;
     int count;
-    if (ptr_batch_plan(o, &items, &count, &err) != PTR_OK)
+    PtrStructureFile *structure;
+    if (ptr_batch_plan(o, &items, &count, &structure, &err) != PTR_OK)
         return fail(&err);
     PtrJobReport *reports = calloc((size_t)count, sizeof *reports);
     if (!reports) {
         ptr_batch_free(items, count);
+        ptr_structure_close(structure);
         ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
         return fail(&err);
     }
@@ -114,6 +116,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         PtrOptions frame = *o;
         frame.orbit_degrees = items[i].orbit_degrees;
         frame.structure_model = items[i].model;
+        frame.structure_file = structure;
         ptr_job_render(&frame, items[i].scene, items[i].output, color, NULL, &reports[done]);
         if (o->skip_existing)
             ptr_claim_release(items[i].output);
@@ -131,6 +134,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         ptr_job_report_free(&reports[i]);
     free(reports);
     ptr_batch_free(items, count);
+    ptr_structure_close(structure);
     return code;
 }
 

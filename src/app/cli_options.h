@@ -93,6 +93,9 @@ typedef struct PtrOptions {
     int skip_existing;
     double orbit_degrees;   /* the camera's turn in the frame being rendered */
     size_t structure_model; /* the structure's model the frame renders (1 the first); 0: none */
+    /* Not an option: the structure whose models the frames render, parsed
+     * once for all of them; NULL: none, or each import reads its scene. */
+    const PtrStructureFile *structure_file;
     int json;
     int quiet;
     int dump_scene;
