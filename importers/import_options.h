@@ -11,6 +11,9 @@
 #include "scene/scene.h"
 #include "structure/structure_parts.h"
 
+/* A structure file parsed for the imports of its models (importer.h). */
+typedef struct PtrStructureFile PtrStructureFile;
+
 /* A list of lines of text (warnings, file names). */
 typedef struct PtrStrings {
     char **lines;
@@ -73,6 +76,10 @@ typedef struct PtrImportOptions {
     /* Structures: the model read, 1 the first (a frame of a sequence of
      * models); 0: the first, with a warning where the file has more. */
     size_t structure_model;
+    /* Structures: the file, read and parsed already (ptr_structure_open,
+     * with structure_assembly) for a sequence of its models; NULL: the
+     * import reads it. */
+    const PtrStructureFile *structure_file;
     /* If set, receives the other files the scene was read from (a glTF's
      * external buffers): what --watch must watch besides the scene file. */
     PtrStrings *dependencies;

@@ -28,9 +28,16 @@ PtrResult ptr_structure_select_parse(const char *text, unsigned *parts, PtrError
  * models a sequence's frames can be. */
 int ptr_import_is_structure(const char *path);
 
-/* The number of models the structure path has, failing as its import
- * does. */
-PtrResult ptr_structure_model_count(const char *path, size_t *models, PtrError *err);
+/* The structure path names, read and parsed once for the imports of its
+ * models (PtrImportOptions.structure_file), with the assembly they ask for
+ * (PtrImportOptions.structure_assembly), into *out (for
+ * ptr_structure_close): fails as its import does, but for an assembly it
+ * cannot read, which fails each import of a model instead. */
+PtrResult ptr_structure_open(const char *path, const char *assembly, PtrStructureFile **out,
+                             PtrError *err);
+/* The number of models the structure has. */
+size_t ptr_structure_models(const PtrStructureFile *file);
+void ptr_structure_close(PtrStructureFile *file);
 
 /* Appends a printf-formatted line. */
 void ptr_warn(PtrStrings *lines, const char *fmt, ...)

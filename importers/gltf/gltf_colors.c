@@ -83,7 +83,9 @@ static PtrResult vertex_values(GltfTextures *textures, const VertexColors *vc, s
             continue;
         float texel[4];
         gltf_element(&vc->uv[r], v, e);
-        PtrResult res = gltf_textures_sample(textures, vc->refs[r], e, texel, err);
+        PtrResult res = gltf_textures_sample(textures, vc->refs[r], e,
+                                             r == 2 ? GLTF_TEXELS_STORED : GLTF_TEXELS_LINEAR,
+                                             texel, err);
         if (res != PTR_OK)
             return res;
         if (r == 2) {
@@ -91,7 +93,7 @@ static PtrResult vertex_values(GltfTextures *textures, const VertexColors *vc, s
             out[7] = texel[1];
         } else {
             for (int k = 0; k < 3; k++)
-                out[3 * r + k] *= gltf_textures_srgb_to_linear(textures, texel[k]);
+                out[3 * r + k] *= texel[k];
         }
     }
     return PTR_OK;

@@ -10,18 +10,17 @@
 typedef struct Decoded {
     int state; /* UNREAD, READ or FAILED */
     GltfTexture info;
-    PtrTexels texels;
+    PtrTexels texels; /* rgba NULL where bytes holds them */
+    /* Where every value is one of the 256 an 8-bit file decodes to (palettes'
+     * are): the texels as those bytes, RGBA, read through the tables of
+     * GltfTextures; else NULL. */
+    unsigned char *bytes;
     PtrError error; /* FAILED: the message, given again at each sample */
 } Decoded;
 
 enum { UNREAD, READ, FAILED };
 
-/* 8-bit texels: the 256 values n / 255, in both of the forms a decoder
- * may give them (divided by 255, or times 1 / 255, which differ in the last
- * bit for 126 of them), and the sRGB decoding of each, so that a texel of
- * an 8-bit texture (palettes' are) is decoded once, not through pow at
- * every vertex. */
-enum { BYTE_VALUES = 256, BYTE_FORMS = 2 };
+enum { BYTE_VALUES = 256 };
 
 struct GltfTextures {
     const GltfDoc *doc;
@@ -29,7 +28,11 @@ struct GltfTextures {
     PtrTextureDecoder decoder;
     Decoded *textures; /* one a texture of the file */
     size_t count;
-    float byte_value[BYTE_FORMS][BYTE_VALUES], byte_linear[BYTE_FORMS][BYTE_VALUES];
+    /* Byte n's value as the image module decodes it (n times 1 / 255, as
+     * OpenImageIO converts), and that value decoded from sRGB: so that the
+     * texels of an 8-bit texture are made linear once an import, not
+     * through pow at every vertex. */
+    float byte_value[BYTE_VALUES], byte_linear[BYTE_VALUES];
 };
 
 PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
@@ -42,13 +45,10 @@ PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
         free(t);
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     }
-    *t = (GltfTextures){ doc, path, *decoder, textures, count, { { 0 } }, { { 0 } } };
-    const volatile float reciprocal = 1.0f / 255.0f; /* not folded into a division */
+    *t = (GltfTextures){ doc, path, *decoder, textures, count, { 0 }, { 0 } };
     for (int n = 0; n < BYTE_VALUES; n++) {
-        t->byte_value[0][n] = (float)n / 255.0f;
-        t->byte_value[1][n] = (float)n * reciprocal;
-        for (int f = 0; f < BYTE_FORMS; f++)
-            t->byte_linear[f][n] = ptr_srgb_to_linear(t->byte_value[f][n]);
+        t->byte_value[n] = (float)n * (1.0f / 255.0f);
+        t->byte_linear[n] = ptr_srgb_to_linear(t->byte_value[n]);
     }
     *out = t;
     return PTR_OK;
@@ -58,10 +58,34 @@ void gltf_textures_free(GltfTextures *textures)
 {
     if (!textures)
         return;
-    for (size_t i = 0; i < textures->count; i++)
+    for (size_t i = 0; i < textures->count; i++) {
         free(textures->textures[i].texels.rgba);
+        free(textures->textures[i].bytes);
+    }
     free(textures->textures);
     free(textures);
+}
+
+/* The texture's texels as bytes (d->bytes) if every value is a byte's value,
+ * the floats then freed; else, or if memory is short, as they are. */
+static void keep_bytes(const GltfTextures *t, Decoded *d)
+{
+    const size_t values = 4 * (size_t)d->texels.width * (size_t)d->texels.height;
+    unsigned char *bytes = malloc(values);
+    for (size_t i = 0; bytes && i < values; i++) {
+        const float v = d->texels.rgba[i];
+        const int n = v >= 0.0f && v <= 1.0f ? (int)(v * 255.0f + 0.5f) : 0; /* not NaN */
+        if (t->byte_value[n] != v) {
+            free(bytes);
+            return;
+        }
+        bytes[i] = (unsigned char)n;
+    }
+    if (!bytes)
+        return;
+    free(d->texels.rgba);
+    d->texels.rgba = NULL;
+    d->bytes = bytes;
 }
 
 /* Texture index decoded, at its first use. */
@@ -86,6 +110,8 @@ static PtrResult decode(GltfTextures *t, int index, const Decoded **out, PtrErro
         else if (d->texels.width <= 0 || d->texels.height <= 0)
             res = ptr_error_set(&d->error, PTR_ERR_SCENE_INVALID, "%s: texture %d is empty",
                                 t->path, index);
+        else
+            keep_bytes(t, d);
         d->state = res == PTR_OK ? READ : FAILED;
     }
     if (d->state == FAILED)
@@ -114,7 +140,8 @@ static int texel_of(double x, int n)
 }
 
 PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
-                               const double uv[2], float rgba[4], PtrError *err)
+                               const double uv[2], GltfTexelValues values, float rgba[4],
+                               PtrError *err)
 {
     const Decoded *d;
     PtrResult res = decode(textures, ref->texture, &d, err);
@@ -132,19 +159,16 @@ PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref
     const PtrTexels *t = &d->texels;
     const size_t x = (size_t)texel_of(wrap(u, d->info.wrap_s), t->width);
     const size_t y = (size_t)texel_of(wrap(v, d->info.wrap_t), t->height);
-    for (int k = 0; k < 4; k++)
-        rgba[k] = t->rgba[4 * (y * (size_t)t->width + x) + (size_t)k];
-    return PTR_OK;
-}
-
-float gltf_textures_srgb_to_linear(const GltfTextures *textures, float encoded)
-{
-    const float scaled = encoded * 255.0f;
-    if (scaled >= 0.0f && scaled <= 255.0f) { /* not NaN */
-        const int n = (int)(scaled + 0.5f);
-        for (int f = 0; f < BYTE_FORMS; f++)
-            if (textures->byte_value[f][n] == encoded)
-                return textures->byte_linear[f][n];
+    const size_t first = 4 * (y * (size_t)t->width + x);
+    for (int k = 0; k < 4; k++) {
+        const int linear = values == GLTF_TEXELS_LINEAR && k < 3;
+        if (d->bytes) {
+            const unsigned char n = d->bytes[first + (size_t)k];
+            rgba[k] = linear ? textures->byte_linear[n] : textures->byte_value[n];
+        } else {
+            const float stored = t->rgba[first + (size_t)k];
+            rgba[k] = linear ? ptr_srgb_to_linear(stored) : stored;
+        }
     }
-    return ptr_srgb_to_linear(encoded);
+    return PTR_OK;
 }

@@ -16,19 +16,21 @@ PtrResult gltf_textures_new(const GltfDoc *doc, const char *path,
                             const PtrTextureDecoder *decoder, GltfTextures **out, PtrError *err);
 void gltf_textures_free(GltfTextures *textures);
 
-/* The texel ref's texture holds at uv (TEXCOORD_n's value), after its
- * KHR_texture_transform and its sampler's wrap modes: the nearest texel, as
- * stored (RGBA, 8-bit values over 255), which a palette's texture
- * coordinates hit exactly. Fails with PTR_ERR_SCENE_INVALID, naming the
- * texture, for one that does not exist or cannot be decoded (KTX2, broken
- * bytes) and for coordinates that are not finite; PTR_ERR_NOMEM. A texture
- * is decoded at its first sample: threads may sample at once only textures
- * sampled before (err NULL or their own). */
-PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
-                               const double uv[2], float rgba[4], PtrError *err);
+/* What a sample gives: the texel as stored (RGBA, 8-bit values over 255),
+ * or its RGB decoded from sRGB to linear (base colour and emissive
+ * textures: ptr_srgb_to_linear's values), alpha as stored. */
+typedef enum GltfTexelValues { GLTF_TEXELS_STORED, GLTF_TEXELS_LINEAR } GltfTexelValues;
 
-/* An sRGB-encoded texel value (base colour and emissive textures) made
- * linear: ptr_srgb_to_linear's value, from a table for 8-bit values. */
-float gltf_textures_srgb_to_linear(const GltfTextures *textures, float encoded);
+/* The texel ref's texture holds at uv (TEXCOORD_n's value), after its
+ * KHR_texture_transform and its sampler's wrap modes: the nearest texel,
+ * which a palette's texture coordinates hit exactly, as values says.
+ * Fails with PTR_ERR_SCENE_INVALID, naming the texture, for one that does
+ * not exist or cannot be decoded (KTX2, broken bytes) and for coordinates
+ * that are not finite; PTR_ERR_NOMEM. A texture is decoded at its first
+ * sample: threads may sample at once only textures sampled before (err
+ * NULL or their own). */
+PtrResult gltf_textures_sample(GltfTextures *textures, const GltfTextureRef *ref,
+                               const double uv[2], GltfTexelValues values, float rgba[4],
+                               PtrError *err);
 
 #endif /* PTR_GLTF_TEXTURES_H */

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <map>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -606,11 +608,33 @@ template <typename T> T *malloc_copy(const std::vector<T> &v)
     return out;
 }
 
+// The assemblies of a file read, or what reading them threw. A sequence of
+// a file's models fails at each frame for an assembly it cannot read, as an
+// import of one model does, while its models are still counted.
+struct Assemblies {
+    std::vector<Assembly> list;
+    std::exception_ptr failed;
+};
+
+// Calls read (which returns the assemblies) into assemblies; what read
+// throws is kept in it if keep_failure, else thrown.
+template <typename Read> void read_assemblies(Assemblies &assemblies, bool keep_failure,
+                                              Read read)
+{
+    try {
+        assemblies.list = read();
+    } catch (...) {
+        if (!keep_failure)
+            throw;
+        assemblies.failed = std::current_exception();
+    }
+}
+
 // The file read and parsed, checked where gemmi reads without checking;
-// with its assemblies (see Assembly, and mmcif_assemblies for asked) where
-// assemblies is not null.
-gemmi::Structure read_structure(const char *path, const char *asked,
-                                std::vector<Assembly> *assemblies)
+// its assemblies (see Assembly, and mmcif_assemblies for asked) into
+// assemblies, with their failure if keep_failure.
+gemmi::Structure read_structure(const char *path, const char *asked, Assemblies &assemblies,
+                                bool keep_failure)
 {
     gemmi::MaybeGzipped input(path);
     const gemmi::CoorFormat format = gemmi::coor_format_from_ext(input.basepath());
@@ -624,8 +648,7 @@ gemmi::Structure read_structure(const char *path, const char *asked,
         text = gemmi::CharArray();
         gemmi::Structure structure = gemmi::read_pdb_from_memory(lines.data(), lines.size(),
                                                                  path);
-        if (assemblies)
-            *assemblies = pdb_assemblies(structure);
+        read_assemblies(assemblies, keep_failure, [&] { return pdb_assemblies(structure); });
         return structure;
     }
     gemmi::cif::Document cif = gemmi::cif::read_memory(text.data(), text.size(), path);
@@ -633,20 +656,61 @@ gemmi::Structure read_structure(const char *path, const char *asked,
     if (!cif.blocks.empty()) {
         check_atom_site_columns(path, cif.blocks[0]);
         check_whole_numbers(path, cif.blocks[0]);
-        if (assemblies)
-            *assemblies = mmcif_assemblies(path, cif.blocks[0], asked);
+        read_assemblies(assemblies, keep_failure,
+                        [&] { return mmcif_assemblies(path, cif.blocks[0], asked); });
     }
     return gemmi::make_structure(cif);
 }
 
 } // namespace
 
-extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest *request,
-                                        StructureDoc *doc, PtrError *err)
+// A file read for any of its models: gemmi's setup_entities, which cannot
+// fail and does not depend on the model, has run once.
+struct PtrStructureFile {
+    gemmi::Structure structure; // its entities set up
+    Assemblies assemblies;
+};
+
+extern "C" PtrResult structure_file_open(const char *path, const char *assembly,
+                                         PtrStructureFile **out, PtrError *err)
 {
     try {
-        std::vector<Assembly> assemblies;
-        gemmi::Structure structure = read_structure(path, request->assembly, &assemblies);
+        std::unique_ptr<PtrStructureFile> file(new PtrStructureFile);
+        file->structure = read_structure(path, assembly, file->assemblies, true);
+        gemmi::setup_entities(file->structure);
+        *out = file.release();
+        return PTR_OK;
+    } catch (const Fault &fault) {
+        return ptr_shim_error(err, fault.code, fault.message);
+    } catch (...) {
+        return caught(err, path);
+    }
+}
+
+extern "C" size_t structure_file_models(const PtrStructureFile *file)
+{
+    return file->structure.models.size();
+}
+
+extern "C" void structure_file_free(PtrStructureFile *file)
+{
+    delete file;
+}
+
+extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest *request,
+                                        const PtrStructureFile *file, StructureDoc *doc,
+                                        PtrError *err)
+{
+    try {
+        PtrStructureFile read;
+        if (!file) {
+            read.structure = read_structure(path, request->assembly, read.assemblies, false);
+            gemmi::setup_entities(read.structure);
+            file = &read;
+        }
+        if (file->assemblies.failed)
+            std::rethrow_exception(file->assemblies.failed);
+        const gemmi::Structure &structure = file->structure;
         if (structure.models.empty())
             return ptr_shim_error(err, PTR_ERR_SCENE_INVALID, std::string(path) + ": no atoms");
         if (request->model >= structure.models.size())
@@ -654,8 +718,8 @@ extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest
                                   std::string(path) + ": no model " +
                                       std::to_string(request->model + 1) + "; it has " +
                                       std::to_string(structure.models.size()));
-        const Assembly *assembly = chosen_assembly(path, assemblies, request->assembly);
-        gemmi::setup_entities(structure);
+        const Assembly *assembly =
+            chosen_assembly(path, file->assemblies.list, request->assembly);
         const Selection kept = select_atoms(path, structure, structure.models[request->model],
                                             request->select, request->hydrogens);
         std::vector<StructureGenerator> generators;
@@ -673,18 +737,6 @@ extern "C" PtrResult structure_doc_read(const char *path, const StructureRequest
             structure_doc_free(doc);
             return ptr_shim_error(err, PTR_ERR_NOMEM, std::string(path) + ": out of memory");
         }
-        return PTR_OK;
-    } catch (const Fault &fault) {
-        return ptr_shim_error(err, fault.code, fault.message);
-    } catch (...) {
-        return caught(err, path);
-    }
-}
-
-extern "C" PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err)
-{
-    try {
-        *models = read_structure(path, nullptr, nullptr).models.size();
         return PTR_OK;
     } catch (const Fault &fault) {
         return ptr_shim_error(err, fault.code, fault.message);

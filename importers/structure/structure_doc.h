@@ -74,7 +74,22 @@ typedef struct StructureRequest {
     size_t model;         /* the model read: 0 the first */
 } StructureRequest;
 
-/* Reads path (.pdb, .ent, .cif or .mmcif, each optionally .gz): of the
+/* A structure file read and parsed once, for several of its models (the
+ * frames of a sequence). */
+typedef struct PtrStructureFile PtrStructureFile;
+
+/* Reads path as structure_doc_read does, with the assembly asked for, into
+ * *out (for structure_file_free). Fails as structure_doc_read does for the
+ * file itself; an assembly it cannot read fails each structure_doc_read of
+ * it instead, so that its models are still counted. */
+PtrResult structure_file_open(const char *path, const char *assembly, PtrStructureFile **out,
+                              PtrError *err);
+/* The number of models the file has. */
+size_t structure_file_models(const PtrStructureFile *file);
+void structure_file_free(PtrStructureFile *file);
+
+/* Reads path (.pdb, .ent, .cif or .mmcif, each optionally .gz), or takes it
+ * from file (opened for path with request->assembly) where that is not NULL: of the
  * model request->model, the atoms of the residues request->select keeps, hydrogens only
  * with request->hydrogens, and of an atom's alternate locations the one of
  * highest occupancy (the first of equals) where the first stood; and the
@@ -86,11 +101,7 @@ typedef struct StructureRequest {
  * PTR_ERR_USAGE (an assembly or a model the file does not have: the message
  * names those it has), PTR_ERR_NOMEM, each with one line naming the file. */
 PtrResult structure_doc_read(const char *path, const StructureRequest *request,
-                             StructureDoc *doc, PtrError *err);
-
-/* The number of models path has (read and checked as structure_doc_read
- * reads its atoms; its assemblies are not read), failing as it does. */
-PtrResult structure_doc_models(const char *path, size_t *models, PtrError *err);
+                             const PtrStructureFile *file, StructureDoc *doc, PtrError *err);
 void structure_doc_free(StructureDoc *doc);
 
 #ifdef __cplusplus

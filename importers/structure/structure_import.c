@@ -280,7 +280,8 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
         atom_coloring(path, options ? options->value_attribute : NULL, &coloring, err);
     StructureDoc doc = { 0 };
     if (res == PTR_OK)
-        res = structure_doc_read(path, &request, &doc, err);
+        res = structure_doc_read(path, &request, options ? options->structure_file : NULL, &doc,
+                                 err);
     if (res == PTR_OK && doc.models > 1 && !(options && options->structure_model))
         ptr_warn(warnings, "%s: the first of %zu models is read, the others are left out (# in "
                  "-o renders each as a frame)", path, doc.models);
@@ -299,9 +300,20 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
 }
 
 
-PtrResult ptr_structure_model_count(const char *path, size_t *models, PtrError *err)
+PtrResult ptr_structure_open(const char *path, const char *assembly, PtrStructureFile **out,
+                             PtrError *err)
 {
-    return structure_doc_models(path, models, err);
+    return structure_file_open(path, assembly, out, err);
+}
+
+size_t ptr_structure_models(const PtrStructureFile *file)
+{
+    return structure_file_models(file);
+}
+
+void ptr_structure_close(PtrStructureFile *file)
+{
+    structure_file_free(file);
 }
 
 PtrResult ptr_structure_select_parse(const char *text, unsigned *parts, PtrError *err)

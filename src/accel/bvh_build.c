@@ -326,7 +326,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
-    Build build = { .set.threads = threads > 0 ? threads : ptr_online_cpus() };
+    Build build = { .set.threads = ptr_thread_count(threads) };
     /* The prims and huge take the tree's spheres, whose memory the
      * scene's arrays give back meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];

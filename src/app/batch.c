@@ -175,16 +175,20 @@ static int renders_models(const PtrOptions *o)
 }
 
 /* The items of a sequence: frames of a scene pattern, of a turntable, or a
- * structure's models (frame k: model k, from 1). */
+ * structure's models (frame k: model k, from 1; *structure the file, parsed
+ * once for them). */
 static PtrResult plan_frames(const PtrOptions *o, PtrBatchItem **items, int *count,
-                             PtrError *err)
+                             PtrStructureFile **structure, PtrError *err)
 {
     const char *scene = o->inputs[0];
     const int models = renders_models(o);
     long *frames = NULL;
     int n = 0;
     size_t model_count = 0;
-    PtrResult res = models ? ptr_structure_model_count(scene, &model_count, err) : PTR_OK;
+    PtrResult res =
+        models ? ptr_structure_open(scene, o->structure_assembly, structure, err) : PTR_OK;
+    if (res == PTR_OK && models)
+        model_count = ptr_structure_models(*structure);
     if (res == PTR_OK)
         res = o->has_frames ? listed_frames(o, &frames, &n, err)
               : o->turntable || models ? PTR_OK
@@ -256,17 +260,19 @@ static const char *sequence_problem(const PtrOptions *o)
     return NULL;
 }
 
-PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, PtrError *err)
+PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count,
+                         PtrStructureFile **structure, PtrError *err)
 {
     *items = NULL;
     *count = 0;
+    *structure = NULL;
     const char *problem = sequence_problem(o);
     if (problem)
         return ptr_error_set(err, PTR_ERR_USAGE, "%s", problem);
     int sequence = o->turntable || ptr_batch_is_pattern(o->inputs[0]) || renders_models(o);
     PtrResult res = PTR_OK;
     if (sequence) {
-        res = plan_frames(o, items, count, err);
+        res = plan_frames(o, items, count, structure, err);
     } else {
         *items = calloc((size_t)o->input_count, sizeof **items);
         if (!*items)
@@ -294,6 +300,8 @@ PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, 
         ptr_batch_free(*items, *count);
         *items = NULL;
         *count = 0;
+        ptr_structure_close(*structure);
+        *structure = NULL;
     }
     return res;
 }

@@ -27,8 +27,11 @@ PtrResult ptr_batch_output(const PtrOptions *o, const char *scene, char *out, Pt
  * each scene to its output, or with a frame pattern (a run of '#' in the
  * scene, with --turntable, or in -o for a structure: its models numbered
  * from 1) the frames found or asked for. Outputs are
- * checked as ptr_output_check does, and must differ. */
-PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count, PtrError *err);
+ * checked as ptr_output_check does, and must differ. For a structure's
+ * models, *structure is the file, parsed once for all of them (for
+ * ptr_structure_close); else NULL. */
+PtrResult ptr_batch_plan(const PtrOptions *o, PtrBatchItem **items, int *count,
+                         PtrStructureFile **structure, PtrError *err);
 
 void ptr_batch_free(PtrBatchItem *items, int count);
 

@@ -95,11 +95,13 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
     PtrError err = { 0 };
     PtrBatchItem *items;
     int count;
-    if (ptr_batch_plan(o, &items, &count, &err) != PTR_OK)
+    PtrStructureFile *structure;
+    if (ptr_batch_plan(o, &items, &count, &structure, &err) != PTR_OK)
         return fail(&err);
     PtrJobReport *reports = calloc((size_t)count, sizeof *reports);
     if (!reports) {
         ptr_batch_free(items, count);
+        ptr_structure_close(structure);
         ptr_error_set(&err, PTR_ERR_NOMEM, "out of memory");
         return fail(&err);
     }
@@ -114,6 +116,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         PtrOptions frame = *o;
         frame.orbit_degrees = items[i].orbit_degrees;
         frame.structure_model = items[i].model;
+        frame.structure_file = structure;
         ptr_job_render(&frame, items[i].scene, items[i].output, color, NULL, &reports[done]);
         if (o->skip_existing)
             ptr_claim_release(items[i].output);
@@ -131,6 +134,7 @@ static int render_all(const PtrOptions *o, const PtrColor *color)
         ptr_job_report_free(&reports[i]);
     free(reports);
     ptr_batch_free(items, count);
+    ptr_structure_close(structure);
     return code;
 }
 
@@ -180,7 +184,7 @@ static int run(const PtrOptions *o)
      * no thread can start while the load runs. */
     char first_output[PTR_PATH_SIZE];
     if (!o->list_views) {
-        int threads = o->threads > 0 ? o->threads : ptr_online_cpus();
+        int threads = ptr_thread_count(o->threads);
         ptr_threads_keep(threads);
         if (o->skip_existing && ptr_claim_keeper_start(&err) != PTR_OK)
             return fail(&err);
@@ -219,12 +223,14 @@ static int run(const PtrOptions *o)
                           ptr_integrator_name(o->integrator), ptr_cpu_level_name(o->cpu_level),
                           built ? "has them from AVX2 on" : "was built without them");
             code = fail(&err);
-        } else if (ptr_live_view_open(o, color, &err) != PTR_OK) {
-            code = fail(&err);
         } else {
-            code = o->watch ? watch_scene(o, color) : render_all(o, color);
+            PtrOptions rendering = *o;
+            if (ptr_live_view_open(o, color, &rendering.live_view, &err) != PTR_OK)
+                code = fail(&err);
+            else
+                code = o->watch ? watch_scene(&rendering, color) : render_all(&rendering, color);
+            ptr_live_view_close(rendering.live_view);
         }
-        ptr_live_view_close();
     }
     ptr_color_close(color);
     ptr_claim_keeper_stop();

@@ -531,6 +531,7 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
         .orbit_degrees = o->orbit_degrees,
         .structure_model = o->structure_model,
+        .structure_file = o->structure_file,
         .dependencies = dependencies,
         .textures = { decode_texture, o->images },
     };

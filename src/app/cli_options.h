@@ -35,6 +35,9 @@ typedef enum PtrPrintRequest {
     PTR_PRINT_DISPATCH,
 } PtrPrintRequest;
 
+/* The live view (app/live_view.h). */
+typedef struct PtrLiveView PtrLiveView;
+
 typedef struct PtrOptions {
     char **inputs;          /* scenes; for `ptr merge`, the parts */
     int input_count;
@@ -90,6 +93,9 @@ typedef struct PtrOptions {
     int skip_existing;
     double orbit_degrees;   /* the camera's turn in the frame being rendered */
     size_t structure_model; /* the structure's model the frame renders (1 the first); 0: none */
+    /* Not an option: the structure whose models the frames render, parsed
+     * once for all of them; NULL: none, or each import reads its scene. */
+    const PtrStructureFile *structure_file;
     int json;
     int quiet;
     int dump_scene;
@@ -101,6 +107,9 @@ typedef struct PtrOptions {
     /* Not an option either: the denoiser of the run, with --denoise, which
      * ptr_cli_main owns too (NULL from ptr_options_parse). */
     PtrDenoiser *denoiser;
+    /* Not an option either: the live view of the renders, with --live or
+     * --tev, which the run that renders owns (NULL otherwise). */
+    PtrLiveView *live_view;
 } PtrOptions;
 
 /* What the importers need of the options. */

@@ -78,7 +78,8 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
-    ptr_live_view_begin(report->scene, report->output, scene, accel, &settings, &passes);
+    ptr_live_view_begin(o->live_view, report->scene, report->output, scene, accel, &settings,
+                        &passes);
     size_t pixels = (size_t)layout.width * (size_t)layout.height;
     float *rgb = malloc(pixels * 3 * sizeof *rgb);
     float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
@@ -134,7 +135,7 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     free(alpha);
     free(albedo);
     free(normal);
-    ptr_live_view_end(res == PTR_OK && !done.stopped);
+    ptr_live_view_end(o->live_view, res == PTR_OK && !done.stopped);
     if (res == PTR_OK && done.stopped && o->skip_existing)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted after %u of %u samples; not written, so that "

@@ -145,7 +145,7 @@ static PtrResult denoise(const char *path, const PtrImageLayout *layout, const f
         .color_stride = 3, .albedo_stride = 3, .normal_stride = 3,
         .width = (size_t)layout->width, .height = (size_t)layout->height,
     };
-    int threads = info->threads > 0 ? info->threads : ptr_online_cpus();
+    int threads = ptr_thread_count(info->threads);
     PtrError problem;
     PtrResult res = ptr_denoise(info->denoiser, &input, threads, denoised, 3, &problem);
     if (res != PTR_OK) {

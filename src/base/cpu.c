@@ -85,6 +85,11 @@ int ptr_online_cpus(void)
     return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
 }
 
+int ptr_thread_count(int requested)
+{
+    return requested > 0 ? requested : ptr_online_cpus();
+}
+
 double ptr_now_seconds(void)
 {
     struct timespec ts;

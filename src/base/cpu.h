@@ -35,6 +35,10 @@ PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *er
  * count. */
 int ptr_online_cpus(void);
 
+/* The threads a run asked for (--threads), or every online CPU where it
+ * asked for none (0 or less). */
+int ptr_thread_count(int requested);
+
 /* Seconds on a monotonic clock, for timing. */
 double ptr_now_seconds(void);
 

@@ -60,12 +60,6 @@ static PtrResult load(const char *folder, const char *file, size_t input_channel
 {
     char path[4096 + 64];
     snprintf(path, sizeof path, "%s/%s", folder, file);
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return ptr_error_set(err, PTR_ERR_INSTALL,
-                             "%s: no such weight file: scripts/install-deps.sh installs the "
-                             "denoiser's weights (or set PTR_WEIGHTS_DIR to their folder)",
-                             path);
     return ptr_unet_load(path, input_channels, level, out, err);
 }
 

@@ -211,6 +211,11 @@ PtrResult ptr_tza_parse(const char *name, const void *bytes, size_t size,
 PtrResult ptr_tza_read(const char *path, PtrTensorArchive **out, PtrError *err)
 {
     FILE *f = fopen(path, "rb");
+    if (!f && errno == ENOENT)
+        return bad(err, path,
+                   "cannot open: %s: scripts/install-deps.sh installs the denoiser's weights "
+                   "(or set PTR_WEIGHTS_DIR to their folder)",
+                   strerror(errno));
     if (!f)
         return bad(err, path, "cannot open: %s", strerror(errno));
     struct stat st;

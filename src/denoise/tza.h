@@ -41,7 +41,8 @@ PtrResult ptr_tza_parse(const char *name, const void *bytes, size_t size,
 
 /* The archive in the file at path, as ptr_tza_parse reads it; a file that
  * cannot be read, or of more than PTR_TZA_MAX_BYTES, is PTR_ERR_INSTALL
- * too (weight files come with the installation). */
+ * too (weight files come with the installation), the message saying why
+ * (and, for a file that does not exist, how to install the weights). */
 enum { PTR_TZA_MAX_BYTES = 1 << 30 };
 PtrResult ptr_tza_read(const char *path, PtrTensorArchive **out, PtrError *err);
 

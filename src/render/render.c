@@ -246,7 +246,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.tiles_done, 0);
 
-    int threads = settings->threads > 0 ? settings->threads : ptr_online_cpus();
+    int threads = ptr_thread_count(settings->threads);
     if (threads > job.tile_count)
         threads = job.tile_count;
     Worker *workers = calloc((size_t)threads, sizeof *workers);

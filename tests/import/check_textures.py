@@ -12,6 +12,8 @@ each imported with --dump-scene.
 - vertex colours: COLOR_0 as float, normalised byte and short, times the
   base colour (ptr's grey 0.8 without a material).
 - emissive: the emissive texture times emissiveFactor and the strength.
+- deep: 16-bit textures, whose values are no byte's, made linear (colour)
+  or not (roughness) alike.
 - varying: spheres whose texels differ take the mean over their vertices,
   and one warning counts them.
 - uri images: a PNG file beside the .gltf and one in a data: URI.
@@ -82,6 +84,15 @@ def main():
             scene = dump(path)
             if scene:
                 check_colours(name, scene, [want], "emission" if name == "emissive" else "albedo")
+
+        path = os.path.join(d, "deep.glb")
+        want, fuzz = tf.deep(path)
+        scene = dump(path)
+        if scene:
+            check_colours("deep", scene, [want])
+            m = scene["materials"][scene["spheres"][0]["material"]]
+            if m["kind"] != "metal" or abs(m["fuzz"] - fuzz) > TOL:
+                failures.append(f"deep: {m}, not metal of fuzz {fuzz}")
 
         for name, make in [("wrap", tf.wrap), ("vertex_colors", tf.vertex_colors)]:
             path = os.path.join(d, name + ".glb")

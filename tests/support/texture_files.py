@@ -23,22 +23,26 @@ import mesh_files as mf  # noqa: E402
 CLAMP, REPEAT = 33071, 10497
 
 
-def png(texels, width):
-    """An 8-bit RGBA PNG of texels (lists of 4 bytes), rows top to bottom."""
+def png(texels, width, bits=8):
+    """An RGBA PNG of texels (lists of 4 values of bits, 8 or 16), rows top
+    to bottom."""
     height = len(texels) // width
+    sample = ">" + ("B" if bits == 8 else "H")
 
     def chunk(kind, data):
         return (struct.pack(">I", len(data)) + kind + data +
                 struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
-    rows = b"".join(b"\0" + bytes(c for t in texels[y * width:(y + 1) * width] for c in t)
+    rows = b"".join(b"\0" + b"".join(struct.pack(sample, c)
+                                     for t in texels[y * width:(y + 1) * width] for c in t)
                     for y in range(height))
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">2I5B", width, height, 8, 6, 0, 0, 0))
+    return (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack(">2I5B", width, height, bits, 6, 0, 0, 0))
             + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
-def linear(byte):
-    """An 8-bit sRGB texel value made linear."""
-    x = byte / 255
+def linear(value, top=255):
+    """An sRGB texel value (an 8-bit one, or of top at most) made linear."""
+    x = value / top
     return x / 12.92 if x <= 0.04045 else ((x + 0.055) / 1.055) ** 2.4
 
 
@@ -188,6 +192,24 @@ def emissive(path):
     w.doc["extensionsUsed"] = ["KHR_materials_emissive_strength"]
     w.write(path)
     return [4 * 0.5 * linear(255), 4 * linear(128), 0.0]
+
+
+def deep(path):
+    """A 16-bit base colour and metallic-roughness texture, whose values are
+    no byte's: the colour (30000, 1000, 65535) / 65535 in sRGB, metallic 1
+    and roughness 20000 / 65535. Returns the colour and the fuzz."""
+    w = Writer()
+    sphere = mf.uv_sphere((0, 0, 0), 1)
+    m = w.material(pbrMetallicRoughness={
+        "baseColorTexture": {"index": w.texture(w.image(png([[30000, 1000, 65535, 65535]], 1,
+                                                             16)))},
+        "metallicRoughnessTexture": {"index": w.texture(w.image(png([[0, 20000, 65535, 65535]],
+                                                                    1, 16)))}})
+    mesh = w.mesh("deep", [(sphere, m)])
+    w.attribute(mesh, 0, "TEXCOORD_0", constant((0.5, 0.5), len(sphere[0])))
+    w.node("Deep", mesh)
+    w.write(path)
+    return [linear(c, 65535) for c in (30000, 1000, 65535)], 20000 / 65535
 
 
 def varying(path):

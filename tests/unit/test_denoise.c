@@ -2,14 +2,16 @@
  * denoise/unet.h): the PU transfer function and its inverse, the guides'
  * mappings for their own networks (sRGB, [-1, 1] to [0, 1]), the exposure
  * of constant images, pooling and upsampling; its errors: a quality that
- * does not exist, a missing weight file (for each quality), an archive
- * whose tensors are not the U-Net's. The networks themselves are checked
+ * does not exist, a missing weight file (for each quality), one that
+ * cannot be read, an archive whose tensors are not the U-Net's. The networks themselves are checked
  * against NumPy by check_denoise_network. */
 #include "denoise/denoise.h"
 #include "denoise/transfer.h"
 #include "denoise/unet.h"
 #include "test.h"
 
+#include <errno.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static void pu_round_trip(void)
@@ -179,24 +181,69 @@ static void write_one_layer(const char *path, uint32_t in)
     fclose(f);
 }
 
+#define TEMP_FOLDER "/tmp/ptr_denoise_XXXXXX"
+enum { PATH_SIZE = 64 };
+
+/* A new folder, dir (of sizeof TEMP_FOLDER), for the balanced quality's
+ * weight file, path (of PATH_SIZE). */
+static void weights_folder(char *dir, char *path)
+{
+    strcpy(dir, TEMP_FOLDER);
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, PATH_SIZE, "%s/rt_hdr_alb_nrm.tza", dir);
+}
+
+/* The balanced denoiser of the weights in dir, which fails: its code, its
+ * message in err. */
+static PtrResult refused(const char *dir, PtrError *err)
+{
+    PtrDenoiser *d = NULL;
+    PtrResult res = ptr_denoiser_new(PTR_DENOISE_BALANCED, dir, PTR_CPU_NONE, &d, err);
+    CHECK(d == NULL);
+    return res;
+}
+
 static void archives_not_a_unet(void)
 {
-    char dir[] = "/tmp/ptr_denoise_XXXXXX";
-    CHECK(mkdtemp(dir) != NULL);
-    char path[64];
-    snprintf(path, sizeof path, "%s/rt_hdr_alb_nrm.tza", dir);
-    PtrDenoiser *d = NULL;
+    char dir[sizeof TEMP_FOLDER], path[PATH_SIZE];
+    weights_folder(dir, path);
     PtrError err;
     write_one_layer(path, 8); /* the input has 9 channels */
-    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_BALANCED, dir, PTR_CPU_NONE, &d, &err),
-              PTR_ERR_INSTALL);
+    CHECK_INT(refused(dir, &err), PTR_ERR_INSTALL);
     CHECK(strstr(err.message, path) != NULL);
     CHECK(strstr(err.message, "enc_conv0.weight") != NULL);
     write_one_layer(path, 9); /* right, but the rest is missing */
-    CHECK_INT(ptr_denoiser_new(PTR_DENOISE_BALANCED, dir, PTR_CPU_NONE, &d, &err),
-              PTR_ERR_INSTALL);
+    CHECK_INT(refused(dir, &err), PTR_ERR_INSTALL);
     CHECK(strstr(err.message, "no tensor enc_conv1.weight") != NULL);
-    CHECK(d == NULL);
+    unlink(path);
+    rmdir(dir);
+}
+
+/* A weight file that is there but cannot be read: the message says why, in
+ * one line naming the file, and gives the installation's hint only where
+ * the file is missing. */
+static void weights_unreadable(void)
+{
+    char dir[sizeof TEMP_FOLDER], path[PATH_SIZE];
+    weights_folder(dir, path);
+    PtrError err;
+    CHECK(mkdir(path, 0700) == 0); /* a folder where the file should be */
+    CHECK_INT(refused(dir, &err), PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, path) && strstr(err.message, "not a file"));
+    CHECK(!strstr(err.message, "install-deps") && !strchr(err.message, '\n'));
+    rmdir(path);
+    CHECK(symlink(path, path) == 0); /* a link to itself: stat fails, not for want of a file */
+    CHECK_INT(refused(dir, &err), PTR_ERR_INSTALL);
+    CHECK(strstr(err.message, path) && strstr(err.message, strerror(ELOOP)));
+    CHECK(!strstr(err.message, "install-deps"));
+    unlink(path);
+    write_one_layer(path, 9);
+    CHECK(chmod(path, 0) == 0);
+    if (access(path, R_OK) != 0) { /* root reads it anyway */
+        CHECK_INT(refused(dir, &err), PTR_ERR_INSTALL);
+        CHECK(strstr(err.message, path) && strstr(err.message, strerror(EACCES)));
+        CHECK(!strstr(err.message, "install-deps"));
+    }
     unlink(path);
     rmdir(dir);
 }
@@ -208,6 +255,7 @@ int main(void)
         TEST_CASE(autoexposure_of_constant_images),
         TEST_CASE(pooling_and_upsampling), TEST_CASE(qualities),
         TEST_CASE(missing_weights), TEST_CASE(archives_not_a_unet),
+        TEST_CASE(weights_unreadable),
     };
     TEST_RUN(cases);
     return test_report();

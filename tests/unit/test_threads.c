@@ -2,14 +2,16 @@
  * thread, and has returned when ptr_thread_join does; the same threads serve
  * round after round. ptr_parallel_ranges covers its range exactly once,
  * whatever the thread count, with at least one thread and never more than
- * asked. Thread counts are bounds, not exact numbers: the system may refuse a
- * thread, and the cases run in any order over the same process's threads. */
+ * asked; ptr_thread_count gives a request's threads. Thread counts are
+ * bounds, not exact numbers: the system may refuse a thread, and the cases
+ * run in any order over the same process's threads. */
 #include "test.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
 #include <time.h>
 
+#include "base/cpu.h"
 #include "base/threads.h"
 
 enum { KEPT = 2, WORK = 5, ROUNDS = 200 };
@@ -155,12 +157,22 @@ static void test_parallel_ranges(void)
     CHECK(process_threads() <= 1 + most_asked);
 }
 
+/* The thread count of a request: as asked above 0, else every online CPU. */
+static void test_thread_count(void)
+{
+    CHECK_INT(ptr_thread_count(1), 1);
+    CHECK_INT(ptr_thread_count(3), 3);
+    CHECK_INT(ptr_thread_count(0), ptr_online_cpus());
+    CHECK_INT(ptr_thread_count(-2), ptr_online_cpus());
+}
+
 int main(void)
 {
     const TestCase cases[] = {
         TEST_CASE(test_keep),
         TEST_CASE(test_every_work_once),
         TEST_CASE(test_parallel_ranges),
+        TEST_CASE(test_thread_count),
     };
     TEST_RUN(cases);
     return test_report();
