@@ -462,30 +462,24 @@ static void mark_off(const Passes *ps, uint32_t c)
     atomic_store_explicit(&ps->off[c], 1, memory_order_relaxed);
 }
 
-/* Marks the components of vertices from .. to - 1 that lie off their sphere. */
-static void check_vertices(void *arg, size_t from, size_t to)
+/* Marks vertex p's component c (if any) if p lies off its sphere. */
+static void check_vertex(const Passes *ps, uint32_t c, const double p[3])
 {
-    const Passes *ps = arg;
-    const double slack = 2 * ps->mesh->quantum;
-    double p[BLOCK][3];
-    uint32_t c[BLOCK];
-    for (size_t v = from; v < to; v += BLOCK)
-        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++) {
-            if (c[i] == UNSET)
-                continue;
-            const PtrMeshSphere *s = &ps->spheres[c[i]];
-            if (!(fabs(distance(p[i], s->centre) - s->radius) <=
-                  PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
-                mark_off(ps, c[i]);
-        }
+    if (c == UNSET)
+        return;
+    const PtrMeshSphere *s = &ps->spheres[c];
+    if (!(fabs(distance(p, s->centre) - s->radius) <=
+          PTR_SPHERE_VERTEX_TOLERANCE * s->radius + 2 * ps->mesh->quantum))
+        mark_off(ps, c);
 }
 
 /* The corners of a block's triangles: where their vertices lie within
  * 3 * BLOCK of each other (a mesh's triangles mostly use nearby vertices),
  * those vertices read at once, each once; else each corner read. Returns
- * the first vertex read at once, or UNSET where each corner was. */
+ * the first vertex read at once, or UNSET where each corner was, and how
+ * many positions were read in *read. */
 static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size_t count,
-                             double (*corner)[3])
+                             double (*corner)[3], size_t *read)
 {
     uint32_t lo = UNSET, hi = 0;
     for (size_t i = 0; i < count; i++)
@@ -494,17 +488,22 @@ static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size
             hi = tri[i][k] > hi ? tri[i][k] : hi;
         }
     if (hi - lo < 3 * BLOCK) {
-        mesh->positions(mesh->user, lo, hi - lo + 1, corner);
+        *read = hi - lo + 1;
+        mesh->positions(mesh->user, lo, *read, corner);
         return lo;
     }
-    mesh->gather(mesh->user, &tri[0][0], 3 * count, corner);
+    *read = 3 * count;
+    mesh->gather(mesh->user, &tri[0][0], *read, corner);
     return UNSET;
 }
 
 /* Marks the components of triangles from .. to - 1 whose centroid lies too
  * deep inside their sphere (compared at three times the scale: the sum of
  * the corners against three times the centre), and finds each component's
- * first triangle. */
+ * first triangle. The positions read for the corners are checked as
+ * vertices too: every vertex a triangle uses is a corner, so every one is
+ * checked (some more than once, to the same effect), while the positions
+ * are in the cache. */
 static void check_triangles(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
@@ -514,7 +513,12 @@ static void check_triangles(void *arg, size_t from, size_t to)
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
-        const uint32_t first = read_corners(ps->mesh, tri, count, corner);
+        size_t read;
+        const uint32_t first = read_corners(ps->mesh, tri, count, corner, &read);
+        for (size_t i = 0; i < read; i++) {
+            const uint32_t v = first == UNSET ? tri[i / 3][i % 3] : first + (uint32_t)i;
+            check_vertex(ps, link_of(ps->parent, v), corner[i]);
+        }
         for (size_t i = 0; i < count; i++) {
             const uint32_t c = link_of(ps->parent, tri[i][0]);
             if (c != last) { /* this thread's first triangle of c: the least of the threads' */
@@ -600,7 +604,6 @@ static int fit_components(Passes *ps, size_t *count)
     ptr_parallel_ranges(threads, 0, n, relabel, ps);
     ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
     fit(ps, components);
-    ptr_parallel_ranges(threads, 0, n, check_vertices, ps);
     ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
     int sorted = 1;
     for (size_t c = 0; c < components; c++) {
