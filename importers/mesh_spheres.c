@@ -99,24 +99,35 @@ typedef struct Keyed {
 
 /* Vertices of equal positions are found partition by partition (the top
  * bits of their hash), each partition's table small enough for the cache.
- * The vertices are cut into slices, one a thread, each counting its
- * vertices of each partition and then placing them, so that a partition
- * holds its vertices in order. */
+ * The vertices are cut into slices, one a thread; a slice hashes each of
+ * its vertices once and files it under its partition, in buckets it takes
+ * from a pool of its own and chains, so that no pass has to count the
+ * partitions first: a partition's vertices are its chains, one a slice. */
+enum { BUCKET = 512 }; /* keyed vertices a bucket */
+
 typedef struct PositionMatch {
     const PtrMeshSource *mesh;
     Link *parent;
-    Keyed *keyed;   /* the vertices, partition after partition */
-    size_t *start;  /* partition p: keyed[start[p] .. start[p + 1] - 1] */
-    size_t *next;   /* slice s, partition p at [s * partitions + p]: first the
-                     * slice's count, then where it places its next vertex */
+    Keyed *keyed;    /* the buckets, one after another */
+    uint32_t *chain; /* a bucket's next in its chain */
+    uint32_t *head;  /* slice s, partition p at [s * partitions + p]: its
+                      * chain's first bucket */
+    size_t *filed;   /* the same: how many vertices its chain holds */
     size_t slices, partitions;
-    int bits;       /* partitions = 2^bits */
-    atomic_int failed; /* a table could not be allocated */
+    int bits;        /* partitions = 2^bits */
+    atomic_int failed; /* scratch could not be allocated */
 } PositionMatch;
 
 static size_t slice_start(const PositionMatch *pm, size_t s)
 {
     return pm->mesh->vertex_count * s / pm->slices;
+}
+
+/* A slice's pool, from this bucket to the next slice's: room for all its
+ * vertices, every partition's last bucket part empty. */
+static size_t pool_start(const PositionMatch *pm, size_t s)
+{
+    return slice_start(pm, s) / BUCKET + s * (pm->partitions + 1);
 }
 
 static size_t partition_of(const PositionMatch *pm, uint64_t hash)
@@ -143,53 +154,61 @@ static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t
     return kept;
 }
 
-static void count_slices(void *arg, size_t from, size_t to)
-{
-    PositionMatch *pm = arg;
-    uint64_t hash[BLOCK];
-    uint32_t vertex[BLOCK];
-    for (size_t s = from; s < to; s++) {
-        size_t *count = &pm->next[s * pm->partitions];
-        for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
-            for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++)
-                count[partition_of(pm, hash[i])]++;
-    }
-}
-
 /* The keyed vertices a partition's buffer holds until they are written out
  * together (a cache line): written one by one, each vertex to its own
- * partition's place, they would miss the cache and the TLB each time. */
+ * partition's bucket, they would miss the cache and the TLB each time. */
 enum { LINE = 8 };
 
-static void place_slices(void *arg, size_t from, size_t to)
+/* Files count keyed vertices at once into slice s's chain of partition p,
+ * starting a bucket where the last is full (a line never straddles two:
+ * LINE divides BUCKET, and only a chain's last line is short). */
+static void file_line(PositionMatch *pm, size_t s, size_t p, uint32_t *tail, size_t *pool,
+                      const Keyed *line, size_t count)
+{
+    const size_t at = s * pm->partitions + p;
+    if (pm->filed[at] % BUCKET == 0) {
+        const uint32_t bucket = (uint32_t)(*pool)++;
+        if (pm->filed[at])
+            pm->chain[tail[p]] = bucket;
+        else
+            pm->head[at] = bucket;
+        tail[p] = bucket;
+    }
+    memcpy(&pm->keyed[(size_t)tail[p] * BUCKET + pm->filed[at] % BUCKET], line,
+           count * sizeof *line);
+    pm->filed[at] += count;
+}
+
+static void file_slices(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
     Keyed (*line)[LINE] = malloc(pm->partitions * sizeof *line);
     unsigned char *held = calloc(pm->partitions, 1);
+    uint32_t *tail = malloc(pm->partitions * sizeof *tail);
     uint64_t hash[BLOCK];
     uint32_t vertex[BLOCK];
-    for (size_t s = from; line && held && s < to; s++) {
-        size_t *next = &pm->next[s * pm->partitions];
+    for (size_t s = from; line && held && tail && s < to; s++) {
+        size_t pool = pool_start(pm, s);
         for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
             for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++) {
                 const size_t p = partition_of(pm, hash[i]);
                 line[p][held[p]++] = (Keyed){ (uint32_t)hash[i], vertex[i] };
                 if (held[p] == LINE) {
-                    memcpy(&pm->keyed[next[p]], line[p], sizeof line[p]);
-                    next[p] += LINE;
+                    file_line(pm, s, p, tail, &pool, line[p], LINE);
                     held[p] = 0;
                 }
             }
         for (size_t p = 0; p < pm->partitions; p++) {
-            memcpy(&pm->keyed[next[p]], line[p], held[p] * sizeof line[p][0]);
-            next[p] += held[p];
+            if (held[p])
+                file_line(pm, s, p, tail, &pool, line[p], held[p]);
             held[p] = 0;
         }
     }
-    if (!line || !held)
+    if (!line || !held || !tail)
         atomic_store(&pm->failed, 1);
     free(line);
     free(held);
+    free(tail);
 }
 
 static int same_position(const PtrMeshSource *mesh, uint32_t v, uint32_t w)
@@ -200,27 +219,45 @@ static int same_position(const PtrMeshSource *mesh, uint32_t v, uint32_t w)
     return p[0][0] == p[1][0] && p[0][1] == p[1][1] && p[0][2] == p[1][2];
 }
 
+static size_t partition_count(const PositionMatch *pm, size_t p)
+{
+    size_t count = 0;
+    for (size_t s = 0; s < pm->slices; s++)
+        count += pm->filed[s * pm->partitions + p];
+    return count;
+}
+
+/* Partition p's keyed vertices, its chains one after another, into k. */
+static void gather_partition(const PositionMatch *pm, size_t p, Keyed *k)
+{
+    for (size_t s = 0; s < pm->slices; s++) {
+        size_t left = pm->filed[s * pm->partitions + p];
+        for (uint32_t b = pm->head[s * pm->partitions + p]; left; b = pm->chain[b]) {
+            const size_t count = left < BUCKET ? left : BUCKET;
+            memcpy(k, &pm->keyed[(size_t)b * BUCKET], count * sizeof *k);
+            k += count;
+            left -= count;
+        }
+    }
+}
+
 /* Partitions from .. to - 1, each through an open-addressed table of twice
  * as many slots as it has vertices: a vertex is united with the first of
- * its position. */
+ * its position (which is first does not change the sets). */
 static void match_partitions(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
     size_t largest = 0;
     for (size_t p = from; p < to; p++)
-        largest = pm->start[p + 1] - pm->start[p] > largest ? pm->start[p + 1] - pm->start[p]
-                                                            : largest;
+        largest = partition_count(pm, p) > largest ? partition_count(pm, p) : largest;
     size_t size = 16;
     while (size < 2 * largest)
         size *= 2;
     uint32_t *table = malloc(size * sizeof *table);
-    if (!table) {
-        atomic_store(&pm->failed, 1);
-        return;
-    }
-    for (size_t p = from; p < to; p++) {
-        const Keyed *k = &pm->keyed[pm->start[p]];
-        const size_t count = pm->start[p + 1] - pm->start[p];
+    Keyed *k = malloc((largest ? largest : 1) * sizeof *k);
+    for (size_t p = from; table && k && p < to; p++) {
+        const size_t count = partition_count(pm, p);
+        gather_partition(pm, p, k);
         size_t mask = 15;
         while (mask + 1 < 2 * count)
             mask = 2 * mask + 1;
@@ -238,43 +275,38 @@ static void match_partitions(void *arg, size_t from, size_t to)
                 }
             }
     }
+    if (!table || !k)
+        atomic_store(&pm->failed, 1);
     free(table);
+    free(k);
 }
 
-/* Joins the vertices of equal positions, keyed (one a vertex) as scratch. */
-static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed)
+/* Joins the vertices of equal positions. */
+static int unite_positions(const PtrMeshSource *mesh, Link *parent)
 {
-    PositionMatch pm = { .mesh = mesh, .parent = parent, .keyed = keyed,
-                         .slices = (size_t)threads_for(mesh) };
+    PositionMatch pm = { .mesh = mesh, .parent = parent, .slices = (size_t)threads_for(mesh) };
     while (pm.bits < MAX_PARTITION_BITS &&
            ((size_t)PARTITION_VERTICES << pm.bits) < mesh->vertex_count)
         pm.bits++;
     pm.partitions = (size_t)1 << pm.bits;
-    pm.start = malloc((pm.partitions + 1) * sizeof *pm.start);
-    pm.next = calloc(pm.slices * pm.partitions, sizeof *pm.next);
+    const size_t buckets = pool_start(&pm, pm.slices);
+    pm.keyed = malloc(buckets * BUCKET * sizeof *pm.keyed);
+    pm.chain = malloc(buckets * sizeof *pm.chain);
+    pm.head = malloc(pm.slices * pm.partitions * sizeof *pm.head);
+    pm.filed = calloc(pm.slices * pm.partitions, sizeof *pm.filed);
     atomic_init(&pm.failed, 0);
-    int ok = pm.start && pm.next;
+    int ok = pm.keyed && pm.chain && pm.head && pm.filed;
     if (ok) {
         const int threads = (int)pm.slices;
-        ptr_parallel_ranges(threads, 0, pm.slices, count_slices, &pm);
-        size_t at = 0;
-        for (size_t p = 0; p < pm.partitions; p++) {
-            pm.start[p] = at;
-            for (size_t s = 0; s < pm.slices; s++) {
-                size_t *next = &pm.next[s * pm.partitions + p];
-                const size_t count = *next;
-                *next = at;
-                at += count;
-            }
-        }
-        pm.start[pm.partitions] = at;
-        ptr_parallel_ranges(threads, 0, pm.slices, place_slices, &pm);
+        ptr_parallel_ranges(threads, 0, pm.slices, file_slices, &pm);
         if (!atomic_load(&pm.failed))
             ptr_parallel_ranges(threads, 0, pm.partitions, match_partitions, &pm);
         ok = !atomic_load(&pm.failed);
     }
-    free(pm.start);
-    free(pm.next);
+    free(pm.keyed);
+    free(pm.chain);
+    free(pm.head);
+    free(pm.filed);
     return ok;
 }
 
@@ -623,23 +655,23 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
     const int threads = threads_for(mesh);
-    /* One a vertex: the positions' keys, then the labels. */
-    Keyed *scratch = malloc(n * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
-                  .label = (Link *)scratch,
                   .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL };
     size_t components = 0;
-    int ok = ps.parent && scratch && (!vertex_spheres || ps.vertex_spheres);
+    int ok = ps.parent && (!vertex_spheres || ps.vertex_spheres);
     if (ok)
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
-    ok = ok && unite_positions(mesh, ps.parent, scratch);
+    ok = ok && unite_positions(mesh, ps.parent);
+    /* Taken once the positions' keys are freed: the memory at its peak. */
+    ps.label = ok ? malloc(n * sizeof *ps.label) : NULL;
+    ok = ok && ps.label;
     if (ok) {
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
         ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
     }
     ok = ok && fit_components(&ps, &components);
     free(ps.parent);
-    free(scratch);
+    free(ps.label);
     free(ps.first);
     free(ps.bounds);
     free(ps.off);
