@@ -322,6 +322,8 @@ typedef struct Passes {
     atomic_size_t *first;   /* a component's first triangle */
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
     atomic_uchar *off;      /* whether a component lies off its sphere */
+    double (*sure)[3];      /* a component's squared distances that pass its
+                             * checks for certain (see sure_bands) */
     uint32_t *order;        /* a component's place among the sorted spheres */
     uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
 } Passes;
@@ -463,6 +465,29 @@ static void bound_vertices(void *arg, size_t from, size_t to)
         merge_bounds(ps, run.component, run.lo, run.hi);
 }
 
+/* The checks below compare distances, a square root each; most distances
+ * are far from the checks' limits, and their squares show it without the
+ * root. sure[0] .. sure[1]: a vertex's squared distance from the centre
+ * that passes the vertex check for certain; sure[2] and above: three times
+ * a centroid's from three times the centre that passes the centroid check.
+ * Each band is narrower than its check by a billionth of the distances
+ * compared, far more than the roundings of either test, so a distance the
+ * band passes is one the check passes: anything else (NaN too) is checked
+ * as before, and the result is the same. Radii so small or large that their
+ * squares would underflow or overflow get empty bands (NaN: no distance
+ * passes). */
+static void sure_bands(double radius, double slack, double sure[3])
+{
+    const double within = PTR_SPHERE_VERTEX_TOLERANCE * radius + slack;
+    const double margin = 1e-9 * (radius + within);
+    const double near = fmax(radius - within + margin, 0.0), far = radius + within - margin;
+    const double deep = fmax(3 * PTR_SPHERE_CENTROID_DEPTH * radius - 3 * slack + 3 * margin, 0.0);
+    const int sane = radius + within > 1e-100 && radius + within < 1e100;
+    sure[0] = sane ? near * near : NAN;
+    sure[1] = sane ? far * far : NAN;
+    sure[2] = sane ? deep * deep : NAN;
+}
+
 /* The fit of each component to its bounds. */
 static void fit(const Passes *ps, size_t count)
 {
@@ -480,13 +505,19 @@ static void fit(const Passes *ps, size_t count)
         ps->spheres[c].is_sphere =
             extent > 0.0 && isfinite(extent) &&
             smallest + 2 * ps->mesh->quantum >= PTR_SPHERE_EXTENT_RATIO * extent;
+        sure_bands(ps->spheres[c].radius, 2 * ps->mesh->quantum, ps->sure[c]);
     }
+}
+
+static double squared_distance(const double a[3], const double b[3])
+{
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+           (a[2] - b[2]) * (a[2] - b[2]);
 }
 
 static double distance(const double a[3], const double b[3])
 {
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                (a[2] - b[2]) * (a[2] - b[2]));
+    return sqrt(squared_distance(a, b));
 }
 
 static void mark_off(const Passes *ps, uint32_t c)
@@ -500,6 +531,9 @@ static void check_vertex(const Passes *ps, uint32_t c, const double p[3])
     if (c == UNSET)
         return;
     const PtrMeshSphere *s = &ps->spheres[c];
+    const double d2 = squared_distance(p, s->centre);
+    if (d2 >= ps->sure[c][0] && d2 <= ps->sure[c][1])
+        return;
     if (!(fabs(distance(p, s->centre) - s->radius) <=
           PTR_SPHERE_VERTEX_TOLERANCE * s->radius + 2 * ps->mesh->quantum))
         mark_off(ps, c);
@@ -570,7 +604,8 @@ static void check_triangles(void *arg, size_t from, size_t to)
             }
             for (int k = 0; k < 3; k++)
                 centre[k] = 3 * s->centre[k];
-            if (!(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
+            if (!(squared_distance(sum, centre) >= ps->sure[c][2]) &&
+                !(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
                 mark_off(ps, c);
         }
     }
@@ -623,7 +658,8 @@ static int fit_components(Passes *ps, size_t *count)
     ps->first = malloc(room * sizeof *ps->first);
     ps->bounds = malloc(6 * room * sizeof *ps->bounds);
     ps->off = malloc(room * sizeof *ps->off);
-    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off)
+    ps->sure = malloc(room * sizeof *ps->sure);
+    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off || !ps->sure)
         return 0;
     for (size_t c = 0; c < components; c++) {
         atomic_init(&ps->first[c], SIZE_MAX);
@@ -675,6 +711,7 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
     free(ps.first);
     free(ps.bounds);
     free(ps.off);
+    free(ps.sure);
     free(ps.order);
     if (!ok) {
         free(ps.spheres);
