@@ -19,7 +19,10 @@ enum {
     BLOCK = 256,                 /* vertices or triangles read at once */
     PARALLEL_SIZE = 1 << 16,     /* vertices and triangles: a mesh this large on all cores */
     PARTITION_VERTICES = 4096,   /* about the vertices of one table of positions */
-    MAX_PARTITION_BITS = 10,
+    /* At most 512 partitions: a slice's write buffers (a cache line a
+     * partition) then stay in L1 and its pages in the TLB; more made
+     * filing slower than the smaller tables made matching faster. */
+    MAX_PARTITION_BITS = 9,
 };
 
 /* A vertex's parent in the union-find forest. Threads unite at once without
@@ -281,21 +284,39 @@ static void match_partitions(void *arg, size_t from, size_t to)
     free(k);
 }
 
-/* Joins the vertices of equal positions. */
-static int unite_positions(const PtrMeshSource *mesh, Link *parent)
+/* The slices and partitions of a mesh's vertices. */
+static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh)
 {
-    PositionMatch pm = { .mesh = mesh, .parent = parent, .slices = (size_t)threads_for(mesh) };
-    while (pm.bits < MAX_PARTITION_BITS &&
-           ((size_t)PARTITION_VERTICES << pm.bits) < mesh->vertex_count)
-        pm.bits++;
-    pm.partitions = (size_t)1 << pm.bits;
+    *pm = (PositionMatch){ .mesh = mesh, .slices = (size_t)threads_for(mesh) };
+    while (pm->bits < MAX_PARTITION_BITS &&
+           ((size_t)PARTITION_VERTICES << pm->bits) < mesh->vertex_count)
+        pm->bits++;
+    pm->partitions = (size_t)1 << pm->bits;
+}
+
+/* The keyed vertices unite_positions needs for its buckets: at least one a
+ * vertex. */
+static size_t keyed_room(const PtrMeshSource *mesh)
+{
+    PositionMatch pm;
+    plan_partitions(&pm, mesh);
+    return pool_start(&pm, pm.slices) * BUCKET;
+}
+
+/* Joins the vertices of equal positions, keyed (keyed_room of them) as
+ * scratch. */
+static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed)
+{
+    PositionMatch pm;
+    plan_partitions(&pm, mesh);
+    pm.parent = parent;
+    pm.keyed = keyed;
     const size_t buckets = pool_start(&pm, pm.slices);
-    pm.keyed = malloc(buckets * BUCKET * sizeof *pm.keyed);
     pm.chain = malloc(buckets * sizeof *pm.chain);
     pm.head = malloc(pm.slices * pm.partitions * sizeof *pm.head);
     pm.filed = calloc(pm.slices * pm.partitions, sizeof *pm.filed);
     atomic_init(&pm.failed, 0);
-    int ok = pm.keyed && pm.chain && pm.head && pm.filed;
+    int ok = pm.chain && pm.head && pm.filed;
     if (ok) {
         const int threads = (int)pm.slices;
         ptr_parallel_ranges(threads, 0, pm.slices, file_slices, &pm);
@@ -303,7 +324,6 @@ static int unite_positions(const PtrMeshSource *mesh, Link *parent)
             ptr_parallel_ranges(threads, 0, pm.partitions, match_partitions, &pm);
         ok = !atomic_load(&pm.failed);
     }
-    free(pm.keyed);
     free(pm.chain);
     free(pm.head);
     free(pm.filed);
@@ -691,23 +711,24 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
     const int threads = threads_for(mesh);
+    /* The positions' keys, then the labels: one allocation, its pages
+     * mapped once. */
+    Keyed *scratch = malloc(keyed_room(mesh) * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
+                  .label = (Link *)scratch,
                   .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL };
     size_t components = 0;
-    int ok = ps.parent && (!vertex_spheres || ps.vertex_spheres);
+    int ok = ps.parent && scratch && (!vertex_spheres || ps.vertex_spheres);
     if (ok)
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
-    ok = ok && unite_positions(mesh, ps.parent);
-    /* Taken once the positions' keys are freed: the memory at its peak. */
-    ps.label = ok ? malloc(n * sizeof *ps.label) : NULL;
-    ok = ok && ps.label;
+    ok = ok && unite_positions(mesh, ps.parent, scratch);
     if (ok) {
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
         ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
     }
     ok = ok && fit_components(&ps, &components);
     free(ps.parent);
-    free(ps.label);
+    free(scratch);
     free(ps.first);
     free(ps.bounds);
     free(ps.off);
