@@ -412,6 +412,20 @@ static void relabel(void *arg, size_t from, size_t to)
                               memory_order_relaxed);
 }
 
+/* Components from .. to - 1 before their first vertex is bounded. */
+static void start_components(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t c = from; c < to; c++) {
+        atomic_init(&ps->first[c], SIZE_MAX);
+        for (int k = 0; k < 3; k++) {
+            atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
+            atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
+        }
+        atomic_init(&ps->off[c], 0);
+    }
+}
+
 static void lower_to(_Atomic double *bound, double x)
 {
     double seen = atomic_load_explicit(bound, memory_order_relaxed);
@@ -508,10 +522,11 @@ static void sure_bands(double radius, double slack, double sure[3])
     sure[2] = sane ? deep * deep : NAN;
 }
 
-/* The fit of each component to its bounds. */
-static void fit(const Passes *ps, size_t count)
+/* The fit of components from .. to - 1 to their bounds. */
+static void fit(void *arg, size_t from, size_t to)
 {
-    for (size_t c = 0; c < count; c++) {
+    const Passes *ps = arg;
+    for (size_t c = from; c < to; c++) {
         double extent = 0.0, smallest = HUGE_VAL;
         for (int k = 0; k < 3; k++) {
             const double lo = atomic_load_explicit(&ps->bounds[6 * c + k], memory_order_relaxed);
@@ -595,7 +610,7 @@ static void check_triangles(void *arg, size_t from, size_t to)
     const Passes *ps = arg;
     const double slack = 2 * ps->mesh->quantum;
     uint32_t tri[BLOCK][3], last = UNSET;
-    double corner[3 * BLOCK][3];
+    double corner[3 * BLOCK][3], centre[3] = { 0, 0, 0 }, deep = 0.0; /* last's, times 3 */
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
@@ -614,18 +629,18 @@ static void check_triangles(void *arg, size_t from, size_t to)
                                            &ps->first[c], &seen, t + i, memory_order_relaxed,
                                            memory_order_relaxed))
                     ;
+                for (int k = 0; k < 3; k++)
+                    centre[k] = 3 * ps->spheres[c].centre[k];
+                deep = 3 * PTR_SPHERE_CENTROID_DEPTH * ps->spheres[c].radius;
             }
-            const PtrMeshSphere *s = &ps->spheres[c];
-            double sum[3] = { 0, 0, 0 }, centre[3];
+            double sum[3] = { 0, 0, 0 };
             for (int j = 0; j < 3; j++) {
                 const double *p = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
                 for (int k = 0; k < 3; k++)
                     sum[k] += p[k];
             }
-            for (int k = 0; k < 3; k++)
-                centre[k] = 3 * s->centre[k];
             if (!(squared_distance(sum, centre) >= ps->sure[c][2]) &&
-                !(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
+                !(distance(sum, centre) + 3 * slack >= deep))
                 mark_off(ps, c);
         }
     }
@@ -681,17 +696,10 @@ static int fit_components(Passes *ps, size_t *count)
     ps->sure = malloc(room * sizeof *ps->sure);
     if (!ps->spheres || !ps->first || !ps->bounds || !ps->off || !ps->sure)
         return 0;
-    for (size_t c = 0; c < components; c++) {
-        atomic_init(&ps->first[c], SIZE_MAX);
-        for (int k = 0; k < 3; k++) {
-            atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
-            atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
-        }
-        atomic_init(&ps->off[c], 0);
-    }
+    ptr_parallel_ranges(threads, 0, components, start_components, ps);
     ptr_parallel_ranges(threads, 0, n, relabel, ps);
     ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
-    fit(ps, components);
+    ptr_parallel_ranges(threads, 0, components, fit, ps);
     ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
     int sorted = 1;
     for (size_t c = 0; c < components; c++) {
