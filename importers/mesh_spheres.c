@@ -333,8 +333,9 @@ static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed
 /* What the passes share. */
 typedef struct Passes {
     const PtrMeshSource *mesh;
-    Link *parent; /* a vertex's parent; from flatten on, its root; from relabel
-                   * on, its component, UNSET if no triangle uses it */
+    Link *parent; /* a vertex's parent; from flatten on, its root; from
+                   * bound_vertices on, its component, UNSET if no triangle
+                   * uses it */
     Link *label;  /* UNSET, or USED for a triangle's first corner and, from
                    * flatten on, for the root of its set; from number_roots
                    * on, a root's component */
@@ -402,16 +403,6 @@ static size_t number_roots(const Passes *ps)
     return n;
 }
 
-/* Each vertex its component, from its root's label. */
-static void relabel(void *arg, size_t from, size_t to)
-{
-    const Passes *ps = arg;
-    for (size_t v = from; v < to; v++)
-        atomic_store_explicit(&ps->parent[v],
-                              link_of(ps->label, link_of(ps->parent, (uint32_t)v)),
-                              memory_order_relaxed);
-}
-
 /* Components from .. to - 1 before their first vertex is bounded. */
 static void start_components(void *arg, size_t from, size_t to)
 {
@@ -452,13 +443,17 @@ static void merge_bounds(const Passes *ps, uint32_t c, const double lo[3], const
 }
 
 /* Vertices v .. to - 1, at most a block of them: their positions into p and
- * their components into c. Returns how many. */
-static size_t vertex_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
+ * their components, from their roots' labels, into c and their parents
+ * (the relabelling, done in the pass that reads the positions). Returns
+ * how many. */
+static size_t relabel_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
 {
     const size_t count = to - v < BLOCK ? to - v : BLOCK;
     ps->mesh->positions(ps->mesh->user, v, count, p);
-    for (size_t i = 0; i < count; i++)
-        c[i] = link_of(ps->parent, (uint32_t)(v + i));
+    for (size_t i = 0; i < count; i++) {
+        c[i] = link_of(ps->label, link_of(ps->parent, (uint32_t)(v + i)));
+        atomic_store_explicit(&ps->parent[v + i], c[i], memory_order_relaxed);
+    }
     return count;
 }
 
@@ -485,6 +480,8 @@ static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[
     }
 }
 
+/* Relabels vertices from .. to - 1 with their components and adds them to
+ * their components' bounds. */
 static void bound_vertices(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
@@ -492,7 +489,7 @@ static void bound_vertices(void *arg, size_t from, size_t to)
     double p[BLOCK][3];
     uint32_t c[BLOCK];
     for (size_t v = from; v < to; v += BLOCK)
-        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++)
+        for (size_t i = 0, n = relabel_block(ps, v, to, p, c); i < n; i++)
             if (c[i] != UNSET)
                 bound_vertex(ps, &run, c[i], p[i]);
     if (run.component != UNSET)
@@ -697,7 +694,6 @@ static int fit_components(Passes *ps, size_t *count)
     if (!ps->spheres || !ps->first || !ps->bounds || !ps->off || !ps->sure)
         return 0;
     ptr_parallel_ranges(threads, 0, components, start_components, ps);
-    ptr_parallel_ranges(threads, 0, n, relabel, ps);
     ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
     ptr_parallel_ranges(threads, 0, components, fit, ps);
     ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
