@@ -380,12 +380,21 @@ static void unite_triangles(void *arg, size_t from, size_t to)
     }
 }
 
+/* v's root where it is at most two links up, as it mostly is once the
+ * vertices below v are flattened, without find's compare-and-swaps (the
+ * root is stored in v next anyway); else find's. */
+static uint32_t near_root(Link *parent, uint32_t v)
+{
+    const uint32_t above = link_of(parent, link_of(parent, v));
+    return link_of(parent, above) == above ? above : find(parent, v);
+}
+
 /* Each vertex its root, and a root USED if a vertex of its set is. */
 static void flatten(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++) {
-        const uint32_t root = find(ps->parent, (uint32_t)v);
+        const uint32_t root = near_root(ps->parent, (uint32_t)v);
         atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
         if (root != v && link_of(ps->label, (uint32_t)v) == USED)
             atomic_store_explicit(&ps->label[root], USED, memory_order_relaxed);
