@@ -118,7 +118,7 @@ typedef struct PositionMatch {
     size_t *filed;   /* the same: how many vertices its chain holds */
     size_t slices, partitions;
     int bits;        /* partitions = 2^bits */
-    atomic_int failed; /* scratch could not be allocated */
+    atomic_int failed; /* a buffer or table could not be allocated */
 } PositionMatch;
 
 static size_t slice_start(const PositionMatch *pm, size_t s)
