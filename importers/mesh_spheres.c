@@ -19,7 +19,10 @@ enum {
     BLOCK = 256,                 /* vertices or triangles read at once */
     PARALLEL_SIZE = 1 << 16,     /* vertices and triangles: a mesh this large on all cores */
     PARTITION_VERTICES = 4096,   /* about the vertices of one table of positions */
-    MAX_PARTITION_BITS = 10,
+    /* At most 512 partitions: a slice's write buffers (a cache line a
+     * partition) then stay in L1 and its pages in the TLB; more made
+     * filing slower than the smaller tables made matching faster. */
+    MAX_PARTITION_BITS = 9,
 };
 
 /* A vertex's parent in the union-find forest. Threads unite at once without
@@ -99,24 +102,35 @@ typedef struct Keyed {
 
 /* Vertices of equal positions are found partition by partition (the top
  * bits of their hash), each partition's table small enough for the cache.
- * The vertices are cut into slices, one a thread, each counting its
- * vertices of each partition and then placing them, so that a partition
- * holds its vertices in order. */
+ * The vertices are cut into slices, one a thread; a slice hashes each of
+ * its vertices once and files it under its partition, in buckets it takes
+ * from a pool of its own and chains, so that no pass has to count the
+ * partitions first: a partition's vertices are its chains, one a slice. */
+enum { BUCKET = 512 }; /* keyed vertices a bucket */
+
 typedef struct PositionMatch {
     const PtrMeshSource *mesh;
     Link *parent;
-    Keyed *keyed;   /* the vertices, partition after partition */
-    size_t *start;  /* partition p: keyed[start[p] .. start[p + 1] - 1] */
-    size_t *next;   /* slice s, partition p at [s * partitions + p]: first the
-                     * slice's count, then where it places its next vertex */
+    Keyed *keyed;    /* the buckets, one after another */
+    uint32_t *chain; /* a bucket's next in its chain */
+    uint32_t *head;  /* slice s, partition p at [s * partitions + p]: its
+                      * chain's first bucket */
+    size_t *filed;   /* the same: how many vertices its chain holds */
     size_t slices, partitions;
-    int bits;       /* partitions = 2^bits */
-    atomic_int failed; /* a table could not be allocated */
+    int bits;        /* partitions = 2^bits */
+    atomic_int failed; /* a buffer or table could not be allocated */
 } PositionMatch;
 
 static size_t slice_start(const PositionMatch *pm, size_t s)
 {
     return pm->mesh->vertex_count * s / pm->slices;
+}
+
+/* A slice's pool, from this bucket to the next slice's: room for all its
+ * vertices, every partition's last bucket part empty. */
+static size_t pool_start(const PositionMatch *pm, size_t s)
+{
+    return slice_start(pm, s) / BUCKET + s * (pm->partitions + 1);
 }
 
 static size_t partition_of(const PositionMatch *pm, uint64_t hash)
@@ -143,53 +157,61 @@ static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t
     return kept;
 }
 
-static void count_slices(void *arg, size_t from, size_t to)
-{
-    PositionMatch *pm = arg;
-    uint64_t hash[BLOCK];
-    uint32_t vertex[BLOCK];
-    for (size_t s = from; s < to; s++) {
-        size_t *count = &pm->next[s * pm->partitions];
-        for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
-            for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++)
-                count[partition_of(pm, hash[i])]++;
-    }
-}
-
 /* The keyed vertices a partition's buffer holds until they are written out
  * together (a cache line): written one by one, each vertex to its own
- * partition's place, they would miss the cache and the TLB each time. */
+ * partition's bucket, they would miss the cache and the TLB each time. */
 enum { LINE = 8 };
 
-static void place_slices(void *arg, size_t from, size_t to)
+/* Files count keyed vertices at once into slice s's chain of partition p,
+ * starting a bucket where the last is full (a line never straddles two:
+ * LINE divides BUCKET, and only a chain's last line is short). */
+static void file_line(PositionMatch *pm, size_t s, size_t p, uint32_t *tail, size_t *pool,
+                      const Keyed *line, size_t count)
+{
+    const size_t at = s * pm->partitions + p;
+    if (pm->filed[at] % BUCKET == 0) {
+        const uint32_t bucket = (uint32_t)(*pool)++;
+        if (pm->filed[at])
+            pm->chain[tail[p]] = bucket;
+        else
+            pm->head[at] = bucket;
+        tail[p] = bucket;
+    }
+    memcpy(&pm->keyed[(size_t)tail[p] * BUCKET + pm->filed[at] % BUCKET], line,
+           count * sizeof *line);
+    pm->filed[at] += count;
+}
+
+static void file_slices(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
     Keyed (*line)[LINE] = malloc(pm->partitions * sizeof *line);
     unsigned char *held = calloc(pm->partitions, 1);
+    uint32_t *tail = malloc(pm->partitions * sizeof *tail);
     uint64_t hash[BLOCK];
     uint32_t vertex[BLOCK];
-    for (size_t s = from; line && held && s < to; s++) {
-        size_t *next = &pm->next[s * pm->partitions];
+    for (size_t s = from; line && held && tail && s < to; s++) {
+        size_t pool = pool_start(pm, s);
         for (size_t v = slice_start(pm, s), end = slice_start(pm, s + 1); v < end; v += BLOCK)
             for (size_t i = 0, n = hash_block(pm, v, end, hash, vertex); i < n; i++) {
                 const size_t p = partition_of(pm, hash[i]);
                 line[p][held[p]++] = (Keyed){ (uint32_t)hash[i], vertex[i] };
                 if (held[p] == LINE) {
-                    memcpy(&pm->keyed[next[p]], line[p], sizeof line[p]);
-                    next[p] += LINE;
+                    file_line(pm, s, p, tail, &pool, line[p], LINE);
                     held[p] = 0;
                 }
             }
         for (size_t p = 0; p < pm->partitions; p++) {
-            memcpy(&pm->keyed[next[p]], line[p], held[p] * sizeof line[p][0]);
-            next[p] += held[p];
+            if (held[p])
+                file_line(pm, s, p, tail, &pool, line[p], held[p]);
             held[p] = 0;
         }
     }
-    if (!line || !held)
+    if (!line || !held || !tail)
         atomic_store(&pm->failed, 1);
     free(line);
     free(held);
+    free(tail);
 }
 
 static int same_position(const PtrMeshSource *mesh, uint32_t v, uint32_t w)
@@ -200,27 +222,45 @@ static int same_position(const PtrMeshSource *mesh, uint32_t v, uint32_t w)
     return p[0][0] == p[1][0] && p[0][1] == p[1][1] && p[0][2] == p[1][2];
 }
 
+static size_t partition_count(const PositionMatch *pm, size_t p)
+{
+    size_t count = 0;
+    for (size_t s = 0; s < pm->slices; s++)
+        count += pm->filed[s * pm->partitions + p];
+    return count;
+}
+
+/* Partition p's keyed vertices, its chains one after another, into k. */
+static void gather_partition(const PositionMatch *pm, size_t p, Keyed *k)
+{
+    for (size_t s = 0; s < pm->slices; s++) {
+        size_t left = pm->filed[s * pm->partitions + p];
+        for (uint32_t b = pm->head[s * pm->partitions + p]; left; b = pm->chain[b]) {
+            const size_t count = left < BUCKET ? left : BUCKET;
+            memcpy(k, &pm->keyed[(size_t)b * BUCKET], count * sizeof *k);
+            k += count;
+            left -= count;
+        }
+    }
+}
+
 /* Partitions from .. to - 1, each through an open-addressed table of twice
  * as many slots as it has vertices: a vertex is united with the first of
- * its position. */
+ * its position (which is first does not change the sets). */
 static void match_partitions(void *arg, size_t from, size_t to)
 {
     PositionMatch *pm = arg;
     size_t largest = 0;
     for (size_t p = from; p < to; p++)
-        largest = pm->start[p + 1] - pm->start[p] > largest ? pm->start[p + 1] - pm->start[p]
-                                                            : largest;
+        largest = partition_count(pm, p) > largest ? partition_count(pm, p) : largest;
     size_t size = 16;
     while (size < 2 * largest)
         size *= 2;
     uint32_t *table = malloc(size * sizeof *table);
-    if (!table) {
-        atomic_store(&pm->failed, 1);
-        return;
-    }
-    for (size_t p = from; p < to; p++) {
-        const Keyed *k = &pm->keyed[pm->start[p]];
-        const size_t count = pm->start[p + 1] - pm->start[p];
+    Keyed *k = malloc((largest ? largest : 1) * sizeof *k);
+    for (size_t p = from; table && k && p < to; p++) {
+        const size_t count = partition_count(pm, p);
+        gather_partition(pm, p, k);
         size_t mask = 15;
         while (mask + 1 < 2 * count)
             mask = 2 * mask + 1;
@@ -238,51 +278,64 @@ static void match_partitions(void *arg, size_t from, size_t to)
                 }
             }
     }
+    if (!table || !k)
+        atomic_store(&pm->failed, 1);
     free(table);
+    free(k);
 }
 
-/* Joins the vertices of equal positions, keyed (one a vertex) as scratch. */
+/* The slices and partitions of a mesh's vertices. */
+static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh)
+{
+    *pm = (PositionMatch){ .mesh = mesh, .slices = (size_t)threads_for(mesh) };
+    while (pm->bits < MAX_PARTITION_BITS &&
+           ((size_t)PARTITION_VERTICES << pm->bits) < mesh->vertex_count)
+        pm->bits++;
+    pm->partitions = (size_t)1 << pm->bits;
+}
+
+/* The keyed vertices unite_positions needs for its buckets: at least one a
+ * vertex. */
+static size_t keyed_room(const PtrMeshSource *mesh)
+{
+    PositionMatch pm;
+    plan_partitions(&pm, mesh);
+    return pool_start(&pm, pm.slices) * BUCKET;
+}
+
+/* Joins the vertices of equal positions, keyed (keyed_room of them) as
+ * scratch. */
 static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed)
 {
-    PositionMatch pm = { .mesh = mesh, .parent = parent, .keyed = keyed,
-                         .slices = (size_t)threads_for(mesh) };
-    while (pm.bits < MAX_PARTITION_BITS &&
-           ((size_t)PARTITION_VERTICES << pm.bits) < mesh->vertex_count)
-        pm.bits++;
-    pm.partitions = (size_t)1 << pm.bits;
-    pm.start = malloc((pm.partitions + 1) * sizeof *pm.start);
-    pm.next = calloc(pm.slices * pm.partitions, sizeof *pm.next);
+    PositionMatch pm;
+    plan_partitions(&pm, mesh);
+    pm.parent = parent;
+    pm.keyed = keyed;
+    const size_t buckets = pool_start(&pm, pm.slices);
+    pm.chain = malloc(buckets * sizeof *pm.chain);
+    pm.head = malloc(pm.slices * pm.partitions * sizeof *pm.head);
+    pm.filed = calloc(pm.slices * pm.partitions, sizeof *pm.filed);
     atomic_init(&pm.failed, 0);
-    int ok = pm.start && pm.next;
+    int ok = pm.chain && pm.head && pm.filed;
     if (ok) {
         const int threads = (int)pm.slices;
-        ptr_parallel_ranges(threads, 0, pm.slices, count_slices, &pm);
-        size_t at = 0;
-        for (size_t p = 0; p < pm.partitions; p++) {
-            pm.start[p] = at;
-            for (size_t s = 0; s < pm.slices; s++) {
-                size_t *next = &pm.next[s * pm.partitions + p];
-                const size_t count = *next;
-                *next = at;
-                at += count;
-            }
-        }
-        pm.start[pm.partitions] = at;
-        ptr_parallel_ranges(threads, 0, pm.slices, place_slices, &pm);
+        ptr_parallel_ranges(threads, 0, pm.slices, file_slices, &pm);
         if (!atomic_load(&pm.failed))
             ptr_parallel_ranges(threads, 0, pm.partitions, match_partitions, &pm);
         ok = !atomic_load(&pm.failed);
     }
-    free(pm.start);
-    free(pm.next);
+    free(pm.chain);
+    free(pm.head);
+    free(pm.filed);
     return ok;
 }
 
 /* What the passes share. */
 typedef struct Passes {
     const PtrMeshSource *mesh;
-    Link *parent; /* a vertex's parent; from flatten on, its root; from relabel
-                   * on, its component, UNSET if no triangle uses it */
+    Link *parent; /* a vertex's parent; from flatten on, its root; from
+                   * bound_vertices on, its component, UNSET if no triangle
+                   * uses it */
     Link *label;  /* UNSET, or USED for a triangle's first corner and, from
                    * flatten on, for the root of its set; from number_roots
                    * on, a root's component */
@@ -290,6 +343,8 @@ typedef struct Passes {
     atomic_size_t *first;   /* a component's first triangle */
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
     atomic_uchar *off;      /* whether a component lies off its sphere */
+    double (*sure)[3];      /* a component's squared distances that pass its
+                             * checks for certain (see sure_bands) */
     uint32_t *order;        /* a component's place among the sorted spheres */
     uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
 } Passes;
@@ -325,12 +380,21 @@ static void unite_triangles(void *arg, size_t from, size_t to)
     }
 }
 
+/* v's root where it is at most two links up, as it mostly is once the
+ * vertices below v are flattened, without find's compare-and-swaps (the
+ * root is stored in v next anyway); else find's. */
+static uint32_t near_root(Link *parent, uint32_t v)
+{
+    const uint32_t above = link_of(parent, link_of(parent, v));
+    return link_of(parent, above) == above ? above : find(parent, v);
+}
+
 /* Each vertex its root, and a root USED if a vertex of its set is. */
 static void flatten(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++) {
-        const uint32_t root = find(ps->parent, (uint32_t)v);
+        const uint32_t root = near_root(ps->parent, (uint32_t)v);
         atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
         if (root != v && link_of(ps->label, (uint32_t)v) == USED)
             atomic_store_explicit(&ps->label[root], USED, memory_order_relaxed);
@@ -348,14 +412,18 @@ static size_t number_roots(const Passes *ps)
     return n;
 }
 
-/* Each vertex its component, from its root's label. */
-static void relabel(void *arg, size_t from, size_t to)
+/* Components from .. to - 1 before their first vertex is bounded. */
+static void start_components(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
-    for (size_t v = from; v < to; v++)
-        atomic_store_explicit(&ps->parent[v],
-                              link_of(ps->label, link_of(ps->parent, (uint32_t)v)),
-                              memory_order_relaxed);
+    for (size_t c = from; c < to; c++) {
+        atomic_init(&ps->first[c], SIZE_MAX);
+        for (int k = 0; k < 3; k++) {
+            atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
+            atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
+        }
+        atomic_init(&ps->off[c], 0);
+    }
 }
 
 static void lower_to(_Atomic double *bound, double x)
@@ -384,13 +452,17 @@ static void merge_bounds(const Passes *ps, uint32_t c, const double lo[3], const
 }
 
 /* Vertices v .. to - 1, at most a block of them: their positions into p and
- * their components into c. Returns how many. */
-static size_t vertex_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
+ * their components, from their roots' labels, into c and their parents
+ * (the relabelling, done in the pass that reads the positions). Returns
+ * how many. */
+static size_t relabel_block(const Passes *ps, size_t v, size_t to, double (*p)[3], uint32_t *c)
 {
     const size_t count = to - v < BLOCK ? to - v : BLOCK;
     ps->mesh->positions(ps->mesh->user, v, count, p);
-    for (size_t i = 0; i < count; i++)
-        c[i] = link_of(ps->parent, (uint32_t)(v + i));
+    for (size_t i = 0; i < count; i++) {
+        c[i] = link_of(ps->label, link_of(ps->parent, (uint32_t)(v + i)));
+        atomic_store_explicit(&ps->parent[v + i], c[i], memory_order_relaxed);
+    }
     return count;
 }
 
@@ -417,6 +489,8 @@ static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[
     }
 }
 
+/* Relabels vertices from .. to - 1 with their components and adds them to
+ * their components' bounds. */
 static void bound_vertices(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
@@ -424,17 +498,41 @@ static void bound_vertices(void *arg, size_t from, size_t to)
     double p[BLOCK][3];
     uint32_t c[BLOCK];
     for (size_t v = from; v < to; v += BLOCK)
-        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++)
+        for (size_t i = 0, n = relabel_block(ps, v, to, p, c); i < n; i++)
             if (c[i] != UNSET)
                 bound_vertex(ps, &run, c[i], p[i]);
     if (run.component != UNSET)
         merge_bounds(ps, run.component, run.lo, run.hi);
 }
 
-/* The fit of each component to its bounds. */
-static void fit(const Passes *ps, size_t count)
+/* The checks below compare distances, a square root each; most distances
+ * are far from the checks' limits, and their squares show it without the
+ * root. sure[0] .. sure[1]: a vertex's squared distance from the centre
+ * that passes the vertex check for certain; sure[2] and above: three times
+ * a centroid's from three times the centre that passes the centroid check.
+ * Each band is narrower than its check by a billionth of the distances
+ * compared, far more than the roundings of either test, so a distance the
+ * band passes is one the check passes: anything else (NaN too) is checked
+ * as before, and the result is the same. Radii so small or large that their
+ * squares would underflow or overflow get empty bands (NaN: no distance
+ * passes). */
+static void sure_bands(double radius, double slack, double sure[3])
 {
-    for (size_t c = 0; c < count; c++) {
+    const double within = PTR_SPHERE_VERTEX_TOLERANCE * radius + slack;
+    const double margin = 1e-9 * (radius + within);
+    const double near = fmax(radius - within + margin, 0.0), far = radius + within - margin;
+    const double deep = fmax(3 * PTR_SPHERE_CENTROID_DEPTH * radius - 3 * slack + 3 * margin, 0.0);
+    const int sane = radius + within > 1e-100 && radius + within < 1e100;
+    sure[0] = sane ? near * near : NAN;
+    sure[1] = sane ? far * far : NAN;
+    sure[2] = sane ? deep * deep : NAN;
+}
+
+/* The fit of components from .. to - 1 to their bounds. */
+static void fit(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t c = from; c < to; c++) {
         double extent = 0.0, smallest = HUGE_VAL;
         for (int k = 0; k < 3; k++) {
             const double lo = atomic_load_explicit(&ps->bounds[6 * c + k], memory_order_relaxed);
@@ -448,13 +546,19 @@ static void fit(const Passes *ps, size_t count)
         ps->spheres[c].is_sphere =
             extent > 0.0 && isfinite(extent) &&
             smallest + 2 * ps->mesh->quantum >= PTR_SPHERE_EXTENT_RATIO * extent;
+        sure_bands(ps->spheres[c].radius, 2 * ps->mesh->quantum, ps->sure[c]);
     }
+}
+
+static double squared_distance(const double a[3], const double b[3])
+{
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+           (a[2] - b[2]) * (a[2] - b[2]);
 }
 
 static double distance(const double a[3], const double b[3])
 {
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                (a[2] - b[2]) * (a[2] - b[2]));
+    return sqrt(squared_distance(a, b));
 }
 
 static void mark_off(const Passes *ps, uint32_t c)
@@ -462,30 +566,27 @@ static void mark_off(const Passes *ps, uint32_t c)
     atomic_store_explicit(&ps->off[c], 1, memory_order_relaxed);
 }
 
-/* Marks the components of vertices from .. to - 1 that lie off their sphere. */
-static void check_vertices(void *arg, size_t from, size_t to)
+/* Marks vertex p's component c (if any) if p lies off its sphere. */
+static void check_vertex(const Passes *ps, uint32_t c, const double p[3])
 {
-    const Passes *ps = arg;
-    const double slack = 2 * ps->mesh->quantum;
-    double p[BLOCK][3];
-    uint32_t c[BLOCK];
-    for (size_t v = from; v < to; v += BLOCK)
-        for (size_t i = 0, n = vertex_block(ps, v, to, p, c); i < n; i++) {
-            if (c[i] == UNSET)
-                continue;
-            const PtrMeshSphere *s = &ps->spheres[c[i]];
-            if (!(fabs(distance(p[i], s->centre) - s->radius) <=
-                  PTR_SPHERE_VERTEX_TOLERANCE * s->radius + slack))
-                mark_off(ps, c[i]);
-        }
+    if (c == UNSET)
+        return;
+    const PtrMeshSphere *s = &ps->spheres[c];
+    const double d2 = squared_distance(p, s->centre);
+    if (d2 >= ps->sure[c][0] && d2 <= ps->sure[c][1])
+        return;
+    if (!(fabs(distance(p, s->centre) - s->radius) <=
+          PTR_SPHERE_VERTEX_TOLERANCE * s->radius + 2 * ps->mesh->quantum))
+        mark_off(ps, c);
 }
 
 /* The corners of a block's triangles: where their vertices lie within
  * 3 * BLOCK of each other (a mesh's triangles mostly use nearby vertices),
  * those vertices read at once, each once; else each corner read. Returns
- * the first vertex read at once, or UNSET where each corner was. */
+ * the first vertex read at once, or UNSET where each corner was, and how
+ * many positions were read in *read. */
 static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size_t count,
-                             double (*corner)[3])
+                             double (*corner)[3], size_t *read)
 {
     uint32_t lo = UNSET, hi = 0;
     for (size_t i = 0; i < count; i++)
@@ -494,27 +595,37 @@ static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size
             hi = tri[i][k] > hi ? tri[i][k] : hi;
         }
     if (hi - lo < 3 * BLOCK) {
-        mesh->positions(mesh->user, lo, hi - lo + 1, corner);
+        *read = hi - lo + 1;
+        mesh->positions(mesh->user, lo, *read, corner);
         return lo;
     }
-    mesh->gather(mesh->user, &tri[0][0], 3 * count, corner);
+    *read = 3 * count;
+    mesh->gather(mesh->user, &tri[0][0], *read, corner);
     return UNSET;
 }
 
 /* Marks the components of triangles from .. to - 1 whose centroid lies too
  * deep inside their sphere (compared at three times the scale: the sum of
  * the corners against three times the centre), and finds each component's
- * first triangle. */
+ * first triangle. The positions read for the corners are checked as
+ * vertices too: every vertex a triangle uses is a corner, so every one is
+ * checked (some more than once, to the same effect), while the positions
+ * are in the cache. */
 static void check_triangles(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     const double slack = 2 * ps->mesh->quantum;
     uint32_t tri[BLOCK][3], last = UNSET;
-    double corner[3 * BLOCK][3];
+    double corner[3 * BLOCK][3], centre[3] = { 0, 0, 0 }, deep = 0.0; /* last's, times 3 */
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
-        const uint32_t first = read_corners(ps->mesh, tri, count, corner);
+        size_t read;
+        const uint32_t first = read_corners(ps->mesh, tri, count, corner, &read);
+        for (size_t i = 0; i < read; i++) {
+            const uint32_t v = first == UNSET ? tri[i / 3][i % 3] : first + (uint32_t)i;
+            check_vertex(ps, link_of(ps->parent, v), corner[i]);
+        }
         for (size_t i = 0; i < count; i++) {
             const uint32_t c = link_of(ps->parent, tri[i][0]);
             if (c != last) { /* this thread's first triangle of c: the least of the threads' */
@@ -524,17 +635,18 @@ static void check_triangles(void *arg, size_t from, size_t to)
                                            &ps->first[c], &seen, t + i, memory_order_relaxed,
                                            memory_order_relaxed))
                     ;
+                for (int k = 0; k < 3; k++)
+                    centre[k] = 3 * ps->spheres[c].centre[k];
+                deep = 3 * PTR_SPHERE_CENTROID_DEPTH * ps->spheres[c].radius;
             }
-            const PtrMeshSphere *s = &ps->spheres[c];
-            double sum[3] = { 0, 0, 0 }, centre[3];
+            double sum[3] = { 0, 0, 0 };
             for (int j = 0; j < 3; j++) {
                 const double *p = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
                 for (int k = 0; k < 3; k++)
                     sum[k] += p[k];
             }
-            for (int k = 0; k < 3; k++)
-                centre[k] = 3 * s->centre[k];
-            if (!(distance(sum, centre) + 3 * slack >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius))
+            if (!(squared_distance(sum, centre) >= ps->sure[c][2]) &&
+                !(distance(sum, centre) + 3 * slack >= deep))
                 mark_off(ps, c);
         }
     }
@@ -587,20 +699,12 @@ static int fit_components(Passes *ps, size_t *count)
     ps->first = malloc(room * sizeof *ps->first);
     ps->bounds = malloc(6 * room * sizeof *ps->bounds);
     ps->off = malloc(room * sizeof *ps->off);
-    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off)
+    ps->sure = malloc(room * sizeof *ps->sure);
+    if (!ps->spheres || !ps->first || !ps->bounds || !ps->off || !ps->sure)
         return 0;
-    for (size_t c = 0; c < components; c++) {
-        atomic_init(&ps->first[c], SIZE_MAX);
-        for (int k = 0; k < 3; k++) {
-            atomic_init(&ps->bounds[6 * c + k], HUGE_VAL);
-            atomic_init(&ps->bounds[6 * c + 3 + k], -HUGE_VAL);
-        }
-        atomic_init(&ps->off[c], 0);
-    }
-    ptr_parallel_ranges(threads, 0, n, relabel, ps);
+    ptr_parallel_ranges(threads, 0, components, start_components, ps);
     ptr_parallel_ranges(threads, 0, n, bound_vertices, ps);
-    fit(ps, components);
-    ptr_parallel_ranges(threads, 0, n, check_vertices, ps);
+    ptr_parallel_ranges(threads, 0, components, fit, ps);
     ptr_parallel_ranges(threads, 0, mesh->triangle_count, check_triangles, ps);
     int sorted = 1;
     for (size_t c = 0; c < components; c++) {
@@ -620,8 +724,9 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
     const int threads = threads_for(mesh);
-    /* One a vertex: the positions' keys, then the labels. */
-    Keyed *scratch = malloc(n * sizeof *scratch);
+    /* The positions' keys, then the labels: one allocation, its pages
+     * mapped once. */
+    Keyed *scratch = malloc(keyed_room(mesh) * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
                   .label = (Link *)scratch,
                   .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL };
@@ -640,6 +745,7 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
     free(ps.first);
     free(ps.bounds);
     free(ps.off);
+    free(ps.sure);
     free(ps.order);
     if (!ok) {
         free(ps.spheres);

@@ -24,9 +24,15 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
 - OBJ: an object of two joined spheres, each under its own usemtl, and a
   cube named like a sphere: the two spheres, each with its material, and the
   warning; with --fit-all-objects one sphere an object, unchecked, no
-  warning.
+  warning;
+- OBJ at the tolerance: spheres each with one vertex moved out to within a
+  few units in the last place of the vertex check's limit, in doubles: the
+  ones the check as written passes, and one warning counting the others
+  (the check first passes distances by their squares, far enough inside the
+  limit; these must take the check itself).
 Usage: check_mesh_spheres.py PTR"""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -87,6 +93,59 @@ def single(folder, name, shape, skipped=1):
     path = os.path.join(folder, name + ".glb")
     w.write(path)
     expect(path, [], skipped, [f"node '{name}' (mesh '{name}_mesh')"])
+
+
+def passes_check(verts, tris):
+    """Whether a component passes mesh_spheres.c's checks, computed as it
+    computes them in doubles (quantum 0)."""
+    lo = [min(v[k] for v in verts) for k in range(3)]
+    hi = [max(v[k] for v in verts) for k in range(3)]
+    centre = [0.5 * (lo[k] + hi[k]) for k in range(3)]
+    extent = max(hi[k] - lo[k] for k in range(3))
+    r = 0.5 * extent
+    if not (extent > 0 and min(hi[k] - lo[k] for k in range(3)) >= 0.75 * extent):
+        return False
+
+    def dist(a, b):
+        return math.sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                         (a[2] - b[2]) * (a[2] - b[2]))
+
+    if not all(abs(dist(v, centre) - r) <= 0.1 * r + 0.0 for v in verts):
+        return False
+    thrice = [3 * x for x in centre]
+    for t in tris:
+        total = [0.0, 0.0, 0.0]
+        for i in t:
+            total = [total[k] + verts[i][k] for k in range(3)]
+        if not dist(total, thrice) + 0.0 >= 3 * 0.88 * r:
+            return False
+    return True
+
+
+def at_tolerance(folder):
+    path = os.path.join(folder, "tolerance.obj")
+    want, skipped = [], 0
+    with open(path, "w") as f:
+        first = 1
+        for k, ulps in enumerate(range(-4, 5)):
+            verts, tris = mf.uv_sphere((0, 0, 0), 1)
+            t = 1.1
+            for _ in range(abs(ulps)):
+                t = math.nextafter(t, math.inf if ulps > 0 else -math.inf)
+            verts[18] = [0.6 * t, 0.0, 0.8 * t]  # on the equator, inside the bounds
+            verts = [[x + 3 * k for x in v] for v in verts]
+            if passes_check(verts, tris):
+                want.append(([3 * k] * 3, 1, -1))
+            else:
+                skipped += 1
+            f.write(f"o Sphere{k}\n")
+            f.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in verts)
+            f.writelines(f"f {a + first} {b + first} {c + first}\n" for a, b, c in tris)
+            first += len(verts)
+    if not want or not skipped:
+        failures.append(f"tolerance.obj: {len(want)} spheres pass, {skipped} fail: "
+                        "the limit was not straddled")
+    expect(path, want, skipped)
 
 
 def main():
@@ -231,6 +290,8 @@ def main():
                 abs(gr - wr) > 1e-5 or max(abs(a - b) for a, b in zip(gc, wc)) > 1e-5
                 for (gc, gr), (wc, wr) in zip(fitted, want)):
             failures.append(f"joined.obj --fit-all-objects: {fitted} {run.stderr}")
+
+        at_tolerance(folder)
 
     for f in failures:
         print("FAIL " + f)
