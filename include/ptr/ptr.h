@@ -244,6 +244,12 @@ PTR_PUBLIC const float *ptr_frame_pixels(const PtrFrame *frame);
 PTR_PUBLIC const float *ptr_frame_albedo(const PtrFrame *frame);
 PTR_PUBLIC const float *ptr_frame_normal(const PtrFrame *frame);
 
+/* A frame of pixels given (width x height x channels floats, 3: RGB, 4:
+ * RGBA with the colour premultiplied), copied: an image made elsewhere, or
+ * changed after a render, to save. Its metadata name no scene. */
+PTR_PUBLIC PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
+                                   PtrFrame **out, PtrErrorInfo *err);
+
 /* Writes the frame through ptr's writers, by the path's extension: EXR
  * (float, with the passes as layers) directly, any other format through the
  * OpenImageIO module, the view applied (integer formats). view is an

@@ -241,6 +241,52 @@ const float *ptr_frame_pixels(const PtrFrame *frame)
 const float *ptr_frame_albedo(const PtrFrame *frame) { return frame->buffers.albedo; }
 const float *ptr_frame_normal(const PtrFrame *frame) { return frame->buffers.normal; }
 
+PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
+                        PtrFrame **out, PtrErrorInfo *err)
+{
+    PtrError e;
+    if (width < 1 || height < 1 || width > PTR_MAX_IMAGE_SIZE || height > PTR_MAX_IMAGE_SIZE ||
+        (channels != 3 && channels != 4)) {
+        ptr_error_set(&e, PTR_ERR_USAGE, "a frame of %dx%d pixels of %d channels: 1 to %d "
+                      "pixels a side, 3 or 4 channels", width, height, channels,
+                      PTR_MAX_IMAGE_SIZE);
+        return ptr_api_fail(err, &e);
+    }
+    const size_t pixel_count = (size_t)width * (size_t)height;
+    PtrFrame *f = calloc(1, sizeof *f);
+    if (f) {
+        f->buffers.rgb = malloc(pixel_count * 3 * sizeof *f->buffers.rgb);
+        f->scene_name = strdup("");
+    }
+    if (f && channels == 4) {
+        f->buffers.alpha = malloc(pixel_count * sizeof *f->buffers.alpha);
+        f->rgba = malloc(pixel_count * 4 * sizeof *f->rgba);
+    }
+    if (!f || !f->buffers.rgb || !f->scene_name ||
+        (channels == 4 && (!f->buffers.alpha || !f->rgba))) {
+        ptr_frame_free(f);
+        ptr_error_set(&e, PTR_ERR_NOMEM, "a frame of %dx%d pixels: out of memory", width,
+                      height);
+        return ptr_api_fail(err, &e);
+    }
+    for (size_t p = 0; p < pixel_count; p++) {
+        memcpy(&f->buffers.rgb[3 * p], &pixels[channels * p], 3 * sizeof *pixels);
+        if (channels == 4)
+            f->buffers.alpha[p] = pixels[4 * p + 3];
+    }
+    if (channels == 4)
+        memcpy(f->rgba, pixels, pixel_count * 4 * sizeof *pixels);
+    f->width = width;
+    f->height = height;
+    f->channels = channels;
+    f->info = (PtrOutputInfo){
+        .scene_path = f->scene_name, .kernel = "", .accel = "",
+        .sampler = ptr_sampler_name(PTR_SAMPLER_SOBOL), .alpha = f->buffers.alpha,
+    };
+    *out = f;
+    return PTR_STATUS_OK;
+}
+
 PtrStatus ptr_frame_save(PtrContext *context, const char *path, const PtrFrame *frame,
                          const char *view, PtrErrorInfo *err)
 {

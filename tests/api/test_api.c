@@ -251,6 +251,21 @@ static void test_save(void)
               PTR_STATUS_USAGE);
     CHECK_INT(ptr_frame_save(context, "/nonexistent/dir/x.exr", frame, NULL, &err),
               PTR_STATUS_OUTPUT);
+
+    /* The same pixels as a frame of their own save to the same pixels. */
+    PtrFrame *copy = NULL;
+    if (frame)
+        CHECK_INT(ptr_frame_new(ptr_frame_width(frame), ptr_frame_height(frame), 4,
+                                ptr_frame_pixels(frame), &copy, &err),
+                  PTR_STATUS_OK);
+    const char *copied = test_path("copied.exr");
+    if (copy)
+        CHECK_INT(ptr_frame_save(context, copied, copy, NULL, &err), PTR_STATUS_OK);
+    check_same_as_file(copy, copied);
+    check_same_as_file(frame, copied);
+    ptr_frame_free(copy);
+    CHECK_INT(ptr_frame_new(0, 4, 3, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_new(4, 4, 2, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
     ptr_frame_free(frame);
 }
 
