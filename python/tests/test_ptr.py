@@ -91,6 +91,10 @@ def test_bad_input():
         scene.render(8, 8, samples=1, integrator="sideways")
     with pytest.raises(ValueError):
         ptr.Scene.from_arrays(centers, radii, sky="purple")
+    with pytest.raises(ValueError, match="cpu_cap: 'avx9000' is not"):
+        ptr.Context(cpu_cap="avx9000")
+    with pytest.raises(ptr.Error, match="^arrays: "):
+        ptr.Scene.from_arrays([[0, 0, 0]], [0.0])  # nothing to frame
     with pytest.raises(ptr.Error) as failure:
         ptr.load("/nonexistent/scene.gltf")
     assert failure.value.code == 3 and "/nonexistent/scene.gltf" in str(failure.value)

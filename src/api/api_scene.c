@@ -50,8 +50,9 @@ PtrStatus ptr_context_new(const PtrContextOptions *options, PtrContext **out, Pt
         ptr_error_set(&e, PTR_ERR_USAGE, "threads: %d is not a count, or 0", o->threads);
         return ptr_api_fail(err, &e);
     }
-    if (o->cpu_cap && ptr_cpu_parse_level(o->cpu_cap, &cap, &e) != PTR_OK) {
-        ptr_error_set(&e, PTR_ERR_USAGE, "cpu_cap: %s", e.message);
+    PtrError problem;
+    if (o->cpu_cap && ptr_cpu_parse_level(o->cpu_cap, &cap, &problem) != PTR_OK) {
+        ptr_error_set(&e, PTR_ERR_USAGE, "cpu_cap: %s", problem.message);
         return ptr_api_fail(err, &e);
     }
     PtrContext *c = calloc(1, sizeof *c);
@@ -274,10 +275,11 @@ PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *array
         res = add_materials(arrays, &scene, &e);
     if (res == PTR_OK)
         res = add_spheres(arrays, &builder, &e);
-    if (res == PTR_OK)
-        res = ptr_builder_finish(&builder, PTR_BUILD_DEFAULT, &e);
-    else
+    PtrError problem;
+    if (res != PTR_OK)
         ptr_builder_free(&builder);
+    else if ((res = ptr_builder_finish(&builder, PTR_BUILD_DEFAULT, &problem)) != PTR_OK)
+        ptr_error_set(&e, res, "arrays: %s", problem.message);
     if (res != PTR_OK) {
         ptr_scene_free(&scene);
         return ptr_api_fail(err, &e);

@@ -208,6 +208,7 @@ static void test_bad_input(void)
     PtrContext *bad = NULL;
     const PtrContextOptions level = { .cpu_cap = "avx9000" };
     CHECK_INT(ptr_context_new(&level, &bad, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "cpu_cap: 'avx9000' is not") != NULL);
     CHECK(bad == NULL);
 }
 
