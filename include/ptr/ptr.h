@@ -180,8 +180,7 @@ PTR_PUBLIC void ptr_scene_handle_free(PtrSceneHandle *scene);
 /* ---- Rendering --------------------------------------------------------- */
 
 /* What a render is asked for, as the command line's options of the same
- * names (README's table); the camera is the scene's (PtrLoadOptions.camera,
- * PtrSceneArrays.camera). Fill with ptr_render_options_default, then
+ * names (README's table). Fill with ptr_render_options_default, then
  * change what differs. The strings are the options' values as the command
  * line takes them; NULL: its default. */
 typedef struct PtrRenderOptions {
@@ -205,6 +204,12 @@ typedef struct PtrRenderOptions {
      * frame's colour is then the denoised one (the passes are taken). */
     const char *denoise;
     const char *sky;        /* replaces the scene's sky; NULL: the scene's */
+    /* Replaces the scene's camera for this render; NULL: the scene's. The
+     * scene's coordinates stay relative to its own camera: the pixels are
+     * the command line's for --lookfrom ... only when the camera is given
+     * where the scene is made (PtrLoadOptions.camera, PtrSceneArrays.camera),
+     * which puts the coordinates relative to it. */
+    const PtrCameraDesc *camera;
 } PtrRenderOptions;
 
 PTR_PUBLIC void ptr_render_options_default(PtrRenderOptions *options);

@@ -96,7 +96,7 @@ class RenderOptions(ctypes.Structure):
                 ("direct_lighting", ctypes.c_int), ("noise_threshold", ctypes.c_float),
                 ("min_samples", ctypes.c_uint32), ("transparent", ctypes.c_int),
                 ("passes", ctypes.c_int), ("denoise", ctypes.c_char_p),
-                ("sky", ctypes.c_char_p)]
+                ("sky", ctypes.c_char_p), ("camera", ctypes.POINTER(CameraDesc))]
 
 
 class ProgressInfo(ctypes.Structure):

@@ -7,6 +7,7 @@
 #include "color/color.h"
 #include "denoise/denoise.h"
 #include "image/image.h"
+#include "import_options.h"
 #include "ptr/ptr.h"
 
 struct PtrContext {
@@ -36,6 +37,9 @@ struct PtrSceneHandle {
     PtrPreparedFor prepared_for;
     PtrPrepared prepared;
 };
+
+/* A public camera as the command line's (the importers' PtrCameraSpec). */
+void ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec);
 
 /* Copies an internal error into the caller's (which may be NULL) and
  * returns its code as a status. */

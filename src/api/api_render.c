@@ -1,11 +1,13 @@
 /* The public API's renders and frames (include/ptr/ptr.h), through the
  * command line's steps (api/pipeline.h, api/output.h). */
+#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "api/api_internal.h"
 #include "api/output.h"
+#include "builder.h"
 
 struct PtrFrame {
     int width, height, channels;
@@ -74,6 +76,29 @@ static PtrResult read_choices(const PtrContext *context, const PtrRenderOptions 
         return option_error("denoise", &problem, err);
     if (o->width < 0 || o->height < 0 || o->threads < 0 || o->max_depth < 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "width, height, threads and max_depth are >= 0");
+    return PTR_OK;
+}
+
+/* The camera desc as the scene's, relative to its origin, into camera;
+ * PTR_ERR_USAGE if it is not finite. */
+static PtrResult camera_at(const PtrCameraDesc *desc, const double origin[3], PtrCamera *camera,
+                           PtrError *err)
+{
+    const double *points[] = { desc->lookfrom, desc->lookat, desc->up };
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(points[p][k]))
+                return ptr_error_set(err, PTR_ERR_USAGE,
+                                     "camera: lookfrom, lookat and up are finite");
+    PtrCameraSpec spec;
+    ptr_api_camera_spec(desc, &spec);
+    *camera = ptr_camera_lens(&spec);
+    camera->lookfrom = v3((float)(desc->lookfrom[0] - origin[0]),
+                          (float)(desc->lookfrom[1] - origin[1]),
+                          (float)(desc->lookfrom[2] - origin[2]));
+    camera->lookat = v3((float)(desc->lookat[0] - origin[0]), (float)(desc->lookat[1] - origin[1]),
+                        (float)(desc->lookat[2] - origin[2]));
+    camera->up = v3((float)desc->up[0], (float)desc->up[1], (float)desc->up[2]);
     return PTR_OK;
 }
 
@@ -161,7 +186,10 @@ static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderO
         if (res != PTR_OK)
             return res;
     }
-    PtrResult res = prepare(h, c, threads, err);
+    PtrCamera camera = h->scene.camera;
+    PtrResult res = o->camera ? camera_at(o->camera, h->scene.origin, &camera, err) : PTR_OK;
+    if (res == PTR_OK)
+        res = prepare(h, c, threads, err);
     if (res != PTR_OK)
         return res;
     PtrRenderSettings settings = {
@@ -171,23 +199,28 @@ static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderO
         .integrator = h->prepared.integrator, .transparent = o->transparent,
         .passes = o->passes || c->denoise, /* the denoiser's guides */
     };
+    /* This render's sky and camera, the scene's own kept for the next. */
+    const PtrSky sky = h->scene.sky;
+    const PtrCamera scene_camera = h->scene.camera;
+    if (c->has_sky)
+        h->scene.sky = c->sky;
+    h->scene.camera = camera;
     ptr_choose_size(&h->scene, o->width, o->height, 1, &settings.width, &settings.height);
     const PtrProgressiveOptions passes = {
         .first_sample = o->first_sample, .samples = o->samples, .stop = &progress->stop,
         .report = progress->callback ? report_progress : NULL, .user = progress,
     };
     PtrFrame *f = calloc(1, sizeof *f);
-    if (!f || !(f->scene_name = strdup(h->name))) {
-        free(f);
-        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", h->name);
-    }
-    const PtrSky sky = h->scene.sky;
-    if (c->has_sky)
-        h->scene.sky = c->sky;
-    PtrProgressiveResult done;
-    res = ptr_render_frame(&h->scene, &h->prepared.accel, &settings, &passes, h->name,
-                           &f->buffers, &done, err);
+    PtrProgressiveResult done = { 0 };
+    if (!f || !(f->scene_name = strdup(h->name)))
+        res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", h->name);
+    else
+        res = ptr_render_frame(&h->scene, &h->prepared.accel, &settings, &passes, h->name,
+                               &f->buffers, &done, err);
     h->scene.sky = sky;
+    h->scene.camera = scene_camera;
+    if (!f)
+        return res;
     f->width = settings.width;
     f->height = settings.height;
     f->channels = o->transparent ? 4 : 3;

@@ -110,7 +110,7 @@ static PtrStatus hand_scene(PtrScene *scene, const char *name, double import_sec
     return PTR_STATUS_OK;
 }
 
-static void camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec)
+void ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec)
 {
     memcpy(spec->lookfrom, desc->lookfrom, sizeof spec->lookfrom);
     memcpy(spec->lookat, desc->lookat, sizeof spec->lookat);
@@ -138,7 +138,7 @@ PtrStatus ptr_scene_load(PtrContext *context, const char *path, const PtrLoadOpt
     PtrError e;
     PtrCameraSpec camera;
     if (o->camera)
-        camera_spec(o->camera, &camera);
+        ptr_api_camera_spec(o->camera, &camera);
     PtrImportOptions import = {
         .camera_name = o->camera_name,
         .camera = o->camera ? &camera : NULL,
@@ -257,7 +257,7 @@ PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *array
     }
     PtrCameraSpec camera;
     if (arrays->camera)
-        camera_spec(arrays->camera, &camera);
+        ptr_api_camera_spec(arrays->camera, &camera);
     const PtrImportOptions import = {
         .camera = arrays->camera ? &camera : NULL,
         .auto_projection = arrays->orthographic ? PTR_PROJECTION_ORTHOGRAPHIC

@@ -145,6 +145,35 @@ static void test_arrays_same_as_file(void)
     PtrFrame *ours = NULL;
     CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &ours, &err),
               PTR_STATUS_OK);
+    /* The scene's own camera given for one render changes nothing; another
+     * changes the image for that render alone. */
+    const PtrCameraDesc above = { .lookfrom = { 0, 2, 1 }, .lookat = { 0, 0, -1 },
+                                  .up = { 0, 1, 0 }, .vfov_deg = 60 };
+    PtrFrame *same = NULL, *other = NULL, *again = NULL;
+    options.camera = &origin_camera;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &same, &err),
+              PTR_STATUS_OK);
+    options.camera = &above;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &other, &err),
+              PTR_STATUS_OK);
+    options.camera = NULL;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &again, &err),
+              PTR_STATUS_OK);
+    const size_t bytes = 96 * 96 * 3 * sizeof(float);
+    if (ours && same && other && again) {
+        CHECK(!memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(same), bytes));
+        CHECK(memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(other), bytes) != 0);
+        CHECK(!memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(again), bytes));
+    }
+    ptr_frame_free(same);
+    ptr_frame_free(other);
+    ptr_frame_free(again);
+    const PtrCameraDesc broken = { .lookfrom = { NAN, 0, 0 }, .up = { 0, 1, 0 } };
+    options.camera = &broken;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &same, &err),
+              PTR_STATUS_USAGE);
+    options.camera = NULL;
+
     const PtrLoadOptions load = { .camera = &origin_camera };
     PtrFrame *file = render_file(SCENE("seed.gltf"), &load, NULL);
     if (ours && file) {
