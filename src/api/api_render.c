@@ -235,7 +235,7 @@ static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderO
         .sample_counts = f->buffers.sample_counts, .albedo = f->buffers.albedo,
         .normal = f->buffers.normal, .alpha = f->buffers.alpha,
         .denoiser = c->denoise ? context->denoisers[c->denoise_quality] : NULL,
-        .denoise_quality = o->denoise, .threads = threads,
+        .threads = threads,
         .render_seconds = done.stats.seconds,
     };
     if (res == PTR_OK && done.stopped)
