@@ -388,7 +388,11 @@ class Scene:
         finally:
             if in_main:
                 signal.signal(signal.SIGINT, previous)
-        if interrupted and status == _native.STATUS_CANCELLED:
+        # Ctrl-C, or an exception of the progress callback: raised, whether
+        # the render stopped for it or had just finished.
+        if interrupted:
+            if status == _native.STATUS_OK:
+                lib.ptr_frame_free(frame)
             raise interrupted[0]
         _check(status, err)
         return frame

@@ -178,6 +178,14 @@ def test_ctrl_c_cancels():
     assert signal.getsignal(signal.SIGINT) is handler
 
 
+def test_progress_exception_raised():
+    def broken(done, total):
+        raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        ptr.load(SEED).render(64, samples=4, progress=broken)
+
+
 def test_help_reads():
     assert "numpy in, numpy out" in ptr.__doc__
     for name in ptr.__all__:
