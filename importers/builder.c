@@ -232,19 +232,24 @@ void ptr_builder_set_camera(PtrSceneBuilder *b, const double eye[3], const doubl
         place_camera(b, eye, target, up, lens);
 }
 
-static void use_override(PtrSceneBuilder *b)
+PtrCamera ptr_camera_lens(const PtrCameraSpec *c)
 {
-    const PtrCameraSpec *c = b->override;
     double d2 = 0;
     for (int k = 0; k < 3; k++)
         d2 += (c->lookat[k] - c->lookfrom[k]) * (c->lookat[k] - c->lookfrom[k]);
-    const PtrCamera lens = {
+    return (PtrCamera){
         .projection = c->ortho_height > 0 ? PTR_PROJECTION_ORTHOGRAPHIC
                                           : PTR_PROJECTION_PERSPECTIVE,
         .vfov_deg = (float)c->vfov_deg, .aperture = (float)c->aperture,
         .focus_distance = (float)(c->focus_distance > 0 ? c->focus_distance : sqrt(d2)),
         .ymag = (float)(0.5 * c->ortho_height),
     };
+}
+
+static void use_override(PtrSceneBuilder *b)
+{
+    const PtrCameraSpec *c = b->override;
+    const PtrCamera lens = ptr_camera_lens(c);
     place_camera(b, c->lookfrom, c->lookat, c->up, &lens);
 }
 

@@ -77,6 +77,11 @@ PtrResult ptr_builder_set_value(PtrSceneBuilder *builder, double value, PtrError
 void ptr_builder_set_camera(PtrSceneBuilder *builder, const double eye[3],
                             const double target[3], const double up[3], const PtrCamera *lens);
 
+/* The lens of a camera the command line gives (its projection, field of
+ * view, aperture, focus distance, orthographic height), without its
+ * position and orientation. */
+PtrCamera ptr_camera_lens(const PtrCameraSpec *spec);
+
 /* How ptr_builder_finish stores the scene. Importers use both; the stability
  * suite measures what leaving either out costs. */
 typedef enum PtrBuildFlags {

@@ -26,11 +26,15 @@ LAYERS = {
     "color": ("src/color", ["base"]),
     "live": ("src/live", ["base"]),
     "denoise": ("src/denoise", ["base"]),
+    # The public header of the library (include/ptr/ptr.h): self-contained.
+    "public": ("include", []),
+    "api": ("src/api", ["base", "scene", "sampling", "accel", "render", "importers", "image",
+                        "color", "denoise", "public"]),
     "app": ("src/app", ["base", "scene", "sampling", "accel", "render", "importers", "image",
-                        "color", "live", "denoise"]),
+                        "color", "live", "denoise", "public", "api"]),
 }
 # Where a quoted include is looked for, after the including file's folder.
-INCLUDE_DIRS = ["src", "importers", "importers/gltf"]
+INCLUDE_DIRS = ["src", "include", "importers", "importers/gltf"]
 # Generated into the build tree from the file named.
 GENERATED = {"base/version.h": "src/base/version.h.in"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')

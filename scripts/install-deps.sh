@@ -8,7 +8,7 @@ DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommend
     build-essential cmake pkg-config python3 nasm \
     libopenexr-dev libopenimageio-dev openimageio-tools libopencolorio-dev opencolorio-tools \
     libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev gemmi-dev tao-pegtl-dev zlib1g-dev parallel \
-    libmicrohttpd-dev libpng-dev chromium chromium-driver python3-selenium python3-numpy >/dev/null
+    libmicrohttpd-dev libpng-dev chromium chromium-driver python3-selenium python3-numpy python3-pytest >/dev/null
 
 
 # The denoiser's trained weights: Open Image Denoise's networks (Apache-2.0,

@@ -6,7 +6,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "app/output.h"
+#include "api/output.h"
 #include "importer.h"
 
 /* The last run of '#' in text: its offset and width; 0 if there is none. */

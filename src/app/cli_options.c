@@ -461,7 +461,7 @@ PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *o, PtrError *err)
     if (env_mask && ptr_cpu_parse_level(env_mask, &env_cap, &problem) != PTR_OK)
         return value_error("PTR_CPUMASK", &problem, err);
     *o = (PtrOptions){
-        .samples = PTR_DEFAULT_SAMPLES, .seed = 1, .max_depth = PTR_DEFAULT_MAX_DEPTH,
+        .samples = PTR_DEFAULT_SAMPLES, .seed = PTR_DEFAULT_SEED, .max_depth = PTR_DEFAULT_MAX_DEPTH,
         .min_samples = PTR_DEFAULT_MIN_SAMPLES,
         .kernel = PTR_KERNEL_AUTO, .cpu_level = ptr_cpu_level(), .camera = { .up = { 0, 1, 0 } },
     };
@@ -491,32 +491,6 @@ PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *o, PtrError *err)
                  : PTR_OK;
 }
 
-/* The import's texture decoder (PtrTextureDecoder): through the run's image
- * loader, context; alpha 1 where the image has none. */
-static PtrResult decode_texture(void *context, const char *name, const unsigned char *bytes,
-                                size_t size, PtrTexels *out, PtrError *err)
-{
-    PtrImage *image;
-    PtrResult res = ptr_image_decode(context, name, bytes, size, &image, err);
-    if (res != PTR_OK)
-        return res;
-    const size_t pixels = (size_t)ptr_image_width(image) * (size_t)ptr_image_height(image);
-    out->rgba = malloc((pixels ? pixels : 1) * 4 * sizeof *out->rgba);
-    if (!out->rgba) {
-        ptr_image_free(image);
-        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", name);
-    }
-    const float *rgb = ptr_image_pixels(image), *alpha = ptr_image_alpha(image);
-    for (size_t p = 0; p < pixels; p++) {
-        memcpy(&out->rgba[4 * p], &rgb[3 * p], 3 * sizeof *rgb);
-        out->rgba[4 * p + 3] = alpha ? alpha[p] : 1.0f;
-    }
-    out->width = ptr_image_width(image);
-    out->height = ptr_image_height(image);
-    ptr_image_free(image);
-    return PTR_OK;
-}
-
 PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencies)
 {
     return (PtrImportOptions){
@@ -533,6 +507,6 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .structure_model = o->structure_model,
         .structure_file = o->structure_file,
         .dependencies = dependencies,
-        .textures = { decode_texture, o->images },
+        .textures = ptr_texture_decoder(o->images),
     };
 }

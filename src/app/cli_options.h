@@ -6,7 +6,8 @@
 
 #include "accel/accel.h"
 #include "accel/isect.h"
-#include "app/output.h"
+#include "api/output.h"
+#include "api/pipeline.h"
 #include "base/cpu.h"
 #include "base/result.h"
 #include "denoise/denoise.h"
@@ -14,15 +15,6 @@
 #include "render/render.h"
 #include "scene/colormap.h"
 #include "scene/scene.h"
-
-/* Defaults, as macros: the --help text spells them out. */
-#define PTR_DEFAULT_WIDTH 800
-#define PTR_DEFAULT_SAMPLES 100
-#define PTR_DEFAULT_MAX_DEPTH 50
-#define PTR_DEFAULT_MIN_SAMPLES 32
-#define PTR_DEFAULT_DENOISE "balanced"
-
-enum { PTR_MAX_IMAGE_SIZE = 1 << 16 };
 
 /* At most this many frames in one sequence. */
 enum { PTR_MAX_FRAMES = 1000000 };

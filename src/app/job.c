@@ -1,44 +1,18 @@
 #include "app/job.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "app/color_by.h"
 #include "app/live_view.h"
-#include "app/output.h"
+#include "api/output.h"
+#include "api/pipeline.h"
 #include "app/signals.h"
 #include "base/cpu.h"
 #include "importer.h"
 #include "render/progressive.h"
 
 enum { PREVIEW_SCALE = 4, PREVIEW_SAMPLES = 4 };
-
-/* Width and height: the command line's, else the scene's, filling a missing
- * one from the camera's aspect ratio (else the scene's, else 16:9). */
-static void choose_size(const PtrOptions *o, const PtrScene *scene, int *width, int *height)
-{
-    float aspect = scene->camera.aspect > 0.0f ? scene->camera.aspect
-                   : scene->width > 0          ? (float)scene->width / (float)scene->height
-                                               : 16.0f / 9.0f;
-    int w = o->width, h = o->height;
-    if (!w && !h && scene->width > 0) {
-        w = scene->width;
-        h = scene->height;
-    }
-    if (!w && !h)
-        w = PTR_DEFAULT_WIDTH;
-    if (!h)
-        h = (int)lroundf((float)w / aspect);
-    if (!w)
-        w = (int)lroundf((float)h * aspect);
-    if (o->preview) {
-        w /= PREVIEW_SCALE;
-        h /= PREVIEW_SCALE;
-    }
-    *width = w < 1 ? 1 : w > PTR_MAX_IMAGE_SIZE ? PTR_MAX_IMAGE_SIZE : w;
-    *height = h < 1 ? 1 : h > PTR_MAX_IMAGE_SIZE ? PTR_MAX_IMAGE_SIZE : h;
-}
 
 static PtrResult fail(PtrJobReport *report, const PtrError *err)
 {
@@ -47,20 +21,20 @@ static PtrResult fail(PtrJobReport *report, const PtrError *err)
     return err->code;
 }
 
-/* Renders with the structure chosen and writes the image. */
-static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, const PtrScene *scene,
-                              const PtrAccel *accel, uint64_t scene_hash, const PtrColor *color,
-                              PtrJobReport *report, PtrError *err)
+/* Renders the prepared scene and writes the image. */
+static PtrResult render_prepared(const PtrOptions *o, const PtrScene *scene,
+                                 const PtrPrepared *prepared, const PtrColor *color,
+                                 PtrJobReport *report, PtrError *err)
 {
-
     PtrRenderSettings settings = {
         .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = integrator, .transparent = o->transparent,
+        .integrator = prepared->integrator, .transparent = o->transparent,
         .passes = o->passes || o->denoise, /* the denoiser's guides */
     };
-    choose_size(o, scene, &settings.width, &settings.height);
+    ptr_choose_size(scene, o->width, o->height, o->preview ? PREVIEW_SCALE : 1,
+                    &settings.width, &settings.height);
     report->width = settings.width;
     report->height = settings.height;
     PtrRegion region = ptr_render_region(&settings);
@@ -78,48 +52,29 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         .time_budget = o->time_budget, .stop = &ptr_stop_requested,
         .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
     };
+    const PtrAccel *accel = &prepared->accel;
     ptr_live_view_begin(o->live_view, report->scene, report->output, scene, accel, &settings,
                         &passes);
-    size_t pixels = (size_t)layout.width * (size_t)layout.height;
-    float *rgb = malloc(pixels * 3 * sizeof *rgb);
-    float *counts = o->noise_threshold > 0 ? malloc(pixels * sizeof *counts) : NULL;
-    float *alpha = o->transparent ? malloc(pixels * sizeof *alpha) : NULL;
-    float *albedo = settings.passes ? malloc(pixels * 3 * sizeof *albedo) : NULL;
-    float *normal = settings.passes ? malloc(pixels * 3 * sizeof *normal) : NULL;
-    if (!rgb || (o->noise_threshold > 0 && !counts) || (o->transparent && !alpha) ||
-        (settings.passes && (!albedo || !normal))) {
-        free(rgb);
-        free(counts);
-        free(alpha);
-        free(albedo);
-        free(normal);
-        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: cannot allocate a %dx%d image",
-                             report->output, layout.width, layout.height);
-    }
-    PtrProgressiveResult done;
-    PtrResult res = ptr_render_progressive(scene, accel, &settings, &passes, rgb, alpha, counts,
-                                           albedo, normal, &done, err);
+    PtrFrameBuffers frame;
+    PtrProgressiveResult done = { 0 };
+    PtrResult res = ptr_render_frame(scene, accel, &settings, &passes, report->scene, &frame,
+                                     &done, err);
     ptr_progress_done(&printer);
-    if (res == PTR_ERR_SCENE_INVALID) {
-        /* The renderer does not know where the scene came from. */
-        char message[sizeof err->message];
-        memcpy(message, err->message, sizeof message);
-        ptr_error_set(err, res, "%s: %s", report->scene, message);
-    }
     if (res == PTR_OK) {
         report->samples = done.samples_done;
         report->seconds = done.stats.seconds;
         report->rays = done.stats.rays;
         report->interrupted = done.stopped;
         PtrOutputInfo info = {
-            .scene_path = report->scene, .scene_hash = scene_hash,
+            .scene_path = report->scene, .scene_hash = prepared->scene_hash,
             .kernel = accel->isect.name, .accel = report->accel, .spheres = report->spheres,
             .import_seconds = report->import_seconds, .build_seconds = report->build_seconds, .sample_first = report->sample_first,
             .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
             .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
             .direct_lighting = o->direct_lighting == PTR_ON,
             .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-            .sample_counts = counts, .albedo = albedo, .normal = normal, .alpha = alpha,
+            .sample_counts = frame.sample_counts, .albedo = frame.albedo,
+            .normal = frame.normal, .alpha = frame.alpha,
             .denoiser = o->denoiser, .denoise_quality = o->denoise, .threads = o->threads,
             .render_seconds = done.stats.seconds, .depth = o->depth,
             .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
@@ -128,13 +83,9 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
         /* A frame of a sequence that --skip-existing resumes is written
          * whole or not at all: an output that exists is never rendered again. */
         if (!(done.stopped && o->skip_existing))
-            res = ptr_output_write(o->images, report->output, &layout, rgb, &info, err);
+            res = ptr_output_write(o->images, report->output, &layout, frame.rgb, &info, err);
+        ptr_frame_buffers_free(&frame);
     }
-    free(rgb);
-    free(counts);
-    free(alpha);
-    free(albedo);
-    free(normal);
     ptr_live_view_end(o->live_view, res == PTR_OK && !done.stopped);
     if (res == PTR_OK && done.stopped && o->skip_existing)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
@@ -148,36 +99,26 @@ static PtrResult render_accel(const PtrOptions *o, PtrIntegrator integrator, con
     return res;
 }
 
-/* Chooses the structure for the imported scene (the tree's build reorders
- * its spheres, for either), renders and writes the image. */
+/* Chooses the kernels and the structure for the imported scene (the tree's
+ * build reorders its spheres, for either), renders and writes the image. */
 static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const PtrColor *color,
                                   PtrJobReport *report, PtrError *err)
 {
-    PtrIsectTable isect;
-    /* The kernel was checked before any scene was read: this cannot fail. */
-    ptr_isect_init(&isect, o->kernel, o->cpu_level, scene->spheres.count, NULL);
-    snprintf(report->kernel, sizeof report->kernel, "%s", isect.name);
-    PtrIntegrator integrator = ptr_integrator_resolve(o->integrator, o->cpu_level);
-    snprintf(report->integrator, sizeof report->integrator, "%s", ptr_integrator_name(integrator));
-    /* Before the build, which reorders the spheres and frees the ids that
-     * give the file's order, which the hash takes. */
-    uint64_t scene_hash;
-    PtrError problem;
-    PtrResult hashed = ptr_scene_hash(scene, &scene_hash, &problem);
-    if (hashed != PTR_OK)
-        return ptr_error_set(err, hashed, "%s: %s", report->scene, problem.message);
-    PtrAccel accel;
-    PtrResult built = ptr_accel_init(&accel, o->accel, &isect,
-                                     integrator == PTR_INTEGRATOR_BUNDLES, scene, o->threads,
-                                     &problem);
-    if (built != PTR_OK)
-        return ptr_error_set(err, built, "%s: cannot build the tree over %zu spheres: %s",
-                             report->scene, scene->spheres.count, problem.message);
-    snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&accel));
+    PtrPrepared prepared;
+    /* The kernel was checked before any scene was read: only the tree can
+     * fail here. */
+    PtrResult res = ptr_prepare_render(scene, o->kernel, o->cpu_level, o->integrator, o->accel,
+                                       o->threads, report->scene, &prepared, err);
+    if (res != PTR_OK)
+        return res;
+    snprintf(report->kernel, sizeof report->kernel, "%s", prepared.isect.name);
+    snprintf(report->integrator, sizeof report->integrator, "%s",
+             ptr_integrator_name(prepared.integrator));
+    snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&prepared.accel));
     report->spheres = scene->spheres.count;
-    report->build_seconds = accel.build_seconds;
-    PtrResult res = render_accel(o, integrator, scene, &accel, scene_hash, color, report, err);
-    ptr_accel_free(&accel);
+    report->build_seconds = prepared.accel.build_seconds;
+    res = render_prepared(o, scene, &prepared, color, report, err);
+    ptr_prepared_free(&prepared);
     return res;
 }
 

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "app/output.h"
+#include "api/output.h"
 #include "image/image.h"
 
 typedef struct Part {

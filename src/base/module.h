@@ -1,6 +1,7 @@
-/* ptr's modules: shared objects beside the executable, loaded only when a
- * render needs what they hold (the OpenImageIO writers, the live view), so
- * that a render without them never pays for their libraries. */
+/* ptr's modules: shared objects beside the executable (or libptr.so),
+ * loaded only when a render needs what they hold (the OpenImageIO writers,
+ * the live view), so that a render without them never pays for their
+ * libraries. */
 #ifndef PTR_MODULE_H
 #define PTR_MODULE_H
 
@@ -8,9 +9,11 @@
 
 #include "base/result.h"
 
-/* The path of a module given relative to the executable's folder
- * ("../lib/ptr/NAME.so": each leading "../" takes a folder off, so that
- * messages show a plain path), in path. what names the module in messages
+/* The path of a module given relative to the folder of the file this code
+ * runs from: the executable's, or libptr.so's when the code is the
+ * library's ("../lib/ptr/NAME.so": each leading "../" takes a folder off,
+ * so that messages show a plain path; lib/libptr.so and bin/ptr are both
+ * one folder below the top), in path. what names the module in messages
  * ("image", "live"). PTR_ERR_INSTALL if the folder cannot be found. */
 PtrResult ptr_module_path(const char *relative, const char *what, char *path, size_t size,
                           PtrError *err);

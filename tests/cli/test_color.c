@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "app/cli.h"
-#include "app/output.h"
+#include "api/output.h"
 #include "base/result.h"
 #include "color/color.h"
 #include "image/image.h"

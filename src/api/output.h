@@ -67,6 +67,13 @@ PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err);
 PtrResult ptr_output_check(PtrImageLoader *images, const char *path, PtrDepth depth, int alpha,
                            int passes, PtrError *err);
 
+/* The denoised colour of the image (as ptr_output_write takes it) into
+ * *out (for free), from its colour (premultiplied by alpha, if there is
+ * one) and info's passes, through info's denoiser; path names it in
+ * messages. */
+PtrResult ptr_output_denoise(const char *path, const PtrImageLayout *layout, const float *rgb,
+                             const PtrOutputInfo *info, float **out, PtrError *err);
+
 /* Writes the image (RGB scene-linear, rows top to bottom, laid out in the
  * full image as layout says) as info says, denoised first if info has a
  * denoiser. The file is replaced atomically.

@@ -1,4 +1,4 @@
-#include "app/output.h"
+#include "api/output.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -127,14 +127,12 @@ static void scale_by_alpha(float *rgb, const float *alpha, size_t pixels, int pr
             rgb[3 * p + c] = premultiply ? rgb[3 * p + c] * alpha[p] : rgb[3 * p + c] / alpha[p];
 }
 
-/* The denoised colour of the image into *out (for free), from its colour
- * (premultiplied by alpha, if there is one) and passes. The premultiplied
- * colour is what the network takes: where camera rays met nothing it adds
- * nothing, as a black background would. Where no camera ray met anything
- * (alpha 0), the colour stays 0: the network's blur must not put light
- * where the image holds nothing to composite. */
-static PtrResult denoise(const char *path, const PtrImageLayout *layout, const float *rgb,
-                         const PtrOutputInfo *info, float **out, PtrError *err)
+/* The premultiplied colour is what the network takes: where camera rays
+ * met nothing it adds nothing, as a black background would. Where no camera
+ * ray met anything (alpha 0), the colour stays 0: the network's blur must
+ * not put light where the image holds nothing to composite. */
+PtrResult ptr_output_denoise(const char *path, const PtrImageLayout *layout, const float *rgb,
+                             const PtrOutputInfo *info, float **out, PtrError *err)
 {
     size_t pixels = (size_t)layout->width * (size_t)layout->height;
     float *denoised = malloc(pixels * 3 * sizeof *denoised);
@@ -175,7 +173,7 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         if (!info->albedo || !info->normal)
             return ptr_error_set(err, PTR_ERR_INTERNAL, "%s: a denoiser without the passes",
                                  path);
-        PtrResult res = denoise(path, layout, rgb, info, &denoised, err);
+        PtrResult res = ptr_output_denoise(path, layout, rgb, info, &denoised, err);
         if (res != PTR_OK)
             return res;
         noisy = rgb;

@@ -1,0 +1,272 @@
+/* ptr: an offline path tracer of sphere sets, as a library.
+ *
+ * One render: create a context (ptr_context_new), make a scene from a file
+ * (ptr_scene_load) or from arrays (ptr_scene_from_arrays), render it
+ * (ptr_scene_render) into a frame of scene-linear floats, save the frame
+ * (ptr_frame_save) or read its pixels (ptr_frame_pixels), and free each
+ * object with its own ptr_*_free. The image ptr_scene_render returns is the
+ * one the command line `ptr` writes to EXR for the same scene and options,
+ * float for float.
+ *
+ * Errors: every call that can fail returns a PtrStatus and takes a last
+ * parameter PtrErrorInfo *err, which the caller owns (usually on its stack)
+ * and may pass as NULL. On failure the call fills err with the same code
+ * and one line naming the file (or the option) and the problem; on success
+ * it leaves err alone. An object handed through an out-parameter is set
+ * only on success.
+ *
+ * Ownership: no call keeps a pointer the caller passed beyond its return
+ * (arrays, strings and structures are copied), except where a comment
+ * below says otherwise.
+ *
+ * Threads: the contexts are independent: several in one process, used from
+ * different threads, never see each other's settings. One context, and the
+ * scenes made through it, serve one call at a time. */
+#ifndef PTR_PTR_H
+#define PTR_PTR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Raised whenever a change breaks a program built against an earlier
+ * version; the shared library's SONAME carries it (libptr.so.1). */
+#define PTR_API_VERSION 1
+
+#if defined(__GNUC__)
+#define PTR_PUBLIC __attribute__((visibility("default")))
+#else
+#define PTR_PUBLIC
+#endif
+
+/* The same numbers as the command line's exit codes. */
+typedef enum PtrStatus {
+    PTR_STATUS_OK = 0,
+    PTR_STATUS_INTERNAL = 1,
+    PTR_STATUS_USAGE = 2,             /* a bad argument or option value */
+    PTR_STATUS_SCENE_UNREADABLE = 3,  /* a scene file cannot be read */
+    PTR_STATUS_SCENE_INVALID = 4,     /* a scene is malformed or invalid */
+    PTR_STATUS_OUTPUT = 5,            /* an image cannot be written */
+    PTR_STATUS_NOMEM = 6,
+    PTR_STATUS_COLOR = 7,             /* the OpenColorIO config or view cannot be used */
+    PTR_STATUS_CANCELLED = 8,         /* the progress callback asked to stop */
+    PTR_STATUS_INSTALL = 10,          /* a module or weight file of ptr cannot be loaded */
+} PtrStatus;
+
+typedef struct PtrErrorInfo {
+    PtrStatus code;
+    char message[512]; /* one line, NUL-terminated */
+} PtrErrorInfo;
+
+/* ptr's version, "MAJOR.MINOR.PATCH". */
+PTR_PUBLIC const char *ptr_version(void);
+
+/* ---- Contexts ---------------------------------------------------------- */
+
+/* What a context owns: what the command line takes from its process (the
+ * CPU level, the threads, the modules and the colour configuration). */
+typedef struct PtrContext PtrContext;
+
+typedef struct PtrContextOptions {
+    int threads;             /* render threads; 0: one per online CPU */
+    /* The highest CPU level used ("none", "sse41", "avx2", "avx512"), as
+     * --cpumask takes it; NULL: the CPU's, capped by $PTR_CPUMASK. */
+    const char *cpu_cap;
+    /* The denoiser's weights; NULL: $PTR_WEIGHTS_DIR, else the installed. */
+    const char *weights_dir;
+    /* An OpenColorIO config file for ptr_frame_save's views; NULL: ptr's. */
+    const char *ocio_config;
+} PtrContextOptions;
+
+/* options may be NULL: all defaults. */
+PTR_PUBLIC PtrStatus ptr_context_new(const PtrContextOptions *options, PtrContext **out,
+                                     PtrErrorInfo *err);
+PTR_PUBLIC void ptr_context_free(PtrContext *context);
+
+/* ---- Scenes ------------------------------------------------------------ */
+
+typedef struct PtrSceneHandle PtrSceneHandle;
+
+/* A camera in world coordinates (--lookfrom, --lookat, ...). */
+typedef struct PtrCameraDesc {
+    double lookfrom[3], lookat[3], up[3];
+    double vfov_deg;       /* vertical field of view */
+    double ortho_height;   /* above 0: orthographic, the view this high (vfov unused) */
+    double aperture;       /* lens diameter; 0: a pinhole */
+    double focus_distance; /* 0: the distance from lookfrom to lookat */
+} PtrCameraDesc;
+
+/* How a file is read, as the command line's options of the same names say
+ * (README's table); zero for each is the command line's default. */
+typedef struct PtrLoadOptions {
+    const char *camera_name;      /* --camera */
+    const PtrCameraDesc *camera;  /* --lookfrom ...: replaces the file's */
+    int orthographic;             /* --auto-camera orthographic */
+    int fit_all_objects;          /* --fit-all-objects (OBJ) */
+    const char *select;           /* --select (structures) */
+    int drop_hydrogens;           /* --hydrogens off */
+    const char *assembly;         /* --assembly */
+    size_t model;                 /* a structure's model, 1 the first; 0: the first */
+    double orbit_degrees;         /* the camera's turn about +Y (a turntable's frame) */
+    /* The width and height the image will have, which frame the automatic
+     * camera of a scene without one, as --width and --height do; 0: the
+     * scene's. */
+    int width, height;
+    const char *sky;              /* --sky: "gradient", "black" or "R,G,B"; NULL: the file's */
+} PtrLoadOptions;
+
+/* Reads a scene file of any format ptr reads (glTF, OBJ, PDB, mmCIF, ...,
+ * by its extension; docs/scenes.md). options may be NULL. */
+PTR_PUBLIC PtrStatus ptr_scene_load(PtrContext *context, const char *path,
+                                    const PtrLoadOptions *options, PtrSceneHandle **out,
+                                    PtrErrorInfo *err);
+
+typedef enum PtrMaterialType {
+    PTR_MATERIAL_TYPE_DIFFUSE,    /* albedo */
+    PTR_MATERIAL_TYPE_METAL,      /* albedo, fuzz (0: a mirror) */
+    PTR_MATERIAL_TYPE_DIELECTRIC, /* albedo (the attenuation), ior */
+    PTR_MATERIAL_TYPE_EMISSIVE,   /* a diffuse surface that emits: albedo, emission */
+} PtrMaterialType;
+
+/* A material as the scene holds it; every type may emit. */
+typedef struct PtrMaterialDesc {
+    PtrMaterialType type;
+    float albedo[3];
+    float fuzz;
+    float ior;
+    float emission[3]; /* radiance, seen from both sides */
+} PtrMaterialDesc;
+
+/* Spheres as arrays, each of count entries and contiguous. */
+typedef struct PtrSceneArrays {
+    size_t count;
+    /* Centres, x y z each (3 x count), in float or in double: one of the
+     * two, the other NULL. */
+    const float *centers;
+    const double *centers_f64;
+    const float *radii;                /* each finite and >= 0 */
+    /* Each sphere's index into materials; NULL: 0 for every sphere. */
+    const uint32_t *material_indices;
+    /* Each sphere's own colour, r g b (3 x count), each clamped to [0, 1],
+     * multiplying its material's albedo; NULL: none (white). */
+    const float *colors;
+    /* NULL with material_count 0: one grey diffuse material (albedo 0.5). */
+    const PtrMaterialDesc *materials;
+    size_t material_count;
+    /* NULL: a camera framing the spheres from +Z, as for a file without
+     * one. */
+    const PtrCameraDesc *camera;
+    int orthographic;      /* the automatic camera's projection */
+    int width, height;     /* the image size the scene suggests; 0: none */
+    const char *sky;       /* as PtrLoadOptions.sky; NULL: the gradient */
+} PtrSceneArrays;
+
+/* Makes a scene of arrays, copied: the scene is the same as a file of the
+ * same spheres gives (the same coordinates relative to the camera, the same
+ * spheres kept in double). A NaN or infinite coordinate, a negative or NaN
+ * radius, a NaN colour or a material index out of the table is
+ * PTR_STATUS_USAGE naming the sphere. */
+PTR_PUBLIC PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *arrays,
+                                           PtrSceneHandle **out, PtrErrorInfo *err);
+
+/* The number of spheres. */
+PTR_PUBLIC size_t ptr_scene_sphere_count(const PtrSceneHandle *scene);
+
+PTR_PUBLIC void ptr_scene_handle_free(PtrSceneHandle *scene);
+
+/* ---- Rendering --------------------------------------------------------- */
+
+/* What a render is asked for, as the command line's options of the same
+ * names (README's table). Fill with ptr_render_options_default, then
+ * change what differs. The strings are the options' values as the command
+ * line takes them; NULL: its default. */
+typedef struct PtrRenderOptions {
+    int width, height;      /* 0: the scene's, else 800 wide (--width, --height) */
+    uint32_t samples;       /* per pixel (--samples) */
+    uint32_t first_sample;  /* the first sample's index (--sample-range) */
+    uint64_t seed;          /* --seed */
+    int max_depth;          /* --max-depth */
+    int threads;            /* 0: the context's */
+    const char *integrator; /* --integrator: "auto", "paths", "bundles" */
+    const char *kernel;     /* "c" (--c) or "asm" (--asm); NULL: the fastest */
+    const char *cpu_cap;    /* lowers the context's level for this render (--cpumask) */
+    const char *accel;      /* --accel: "auto", "brute", "bvh" */
+    const char *sampler;    /* --sampler */
+    int direct_lighting;    /* --direct-lighting: 1 on (the default), 0 off */
+    float noise_threshold;  /* --noise-threshold; 0: off */
+    uint32_t min_samples;   /* --min-samples */
+    int transparent;        /* --transparent: RGBA, alpha the covered share */
+    int passes;             /* --passes albedo,normal: the frame keeps both */
+    /* --denoise: "fast", "balanced" or "high"; NULL: no denoising. The
+     * frame's colour is then the denoised one (the passes are taken). */
+    const char *denoise;
+    const char *sky;        /* replaces the scene's sky; NULL: the scene's */
+    /* Replaces the scene's camera for this render; NULL: the scene's. The
+     * scene's coordinates stay relative to its own camera: the pixels are
+     * the command line's for --lookfrom ... only when the camera is given
+     * where the scene is made (PtrLoadOptions.camera, PtrSceneArrays.camera),
+     * which puts the coordinates relative to it. */
+    const PtrCameraDesc *camera;
+} PtrRenderOptions;
+
+PTR_PUBLIC void ptr_render_options_default(PtrRenderOptions *options);
+
+typedef struct PtrProgressInfo {
+    uint32_t samples_done, samples_total;
+    double fraction; /* of all samples, counting the pass under way */
+    double elapsed;  /* seconds */
+} PtrProgressInfo;
+
+/* Called about ten times a second on the thread that called
+ * ptr_scene_render: nonzero stops the render after the pass under way,
+ * which then fails with PTR_STATUS_CANCELLED. */
+typedef int (*PtrProgressCallback)(void *user, const PtrProgressInfo *progress);
+
+/* The image a render made: scene-linear floats, rows top to bottom. */
+typedef struct PtrFrame PtrFrame;
+
+/* Renders the scene. progress may be NULL. The first render of a scene
+ * builds its tree, which later renders reuse (the spheres are then in the
+ * tree's order: on exactly equal hit distances, a later render with another
+ * accel, kernel or integrator may show the other sphere). */
+PTR_PUBLIC PtrStatus ptr_scene_render(PtrContext *context, PtrSceneHandle *scene,
+                                      const PtrRenderOptions *options,
+                                      PtrProgressCallback progress, void *user, PtrFrame **out,
+                                      PtrErrorInfo *err);
+
+PTR_PUBLIC int ptr_frame_width(const PtrFrame *frame);
+PTR_PUBLIC int ptr_frame_height(const PtrFrame *frame);
+/* 3 (RGB) or 4 (RGBA, with a transparent background: the colour
+ * premultiplied by alpha, as EXR stores it). */
+PTR_PUBLIC int ptr_frame_channels(const PtrFrame *frame);
+/* width x height x channels floats, kept by the frame. */
+PTR_PUBLIC const float *ptr_frame_pixels(const PtrFrame *frame);
+/* The albedo and normal passes, width x height x 3 floats; NULL unless the
+ * render asked for passes or denoising. */
+PTR_PUBLIC const float *ptr_frame_albedo(const PtrFrame *frame);
+PTR_PUBLIC const float *ptr_frame_normal(const PtrFrame *frame);
+
+/* A frame of pixels given (width x height x channels floats, 3: RGB, 4:
+ * RGBA with the colour premultiplied), copied: an image made elsewhere, or
+ * changed after a render, to save. Its metadata name no scene. */
+PTR_PUBLIC PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
+                                   PtrFrame **out, PtrErrorInfo *err);
+
+/* Writes the frame through ptr's writers, by the path's extension: EXR
+ * (float, with the passes as layers) directly, any other format through the
+ * OpenImageIO module, the view applied (integer formats). view is an
+ * OpenColorIO view of the context's config's default display; NULL: its
+ * default view. The file is replaced atomically. */
+PTR_PUBLIC PtrStatus ptr_frame_save(PtrContext *context, const char *path,
+                                    const PtrFrame *frame, const char *view, PtrErrorInfo *err);
+
+PTR_PUBLIC void ptr_frame_free(PtrFrame *frame);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PTR_PTR_H */

@@ -1,0 +1,429 @@
+"""ptr: render sets of spheres with ptr's path tracer, numpy in, numpy out.
+
+    import numpy as np, ptr
+
+    scene = ptr.load("molecule.pdb")              # any file ptr reads
+    image = scene.render(640, 480, samples=64)    # (480, 640, 3) float32
+    ptr.save("molecule.png", image)               # through ptr's writers
+
+    centers = np.random.rand(1000, 3).astype(np.float32)
+    radii = np.full(1000, 0.02, np.float32)
+    image = ptr.Scene.from_arrays(centers, radii).render(320, 240)
+
+Images are scene-linear floats (the command line's EXR pixels, float for
+float, for the same scene and options); with transparent=True they have a
+fourth channel, alpha, the colour premultiplied by it. ptr.save applies an
+OpenColorIO view for the integer formats (PNG, JPEG, ...).
+
+Each scene belongs to a Context, which holds the CPU level, the threads,
+the loaded modules and the colour configuration; one is made for the
+process unless given. A context serves one call at a time (its calls wait
+for each other); scenes of different contexts render at the same time on
+different threads.
+
+The library is libptr.so (ptr's C API, include/ptr/ptr.h), found through
+$PTR_LIBRARY, else where this package was installed beside it, the build
+tree, /usr/local/lib or /usr/lib.
+"""
+
+import ctypes
+import math
+import signal
+import threading
+
+import numpy as np
+
+from . import _native
+from ._native import lib
+
+__all__ = ["Camera", "Material", "Context", "Scene", "Error", "Cancelled", "load", "save",
+           "version"]
+
+
+class Error(Exception):
+    """A failure of ptr, with the command line's exit code as `code` and its
+    one-line message."""
+
+    def __init__(self, code, message):
+        super().__init__(message)
+        self.code = code
+
+
+class UsageError(Error, ValueError):
+    """A bad argument or option value (ptr's exit code 2)."""
+
+
+class Cancelled(Error):
+    """A render stopped because its progress callback returned True."""
+
+
+def _check(status, err):
+    if status == _native.STATUS_OK:
+        return
+    message = err.message.decode(errors="replace")
+    kind = UsageError if status == _native.STATUS_USAGE else \
+        Cancelled if status == _native.STATUS_CANCELLED else Error
+    raise kind(status, message)
+
+
+def version():
+    """ptr's version, "MAJOR.MINOR.PATCH"."""
+    return lib.ptr_version().decode()
+
+
+class Camera:
+    """A camera in world coordinates, as the command line's --lookfrom,
+    --lookat, --up, --vfov, --ortho-height, --aperture and --focus-distance
+    give it. ortho_height above 0 makes it orthographic."""
+
+    def __init__(self, lookfrom, lookat, up=(0.0, 1.0, 0.0), vfov=40.0, ortho_height=0.0,
+                 aperture=0.0, focus_distance=0.0):
+        self.lookfrom, self.lookat, self.up = lookfrom, lookat, up
+        self.vfov, self.ortho_height = vfov, ortho_height
+        self.aperture, self.focus_distance = aperture, focus_distance
+
+    def _desc(self):
+        values = [self.lookfrom, self.lookat, self.up, self.vfov, self.ortho_height,
+                  self.aperture, self.focus_distance]
+        if not all(math.isfinite(v) for v in np.ravel(np.array(values[:3], dtype=np.float64))):
+            raise ValueError("camera: lookfrom, lookat and up are three finite numbers each")
+        return _native.CameraDesc(
+            (ctypes.c_double * 3)(*self.lookfrom), (ctypes.c_double * 3)(*self.lookat),
+            (ctypes.c_double * 3)(*self.up), self.vfov, self.ortho_height, self.aperture,
+            self.focus_distance)
+
+
+class Material:
+    """A material as ptr's scenes hold them: kind "diffuse" (albedo),
+    "metal" (albedo, fuzz: 0 a mirror), "dielectric" (albedo as its
+    attenuation, ior) or "emissive" (a diffuse surface that emits); every
+    kind may have an emission (radiance)."""
+
+    KINDS = ("diffuse", "metal", "dielectric", "emissive")
+
+    def __init__(self, kind="diffuse", albedo=(0.5, 0.5, 0.5), fuzz=0.0, ior=1.5,
+                 emission=(0.0, 0.0, 0.0)):
+        if kind not in self.KINDS:
+            raise ValueError("material: kind %r is not one of %s" % (kind, ", ".join(self.KINDS)))
+        self.kind, self.albedo, self.fuzz, self.ior, self.emission = \
+            kind, albedo, fuzz, ior, emission
+
+    def _desc(self):
+        return _native.MaterialDesc(self.KINDS.index(self.kind),
+                                    (ctypes.c_float * 3)(*self.albedo), self.fuzz, self.ior,
+                                    (ctypes.c_float * 3)(*self.emission))
+
+
+class Context:
+    """What renders share: threads (0: one per CPU), the highest CPU level
+    used (cpu_cap: "none", "sse41", "avx2", "avx512"; None: the CPU's,
+    capped by $PTR_CPUMASK), the denoiser's weights folder and an
+    OpenColorIO config (None: ptr's). Its calls run one at a time."""
+
+    def __init__(self, threads=0, cpu_cap=None, weights_dir=None, ocio_config=None):
+        options = _native.ContextOptions(threads, _native.text(cpu_cap),
+                                         _native.text(weights_dir), _native.text(ocio_config))
+        handle = ctypes.c_void_p()
+        err = _native.ErrorInfo()
+        _check(lib.ptr_context_new(ctypes.byref(options), ctypes.byref(handle),
+                                   ctypes.byref(err)), err)
+        self._handle = handle
+        self._lock = threading.Lock()
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            lib.ptr_context_free(self._handle)
+            self._handle = None
+
+
+_default_context = None
+_default_lock = threading.Lock()
+
+
+def _context(context):
+    global _default_context
+    if context is not None:
+        return context
+    with _default_lock:
+        if _default_context is None:
+            _default_context = Context()
+        return _default_context
+
+
+def load(path, context=None, **options):
+    """Reads a scene file of any format ptr reads (glTF, OBJ, PDB, mmCIF,
+    ...) into a Scene. options are the command line's, by name: camera
+    (a Camera, replacing the file's), camera_name, orthographic,
+    fit_all_objects, select, drop_hydrogens, assembly, model, orbit_degrees,
+    width and height (framing the automatic camera), sky ("gradient",
+    "black" or "R,G,B")."""
+    context = _context(context)
+    return Scene._load(context, path, options)
+
+
+def _load_options(options):
+    known = {"camera", "camera_name", "orthographic", "fit_all_objects", "select",
+             "drop_hydrogens", "assembly", "model", "orbit_degrees", "width", "height", "sky"}
+    unknown = set(options) - known
+    if unknown:
+        raise TypeError("load: unknown options %s" % ", ".join(sorted(unknown)))
+    camera = options.get("camera")
+    desc = camera._desc() if camera is not None else None
+    load_options = _native.LoadOptions(
+        _native.text(options.get("camera_name")),
+        ctypes.pointer(desc) if desc is not None else None,
+        int(bool(options.get("orthographic"))), int(bool(options.get("fit_all_objects"))),
+        _native.text(options.get("select")), int(bool(options.get("drop_hydrogens"))),
+        _native.text(options.get("assembly")), int(options.get("model", 0)),
+        float(options.get("orbit_degrees", 0.0)), int(options.get("width", 0)),
+        int(options.get("height", 0)), _native.text(options.get("sky")))
+    return load_options, desc
+
+
+def _float_array(name, values, shape_text, columns):
+    """values as an array of numbers, checked for shape (N, columns), or
+    (N,) when columns is 0; shape_text says the shape in messages."""
+    array = np.asarray(values)
+    if array.dtype.kind not in "fiub":
+        raise ValueError("%s: numbers are needed, not %s" % (name, array.dtype))
+    expected = 2 if columns else 1
+    if array.ndim != expected or (columns and array.shape[1] != columns):
+        raise ValueError("%s: shape %s, not %s" % (name, array.shape, shape_text))
+    return array
+
+
+def _contiguous(array, dtype):
+    """array as a C-contiguous array of dtype: itself (no copy) if it is one."""
+    return np.ascontiguousarray(array, dtype=dtype)
+
+
+class Scene:
+    """Spheres, their materials, a camera and a sky: from a file (ptr.load)
+    or from arrays (Scene.from_arrays); rendered by render()."""
+
+    def __init__(self, *args, **kwargs):
+        raise TypeError("make a Scene with ptr.load or Scene.from_arrays")
+
+    @classmethod
+    def _new(cls, context, handle, remake):
+        scene = object.__new__(cls)
+        scene._context, scene._handle, scene._remake = context, handle, remake
+        return scene
+
+    @classmethod
+    def _load(cls, context, path, options):
+        load_options, _ = _load_options(options)
+        handle = ctypes.c_void_p()
+        err = _native.ErrorInfo()
+        with context._lock:
+            status = lib.ptr_scene_load(context._handle, _native.text(path),
+                                        ctypes.byref(load_options), ctypes.byref(handle),
+                                        ctypes.byref(err))
+        _check(status, err)
+
+        def remake(camera):
+            return cls._load(context, path, dict(options, camera=camera))
+        return cls._new(context, handle, remake)
+
+    @classmethod
+    def from_arrays(cls, centers, radii, colors=None, materials=None, material_indices=None,
+                    camera=None, sky=None, orthographic=False, width=0, height=0, context=None):
+        """A scene of spheres from numpy arrays, copied by ptr (a render
+        with another camera reads them again).
+
+        centers: (N, 3), float32 read in place if C-contiguous, float64 read
+        in place too (its precision kept), any other numbers converted;
+        radii: (N,), each finite and >= 0; colors: (N, 3) in [0, 1]
+        (clamped), multiplying the material's albedo; materials: a list of
+        Material (default: one grey diffuse); material_indices: (N,)
+        integers into materials; camera: a Camera (default: framing the
+        spheres from +Z); sky: "gradient" (default), "black" or "R,G,B";
+        width, height: the image size the scene suggests.
+
+        Wrong shapes, NaN or infinite centres, negative or NaN radii and
+        indices outside materials raise ValueError."""
+        context = _context(context)
+        centers = _float_array("centers", centers, "(N, 3)", 3)
+        count = centers.shape[0]
+        centers = _contiguous(centers, np.float64 if centers.dtype == np.float64 else np.float32)
+        radii = _contiguous(_float_array("radii", radii, "(N,)", 0), np.float32)
+        if radii.shape[0] != count:
+            raise ValueError("radii: %d of them for %d centers" % (radii.shape[0], count))
+        if not np.isfinite(centers).all():
+            raise ValueError("centers: sphere %d is not finite"
+                             % int(np.argmin(np.isfinite(centers).all(axis=1))))
+        bad = ~(np.isfinite(radii) & (radii >= 0))
+        if bad.any():
+            raise ValueError("radii: sphere %d has radius %g, not finite and >= 0"
+                             % (int(np.argmax(bad)), radii[np.argmax(bad)]))
+        if colors is not None:
+            colors = _contiguous(_float_array("colors", colors, "(N, 3)", 3), np.float32)
+            if colors.shape[0] != count:
+                raise ValueError("colors: %d of them for %d centers" % (colors.shape[0], count))
+            if np.isnan(colors).any():
+                raise ValueError("colors: NaN")
+        table = list(materials) if materials is not None else []
+        if material_indices is not None:
+            indices = np.asarray(material_indices)
+            if indices.shape != (count,) or indices.dtype.kind not in "iu":
+                raise ValueError("material_indices: integers of shape (%d,), not %s %s"
+                                 % (count, indices.dtype, indices.shape))
+            if count and (indices.min() < 0 or indices.max() >= max(len(table), 1)):
+                raise ValueError("material_indices: outside the %d materials"
+                                 % max(len(table), 1))
+            material_indices = _contiguous(indices, np.uint32)
+        descs = (_native.MaterialDesc * len(table))(*[m._desc() for m in table]) \
+            if table else None
+        camera_desc = camera._desc() if camera is not None else None
+        arrays = _native.SceneArrays(
+            count=count,
+            centers=centers.ctypes.data if centers.dtype == np.float32 else None,
+            centers_f64=centers.ctypes.data if centers.dtype == np.float64 else None,
+            radii=radii.ctypes.data,
+            material_indices=material_indices.ctypes.data if material_indices is not None
+            else None,
+            colors=colors.ctypes.data if colors is not None else None,
+            materials=descs, material_count=len(table),
+            camera=ctypes.pointer(camera_desc) if camera_desc is not None else None,
+            orthographic=int(bool(orthographic)), width=width, height=height,
+            sky=_native.text(sky))
+        handle = ctypes.c_void_p()
+        err = _native.ErrorInfo()
+        with context._lock:
+            status = lib.ptr_scene_from_arrays(context._handle, ctypes.byref(arrays),
+                                               ctypes.byref(handle), ctypes.byref(err))
+        _check(status, err)
+
+        def remake(new_camera):
+            return cls.from_arrays(centers, radii, colors, table, material_indices, new_camera,
+                                   sky, orthographic, width, height, context)
+        return cls._new(context, handle, remake)
+
+    def __len__(self):
+        """The number of spheres."""
+        return lib.ptr_scene_sphere_count(self._handle)
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            lib.ptr_scene_handle_free(self._handle)
+            self._handle = None
+
+    def render(self, width=0, height=0, samples=100, seed=1, camera=None, threads=0,
+               denoise=None, progress=None, transparent=False, passes=False, max_depth=50,
+               integrator=None, kernel=None, cpu_cap=None, accel=None, sampler=None,
+               direct_lighting=True, noise_threshold=0.0, min_samples=32, first_sample=0,
+               sky=None):
+        """Renders the scene into a numpy array of shape (height, width, 3),
+        or (height, width, 4) with transparent=True, float32, scene-linear.
+
+        width, height: 0 takes the scene's (else 800 wide); camera: a Camera
+        for this render (the scene is read again with it); threads: 0 for
+        the context's; denoise: "fast", "balanced" or "high"; progress: a
+        function of (samples_done, samples_total), called about ten times a
+        second, that returns True to cancel (then ptr.Cancelled is raised);
+        passes=True returns (image, albedo, normal), each pass (H, W, 3).
+        The other options are the command line's of the same names.
+
+        Ctrl-C (SIGINT) stops the render after the pass under way and raises
+        KeyboardInterrupt."""
+        if camera is not None:
+            return self._remake(camera).render(
+                width, height, samples, seed, None, threads, denoise, progress, transparent,
+                passes, max_depth, integrator, kernel, cpu_cap, accel, sampler,
+                direct_lighting, noise_threshold, min_samples, first_sample, sky)
+        options = _native.RenderOptions()
+        lib.ptr_render_options_default(ctypes.byref(options))
+        for name, value in (("width", width), ("height", height), ("samples", samples),
+                            ("seed", seed), ("threads", threads), ("max_depth", max_depth),
+                            ("min_samples", min_samples), ("first_sample", first_sample)):
+            if int(value) < 0:
+                raise ValueError("%s: %d is negative" % (name, value))
+            setattr(options, name, int(value))
+        options.transparent, options.passes = int(bool(transparent)), int(bool(passes))
+        options.direct_lighting = int(bool(direct_lighting))
+        options.noise_threshold = float(noise_threshold)
+        for name, value in (("integrator", integrator), ("kernel", kernel),
+                            ("cpu_cap", cpu_cap), ("accel", accel), ("sampler", sampler),
+                            ("denoise", denoise), ("sky", sky)):
+            setattr(options, name, _native.text(value))
+        frame = self._render_frame(options, progress)
+        try:
+            image = _frame_array(lib.ptr_frame_pixels(frame), frame)
+            if not passes:
+                return image
+            return (image, _frame_array(lib.ptr_frame_albedo(frame), frame, 3),
+                    _frame_array(lib.ptr_frame_normal(frame), frame, 3))
+        finally:
+            lib.ptr_frame_free(frame)
+
+    def _render_frame(self, options, progress):
+        """The frame of a render, cancelled by progress or by SIGINT."""
+        interrupted = []
+
+        def on_progress(user, info):
+            if interrupted:
+                return 1
+            try:
+                return 1 if progress and progress(info.contents.samples_done,
+                                                  info.contents.samples_total) else 0
+            except BaseException as error:  # noqa: B902 - raised again after the render
+                interrupted.append(error)
+                return 1
+
+        callback = _native.ProgressCallback(on_progress)
+        # Python runs signal handlers between the callback's bytecodes, on the
+        # main thread: the handler asks the render to stop.
+        in_main = threading.current_thread() is threading.main_thread()
+        previous = None
+        if in_main:
+            previous = signal.signal(signal.SIGINT,
+                                     lambda number, stack: interrupted.append(KeyboardInterrupt()))
+        frame = ctypes.c_void_p()
+        err = _native.ErrorInfo()
+        try:
+            with self._context._lock:
+                status = lib.ptr_scene_render(self._context._handle, self._handle,
+                                              ctypes.byref(options), callback, None,
+                                              ctypes.byref(frame), ctypes.byref(err))
+        finally:
+            if in_main:
+                signal.signal(signal.SIGINT, previous)
+        # Ctrl-C, or an exception of the progress callback: raised, whether
+        # the render stopped for it or had just finished.
+        if interrupted:
+            if status == _native.STATUS_OK:
+                lib.ptr_frame_free(frame)
+            raise interrupted[0]
+        _check(status, err)
+        return frame
+
+
+def _frame_array(pointer, frame, channels=None):
+    """A copy of a frame's buffer as an (H, W, channels) float32 array."""
+    height, width = lib.ptr_frame_height(frame), lib.ptr_frame_width(frame)
+    channels = channels or lib.ptr_frame_channels(frame)
+    return np.ctypeslib.as_array(pointer, shape=(height, width, channels)).copy()
+
+
+def save(path, image, view=None, context=None):
+    """Writes an image (an array (H, W, 3) or (H, W, 4), scene-linear, RGBA
+    premultiplied) through ptr's writers, by the path's extension: EXR as
+    floats; other formats (PNG, JPEG, TIFF, ...) through OpenImageIO with
+    the OpenColorIO view applied (view: a view of the config's default
+    display, such as "Standard" or "Raw"; None: its default)."""
+    context = _context(context)
+    image = np.asarray(image)
+    if image.ndim != 3 or image.shape[2] not in (3, 4):
+        raise ValueError("image: shape %s, not (H, W, 3) or (H, W, 4)" % (image.shape,))
+    pixels = _contiguous(image, np.float32)
+    frame = ctypes.c_void_p()
+    err = _native.ErrorInfo()
+    _check(lib.ptr_frame_new(pixels.shape[1], pixels.shape[0], pixels.shape[2],
+                             pixels.ctypes.data, ctypes.byref(frame), ctypes.byref(err)), err)
+    try:
+        with context._lock:
+            status = lib.ptr_frame_save(context._handle, _native.text(path), frame,
+                                        _native.text(view), ctypes.byref(err))
+        _check(status, err)
+    finally:
+        lib.ptr_frame_free(frame)

@@ -1,0 +1,146 @@
+"""The C API of libptr (include/ptr/ptr.h) through ctypes: the library found,
+its structures and its functions' signatures. Nothing here is public."""
+
+import ctypes
+import os
+
+PTR_API_VERSION = 1
+
+STATUS_OK = 0
+STATUS_USAGE = 2
+STATUS_CANCELLED = 8
+
+
+def _candidates():
+    """Where libptr.so is looked for, in order: $PTR_LIBRARY alone if set;
+    else the prefix this package was installed into (PREFIX/lib/pythonX.Y/
+    site-packages/ptr: PREFIX/lib three folders up), the build trees beside
+    python/ in the source tree, /usr/local and /usr; then the system's
+    search path."""
+    name = "libptr.so.%d" % PTR_API_VERSION
+    given = os.environ.get("PTR_LIBRARY")
+    if given:
+        yield given
+        return
+    here = os.path.dirname(os.path.abspath(__file__))
+    yield os.path.normpath(os.path.join(here, "..", "..", "..", name))
+    source = os.path.dirname(os.path.dirname(here))
+    for build in ("build", "build-release", "build-debug"):
+        yield os.path.join(source, build, "lib", name)
+    for prefix in ("/usr/local", "/usr"):
+        yield os.path.join(prefix, "lib", name)
+    yield name
+
+
+def _load():
+    tried = []
+    for path in _candidates():
+        if os.sep in path and not os.path.exists(path):
+            tried.append(path)
+            continue
+        try:
+            return ctypes.CDLL(path)
+        except OSError as error:
+            tried.append("%s (%s)" % (path, error))
+    raise ImportError("ptr: cannot find libptr.so (set PTR_LIBRARY to its path); tried: "
+                      + ", ".join(tried))
+
+
+class ErrorInfo(ctypes.Structure):
+    _fields_ = [("code", ctypes.c_int), ("message", ctypes.c_char * 512)]
+
+
+class ContextOptions(ctypes.Structure):
+    _fields_ = [("threads", ctypes.c_int), ("cpu_cap", ctypes.c_char_p),
+                ("weights_dir", ctypes.c_char_p), ("ocio_config", ctypes.c_char_p)]
+
+
+class CameraDesc(ctypes.Structure):
+    _fields_ = [("lookfrom", ctypes.c_double * 3), ("lookat", ctypes.c_double * 3),
+                ("up", ctypes.c_double * 3), ("vfov_deg", ctypes.c_double),
+                ("ortho_height", ctypes.c_double), ("aperture", ctypes.c_double),
+                ("focus_distance", ctypes.c_double)]
+
+
+class LoadOptions(ctypes.Structure):
+    _fields_ = [("camera_name", ctypes.c_char_p), ("camera", ctypes.POINTER(CameraDesc)),
+                ("orthographic", ctypes.c_int), ("fit_all_objects", ctypes.c_int),
+                ("select", ctypes.c_char_p), ("drop_hydrogens", ctypes.c_int),
+                ("assembly", ctypes.c_char_p), ("model", ctypes.c_size_t),
+                ("orbit_degrees", ctypes.c_double), ("width", ctypes.c_int),
+                ("height", ctypes.c_int), ("sky", ctypes.c_char_p)]
+
+
+class MaterialDesc(ctypes.Structure):
+    _fields_ = [("type", ctypes.c_int), ("albedo", ctypes.c_float * 3),
+                ("fuzz", ctypes.c_float), ("ior", ctypes.c_float),
+                ("emission", ctypes.c_float * 3)]
+
+
+class SceneArrays(ctypes.Structure):
+    _fields_ = [("count", ctypes.c_size_t), ("centers", ctypes.c_void_p),
+                ("centers_f64", ctypes.c_void_p), ("radii", ctypes.c_void_p),
+                ("material_indices", ctypes.c_void_p), ("colors", ctypes.c_void_p),
+                ("materials", ctypes.POINTER(MaterialDesc)), ("material_count", ctypes.c_size_t),
+                ("camera", ctypes.POINTER(CameraDesc)), ("orthographic", ctypes.c_int),
+                ("width", ctypes.c_int), ("height", ctypes.c_int), ("sky", ctypes.c_char_p)]
+
+
+class RenderOptions(ctypes.Structure):
+    _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int),
+                ("samples", ctypes.c_uint32), ("first_sample", ctypes.c_uint32),
+                ("seed", ctypes.c_uint64), ("max_depth", ctypes.c_int),
+                ("threads", ctypes.c_int), ("integrator", ctypes.c_char_p),
+                ("kernel", ctypes.c_char_p), ("cpu_cap", ctypes.c_char_p),
+                ("accel", ctypes.c_char_p), ("sampler", ctypes.c_char_p),
+                ("direct_lighting", ctypes.c_int), ("noise_threshold", ctypes.c_float),
+                ("min_samples", ctypes.c_uint32), ("transparent", ctypes.c_int),
+                ("passes", ctypes.c_int), ("denoise", ctypes.c_char_p),
+                ("sky", ctypes.c_char_p), ("camera", ctypes.POINTER(CameraDesc))]
+
+
+class ProgressInfo(ctypes.Structure):
+    _fields_ = [("samples_done", ctypes.c_uint32), ("samples_total", ctypes.c_uint32),
+                ("fraction", ctypes.c_double), ("elapsed", ctypes.c_double)]
+
+
+ProgressCallback = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ProgressInfo))
+
+lib = _load()
+
+_P = ctypes.c_void_p
+_ERR = ctypes.POINTER(ErrorInfo)
+_SIGNATURES = {
+    "ptr_version": (ctypes.c_char_p, []),
+    "ptr_context_new": (ctypes.c_int, [ctypes.POINTER(ContextOptions), ctypes.POINTER(_P), _ERR]),
+    "ptr_context_free": (None, [_P]),
+    "ptr_scene_load": (ctypes.c_int, [_P, ctypes.c_char_p, ctypes.POINTER(LoadOptions),
+                                      ctypes.POINTER(_P), _ERR]),
+    "ptr_scene_from_arrays": (ctypes.c_int, [_P, ctypes.POINTER(SceneArrays),
+                                             ctypes.POINTER(_P), _ERR]),
+    "ptr_scene_sphere_count": (ctypes.c_size_t, [_P]),
+    "ptr_scene_handle_free": (None, [_P]),
+    "ptr_render_options_default": (None, [ctypes.POINTER(RenderOptions)]),
+    "ptr_scene_render": (ctypes.c_int, [_P, _P, ctypes.POINTER(RenderOptions), ProgressCallback,
+                                        _P, ctypes.POINTER(_P), _ERR]),
+    "ptr_frame_width": (ctypes.c_int, [_P]),
+    "ptr_frame_height": (ctypes.c_int, [_P]),
+    "ptr_frame_channels": (ctypes.c_int, [_P]),
+    "ptr_frame_pixels": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_albedo": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_normal": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_new": (ctypes.c_int, [ctypes.c_int, ctypes.c_int, ctypes.c_int, _P,
+                                     ctypes.POINTER(_P), _ERR]),
+    "ptr_frame_save": (ctypes.c_int, [_P, ctypes.c_char_p, _P, ctypes.c_char_p, _ERR]),
+    "ptr_frame_free": (None, [_P]),
+}
+for _name, (_result, _arguments) in _SIGNATURES.items():
+    _function = getattr(lib, _name)
+    _function.restype = _result
+    _function.argtypes = _arguments
+
+
+def text(value):
+    """A str (or None) as the C API takes it."""
+    return None if value is None else os.fsencode(value) if isinstance(value, os.PathLike) \
+        else value.encode()

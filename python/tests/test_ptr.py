@@ -1,0 +1,193 @@
+"""The Python module against the command line and on bad input: shapes and
+dtypes, errors as ValueError, the CLI's EXR pixels float for float,
+contexts rendering at once, cancellation by callback and by SIGINT.
+
+Run by ctest (python_tests) with PTR_LIBRARY, PTR_EXECUTABLE and
+PTR_SOURCE_DIR set; by hand: PTR_LIBRARY=build/lib/libptr.so.1
+PTR_EXECUTABLE=build/src/ptr python3 -m pytest python/tests."""
+
+import os
+import signal
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import ptr
+
+SOURCE = os.environ.get("PTR_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+SEED = os.path.join(SOURCE, "scenes", "seed.gltf")
+FINAL = os.path.join(SOURCE, "scenes", "final.gltf")
+MOLECULE = os.path.join(SOURCE, "scenes", "1tii.pdb")
+
+
+def spheres(count=50, seed=3):
+    rng = np.random.default_rng(seed)
+    centers = rng.uniform(-1, 1, (count, 3)).astype(np.float32)
+    radii = rng.uniform(0.05, 0.2, count).astype(np.float32)
+    return centers, radii
+
+
+def same_pixels(a, b):
+    """Whether two EXR files hold the same pixels, bit for bit."""
+    return subprocess.run(["idiff", "-q", "-a", "-fail", "0", "-failpercent", "0", a, b],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
+
+
+def test_shapes_and_dtypes():
+    centers, radii = spheres()
+    scene = ptr.Scene.from_arrays(centers, radii)
+    assert len(scene) == 50
+    image = scene.render(40, 30, samples=2)
+    assert image.shape == (30, 40, 3) and image.dtype == np.float32
+    assert np.isfinite(image).all() and image.max() > 0
+    assert scene.render(40, 30, samples=2, transparent=True).shape == (30, 40, 4)
+    image, albedo, normal = scene.render(16, 8, samples=1, passes=True)
+    assert image.shape == albedo.shape == normal.shape == (8, 16, 3)
+    # Width alone: the height from the camera's aspect ratio (16:9 here).
+    assert scene.render(64, samples=1).shape == (36, 64, 3)
+
+
+def test_dtypes_converted_and_exact():
+    centers, radii = spheres()
+    reference = ptr.Scene.from_arrays(centers, radii).render(24, 24, samples=2)
+    # float64 holding the same values, a strided view and a list: the same image.
+    wide = np.zeros((50, 6), np.float32)
+    wide[:, ::2] = centers
+    for variant in (centers.astype(np.float64), wide[:, ::2], centers.tolist()):
+        image = ptr.Scene.from_arrays(variant, radii.astype(np.float64)).render(
+            24, 24, samples=2)
+        assert np.array_equal(image, reference)
+    # float32 and C-contiguous: read where it is.
+    assert ptr._contiguous(centers, np.float32) is centers
+    integers = np.array([[0, 0, -3], [1, 0, -3]], np.int32)
+    assert len(ptr.Scene.from_arrays(integers, [0.5, 0.5])) == 2
+
+
+def test_bad_input():
+    centers, radii = spheres(4)
+    with pytest.raises(ValueError, match="shape"):
+        ptr.Scene.from_arrays(centers[:, :2], radii)
+    with pytest.raises(ValueError, match="radii"):
+        ptr.Scene.from_arrays(centers, radii[:3])
+    bad = centers.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(ValueError, match="sphere 2"):
+        ptr.Scene.from_arrays(bad, radii)
+    negative = radii.copy()
+    negative[1] = -0.5
+    with pytest.raises(ValueError, match="sphere 1"):
+        ptr.Scene.from_arrays(centers, negative)
+    with pytest.raises(ValueError, match="material_indices"):
+        ptr.Scene.from_arrays(centers, radii, material_indices=[0, 0, 1, 0])
+    with pytest.raises(ValueError, match="numbers"):
+        ptr.Scene.from_arrays(np.array([["a", "b", "c"]]), [1.0])
+    with pytest.raises(ValueError, match="kind"):
+        ptr.Material("velvet")
+    scene = ptr.Scene.from_arrays(centers, radii)
+    with pytest.raises(ValueError, match="integrator"):
+        scene.render(8, 8, samples=1, integrator="sideways")
+    with pytest.raises(ValueError):
+        ptr.Scene.from_arrays(centers, radii, sky="purple")
+    with pytest.raises(ValueError, match="cpu_cap: 'avx9000' is not"):
+        ptr.Context(cpu_cap="avx9000")
+    with pytest.raises(ptr.Error, match="^arrays: "):
+        ptr.Scene.from_arrays([[0, 0, 0]], [0.0])  # nothing to frame
+    with pytest.raises(ptr.Error) as failure:
+        ptr.load("/nonexistent/scene.gltf")
+    assert failure.value.code == 3 and "/nonexistent/scene.gltf" in str(failure.value)
+    with pytest.raises(ValueError, match="shape"):
+        ptr.save("/tmp/never.exr", np.zeros((4, 4)))
+
+
+@pytest.mark.parametrize("scene,extra,kwargs", [
+    (FINAL, [], {}),
+    (SEED, ["--transparent"], {"transparent": True}),
+    (MOLECULE, [], {}),
+])
+def test_same_pixels_as_command_line(tmp_path, scene, extra, kwargs):
+    cli = str(tmp_path / "cli.exr")
+    subprocess.run([os.environ["PTR_EXECUTABLE"], scene, "-o", cli, "--width", "80",
+                    "--samples", "4", "--quiet"] + extra, check=True)
+    image = ptr.load(scene).render(80, samples=4, **kwargs)
+    ours = str(tmp_path / "ours.exr")
+    ptr.save(ours, image)
+    assert same_pixels(cli, ours)
+
+
+def test_materials_and_save(tmp_path):
+    centers = np.array([[0, 0, -3], [1.2, 0, -3], [0, -101, -3]], np.float32)
+    radii = np.array([0.5, 0.5, 100], np.float32)
+    materials = [ptr.Material("metal", (0.8, 0.8, 0.8), fuzz=0.1),
+                 ptr.Material("emissive", (0, 0, 0), emission=(4, 4, 4)),
+                 ptr.Material("diffuse", (0.5, 0.5, 0.5))]
+    camera = ptr.Camera((0, 0, 0), (0, 0, -1), vfov=60)
+    scene = ptr.Scene.from_arrays(centers, radii, colors=[[1, 0, 0], [1, 1, 1], [1, 1, 1]],
+                                  materials=materials, material_indices=[0, 1, 2],
+                                  camera=camera, sky="black")
+    image = scene.render(32, 24, samples=4)
+    assert image.max() > 1  # the emitter
+    png = tmp_path / "image.png"
+    ptr.save(png, image, view="Raw")
+    assert png.stat().st_size > 0
+    # Another camera for one render: the scene read again with it.
+    turned = scene.render(32, 24, samples=4, camera=ptr.Camera((0, 3, 0), (0, 0, -3)))
+    assert not np.array_equal(turned, image)
+
+
+def test_contexts_at_once():
+    jobs = [(SEED, "none"), (FINAL, None)]
+    alone = [ptr.load(path, context=ptr.Context(1, cap)).render(48, samples=2)
+             for path, cap in jobs]
+    results = [None, None]
+
+    def run(i):
+        path, cap = jobs[i]
+        results[i] = ptr.load(path, context=ptr.Context(1, cap)).render(48, samples=2)
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for i in range(2):
+        assert np.array_equal(results[i], alone[i])
+
+
+def test_cancel_by_callback():
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+        return True
+
+    with pytest.raises(ptr.Cancelled):
+        ptr.load(FINAL).render(400, samples=100000, progress=progress)
+    assert calls and calls[0][1] == 100000
+
+
+def test_ctrl_c_cancels():
+    def interrupt(done, total):
+        os.kill(os.getpid(), signal.SIGINT)
+
+    handler = signal.getsignal(signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt):
+        ptr.load(FINAL).render(400, samples=100000, progress=interrupt)
+    assert signal.getsignal(signal.SIGINT) is handler
+
+
+def test_progress_exception_raised():
+    def broken(done, total):
+        raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        ptr.load(SEED).render(64, samples=4, progress=broken)
+
+
+def test_help_reads():
+    assert "numpy in, numpy out" in ptr.__doc__
+    for name in ptr.__all__:
+        assert getattr(ptr, name).__doc__
+    assert ptr.version().count(".") == 2

@@ -1,0 +1,48 @@
+/* What the objects of the public API (include/ptr/ptr.h) hold, shared by
+ * the files that implement it. */
+#ifndef PTR_API_INTERNAL_H
+#define PTR_API_INTERNAL_H
+
+#include "api/pipeline.h"
+#include "color/color.h"
+#include "denoise/denoise.h"
+#include "image/image.h"
+#include "import_options.h"
+#include "ptr/ptr.h"
+
+struct PtrContext {
+    int threads;           /* 0: one per online CPU */
+    PtrCpuLevel cpu_level; /* the CPU's, capped by $PTR_CPUMASK, then by the options */
+    char *weights_dir;     /* NULL: the denoiser's default */
+    PtrImageLoader *images;
+    PtrColor *color;
+    /* Loaded on the first render that asks for each quality. */
+    PtrDenoiser *denoisers[PTR_DENOISE_HIGH + 1];
+};
+
+/* The choices a scene's tree was built for: a render asking for others
+ * builds again. */
+typedef struct PtrPreparedFor {
+    PtrKernel kernel;
+    PtrCpuLevel level;
+    PtrIntegrator integrator;
+    PtrAccelChoice accel;
+} PtrPreparedFor;
+
+struct PtrSceneHandle {
+    PtrScene scene;
+    char *name;            /* the file, or "arrays": what messages and metadata name */
+    double import_seconds;
+    int prepared_valid;
+    PtrPreparedFor prepared_for;
+    PtrPrepared prepared;
+};
+
+/* A public camera as the command line's (the importers' PtrCameraSpec). */
+void ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec);
+
+/* Copies an internal error into the caller's (which may be NULL) and
+ * returns its code as a status. */
+PtrStatus ptr_api_fail(PtrErrorInfo *err, const PtrError *error);
+
+#endif /* PTR_API_INTERNAL_H */

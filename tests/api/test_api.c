@@ -1,0 +1,367 @@
+/* The public API (include/ptr/ptr.h) against the command line: the image
+ * ptr_scene_render returns equals, float for float, the EXR `ptr` writes for
+ * the same scene and options (a glTF, the seed scene with a transparent
+ * background, a molecule); a scene from arrays equals the file it came from;
+ * and the errors, cancellation, saving and contexts side by side. */
+#include <math.h>
+#include <pthread.h>
+#include <string.h>
+
+#include "image/image.h"
+#include "importer.h"
+#include "ptr/ptr.h"
+#include "test.h"
+#include "test_files.h"
+
+#define SCENE(name) PTR_SOURCE_DIR "/scenes/" name
+
+static PtrContext *context;
+
+/* Renders path through the API with the options, width 96, 6 samples. */
+static PtrFrame *render_file(const char *path, const PtrLoadOptions *load,
+                             void (*change)(PtrRenderOptions *))
+{
+    PtrSceneHandle *scene = NULL;
+    PtrFrame *frame = NULL;
+    PtrErrorInfo err = { 0 };
+    CHECK_INT(ptr_scene_load(context, path, load, &scene, &err), PTR_STATUS_OK);
+    if (!scene) {
+        fprintf(stderr, "%s\n", err.message);
+        return NULL;
+    }
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    options.width = 96;
+    options.samples = 6;
+    if (change)
+        change(&options);
+    CHECK_INT(ptr_scene_render(context, scene, &options, NULL, NULL, &frame, &err), PTR_STATUS_OK);
+    if (!frame)
+        fprintf(stderr, "%s\n", err.message);
+    ptr_scene_handle_free(scene);
+    return frame;
+}
+
+/* Whether the frame holds exactly the EXR's pixels (and alpha). */
+static void check_same_as_file(const PtrFrame *frame, const char *exr)
+{
+    PtrImage *image;
+    PtrError err;
+    CHECK_INT(test_image_read(exr, &image, &err), PTR_OK);
+    if (!frame)
+        return;
+    const int w = ptr_frame_width(frame), h = ptr_frame_height(frame);
+    CHECK_INT(ptr_image_width(image), w);
+    CHECK_INT(ptr_image_height(image), h);
+    const size_t pixels = (size_t)w * (size_t)h;
+    const int channels = ptr_frame_channels(frame);
+    const float *ours = ptr_frame_pixels(frame), *rgb = ptr_image_pixels(image),
+                *alpha = ptr_image_alpha(image);
+    CHECK_INT(alpha != NULL, channels == 4);
+    size_t differ = 0;
+    for (size_t p = 0; p < pixels; p++) {
+        differ += memcmp(&ours[channels * p], &rgb[3 * p], 3 * sizeof *rgb) != 0;
+        differ += channels == 4 && alpha && memcmp(&ours[4 * p + 3], &alpha[p], sizeof *alpha);
+    }
+    CHECK_INT(differ, 0);
+    ptr_image_free(image);
+}
+
+static void transparent(PtrRenderOptions *o) { o->transparent = 1; }
+
+static void test_same_as_command_line(void)
+{
+    struct {
+        const char *scene;
+        void (*change)(PtrRenderOptions *);
+        const char *extra;
+    } cases[] = {
+        { SCENE("final.gltf"), NULL, NULL },
+        { SCENE("seed.gltf"), transparent, "--transparent" },
+        { SCENE("1tii.pdb"), NULL, NULL },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *out = test_path("cli.exr");
+        CHECK_INT(test_ptr(cases[i].scene, "-o", out, "--width", "96", "--samples", "6",
+                           "--quiet", cases[i].extra, (char *)NULL),
+                  0);
+        PtrFrame *frame = render_file(cases[i].scene, NULL, cases[i].change);
+        check_same_as_file(frame, out);
+        ptr_frame_free(frame);
+    }
+}
+
+/* Seen from the world's origin, the coordinates relative to the camera are
+ * the file's own, rounded to float as the arrays hold them. */
+static const PtrCameraDesc origin_camera = {
+    .lookat = { 0, 0, -1 }, .up = { 0, 1, 0 }, .vfov_deg = 60,
+};
+
+static void test_arrays_same_as_file(void)
+{
+    /* The spheres as the file gives them, in its order. */
+    PtrScene scene;
+    PtrStrings warnings = { 0 };
+    PtrCameraSpec spec = { .lookat = { 0, 0, -1 }, .up = { 0, 1, 0 }, .vfov_deg = 60 };
+    const PtrImportOptions import = { .camera = &spec };
+    CHECK_INT(ptr_import_scene(SCENE("seed.gltf"), &import, &scene, &warnings, NULL), PTR_OK);
+    ptr_strings_free(&warnings);
+    const size_t n = scene.spheres.count;
+    float *centers = malloc(n * 3 * sizeof *centers), *radii = malloc(n * sizeof *radii);
+    uint32_t *materials = malloc(n * sizeof *materials);
+    PtrMaterialDesc *table = calloc(scene.material_count, sizeof *table);
+    for (size_t i = 0; i < n; i++) {
+        const size_t at = ptr_sphere_id(&scene.spheres, i);
+        centers[3 * at] = scene.spheres.cx[i];
+        centers[3 * at + 1] = scene.spheres.cy[i];
+        centers[3 * at + 2] = scene.spheres.cz[i];
+        radii[at] = scene.spheres.radius[i];
+        materials[at] = ptr_sphere_material(&scene.spheres, i);
+    }
+    for (size_t m = 0; m < scene.material_count; m++) {
+        const PtrMaterial *s = &scene.materials[m];
+        table[m] = (PtrMaterialDesc){
+            .type = (PtrMaterialType)s->kind, .albedo = { s->albedo.x, s->albedo.y, s->albedo.z },
+            .fuzz = s->fuzz, .ior = s->ior,
+            .emission = { s->emission.x, s->emission.y, s->emission.z },
+        };
+    }
+    CHECK(scene.origin[0] == 0 && scene.origin[1] == 0 && scene.origin[2] == 0);
+    CHECK(!scene.spheres.color);
+    const PtrSceneArrays arrays = {
+        .count = n, .centers = centers, .radii = radii, .material_indices = materials,
+        .materials = table, .material_count = scene.material_count, .camera = &origin_camera,
+        .width = scene.width, .height = scene.height, .sky = "gradient",
+    };
+    ptr_scene_free(&scene);
+    PtrSceneHandle *from_arrays = NULL;
+    PtrErrorInfo err;
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &from_arrays, &err), PTR_STATUS_OK);
+    CHECK_INT((int)ptr_scene_sphere_count(from_arrays), (int)n);
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    options.width = 96; /* as render_file renders the file */
+    options.samples = 6;
+    PtrFrame *ours = NULL;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &ours, &err),
+              PTR_STATUS_OK);
+    /* The scene's own camera given for one render changes nothing; another
+     * changes the image for that render alone. */
+    const PtrCameraDesc above = { .lookfrom = { 0, 2, 1 }, .lookat = { 0, 0, -1 },
+                                  .up = { 0, 1, 0 }, .vfov_deg = 60 };
+    PtrFrame *same = NULL, *other = NULL, *again = NULL;
+    options.camera = &origin_camera;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &same, &err),
+              PTR_STATUS_OK);
+    options.camera = &above;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &other, &err),
+              PTR_STATUS_OK);
+    options.camera = NULL;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &again, &err),
+              PTR_STATUS_OK);
+    const size_t bytes = 96 * 96 * 3 * sizeof(float);
+    if (ours && same && other && again) {
+        CHECK(!memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(same), bytes));
+        CHECK(memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(other), bytes) != 0);
+        CHECK(!memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(again), bytes));
+    }
+    ptr_frame_free(same);
+    ptr_frame_free(other);
+    ptr_frame_free(again);
+    const PtrCameraDesc broken = { .lookfrom = { NAN, 0, 0 }, .up = { 0, 1, 0 } };
+    options.camera = &broken;
+    CHECK_INT(ptr_scene_render(context, from_arrays, &options, NULL, NULL, &same, &err),
+              PTR_STATUS_USAGE);
+    options.camera = NULL;
+
+    const PtrLoadOptions load = { .camera = &origin_camera };
+    PtrFrame *file = render_file(SCENE("seed.gltf"), &load, NULL);
+    if (ours && file) {
+        CHECK_INT(ptr_frame_width(ours) * ptr_frame_height(ours),
+                  ptr_frame_width(file) * ptr_frame_height(file));
+        CHECK(!memcmp(ptr_frame_pixels(ours), ptr_frame_pixels(file),
+                      (size_t)ptr_frame_width(ours) * ptr_frame_height(ours) * 3 * sizeof(float)));
+    }
+    ptr_frame_free(ours);
+    ptr_frame_free(file);
+    ptr_scene_handle_free(from_arrays);
+    free(centers);
+    free(radii);
+    free(materials);
+    free(table);
+}
+
+static void test_bad_input(void)
+{
+    PtrErrorInfo err = { 0 };
+    PtrSceneHandle *scene = NULL;
+    CHECK_INT(ptr_scene_load(context, "/nonexistent/x.gltf", NULL, &scene, &err),
+              PTR_STATUS_SCENE_UNREADABLE);
+    CHECK(strstr(err.message, "/nonexistent/x.gltf") != NULL);
+    CHECK(scene == NULL);
+    /* No message wanted: NULL. */
+    CHECK_INT(ptr_scene_load(context, "/nonexistent/x.gltf", NULL, &scene, NULL),
+              PTR_STATUS_SCENE_UNREADABLE);
+
+    float centers[6] = { 0, 0, 0, 1, 0, 0 }, radii[2] = { 0.5f, 0.5f };
+    uint32_t materials[2] = { 0, 3 };
+    PtrSceneArrays arrays = { .count = 2, .centers = centers, .radii = radii };
+    centers[4] = NAN;
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "sphere 1") != NULL);
+    centers[4] = 0;
+    radii[0] = -1;
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "sphere 0") != NULL);
+    radii[0] = 0.5f;
+    arrays.material_indices = materials;
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_USAGE);
+    arrays.material_indices = NULL;
+    arrays.sky = "purple";
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_USAGE);
+    CHECK(scene == NULL);
+    arrays.sky = NULL;
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_OK);
+
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    options.width = 8;
+    options.integrator = "sideways";
+    PtrFrame *frame = NULL;
+    CHECK_INT(ptr_scene_render(context, scene, &options, NULL, NULL, &frame, &err),
+              PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "integrator") != NULL);
+    CHECK(frame == NULL);
+    ptr_scene_handle_free(scene);
+
+    PtrContext *bad = NULL;
+    const PtrContextOptions level = { .cpu_cap = "avx9000" };
+    CHECK_INT(ptr_context_new(&level, &bad, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "cpu_cap: 'avx9000' is not") != NULL);
+    CHECK(bad == NULL);
+}
+
+static int calls;
+static int cancel_at_once(void *user, const PtrProgressInfo *progress)
+{
+    (void)user;
+    (void)progress;
+    calls++;
+    return 1;
+}
+
+static void test_cancel(void)
+{
+    PtrSceneHandle *scene = NULL;
+    PtrErrorInfo err;
+    CHECK_INT(ptr_scene_load(context, SCENE("final.gltf"), NULL, &scene, &err), PTR_STATUS_OK);
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    options.width = 400;
+    options.samples = 100000;
+    PtrFrame *frame = NULL;
+    CHECK_INT(ptr_scene_render(context, scene, &options, cancel_at_once, NULL, &frame, &err),
+              PTR_STATUS_CANCELLED);
+    CHECK(calls > 0);
+    CHECK(frame == NULL);
+    CHECK(strstr(err.message, "cancelled") != NULL);
+    ptr_scene_handle_free(scene);
+}
+
+static void test_save(void)
+{
+    PtrFrame *frame = render_file(SCENE("seed.gltf"), NULL, transparent);
+    const char *exr = test_path("saved.exr"), *png = test_path("saved.png");
+    PtrErrorInfo err;
+    CHECK_INT(ptr_frame_save(context, exr, frame, NULL, &err), PTR_STATUS_OK);
+    check_same_as_file(frame, exr);
+    CHECK_INT(ptr_frame_save(context, png, frame, "Raw", &err), PTR_STATUS_OK);
+    CHECK(access(png, F_OK) == 0);
+    CHECK_INT(ptr_frame_save(context, test_path("saved.png"), frame, "no such view", &err),
+              PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_save(context, "/nonexistent/dir/x.exr", frame, NULL, &err),
+              PTR_STATUS_OUTPUT);
+
+    /* The same pixels as a frame of their own save to the same pixels. */
+    PtrFrame *copy = NULL;
+    if (frame)
+        CHECK_INT(ptr_frame_new(ptr_frame_width(frame), ptr_frame_height(frame), 4,
+                                ptr_frame_pixels(frame), &copy, &err),
+                  PTR_STATUS_OK);
+    const char *copied = test_path("copied.exr");
+    if (copy)
+        CHECK_INT(ptr_frame_save(context, copied, copy, NULL, &err), PTR_STATUS_OK);
+    check_same_as_file(copy, copied);
+    check_same_as_file(frame, copied);
+    ptr_frame_free(copy);
+    CHECK_INT(ptr_frame_new(0, 4, 3, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_new(4, 4, 2, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
+    ptr_frame_free(frame);
+}
+
+/* Two contexts, each with its own CPU level and threads, rendering at once
+ * on two threads: each gets the image it gets alone. */
+typedef struct Job {
+    const char *cap;
+    PtrFrame *frame;
+} Job;
+
+static void *render_job(void *arg)
+{
+    Job *job = arg;
+    const PtrContextOptions options = { .threads = 1, .cpu_cap = job->cap };
+    PtrContext *own = NULL;
+    PtrSceneHandle *scene = NULL;
+    PtrRenderOptions render;
+    ptr_render_options_default(&render);
+    render.width = 64;
+    render.samples = 4;
+    if (ptr_context_new(&options, &own, NULL) == PTR_STATUS_OK &&
+        ptr_scene_load(own, SCENE("seed.gltf"), NULL, &scene, NULL) == PTR_STATUS_OK)
+        ptr_scene_render(own, scene, &render, NULL, NULL, &job->frame, NULL);
+    ptr_scene_handle_free(scene);
+    ptr_context_free(own);
+    return NULL;
+}
+
+static void test_two_contexts(void)
+{
+    Job jobs[2] = { { "none", NULL }, { NULL, NULL } };
+    pthread_t threads[2];
+    for (int i = 0; i < 2; i++)
+        CHECK_INT(pthread_create(&threads[i], NULL, render_job, &jobs[i]), 0);
+    for (int i = 0; i < 2; i++)
+        pthread_join(threads[i], NULL);
+    CHECK(jobs[0].frame && jobs[1].frame);
+    if (jobs[0].frame && jobs[1].frame)
+        CHECK(!memcmp(ptr_frame_pixels(jobs[0].frame), ptr_frame_pixels(jobs[1].frame),
+                      64 * 64 * 3 * sizeof(float)));
+    Job alone = { "none", NULL };
+    render_job(&alone);
+    if (alone.frame && jobs[0].frame)
+        CHECK(!memcmp(ptr_frame_pixels(alone.frame), ptr_frame_pixels(jobs[0].frame),
+                      64 * 64 * 3 * sizeof(float)));
+    for (int i = 0; i < 2; i++)
+        ptr_frame_free(jobs[i].frame);
+    ptr_frame_free(alone.frame);
+}
+
+int main(void)
+{
+    if (!test_dir_create("api"))
+        return 1;
+    PtrErrorInfo err;
+    if (ptr_context_new(NULL, &context, &err) != PTR_STATUS_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return 1;
+    }
+    static const TestCase cases[] = {
+        TEST_CASE(test_same_as_command_line), TEST_CASE(test_arrays_same_as_file),
+        TEST_CASE(test_bad_input), TEST_CASE(test_cancel), TEST_CASE(test_save),
+        TEST_CASE(test_two_contexts),
+    };
+    test_run(cases, sizeof cases / sizeof cases[0]);
+    ptr_context_free(context);
+    test_dir_remove();
+    return test_report();
+}
