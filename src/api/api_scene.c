@@ -66,7 +66,7 @@ PtrStatus ptr_context_new(const PtrContextOptions *options, PtrContext **out, Pt
     /* The kept threads and the EXR writer's are the process's: both only
      * change how fast work is done, never a result (docs/architecture.md,
      * "State a caller owns"). */
-    const int threads = o->threads > 0 ? o->threads : ptr_online_cpus();
+    const int threads = ptr_thread_count(o->threads);
     ptr_threads_keep(threads);
     if (ptr_image_set_threads(threads, &e) != PTR_OK ||
         ptr_image_loader_new(&c->images, &e) != PTR_OK ||
