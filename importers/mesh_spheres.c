@@ -118,6 +118,7 @@ typedef struct PositionMatch {
     size_t *filed;   /* the same: how many vertices its chain holds */
     size_t slices, partitions;
     int bits;        /* partitions = 2^bits */
+    int threads;
     atomic_int failed; /* a buffer or table could not be allocated */
 } PositionMatch;
 
@@ -284,10 +285,13 @@ static void match_partitions(void *arg, size_t from, size_t to)
     free(k);
 }
 
-/* The slices and partitions of a mesh's vertices. */
-static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh)
+/* The slices and partitions of a mesh's vertices, on threads: decided once,
+ * so that the scratch keyed_room sizes and the pools unite_positions files
+ * into are cut alike (the number of online CPUs can change between two
+ * questions). */
+static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh, int threads)
 {
-    *pm = (PositionMatch){ .mesh = mesh, .slices = (size_t)threads_for(mesh) };
+    *pm = (PositionMatch){ .mesh = mesh, .slices = (size_t)threads, .threads = threads };
     while (pm->bits < MAX_PARTITION_BITS &&
            ((size_t)PARTITION_VERTICES << pm->bits) < mesh->vertex_count)
         pm->bits++;
@@ -296,37 +300,32 @@ static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh)
 
 /* The keyed vertices unite_positions needs for its buckets: at least one a
  * vertex. */
-static size_t keyed_room(const PtrMeshSource *mesh)
+static size_t keyed_room(const PositionMatch *pm)
 {
-    PositionMatch pm;
-    plan_partitions(&pm, mesh);
-    return pool_start(&pm, pm.slices) * BUCKET;
+    return pool_start(pm, pm->slices) * BUCKET;
 }
 
-/* Joins the vertices of equal positions, keyed (keyed_room of them) as
- * scratch. */
-static int unite_positions(const PtrMeshSource *mesh, Link *parent, Keyed *keyed)
+/* Joins the vertices of equal positions as planned, keyed (keyed_room of
+ * them) as scratch. */
+static int unite_positions(PositionMatch *pm, Link *parent, Keyed *keyed)
 {
-    PositionMatch pm;
-    plan_partitions(&pm, mesh);
-    pm.parent = parent;
-    pm.keyed = keyed;
-    const size_t buckets = pool_start(&pm, pm.slices);
-    pm.chain = malloc(buckets * sizeof *pm.chain);
-    pm.head = malloc(pm.slices * pm.partitions * sizeof *pm.head);
-    pm.filed = calloc(pm.slices * pm.partitions, sizeof *pm.filed);
-    atomic_init(&pm.failed, 0);
-    int ok = pm.chain && pm.head && pm.filed;
+    pm->parent = parent;
+    pm->keyed = keyed;
+    const size_t buckets = pool_start(pm, pm->slices);
+    pm->chain = malloc(buckets * sizeof *pm->chain);
+    pm->head = malloc(pm->slices * pm->partitions * sizeof *pm->head);
+    pm->filed = calloc(pm->slices * pm->partitions, sizeof *pm->filed);
+    atomic_init(&pm->failed, 0);
+    int ok = pm->chain && pm->head && pm->filed;
     if (ok) {
-        const int threads = (int)pm.slices;
-        ptr_parallel_ranges(threads, 0, pm.slices, file_slices, &pm);
-        if (!atomic_load(&pm.failed))
-            ptr_parallel_ranges(threads, 0, pm.partitions, match_partitions, &pm);
-        ok = !atomic_load(&pm.failed);
+        ptr_parallel_ranges(pm->threads, 0, pm->slices, file_slices, pm);
+        if (!atomic_load(&pm->failed))
+            ptr_parallel_ranges(pm->threads, 0, pm->partitions, match_partitions, pm);
+        ok = !atomic_load(&pm->failed);
     }
-    free(pm.chain);
-    free(pm.head);
-    free(pm.filed);
+    free(pm->chain);
+    free(pm->head);
+    free(pm->filed);
     return ok;
 }
 
@@ -347,6 +346,7 @@ typedef struct Passes {
                              * checks for certain (see sure_bands) */
     uint32_t *order;        /* a component's place among the sorted spheres */
     uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
+    int threads;
 } Passes;
 
 enum { USED = UNSET - 1 };
@@ -674,7 +674,7 @@ static int sort_labels(Passes *ps, size_t components)
         ps->mesh->triangles(ps->mesh->user, ps->spheres[i].first_triangle, 1, tri);
         ps->order[link_of(ps->parent, tri[0][0])] = (uint32_t)i;
     }
-    ptr_parallel_ranges(threads_for(ps->mesh), 0, ps->mesh->vertex_count, label_vertices, ps);
+    ptr_parallel_ranges(ps->threads, 0, ps->mesh->vertex_count, label_vertices, ps);
     return 1;
 }
 
@@ -691,7 +691,7 @@ static int by_first_triangle(const void *a, const void *b)
 static int fit_components(Passes *ps, size_t *count)
 {
     const PtrMeshSource *mesh = ps->mesh;
-    const int threads = threads_for(mesh);
+    const int threads = ps->threads;
     const size_t n = mesh->vertex_count;
     ptr_parallel_ranges(threads, 0, n, flatten, ps);
     const size_t components = number_roots(ps), room = components ? components : 1;
@@ -724,17 +724,20 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
     const int threads = threads_for(mesh);
+    PositionMatch pm;
+    plan_partitions(&pm, mesh, threads);
     /* The positions' keys, then the labels: one allocation, its pages
      * mapped once. */
-    Keyed *scratch = malloc(keyed_room(mesh) * sizeof *scratch);
+    Keyed *scratch = malloc(keyed_room(&pm) * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
                   .label = (Link *)scratch,
-                  .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL };
+                  .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL,
+                  .threads = threads };
     size_t components = 0;
     int ok = ps.parent && scratch && (!vertex_spheres || ps.vertex_spheres);
     if (ok)
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
-    ok = ok && unite_positions(mesh, ps.parent, scratch);
+    ok = ok && unite_positions(&pm, ps.parent, scratch);
     if (ok) {
         ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
         ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
