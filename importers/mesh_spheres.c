@@ -102,11 +102,20 @@ typedef struct Keyed {
 
 /* Vertices of equal positions are found partition by partition (the top
  * bits of their hash), each partition's table small enough for the cache.
- * The vertices are cut into slices, one a thread; a slice hashes each of
- * its vertices once and files it under its partition, in buckets it takes
- * from a pool of its own and chains, so that no pass has to count the
- * partitions first: a partition's vertices are its chains, one a slice. */
-enum { BUCKET = 512 }; /* keyed vertices a bucket */
+ * The vertices are cut into slices, one a thread up to MAX_SLICES; a slice
+ * hashes each of its vertices once and files it under its partition, in
+ * buckets it takes from a pool of its own and chains, so that no pass has
+ * to count the partitions first: a partition's vertices are its chains, one
+ * a slice.
+ * Each chain ends in a part-empty bucket, and every chain that holds a
+ * vertex touches its pages: hence the cap on slices, whatever the cores,
+ * and a bucket the least power of two from MIN_BUCKET that holds a chain's
+ * even share, up to MAX_BUCKET (4 KiB). For n vertices, S slices and P
+ * partitions the pools hold n + S (P + 1) bucket keyed vertices, where
+ * S P bucket is below 2n or at its floor S P MIN_BUCKET: at most
+ * 5n + 2^21 (40 bytes a vertex and 16 MB), where a slice a core and 4 KiB
+ * buckets came to 0.5 GB for 2M vertices on 256 cores. */
+enum { MAX_SLICES = 32, MIN_BUCKET = 64, MAX_BUCKET = 512 };
 
 typedef struct PositionMatch {
     const PtrMeshSource *mesh;
@@ -119,6 +128,7 @@ typedef struct PositionMatch {
     size_t slices, partitions;
     int bits;        /* partitions = 2^bits */
     int threads;
+    size_t bucket;   /* keyed vertices a bucket */
     atomic_int failed; /* a buffer or table could not be allocated */
 } PositionMatch;
 
@@ -131,7 +141,7 @@ static size_t slice_start(const PositionMatch *pm, size_t s)
  * vertices, every partition's last bucket part empty. */
 static size_t pool_start(const PositionMatch *pm, size_t s)
 {
-    return slice_start(pm, s) / BUCKET + s * (pm->partitions + 1);
+    return slice_start(pm, s) / pm->bucket + s * (pm->partitions + 1);
 }
 
 static size_t partition_of(const PositionMatch *pm, uint64_t hash)
@@ -165,12 +175,12 @@ enum { LINE = 8 };
 
 /* Files count keyed vertices at once into slice s's chain of partition p,
  * starting a bucket where the last is full (a line never straddles two:
- * LINE divides BUCKET, and only a chain's last line is short). */
+ * LINE divides a bucket, and only a chain's last line is short). */
 static void file_line(PositionMatch *pm, size_t s, size_t p, uint32_t *tail, size_t *pool,
                       const Keyed *line, size_t count)
 {
     const size_t at = s * pm->partitions + p;
-    if (pm->filed[at] % BUCKET == 0) {
+    if (pm->filed[at] % pm->bucket == 0) {
         const uint32_t bucket = (uint32_t)(*pool)++;
         if (pm->filed[at])
             pm->chain[tail[p]] = bucket;
@@ -178,7 +188,7 @@ static void file_line(PositionMatch *pm, size_t s, size_t p, uint32_t *tail, siz
             pm->head[at] = bucket;
         tail[p] = bucket;
     }
-    memcpy(&pm->keyed[(size_t)tail[p] * BUCKET + pm->filed[at] % BUCKET], line,
+    memcpy(&pm->keyed[(size_t)tail[p] * pm->bucket + pm->filed[at] % pm->bucket], line,
            count * sizeof *line);
     pm->filed[at] += count;
 }
@@ -237,8 +247,8 @@ static void gather_partition(const PositionMatch *pm, size_t p, Keyed *k)
     for (size_t s = 0; s < pm->slices; s++) {
         size_t left = pm->filed[s * pm->partitions + p];
         for (uint32_t b = pm->head[s * pm->partitions + p]; left; b = pm->chain[b]) {
-            const size_t count = left < BUCKET ? left : BUCKET;
-            memcpy(k, &pm->keyed[(size_t)b * BUCKET], count * sizeof *k);
+            const size_t count = left < pm->bucket ? left : pm->bucket;
+            memcpy(k, &pm->keyed[(size_t)b * pm->bucket], count * sizeof *k);
             k += count;
             left -= count;
         }
@@ -291,18 +301,21 @@ static void match_partitions(void *arg, size_t from, size_t to)
  * questions). */
 static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh, int threads)
 {
-    *pm = (PositionMatch){ .mesh = mesh, .slices = (size_t)threads, .threads = threads };
+    *pm = (PositionMatch){ .mesh = mesh, .threads = threads, .bucket = MIN_BUCKET,
+                           .slices = threads < MAX_SLICES ? (size_t)threads : MAX_SLICES };
     while (pm->bits < MAX_PARTITION_BITS &&
            ((size_t)PARTITION_VERTICES << pm->bits) < mesh->vertex_count)
         pm->bits++;
     pm->partitions = (size_t)1 << pm->bits;
+    while (pm->bucket < MAX_BUCKET && pm->bucket * pm->slices * pm->partitions < mesh->vertex_count)
+        pm->bucket *= 2;
 }
 
 /* The keyed vertices unite_positions needs for its buckets: at least one a
  * vertex. */
 static size_t keyed_room(const PositionMatch *pm)
 {
-    return pool_start(pm, pm->slices) * BUCKET;
+    return pool_start(pm, pm->slices) * pm->bucket;
 }
 
 /* Joins the vertices of equal positions as planned, keyed (keyed_room of
@@ -318,7 +331,7 @@ static int unite_positions(PositionMatch *pm, Link *parent, Keyed *keyed)
     atomic_init(&pm->failed, 0);
     int ok = pm->chain && pm->head && pm->filed;
     if (ok) {
-        ptr_parallel_ranges(pm->threads, 0, pm->slices, file_slices, pm);
+        ptr_parallel_ranges((int)pm->slices, 0, pm->slices, file_slices, pm);
         if (!atomic_load(&pm->failed))
             ptr_parallel_ranges(pm->threads, 0, pm->partitions, match_partitions, pm);
         ok = !atomic_load(&pm->failed);

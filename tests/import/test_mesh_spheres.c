@@ -108,7 +108,8 @@ static void test_online_cpus(void)
     static const int steady2[] = { 2 }, steady64[] = { 64 }, steady1024[] = { 1024 },
                      coming[] = { 1, 64 }, going[] = { 64, 1 }, rising[] = { 1, 2, 3, 5, 8, 13 };
     static const struct { const int *answers; size_t length; } scripts[] = {
-        { steady2, 1 }, { steady64, 1 }, { steady1024, 1 }, { coming, 2 }, { going, 2 }, { rising, 6 }
+        { steady2, 1 }, { steady64, 1 }, { steady1024, 1 },
+        { coming, 2 },  { going, 2 },    { rising, 6 },
     };
     for (size_t i = 0; i < sizeof scripts / sizeof *scripts; i++) {
         script = scripts[i].answers, script_length = scripts[i].length, asked = 0;
