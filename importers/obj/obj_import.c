@@ -26,9 +26,18 @@ enum { MAX_LINE = 64 << 20 }; /* longer lines are not OBJ */
  * of several materials, each run of faces its own. */
 typedef struct MaterialRun {
     size_t first_triangle;
-    char *material;       /* NULL: no usemtl yet */
-    uint32_t scene_index; /* once a sphere uses it, else UINT32_MAX */
+    uint32_t material;    /* its usemtl's name among the reader's names,
+                           * NO_MATERIAL before any usemtl */
 } MaterialRun;
+
+enum { NO_MATERIAL = UINT32_MAX };
+
+/* A name usemtl gave, held once however many runs use it (files switch
+ * material at every face). */
+typedef struct MaterialName {
+    char *text;
+    uint32_t scene_index; /* its material's once a sphere uses it, else UINT32_MAX */
+} MaterialName;
 
 typedef struct Part { /* an object (o) or a group (g) */
     char *name;       /* NULL: faces before any o or g */
@@ -64,7 +73,11 @@ typedef struct Reader {
     double *v;        /* x, y, z per vertex */
     size_t nv, capacity;
     Parts objects, groups;
-    char *material;   /* usemtl in force */
+    MaterialName *names;
+    size_t nnames, names_capacity;
+    uint32_t *slots;  /* names by hash, open-addressed: indices, UINT32_MAX for none */
+    size_t nslots;    /* a power of two, at least twice nnames */
+    uint32_t material; /* usemtl in force: its name, NO_MATERIAL before any */
     char **libs;      /* mtllib files, as paths */
     size_t nlibs;
     Mtl *mtls;
@@ -165,12 +178,6 @@ static PtrResult start_part(Reader *r, Parts *parts, const char *name, long line
     return PTR_OK;
 }
 
-/* Whether two names, either NULL (none), are the same. */
-static int same_name(const char *a, const char *b)
-{
-    return a && b ? !strcmp(a, b) : a == b;
-}
-
 static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int first_corner)
 {
     if (parts->current < 0 && start_part(r, parts, NULL, line) != PTR_OK)
@@ -182,17 +189,12 @@ static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int
     }
     if (first_corner) {
         const MaterialRun *last = part->nruns ? &part->runs[part->nruns - 1] : NULL;
-        if (!last || !same_name(last->material, r->material)) {
+        if (!last || last->material != r->material) {
             if (grow((void **)&part->runs, &part->runs_capacity, part->nruns + 1,
                      sizeof *part->runs))
                 return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
-            MaterialRun *run = &part->runs[part->nruns];
-            *run = (MaterialRun){ .first_triangle = part->ntris,
-                                  .material = r->material ? copy(r->material) : NULL,
-                                  .scene_index = UINT32_MAX };
-            if (r->material && !run->material)
-                return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
-            part->nruns++;
+            part->runs[part->nruns++] =
+                (MaterialRun){ .first_triangle = part->ntris, .material = r->material };
         }
         part->faces++;
     }
@@ -256,6 +258,55 @@ static PtrResult face(Reader *r, char *s, long line)
 
 /* Splits a line into its keyword and the rest, both trimmed; returns 0 for a
  * blank line or a comment. */
+/* FNV-1a. */
+static uint64_t name_hash(const char *name)
+{
+    uint64_t h = 0xcbf29ce484222325u;
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 0x100000001b3u;
+    return h;
+}
+
+/* The slot of slots (nslots of them) that holds name, or the empty one
+ * where it goes. */
+static size_t slot_of(const Reader *r, const uint32_t *slots, size_t nslots, const char *name)
+{
+    size_t slot = name_hash(name) & (nslots - 1);
+    while (slots[slot] != UINT32_MAX && strcmp(r->names[slots[slot]].text, name))
+        slot = (slot + 1) & (nslots - 1);
+    return slot;
+}
+
+/* Name's index among the reader's names, added if it is new. */
+static PtrResult intern(Reader *r, const char *name, uint32_t *index)
+{
+    if (2 * (r->nnames + 1) > r->nslots) {
+        const size_t nslots = r->nslots ? 2 * r->nslots : 64;
+        uint32_t *slots = malloc(nslots * sizeof *slots);
+        if (!slots)
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        memset(slots, 0xff, nslots * sizeof *slots);
+        for (size_t i = 0; i < r->nnames; i++)
+            slots[slot_of(r, slots, nslots, r->names[i].text)] = (uint32_t)i;
+        free(r->slots);
+        r->slots = slots;
+        r->nslots = nslots;
+    }
+    const size_t slot = slot_of(r, r->slots, r->nslots, name);
+    if (r->slots[slot] == UINT32_MAX) {
+        char *text = copy(name);
+        if (!text ||
+            grow((void **)&r->names, &r->names_capacity, r->nnames + 1, sizeof *r->names)) {
+            free(text);
+            return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
+        }
+        r->names[r->nnames] = (MaterialName){ .text = text, .scene_index = UINT32_MAX };
+        r->slots[slot] = (uint32_t)r->nnames++;
+    }
+    *index = r->slots[slot];
+    return PTR_OK;
+}
+
 static int split_keyword(char *line, char **keyword, char **rest)
 {
     char *s = trim(line);
@@ -294,8 +345,8 @@ static PtrResult obj_line(Reader *r, const char *path, char *line, long number)
     } else if (!strcmp(s, "g")) {
         return start_part(r, &r->groups, rest, number);
     } else if (!strcmp(s, "usemtl")) {
-        free(r->material);
-        r->material = *rest ? copy(rest) : NULL;
+        r->material = NO_MATERIAL;
+        return *rest ? intern(r, rest, &r->material) : PTR_OK;
     } else if (!strcmp(s, "mtllib")) {
         const char *slash = strrchr(r->path, '/');
         int dir = slash ? (int)(slash - r->path + 1) : 0;
@@ -450,6 +501,22 @@ static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint
     return PTR_OK;
 }
 
+/* The scene's material for a run's name (NO_MATERIAL: grey), looked up once
+ * a name, so that a name missing from the material library is reported
+ * once. */
+static PtrResult material_of(Reader *r, uint32_t name, PtrScene *scene, uint32_t *index,
+                             uint32_t *grey)
+{
+    if (name == NO_MATERIAL)
+        return material_for(r, NULL, scene, index, grey);
+    MaterialName *n = &r->names[name];
+    PtrResult res = PTR_OK;
+    if (n->scene_index == UINT32_MAX)
+        res = material_for(r, n->text, scene, &n->scene_index, grey);
+    *index = n->scene_index;
+    return res;
+}
+
 /* A part's triangles over its own vertices: local vertex k is the file's
  * vertex global[k]. */
 typedef struct PartMesh {
@@ -481,7 +548,7 @@ static void part_triangles(const void *user, size_t first, size_t count, uint32_
 
 /* The run of faces triangle t of part p was read in: the last that starts at
  * or before it (runs of faces with no surface start where the next does). */
-static MaterialRun *run_at(const Part *p, size_t t)
+static const MaterialRun *run_at(const Part *p, size_t t)
 {
     size_t lo = 0, hi = p->nruns;
     while (hi - lo > 1) {
@@ -530,11 +597,11 @@ static PtrResult part_spheres(Reader *r, Part *p, uint32_t *local_of, PtrSceneBu
             ++*skipped;
             continue;
         }
-        MaterialRun *run = run_at(p, spheres[c].first_triangle);
-        if (run->scene_index == UINT32_MAX)
-            res = material_for(r, run->material, scene, &run->scene_index, grey);
+        uint32_t material;
+        res = material_of(r, run_at(p, spheres[c].first_triangle)->material, scene, &material,
+                          grey);
         if (res == PTR_OK && ptr_builder_add_sphere(builder, spheres[c].centre, spheres[c].radius,
-                                                    run->scene_index, NULL))
+                                                    material, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     }
     free(spheres);
@@ -586,7 +653,7 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
         uint32_t material; /* --fit-all-objects: the object's first face's */
         if (!fit_all)
             res = part_spheres(r, p, local_of, &builder, scene, &grey, &skipped);
-        else if ((res = material_for(r, p->runs[0].material, scene, &material, &grey)) == PTR_OK &&
+        else if ((res = material_of(r, p->runs[0].material, scene, &material, &grey)) == PTR_OK &&
                  ptr_builder_add_sphere(&builder, centre, 0.5 * extent, material, NULL))
             res = ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         if (skipped > before) {
@@ -620,8 +687,6 @@ static void free_parts(Parts *parts)
 {
     for (size_t i = 0; i < parts->count; i++) {
         free(parts->items[i].name);
-        for (size_t k = 0; k < parts->items[i].nruns; k++)
-            free(parts->items[i].runs[k].material);
         free(parts->items[i].runs);
         free(parts->items[i].tris);
     }
@@ -632,7 +697,8 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options, PtrS
                          PtrStrings *warnings, PtrError *err)
 {
     Reader r = { .path = path, .warnings = warnings, .err = err,
-                 .objects = { .current = -1 }, .groups = { .current = -1 } };
+                 .objects = { .current = -1 }, .groups = { .current = -1 },
+                 .material = NO_MATERIAL };
     PtrResult res = read_file(&r, path, 1, obj_line);
     for (size_t i = 0; res == PTR_OK && i < r.nlibs; i++) {
         if (options && options->dependencies)
@@ -644,7 +710,10 @@ PtrResult ptr_import_obj(const char *path, const PtrImportOptions *options, PtrS
     free(r.v);
     free_parts(&r.objects);
     free_parts(&r.groups);
-    free(r.material);
+    for (size_t i = 0; i < r.nnames; i++)
+        free(r.names[i].text);
+    free(r.names);
+    free(r.slots);
     free(r.corners);
     for (size_t i = 0; i < r.nlibs; i++)
         free(r.libs[i]);

@@ -1,6 +1,11 @@
 /* The OBJ importer: objects and groups, sphere fitting, every MTL rule of
  * docs/scenes.md (Blender 3.4's exporter, with and without its PBR keys),
  * warnings, errors with line numbers, and a camera from the command line. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
 #include "importer.h"
 #include "test.h"
 #include "test_scene.h"
@@ -84,6 +89,59 @@ static void test_groups_and_missing_mtl(void)
     ptr_scene_free(&s);
 }
 
+/* An object of spheres (12 x 8 latitude-longitude meshes along x) whose
+ * faces alternate between two usemtl, face by face, each sphere's first
+ * face under "Missing", which the library lacks: its spheres are grey, the
+ * others' red, and the missing name is reported once, not once a run. */
+static void test_alternating_materials(void)
+{
+    enum { SPHERES = 4, SEGMENTS = 12, RINGS = 8 };
+    char dir[] = "/tmp/ptr-obj-XXXXXX", path[64];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/alternating.obj", dir);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fprintf(f, "mtllib %s\no Balls.sphere\n", OBJ("spheres.mtl"));
+    const double pi = acos(-1.0);
+    for (int s = 0; s < SPHERES; s++) {
+        for (int ring = 0; ring <= RINGS; ring++)
+            for (int seg = 0; seg < SEGMENTS; seg++) {
+                const double theta = pi * ring / RINGS, phi = 2 * pi * seg / SEGMENTS;
+                fprintf(f, "v %.17g %.17g %.17g\n", 3.0 * s + sin(theta) * cos(phi), cos(theta),
+                        sin(theta) * sin(phi));
+            }
+        const int first = s * (RINGS + 1) * SEGMENTS + 1, faces = RINGS * SEGMENTS;
+        for (int face = 0; face < faces; face++) {
+            const int ring = face / SEGMENTS, seg = face % SEGMENTS;
+            const int a = first + ring * SEGMENTS + seg;
+            const int b = first + ring * SEGMENTS + (seg + 1) % SEGMENTS;
+            fprintf(f, "usemtl %s\nf %d %d %d %d\n", face % 2 ? "Red" : "Missing", a, b,
+                    b + SEGMENTS, a + SEGMENTS);
+        }
+    }
+    fclose(f);
+    PtrScene sc;
+    PtrStrings w = { 0 };
+    PtrError err = { 0 };
+    CHECK_INT(ptr_import_scene(path, NULL, &sc, &w, &err), PTR_OK);
+    CHECK_INT(sc.spheres.count, SPHERES);
+    size_t missing = 0;
+    for (size_t i = 0; i < w.count; i++)
+        missing += strstr(w.lines[i], "material 'Missing' is not in its material library") != NULL;
+    CHECK_INT(missing, 1);
+    for (size_t i = 0; i < sc.spheres.count; i++) {
+        check_sphere(&sc, i, 3.0 * (double)i, 0, 0, 1, 1e-4);
+        CHECK_FLOAT_EQ(material(&sc, i)->albedo.x, 0.8f); /* grey, not Red's 0.8, 0.05, 0.05 */
+        CHECK_FLOAT_EQ(material(&sc, i)->albedo.z, 0.8f);
+    }
+    ptr_strings_free(&w);
+    ptr_scene_free(&sc);
+    unlink(path);
+    rmdir(dir);
+}
+
 static void test_camera_override(void)
 {
     PtrScene s;
@@ -132,6 +190,7 @@ int main(void)
     const TestCase cases[] = {
         TEST_CASE(test_materials),
         TEST_CASE(test_groups_and_missing_mtl),
+        TEST_CASE(test_alternating_materials),
         TEST_CASE(test_camera_override),
         TEST_CASE(test_errors),
     };
