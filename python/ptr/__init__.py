@@ -115,10 +115,10 @@ class Material:
 
 
 class Context:
-    """What renders share: threads (0: one per CPU), the highest CPU level
-    used (cpu_cap: "none", "sse41", "avx2", "avx512"; None: the CPU's,
-    capped by $PTR_CPUMASK), the denoiser's weights folder and an
-    OpenColorIO config (None: ptr's). Its calls run one at a time."""
+    """What renders share: threads (0: one per CPU; at most 1024), the
+    highest CPU level used (cpu_cap: "none", "sse41", "avx2", "avx512";
+    None: the CPU's, capped by $PTR_CPUMASK), the denoiser's weights folder
+    and an OpenColorIO config (None: ptr's). Its calls run one at a time."""
 
     def __init__(self, threads=0, cpu_cap=None, weights_dir=None, ocio_config=None):
         options = _native.ContextOptions(0, _native.text(cpu_cap), _native.text(weights_dir),
