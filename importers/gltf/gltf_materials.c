@@ -23,10 +23,10 @@ MaterialValues gltf_factor_values(const GltfMaterial *g)
 PtrResult gltf_convert_material(Importer *im, int gltf_index, const GltfMaterial *g,
                                 const MaterialValues *v, PtrMaterial *m)
 {
-    if (!all_finite(g->base_color, 4) || !all_finite(v->base, 3) ||
-        !all_finite(v->emission, 3) || !isfinite(g->ior) || !isfinite(v->roughness) ||
-        !isfinite(v->metallic) || !isfinite(g->transmission) || !(g->ior > 0.0) ||
-        v->emission[0] < 0 || v->emission[1] < 0 || v->emission[2] < 0)
+    /* The factors the material does not keep; ptr_material_problem checks
+     * the rest once converted. */
+    if (!all_finite(g->base_color, 4) || !isfinite(g->ior) || !isfinite(v->roughness) ||
+        !isfinite(v->metallic) || !isfinite(g->transmission) || !(g->ior > 0.0))
         return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID,
                              "%s: material %d ('%s') has a value out of range", im->path,
                              gltf_index, label(g->name, "unnamed"));
@@ -39,6 +39,10 @@ PtrResult gltf_convert_material(Importer *im, int gltf_index, const GltfMaterial
         m->kind = PTR_MATERIAL_METAL;
         m->fuzz = (float)v->roughness;
     }
+    const char *problem = ptr_material_problem(m);
+    if (problem)
+        return ptr_error_set(im->err, PTR_ERR_SCENE_INVALID, "%s: material %d ('%s'): %s",
+                             im->path, gltf_index, label(g->name, "unnamed"), problem);
     return PTR_OK;
 }
 

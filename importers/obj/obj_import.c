@@ -491,10 +491,10 @@ static PtrResult material_for(Reader *r, const char *name, PtrScene *scene, uint
         out.kind = PTR_MATERIAL_METAL;
         out.fuzz = (float)(m->has_pr ? m->pr : 1.0 - sqrt(fmin(fmax(m->ns, 0), 1000) / 1000));
     }
-    if (!(out.ior > 0) || out.emission.x < 0 || out.emission.y < 0 || out.emission.z < 0)
-        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
-                             "%s: material '%s' has a value out of range (Ni > 0, Ke >= 0)", r->path,
-                             m->name);
+    const char *problem = ptr_material_problem(&out);
+    if (problem)
+        return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: material '%s': %s", r->path,
+                             m->name, problem);
     if (ptr_scene_add_material(scene, &out, index, NULL) != PTR_OK)
         return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     m->scene_index = *index;

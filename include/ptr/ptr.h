@@ -15,13 +15,29 @@
  * it leaves err alone. An object handed through an out-parameter is set
  * only on success.
  *
+ * NULL: a call given NULL for an object, a path or an out-parameter it
+ * needs fails with PTR_STATUS_USAGE (the options structures and err may be
+ * NULL where said); the accessors (ptr_frame_width, ptr_scene_sphere_count,
+ * ...) answer 0, or NULL, for a NULL object; the ptr_*_free take NULL.
+ *
  * Ownership: no call keeps a pointer the caller passed beyond its return
  * (arrays, strings and structures are copied), except where a comment
  * below says otherwise.
  *
  * Threads: the contexts are independent: several in one process, used from
  * different threads, never see each other's settings. One context, and the
- * scenes made through it, serve one call at a time. */
+ * scenes made through it, serve one call at a time.
+ *
+ * Files of ptr's installation: the image module (OpenImageIO, which every
+ * format but EXR goes through) is looked for in ../lib/ptr from the folder
+ * of the file holding ptr's code, and the denoiser's default weights in
+ * ../share/ptr/weights from there, then under the prefix ptr was built for.
+ * With libptr.so that file is the library, wherever installed; with the
+ * static libptr.a it is the program linked with it, so the module is found
+ * only when that program sits in a bin/ beside ptr's lib/ptr (a program
+ * elsewhere saves EXR alone: other formats fail with PTR_STATUS_INSTALL),
+ * and the weights there or in the prefix (PtrContextOptions.weights_dir
+ * names another folder). */
 #ifndef PTR_PTR_H
 #define PTR_PTR_H
 
@@ -71,7 +87,7 @@ PTR_PUBLIC const char *ptr_version(void);
 typedef struct PtrContext PtrContext;
 
 typedef struct PtrContextOptions {
-    int threads;             /* render threads; 0: one per online CPU */
+    int threads;             /* render threads, at most 1024; 0: one per online CPU */
     /* The highest CPU level used ("none", "sse41", "avx2", "avx512"), as
      * --cpumask takes it; NULL: the CPU's, capped by $PTR_CPUMASK. */
     const char *cpu_cap;
@@ -131,7 +147,9 @@ typedef enum PtrMaterialType {
     PTR_MATERIAL_TYPE_EMISSIVE,   /* a diffuse surface that emits: albedo, emission */
 } PtrMaterialType;
 
-/* A material as the scene holds it; every type may emit. */
+/* A material as the scene holds it; every type may emit. Its values are
+ * finite, the emission is not negative, and a dielectric's ior is above
+ * 0. */
 typedef struct PtrMaterialDesc {
     PtrMaterialType type;
     float albedo[3];
@@ -167,8 +185,11 @@ typedef struct PtrSceneArrays {
 /* Makes a scene of arrays, copied: the scene is the same as a file of the
  * same spheres gives (the same coordinates relative to the camera, the same
  * spheres kept in double). A NaN or infinite coordinate, a negative or NaN
- * radius, a NaN colour or a material index out of the table is
- * PTR_STATUS_USAGE naming the sphere. */
+ * radius, a NaN colour or a material index out of the table (index 0 alone
+ * without one) is PTR_STATUS_USAGE naming the sphere; a material the file
+ * importers would refuse (PtrMaterialDesc) is PTR_STATUS_USAGE naming the
+ * material by its index, and a camera whose lookfrom, lookat or up is not
+ * finite PTR_STATUS_USAGE too (as for ptr_scene_load). */
 PTR_PUBLIC PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *arrays,
                                            PtrSceneHandle **out, PtrErrorInfo *err);
 
@@ -182,7 +203,11 @@ PTR_PUBLIC void ptr_scene_handle_free(PtrSceneHandle *scene);
 /* What a render is asked for, as the command line's options of the same
  * names (README's table). Fill with ptr_render_options_default, then
  * change what differs. The strings are the options' values as the command
- * line takes them; NULL: its default. */
+ * line takes them; NULL: its default. The numbers have the command line's
+ * ranges, a value outside them PTR_STATUS_USAGE: width and height 1 to
+ * 65536 (or 0), samples 1 to 2^30 (first_sample + samples at most 2^30),
+ * max_depth 1 to 100000, min_samples 2 to 2^30, threads at most 1024,
+ * noise_threshold 0 or above 0 up to 10^6, and only with first_sample 0. */
 typedef struct PtrRenderOptions {
     int width, height;      /* 0: the scene's, else 800 wide (--width, --height) */
     uint32_t samples;       /* per pixel (--samples) */

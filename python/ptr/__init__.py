@@ -115,14 +115,15 @@ class Material:
 
 
 class Context:
-    """What renders share: threads (0: one per CPU), the highest CPU level
-    used (cpu_cap: "none", "sse41", "avx2", "avx512"; None: the CPU's,
-    capped by $PTR_CPUMASK), the denoiser's weights folder and an
-    OpenColorIO config (None: ptr's). Its calls run one at a time."""
+    """What renders share: threads (0: one per CPU; at most 1024), the
+    highest CPU level used (cpu_cap: "none", "sse41", "avx2", "avx512";
+    None: the CPU's, capped by $PTR_CPUMASK), the denoiser's weights folder
+    and an OpenColorIO config (None: ptr's). Its calls run one at a time."""
 
     def __init__(self, threads=0, cpu_cap=None, weights_dir=None, ocio_config=None):
-        options = _native.ContextOptions(threads, _native.text(cpu_cap),
-                                         _native.text(weights_dir), _native.text(ocio_config))
+        options = _native.ContextOptions(0, _native.text(cpu_cap), _native.text(weights_dir),
+                                         _native.text(ocio_config))
+        _native.set_whole(options, "threads", threads)
         handle = ctypes.c_void_p()
         err = _native.ErrorInfo()
         _check(lib.ptr_context_new(ctypes.byref(options), ctypes.byref(handle),
@@ -205,25 +206,38 @@ class Scene:
         raise TypeError("make a Scene with ptr.load or Scene.from_arrays")
 
     @classmethod
-    def _new(cls, context, handle, remake):
+    def _made(cls, context, make, remake):
+        """The Scene of the handle make(handle, err) hands, under the
+        context's lock. The Scene holds the handle from the call on, and an
+        exception (Ctrl-C as the call returns) frees it before it is raised."""
         scene = object.__new__(cls)
-        scene._context, scene._handle, scene._remake = context, handle, remake
+        scene._context, scene._remake = context, remake
+        scene._handle = ctypes.c_void_p()
+        err = _native.ErrorInfo()
+        try:
+            with context._lock:
+                status = make(ctypes.byref(scene._handle), ctypes.byref(err))
+            _check(status, err)
+        except BaseException:
+            scene._free()
+            raise
         return scene
+
+    def _free(self):
+        if getattr(self, "_handle", None):
+            lib.ptr_scene_handle_free(self._handle)
+            self._handle = None
 
     @classmethod
     def _load(cls, context, path, options):
         load_options, _ = _load_options(options)
-        handle = ctypes.c_void_p()
-        err = _native.ErrorInfo()
-        with context._lock:
-            status = lib.ptr_scene_load(context._handle, _native.text(path),
-                                        ctypes.byref(load_options), ctypes.byref(handle),
-                                        ctypes.byref(err))
-        _check(status, err)
-
         def remake(camera):
             return cls._load(context, path, dict(options, camera=camera))
-        return cls._new(context, handle, remake)
+
+        def make(handle, err):
+            return lib.ptr_scene_load(context._handle, _native.text(path),
+                                      ctypes.byref(load_options), handle, err)
+        return cls._made(context, make, remake)
 
     @classmethod
     def from_arrays(cls, centers, radii, colors=None, materials=None, material_indices=None,
@@ -287,38 +301,33 @@ class Scene:
             camera=ctypes.pointer(camera_desc) if camera_desc is not None else None,
             orthographic=int(bool(orthographic)), width=width, height=height,
             sky=_native.text(sky))
-        handle = ctypes.c_void_p()
-        err = _native.ErrorInfo()
-        with context._lock:
-            status = lib.ptr_scene_from_arrays(context._handle, ctypes.byref(arrays),
-                                               ctypes.byref(handle), ctypes.byref(err))
-        _check(status, err)
-
         def remake(new_camera):
             return cls.from_arrays(centers, radii, colors, table, material_indices, new_camera,
                                    sky, orthographic, width, height, context)
-        return cls._new(context, handle, remake)
+
+        def make(handle, err):
+            return lib.ptr_scene_from_arrays(context._handle, ctypes.byref(arrays), handle, err)
+        return cls._made(context, make, remake)
 
     def __len__(self):
         """The number of spheres."""
         return lib.ptr_scene_sphere_count(self._handle)
 
     def __del__(self):
-        if getattr(self, "_handle", None):
-            lib.ptr_scene_handle_free(self._handle)
-            self._handle = None
+        self._free()
 
-    def render(self, width=0, height=0, samples=100, seed=1, camera=None, threads=0,
-               denoise=None, progress=None, transparent=False, passes=False, max_depth=50,
+    def render(self, width=0, height=0, samples=None, seed=None, camera=None, threads=0,
+               denoise=None, progress=None, transparent=False, passes=False, max_depth=None,
                integrator=None, kernel=None, cpu_cap=None, accel=None, sampler=None,
-               direct_lighting=True, noise_threshold=0.0, min_samples=32, first_sample=0,
+               direct_lighting=True, noise_threshold=0.0, min_samples=None, first_sample=0,
                sky=None):
         """Renders the scene into a numpy array of shape (height, width, 3),
         or (height, width, 4) with transparent=True, float32, scene-linear.
 
         width, height: 0 takes the scene's (else 800 wide); camera: a Camera
         for this render (the scene is read again with it); threads: 0 for
-        the context's; denoise: "fast", "balanced" or "high"; progress: a
+        the context's; samples, seed, max_depth, min_samples: None for
+        ptr's defaults (the command line's); denoise: "fast", "balanced" or "high"; progress: a
         function of (samples_done, samples_total), called about ten times a
         second, that returns True to cancel (then ptr.Cancelled is raised);
         passes=True returns (image, albedo, normal), each pass (H, W, 3).
@@ -336,9 +345,8 @@ class Scene:
         for name, value in (("width", width), ("height", height), ("samples", samples),
                             ("seed", seed), ("threads", threads), ("max_depth", max_depth),
                             ("min_samples", min_samples), ("first_sample", first_sample)):
-            if int(value) < 0:
-                raise ValueError("%s: %d is negative" % (name, value))
-            setattr(options, name, int(value))
+            if value is not None:
+                _native.set_whole(options, name, value)
         options.transparent, options.passes = int(bool(transparent)), int(bool(passes))
         options.direct_lighting = int(bool(direct_lighting))
         options.noise_threshold = float(noise_threshold)

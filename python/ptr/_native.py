@@ -20,7 +20,9 @@ def _candidates():
     name = "libptr.so.%d" % PTR_API_VERSION
     given = os.environ.get("PTR_LIBRARY")
     if given:
-        yield given
+        # A path, even a bare name: ctypes would search the system's path
+        # for a name without a slash.
+        yield os.path.abspath(given)
         return
     here = os.path.dirname(os.path.abspath(__file__))
     yield os.path.normpath(os.path.join(here, "..", "..", "..", name))
@@ -141,6 +143,19 @@ for _name, (_result, _arguments) in _SIGNATURES.items():
 
 
 def text(value):
-    """A str (or None) as the C API takes it."""
-    return None if value is None else os.fsencode(value) if isinstance(value, os.PathLike) \
-        else value.encode()
+    """A str, bytes or path (or None) as the C API takes it: paths in the
+    file system's encoding, bytes as they are."""
+    return None if value is None else os.fsencode(value)
+
+
+def set_whole(structure, name, value):
+    """Sets an integer field of a ctypes structure, refusing (ValueError) a
+    value the field's C type cannot hold rather than letting it wrap."""
+    field_type = dict(structure._fields_)[name]
+    bits = 8 * ctypes.sizeof(field_type)
+    signed = field_type(-1).value < 0
+    low, high = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+    number = int(value)
+    if number != value or not low <= number <= high:
+        raise ValueError("%s: %r is not a whole number from %d to %d" % (name, value, low, high))
+    setattr(structure, name, number)

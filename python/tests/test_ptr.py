@@ -6,7 +6,10 @@ Run by ctest (python_tests) with PTR_LIBRARY, PTR_EXECUTABLE and
 PTR_SOURCE_DIR set; by hand: PTR_LIBRARY=build/lib/libptr.so.1
 PTR_EXECUTABLE=build/src/ptr python3 -m pytest python/tests."""
 
+import math
 import os
+import pathlib
+import shutil
 import signal
 import subprocess
 import threading
@@ -31,7 +34,10 @@ def spheres(count=50, seed=3):
 
 
 def same_pixels(a, b):
-    """Whether two EXR files hold the same pixels, bit for bit."""
+    """Whether two EXR files hold the same pixels, bit for bit (through
+    OpenImageIO's idiff: the test is skipped without it)."""
+    if shutil.which("idiff") is None:
+        pytest.skip("idiff (OpenImageIO's tools) is missing")
     return subprocess.run(["idiff", "-q", "-a", "-fail", "0", "-failpercent", "0", a, b],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
 
@@ -191,3 +197,79 @@ def test_help_reads():
     for name in ptr.__all__:
         assert getattr(ptr, name).__doc__
     assert ptr.version().count(".") == 2
+
+
+def test_material_values_refused():
+    centers, radii = spheres(2)
+    good = ptr.Material("dielectric", (1, 1, 1), ior=1.5)
+    assert len(ptr.Scene.from_arrays(centers, radii, materials=[good],
+                                     material_indices=[0, 0])) == 2
+    for bad in (ptr.Material("diffuse", (math.nan, 0.5, 0.5)),
+                ptr.Material("emissive", (0, 0, 0), emission=(1, -1, 1)),
+                ptr.Material("dielectric", (1, 1, 1), ior=0.0)):
+        with pytest.raises(ValueError, match="material 1"):
+            ptr.Scene.from_arrays(centers, radii, materials=[good, bad],
+                                  material_indices=[0, 1])
+
+
+def test_whole_numbers_do_not_wrap():
+    centers, radii = spheres(4)
+    scene = ptr.Scene.from_arrays(centers, radii)
+    # 2^32 + 1 would be 1 in the C field; 2^30 + 1 fits it but not ptr's limit.
+    for options in ({"samples": 2 ** 32 + 1}, {"samples": 2 ** 30 + 1}, {"height": 2 ** 31},
+                    {"seed": -1}, {"max_depth": 0}, {"min_samples": 1}, {"samples": 2.5},
+                    {"threads": 1025}, {"first_sample": 1, "noise_threshold": 0.1}):
+        with pytest.raises(ValueError):
+            scene.render(**{"width": 8, "height": 8, **options})
+    for threads in (10 ** 6, 2 ** 40):
+        with pytest.raises(ValueError, match="threads"):
+            ptr.Context(threads=threads)
+
+
+def test_defaults_are_the_libraries(monkeypatch):
+    """Options not given keep ptr_render_options_default's values."""
+    centers, radii = spheres(8)
+    scene = ptr.Scene.from_arrays(centers, radii)
+    real = ptr.lib.ptr_render_options_default
+
+    def two_samples(reference):
+        real(reference)
+        reference._obj.samples, reference._obj.max_depth = 2, 3  # ctypes.byref's object
+
+    monkeypatch.setattr(ptr.lib, "ptr_render_options_default", two_samples)
+    image = scene.render(16, 16)
+    monkeypatch.undo()
+    assert np.array_equal(image, scene.render(16, 16, samples=2, max_depth=3))
+    assert not np.array_equal(image, scene.render(16, 16, samples=100, max_depth=50))
+
+
+def test_paths_and_library(monkeypatch):
+    assert ptr._native.text("scenes/a.gltf") == b"scenes/a.gltf"
+    assert ptr._native.text(b"scenes/\xff.gltf") == b"scenes/\xff.gltf"
+    assert ptr._native.text(pathlib.Path("a") / "b.gltf") == b"a/b.gltf"
+    assert ptr._native.text(None) is None
+    monkeypatch.setenv("PTR_LIBRARY", "build/libptr.so.1")
+    assert list(ptr._native._candidates()) == [os.path.abspath("build/libptr.so.1")]
+    with pytest.raises(ptr.Error) as failure:
+        ptr.load(b"/nonexistent/scene.gltf")
+    assert failure.value.code == 3
+
+
+def test_interrupted_load_frees_the_scene(monkeypatch):
+    """Ctrl-C as the import returns: the scene is freed, then the
+    KeyboardInterrupt raised."""
+    freed = []
+    real_free = ptr.lib.ptr_scene_handle_free
+
+    def free(handle):
+        freed.append(handle)
+        real_free(handle)
+
+    def interrupted(status, err):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ptr.lib, "ptr_scene_handle_free", free)
+    monkeypatch.setattr(ptr, "_check", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        ptr.load(SEED)
+    assert len(freed) == 1

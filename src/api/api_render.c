@@ -1,6 +1,5 @@
 /* The public API's renders and frames (include/ptr/ptr.h), through the
  * command line's steps (api/pipeline.h, api/output.h). */
-#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,8 +73,31 @@ static PtrResult read_choices(const PtrContext *context, const PtrRenderOptions 
     c->denoise = o->denoise != NULL;
     if (o->denoise && ptr_denoise_quality_parse(o->denoise, &c->denoise_quality, &problem) != PTR_OK)
         return option_error("denoise", &problem, err);
-    if (o->width < 0 || o->height < 0 || o->threads < 0 || o->max_depth < 0)
-        return ptr_error_set(err, PTR_ERR_USAGE, "width, height, threads and max_depth are >= 0");
+    /* The command line's ranges; 0 is the scene's size and the context's
+     * threads. */
+    const struct {
+        const char *name;
+        PtrRenderNumber number;
+        long long value;
+    } numbers[] = {
+        { "width", PTR_NUMBER_SIZE, o->width ? o->width : 1 },
+        { "height", PTR_NUMBER_SIZE, o->height ? o->height : 1 },
+        { "samples", PTR_NUMBER_SAMPLES, o->samples },
+        { "min_samples", PTR_NUMBER_MIN_SAMPLES, o->min_samples },
+        { "max_depth", PTR_NUMBER_MAX_DEPTH, o->max_depth },
+        { "threads", PTR_NUMBER_THREADS, o->threads },
+    };
+    for (size_t n = 0; n < sizeof numbers / sizeof numbers[0]; n++)
+        if (ptr_api_check_number(numbers[n].name, numbers[n].number, numbers[n].value, err) !=
+            PTR_OK)
+            return PTR_ERR_USAGE;
+    if (o->noise_threshold != 0 && !ptr_noise_threshold_ok(o->noise_threshold))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "noise_threshold: %g is not 0 (off) or above 0 and at most 10^6",
+                             (double)o->noise_threshold);
+    const char *wrong = ptr_sample_range_problem(o->noise_threshold, o->first_sample, o->samples);
+    if (wrong)
+        return ptr_error_set(err, PTR_ERR_USAGE, "samples: %s", wrong);
     return PTR_OK;
 }
 
@@ -84,14 +106,10 @@ static PtrResult read_choices(const PtrContext *context, const PtrRenderOptions 
 static PtrResult camera_at(const PtrCameraDesc *desc, const double origin[3], PtrCamera *camera,
                            PtrError *err)
 {
-    const double *points[] = { desc->lookfrom, desc->lookat, desc->up };
-    for (int p = 0; p < 3; p++)
-        for (int k = 0; k < 3; k++)
-            if (!isfinite(points[p][k]))
-                return ptr_error_set(err, PTR_ERR_USAGE,
-                                     "camera: lookfrom, lookat and up are finite");
     PtrCameraSpec spec;
-    ptr_api_camera_spec(desc, &spec);
+    PtrResult res = ptr_api_camera_spec(desc, &spec, err);
+    if (res != PTR_OK)
+        return res;
     *camera = ptr_camera_lens(&spec);
     camera->lookfrom = v3((float)(desc->lookfrom[0] - origin[0]),
                           (float)(desc->lookfrom[1] - origin[1]),
@@ -108,9 +126,6 @@ static PtrResult prepare(PtrSceneHandle *h, const Choices *c, int threads, PtrEr
     const PtrPreparedFor wanted = { c->kernel, c->level, c->integrator, c->accel };
     if (h->prepared_valid && !memcmp(&wanted, &h->prepared_for, sizeof wanted))
         return PTR_OK;
-    /* The first build's hash stands: later ones see the tree's order. */
-    const int first = !h->prepared_valid;
-    const uint64_t hash = h->prepared.scene_hash;
     if (h->prepared_valid)
         ptr_prepared_free(&h->prepared);
     h->prepared_valid = 0;
@@ -118,8 +133,10 @@ static PtrResult prepare(PtrSceneHandle *h, const Choices *c, int threads, PtrEr
                                        threads, h->name, &h->prepared, err);
     if (res != PTR_OK)
         return res;
-    if (!first)
-        h->prepared.scene_hash = hash;
+    if (h->hash_valid)
+        h->prepared.scene_hash = h->scene_hash;
+    h->scene_hash = h->prepared.scene_hash;
+    h->hash_valid = 1;
     h->prepared_valid = 1;
     h->prepared_for = wanted;
     return PTR_OK;
@@ -258,26 +275,30 @@ PtrStatus ptr_scene_render(PtrContext *context, PtrSceneHandle *scene,
     PtrError e;
     Choices choices;
     Progress progress = { callback, user, 0 };
+    if (!context || !scene || !options || !out)
+        return ptr_api_usage(err, "render: context, scene, options and out are needed, not NULL");
     if (read_choices(context, options, &choices, &e) != PTR_OK ||
         render(context, scene, options, &choices, &progress, out, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
     return PTR_STATUS_OK;
 }
 
-int ptr_frame_width(const PtrFrame *frame) { return frame->width; }
-int ptr_frame_height(const PtrFrame *frame) { return frame->height; }
-int ptr_frame_channels(const PtrFrame *frame) { return frame->channels; }
+int ptr_frame_width(const PtrFrame *frame) { return frame ? frame->width : 0; }
+int ptr_frame_height(const PtrFrame *frame) { return frame ? frame->height : 0; }
+int ptr_frame_channels(const PtrFrame *frame) { return frame ? frame->channels : 0; }
 const float *ptr_frame_pixels(const PtrFrame *frame)
 {
-    return frame->rgba ? frame->rgba : frame->buffers.rgb;
+    return !frame ? NULL : frame->rgba ? frame->rgba : frame->buffers.rgb;
 }
-const float *ptr_frame_albedo(const PtrFrame *frame) { return frame->buffers.albedo; }
-const float *ptr_frame_normal(const PtrFrame *frame) { return frame->buffers.normal; }
+const float *ptr_frame_albedo(const PtrFrame *frame) { return frame ? frame->buffers.albedo : NULL; }
+const float *ptr_frame_normal(const PtrFrame *frame) { return frame ? frame->buffers.normal : NULL; }
 
 PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
                         PtrFrame **out, PtrErrorInfo *err)
 {
     PtrError e;
+    if (!pixels || !out)
+        return ptr_api_usage(err, "frame: pixels and out are needed, not NULL");
     if (width < 1 || height < 1 || width > PTR_MAX_IMAGE_SIZE || height > PTR_MAX_IMAGE_SIZE ||
         (channels != 3 && channels != 4)) {
         ptr_error_set(&e, PTR_ERR_USAGE, "a frame of %dx%d pixels of %d channels: 1 to %d "
@@ -324,6 +345,8 @@ PtrStatus ptr_frame_save(PtrContext *context, const char *path, const PtrFrame *
                          const char *view, PtrErrorInfo *err)
 {
     PtrError e;
+    if (!context || !path || !frame)
+        return ptr_api_usage(err, "save: context, path and frame are needed, not NULL");
     const int exr = ptr_image_is_exr(path);
     PtrOutputInfo info = frame->info;
     info.color = context->color;

@@ -35,6 +35,22 @@ PtrStatus ptr_api_fail(PtrErrorInfo *err, const PtrError *error)
     return (PtrStatus)error->code;
 }
 
+PtrStatus ptr_api_usage(PtrErrorInfo *err, const char *message)
+{
+    PtrError e;
+    ptr_error_set(&e, PTR_ERR_USAGE, "%s", message);
+    return ptr_api_fail(err, &e);
+}
+
+PtrResult ptr_api_check_number(const char *name, PtrRenderNumber number, long long value,
+                               PtrError *err)
+{
+    if (value < 0 || !ptr_render_number_ok(number, (uint64_t)value))
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s: %lld is not %s", name, value,
+                             ptr_render_number_range(number));
+    return PTR_OK;
+}
+
 const char *ptr_version(void)
 {
     return PTR_VERSION;
@@ -46,10 +62,10 @@ PtrStatus ptr_context_new(const PtrContextOptions *options, PtrContext **out, Pt
     const PtrContextOptions *o = options ? options : &none;
     PtrError e;
     PtrCpuLevel cap = PTR_CPU_LEVEL_COUNT - 1;
-    if (o->threads < 0) {
-        ptr_error_set(&e, PTR_ERR_USAGE, "threads: %d is not a count, or 0", o->threads);
+    if (!out)
+        return ptr_api_usage(err, "context: out is NULL");
+    if (ptr_api_check_number("threads", PTR_NUMBER_THREADS, o->threads, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
-    }
     PtrError problem;
     if (o->cpu_cap && ptr_cpu_parse_level(o->cpu_cap, &cap, &problem) != PTR_OK) {
         ptr_error_set(&e, PTR_ERR_USAGE, "cpu_cap: %s", problem.message);
@@ -110,8 +126,14 @@ static PtrStatus hand_scene(PtrScene *scene, const char *name, double import_sec
     return PTR_STATUS_OK;
 }
 
-void ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec)
+PtrResult ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec, PtrError *err)
 {
+    const double *points[] = { desc->lookfrom, desc->lookat, desc->up };
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(points[p][k]))
+                return ptr_error_set(err, PTR_ERR_USAGE,
+                                     "camera: lookfrom, lookat and up are finite");
     memcpy(spec->lookfrom, desc->lookfrom, sizeof spec->lookfrom);
     memcpy(spec->lookat, desc->lookat, sizeof spec->lookat);
     memcpy(spec->up, desc->up, sizeof spec->up);
@@ -119,6 +141,7 @@ void ptr_api_camera_spec(const PtrCameraDesc *desc, PtrCameraSpec *spec)
     spec->ortho_height = desc->ortho_height;
     spec->aperture = desc->aperture;
     spec->focus_distance = desc->focus_distance;
+    return PTR_OK;
 }
 
 /* The sky text, if any, into scene. */
@@ -136,9 +159,11 @@ PtrStatus ptr_scene_load(PtrContext *context, const char *path, const PtrLoadOpt
     const PtrLoadOptions none = { 0 };
     const PtrLoadOptions *o = options ? options : &none;
     PtrError e;
+    if (!context || !path || !out)
+        return ptr_api_usage(err, "load: context, path and out are needed, not NULL");
     PtrCameraSpec camera;
-    if (o->camera)
-        ptr_api_camera_spec(o->camera, &camera);
+    if (o->camera && ptr_api_camera_spec(o->camera, &camera, &e) != PTR_OK)
+        return ptr_api_fail(err, &e);
     PtrImportOptions import = {
         .camera_name = o->camera_name,
         .camera = o->camera ? &camera : NULL,
@@ -185,9 +210,11 @@ static PtrResult check_sphere(const PtrSceneArrays *a, size_t i, const double ce
     if (!(a->radii[i] >= 0.0f) || isinf(a->radii[i]))
         return ptr_error_set(err, PTR_ERR_USAGE, "sphere %zu: radius %g is not >= 0 and finite", i,
                              (double)a->radii[i]);
-    if (a->material_indices && a->material_indices[i] >= a->material_count)
+    /* No table: one grey material, index 0. */
+    const size_t materials = a->material_count ? a->material_count : 1;
+    if (a->material_indices && a->material_indices[i] >= materials)
         return ptr_error_set(err, PTR_ERR_USAGE, "sphere %zu: material %u, of %zu materials", i,
-                             a->material_indices[i], a->material_count);
+                             a->material_indices[i], materials);
     for (int k = 0; a->colors && k < 3; k++)
         if (isnan(a->colors[3 * i + k]))
             return ptr_error_set(err, PTR_ERR_USAGE, "sphere %zu: its colour is NaN", i);
@@ -216,6 +243,9 @@ static PtrResult add_materials(const PtrSceneArrays *a, PtrScene *scene, PtrErro
             .fuzz = d->fuzz, .ior = d->ior,
             .emission = v3(d->emission[0], d->emission[1], d->emission[2]),
         };
+        const char *problem = ptr_material_problem(&material);
+        if (problem)
+            return ptr_error_set(err, PTR_ERR_USAGE, "material %zu: %s", m, problem);
         uint32_t index;
         PtrResult res = ptr_scene_add_material(scene, &material, &index, err);
         if (res != PTR_OK)
@@ -249,15 +279,15 @@ PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *array
 {
     (void)context; /* the arrays need nothing of it: every context takes them */
     PtrError e;
+    if (!arrays || !out)
+        return ptr_api_usage(err, "arrays: arrays and out are needed, not NULL");
     if (!arrays->radii || !arrays->centers == !arrays->centers_f64 ||
-        (arrays->material_count && !arrays->materials)) {
-        ptr_error_set(&e, PTR_ERR_USAGE, "arrays: the radii, one of centers and centers_f64, "
-                                         "and the materials counted are needed");
-        return ptr_api_fail(err, &e);
-    }
+        (arrays->material_count && !arrays->materials))
+        return ptr_api_usage(err, "arrays: the radii, one of centers and centers_f64, and the "
+                                  "materials counted are needed");
     PtrCameraSpec camera;
-    if (arrays->camera)
-        ptr_api_camera_spec(arrays->camera, &camera);
+    if (arrays->camera && ptr_api_camera_spec(arrays->camera, &camera, &e) != PTR_OK)
+        return ptr_api_fail(err, &e);
     const PtrImportOptions import = {
         .camera = arrays->camera ? &camera : NULL,
         .auto_projection = arrays->orthographic ? PTR_PROJECTION_ORTHOGRAPHIC
@@ -289,7 +319,7 @@ PtrStatus ptr_scene_from_arrays(PtrContext *context, const PtrSceneArrays *array
 
 size_t ptr_scene_sphere_count(const PtrSceneHandle *scene)
 {
-    return scene->scene.spheres.count;
+    return scene ? scene->scene.spheres.count : 0;
 }
 
 void ptr_scene_handle_free(PtrSceneHandle *scene)

@@ -30,6 +30,46 @@ static PtrResult decode_texture(void *context, const char *name, const unsigned 
     return PTR_OK;
 }
 
+static const struct {
+    uint64_t lo, hi;
+    const char *words;
+} number_ranges[] = {
+    [PTR_NUMBER_SIZE] = { 1, PTR_MAX_IMAGE_SIZE, "a whole number from 1 to 65536" },
+    [PTR_NUMBER_SAMPLES] = { 1, 1u << 30, "a whole number from 1 to 2^30" },
+    [PTR_NUMBER_MIN_SAMPLES] = { 2, 1u << 30, "a whole number from 2 to 2^30" },
+    [PTR_NUMBER_MAX_DEPTH] = { 1, 100000, "a whole number from 1 to 100000" },
+    /* Beyond this, a mistake: threads are started, and kept, for every one. */
+    [PTR_NUMBER_THREADS] = { 0, 1024, "a whole number from 0 to 1024" },
+};
+_Static_assert(PTR_MAX_IMAGE_SIZE == 65536, "number_ranges' words");
+
+int ptr_render_number_ok(PtrRenderNumber number, uint64_t value)
+{
+    return value >= number_ranges[number].lo && value <= number_ranges[number].hi;
+}
+
+const char *ptr_render_number_range(PtrRenderNumber number)
+{
+    return number_ranges[number].words;
+}
+
+int ptr_noise_threshold_ok(double threshold)
+{
+    return threshold > 0 && threshold <= 1e6;
+}
+
+const char *ptr_sample_range_problem(float noise_threshold, uint64_t first_sample,
+                                     uint64_t samples)
+{
+    if (first_sample + samples > number_ranges[PTR_NUMBER_SAMPLES].hi)
+        return "the samples end past 2^30";
+    /* Stopping decisions need every sample of a pixel from the first on; a
+     * later range cannot know them. */
+    if (noise_threshold > 0 && first_sample > 0)
+        return "a noise threshold needs samples from 0, not from a later first sample";
+    return NULL;
+}
+
 PtrTextureDecoder ptr_texture_decoder(PtrImageLoader *images)
 {
     return (PtrTextureDecoder){ decode_texture, images };

@@ -24,6 +24,29 @@
 
 enum { PTR_MAX_IMAGE_SIZE = 1 << 16 };
 
+/* The whole-number settings of a render whose ranges the command line's
+ * options and the library's PtrRenderOptions share. */
+typedef enum PtrRenderNumber {
+    PTR_NUMBER_SIZE,        /* a width or a height */
+    PTR_NUMBER_SAMPLES,     /* samples per pixel, and the end of a sample range */
+    PTR_NUMBER_MIN_SAMPLES,
+    PTR_NUMBER_MAX_DEPTH,
+    PTR_NUMBER_THREADS,     /* 0: one per online CPU */
+} PtrRenderNumber;
+
+/* Whether value is in number's range. */
+int ptr_render_number_ok(PtrRenderNumber number, uint64_t value);
+/* number's range in words, "a whole number from LO to HI", for messages. */
+const char *ptr_render_number_range(PtrRenderNumber number);
+/* Whether a noise threshold (--noise-threshold) is one: above 0, at most
+ * 10^6. */
+int ptr_noise_threshold_ok(double threshold);
+/* What is wrong with a render's samples taken together: adaptive sampling
+ * (noise_threshold above 0) from a first sample other than 0, or a range
+ * ending past 2^30; NULL if nothing. */
+const char *ptr_sample_range_problem(float noise_threshold, uint64_t first_sample,
+                                     uint64_t samples);
+
 /* The decoder of an import's textures (PtrImportOptions.textures): through
  * images, the image module's loader, which must outlive the import. */
 PtrTextureDecoder ptr_texture_decoder(PtrImageLoader *images);

@@ -7,8 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { MAX_THREADS = 1024 };
-
 /* Which of --lookfrom, --lookat, --vfov and --ortho were given: a camera
  * needs the first two and one of the others. */
 enum {
@@ -147,6 +145,25 @@ static PtrResult set_int(OptionId id, const char *value, int lo, int hi, int *ou
     return PTR_OK;
 }
 
+/* A render's number (pipeline.h), in its range. */
+static PtrResult set_number(OptionId id, const char *value, PtrRenderNumber number,
+                            uint64_t *out, PtrError *err)
+{
+    if (!parse_uint(value, 0, UINT64_MAX, out) || !ptr_render_number_ok(number, *out))
+        return bad_value(id, value, ptr_render_number_range(number), err);
+    return PTR_OK;
+}
+
+static PtrResult set_count(OptionId id, const char *value, PtrRenderNumber number, int *out,
+                           PtrError *err)
+{
+    uint64_t v;
+    PtrResult res = set_number(id, value, number, &v, err);
+    if (res == PTR_OK)
+        *out = (int)v;
+    return res;
+}
+
 static PtrResult set_point(OptionId id, const char *value, double xyz[3], PtrError *err)
 {
     char tail;
@@ -161,8 +178,8 @@ static PtrResult set_sample_range(OptionId id, const char *value, PtrOptions *o,
     unsigned long long a, b;
     char tail;
     /* %llu alone would take spaces and a sign. */
-    if (sscanf(value, "%llu:%llu%c", &a, &b, &tail) != 2 || b <= a || b > (1u << 30) ||
-        value[0] < '0' || value[0] > '9')
+    if (sscanf(value, "%llu:%llu%c", &a, &b, &tail) != 2 || b <= a ||
+        !ptr_render_number_ok(PTR_NUMBER_SAMPLES, b) || value[0] < '0' || value[0] > '9')
         return bad_value(id, value, "START:END with 0 <= START < END <= 2^30", err);
     o->sample_first = (uint32_t)a;
     o->samples = (uint32_t)(b - a);
@@ -210,13 +227,13 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     switch (id) {
     case OPT_output: o->output = value; break;
     case OPT_samples:
-        if (!parse_uint(value, 1, 1u << 30, &v))
-            return bad_value(id, value, "a whole number from 1 to 2^30", err);
+        if (set_number(id, value, PTR_NUMBER_SAMPLES, &v, err) != PTR_OK)
+            return PTR_ERR_USAGE;
         o->samples = (uint32_t)v;
         o->sample_first = 0; /* the last of --samples and --sample-range counts */
         break;
-    case OPT_width: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->width, err);
-    case OPT_height: return set_int(id, value, 1, PTR_MAX_IMAGE_SIZE, &o->height, err);
+    case OPT_width: return set_count(id, value, PTR_NUMBER_SIZE, &o->width, err);
+    case OPT_height: return set_count(id, value, PTR_NUMBER_SIZE, &o->height, err);
     case OPT_transparent: o->transparent = 1; break;
     case OPT_passes:
         /* Both or none: a denoiser takes the albedo and normal together. */
@@ -229,25 +246,25 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
         if (ptr_denoise_quality_parse(o->denoise, &o->denoise_quality, &problem) != PTR_OK)
             return option_error(id, &problem, err);
         break;
-    case OPT_threads: return set_int(id, value, 0, MAX_THREADS, &o->threads, err);
+    case OPT_threads: return set_count(id, value, PTR_NUMBER_THREADS, &o->threads, err);
     case OPT_seed:
         if (!parse_uint(value, 0, UINT64_MAX, &o->seed))
             return bad_value(id, value, "a whole number from 0 to 2^64-1", err);
         break;
-    case OPT_max_depth: return set_int(id, value, 1, 100000, &o->max_depth, err);
+    case OPT_max_depth: return set_count(id, value, PTR_NUMBER_MAX_DEPTH, &o->max_depth, err);
     case OPT_sampler:
         if (ptr_sampler_parse(value, &o->sampler, &problem) != PTR_OK)
             return option_error(id, &problem, err);
         break;
     case OPT_direct_lighting: return set_switch(id, value, &o->direct_lighting, err);
     case OPT_noise_threshold:
-        if (!parse_number(value, &x) || !(x > 0 && x <= 1e6))
+        if (!parse_number(value, &x) || !ptr_noise_threshold_ok(x))
             return bad_value(id, value, "a number above 0", err);
         o->noise_threshold = (float)x;
         break;
     case OPT_min_samples:
-        if (!parse_uint(value, 2, 1u << 30, &v))
-            return bad_value(id, value, "a whole number from 2 to 2^30", err);
+        if (set_number(id, value, PTR_NUMBER_MIN_SAMPLES, &v, err) != PTR_OK)
+            return PTR_ERR_USAGE;
         o->min_samples = (uint32_t)v;
         break;
     case OPT_sky:
@@ -446,11 +463,7 @@ static const char *usage_problem(const PtrOptions *o)
                "--skip-existing)";
     if (o->merge && o->dump_scene)
         return "--dump-scene is not for merge";
-    /* Stopping decisions need every sample of a pixel from the first on; a
-     * later range cannot know them. */
-    if (o->noise_threshold > 0 && o->sample_first > 0)
-        return "--noise-threshold needs samples from 0 (not --sample-range A:B with A > 0)";
-    return NULL;
+    return ptr_sample_range_problem(o->noise_threshold, o->sample_first, o->samples);
 }
 
 PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *o, PtrError *err)

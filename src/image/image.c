@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -12,10 +13,16 @@
 
 enum { PATH_SIZE = 4096 };
 
-/* The temporary file of the write under way, for ptr_image_discard_partial:
- * plain storage a signal handler may read. */
+/* The temporary file of a write under way, for ptr_image_discard_partial:
+ * plain storage a signal handler may read. Writes may run on several
+ * threads at once (the library's): the one that claims it keeps it until
+ * done, and the others write without it. */
 static char partial_path[PATH_SIZE];
 static volatile sig_atomic_t partial_active;
+static atomic_flag partial_claimed = ATOMIC_FLAG_INIT;
+
+/* The writes of this process so far: each temporary name is its own. */
+static atomic_ulong writes_started;
 
 int ptr_image_is_exr(const char *path)
 {
@@ -41,17 +48,19 @@ int ptr_image_can_write(PtrImageLoader *loader, const char *path)
            (ptr_oiio_module(loader, path, &m, NULL) == PTR_OK && m->can_write(path));
 }
 
-/* "dir/name.ext" -> "dir/.name.ptr-PID.ext": hidden, unique to this process,
- * and keeping the extension for tools that look at it. Returns 0 if it does
- * not fit. */
+/* "dir/name.ext" -> "dir/.name.ptr-PID-N.ext", N counting this process's
+ * writes: hidden, unique to this write even when threads write the same
+ * path, and keeping the extension for tools that look at it. Returns 0 if
+ * it does not fit. */
 static int temporary_name(const char *path, char *tmp, size_t size)
 {
     const char *slash = strrchr(path, '/');
     const char *base = slash ? slash + 1 : path;
     const char *dot = strrchr(base, '.');
     int stem = (int)(dot ? dot - base : (ptrdiff_t)strlen(base));
-    int n = snprintf(tmp, size, "%.*s.%.*s.ptr-%ld%s", (int)(base - path), path, stem, base,
-                     (long)getpid(), dot ? dot : "");
+    int n = snprintf(tmp, size, "%.*s.%.*s.ptr-%ld-%lu%s", (int)(base - path), path, stem,
+                     base, (long)getpid(), atomic_fetch_add(&writes_started, 1),
+                     dot ? dot : "");
     return n > 0 && (size_t)n < size;
 }
 
@@ -68,8 +77,11 @@ PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrIma
     char tmp[PATH_SIZE];
     if (!temporary_name(path, tmp, sizeof tmp))
         return ptr_error_set(err, PTR_ERR_OUTPUT, "%s: path too long", path);
-    memcpy(partial_path, tmp, sizeof tmp);
-    partial_active = 1;
+    const int tracked = !atomic_flag_test_and_set(&partial_claimed);
+    if (tracked) {
+        memcpy(partial_path, tmp, sizeof tmp);
+        partial_active = 1;
+    }
     PtrResult res = exr ? ptr_exr_write(tmp, path, layout, rgb, alpha, extras, format,
                                         attrs, attr_count, err)
                         : m->write(tmp, path, layout, rgb, alpha, format, attrs, attr_count, err);
@@ -78,7 +90,10 @@ PtrResult ptr_image_write(PtrImageLoader *loader, const char *path, const PtrIma
                             strerror(errno));
     if (res != PTR_OK)
         unlink(tmp);
-    partial_active = 0;
+    if (tracked) {
+        partial_active = 0;
+        atomic_flag_clear(&partial_claimed);
+    }
     return res;
 }
 

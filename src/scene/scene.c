@@ -284,6 +284,20 @@ static PtrResult widen_materials(PtrSpheres *s, size_t size, PtrError *err)
     return PTR_OK;
 }
 
+const char *ptr_material_problem(const PtrMaterial *m)
+{
+    const float values[] = { m->albedo.x, m->albedo.y, m->albedo.z, m->fuzz, m->ior,
+                             m->emission.x, m->emission.y, m->emission.z };
+    for (size_t k = 0; k < sizeof values / sizeof values[0]; k++)
+        if (!isfinite(values[k]))
+            return "a value is not finite";
+    if (m->kind == PTR_MATERIAL_DIELECTRIC && !(m->ior > 0.0f))
+        return "it refracts with an ior not above 0";
+    if (m->emission.x < 0.0f || m->emission.y < 0.0f || m->emission.z < 0.0f)
+        return "its emission is negative";
+    return NULL;
+}
+
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index, PtrError *err)
 {

@@ -249,6 +249,11 @@ static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
     return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
 }
 
+/* What makes a material unrenderable, as every importer and the library's
+ * arrays refuse it: a value that is not finite, a dielectric's ior not above
+ * 0, a negative emission; NULL if nothing does. */
+const char *ptr_material_problem(const PtrMaterial *material);
+
 /* Appends a material and stores its index in *index; the spheres' material
  * array widens if the count needs it (PtrSpheres.material). */
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,

@@ -241,6 +241,201 @@ static void test_bad_input(void)
     CHECK(bad == NULL);
 }
 
+/* Two spheres of arrays, to make scenes of with one thing changed. */
+static float two_centers[6] = { 0, 0, -3, 1, 0, -3 }, two_radii[2] = { 0.5f, 0.5f };
+
+static PtrStatus two_spheres(const PtrMaterialDesc *materials, size_t count,
+                             const uint32_t *indices, PtrErrorInfo *err)
+{
+    const PtrSceneArrays arrays = { .count = 2, .centers = two_centers, .radii = two_radii,
+                                    .material_indices = indices, .materials = materials,
+                                    .material_count = count };
+    PtrSceneHandle *scene = NULL;
+    const PtrStatus status = ptr_scene_from_arrays(context, &arrays, &scene, err);
+    CHECK_INT(scene != NULL, status == PTR_STATUS_OK);
+    ptr_scene_handle_free(scene);
+    return status;
+}
+
+/* The materials the importers refuse are refused, naming the material;
+ * index 0 without a table is the grey material. */
+static void test_materials_checked(void)
+{
+    PtrErrorInfo err;
+    const uint32_t first[2] = { 0, 0 }, second[2] = { 0, 1 };
+    PtrMaterialDesc table[2] = {
+        { .type = PTR_MATERIAL_TYPE_DIFFUSE, .albedo = { .5f, .5f, .5f }, .ior = 1.5f },
+        { .type = PTR_MATERIAL_TYPE_DIELECTRIC, .albedo = { 1, 1, 1 }, .ior = 1.5f },
+    };
+    CHECK_INT(two_spheres(table, 2, second, &err), PTR_STATUS_OK);
+    CHECK_INT(two_spheres(NULL, 0, first, &err), PTR_STATUS_OK);
+    CHECK_INT(two_spheres(NULL, 0, second, &err), PTR_STATUS_USAGE);
+    const PtrMaterialDesc zeroed_glass = { .type = PTR_MATERIAL_TYPE_DIELECTRIC };
+    PtrMaterialDesc bad[4];
+    for (int k = 0; k < 4; k++)
+        bad[k] = table[1];
+    bad[0].albedo[1] = NAN;
+    bad[1].emission[2] = -1;
+    bad[2].ior = 0;
+    bad[3] = zeroed_glass;
+    for (int k = 0; k < 4; k++) {
+        const PtrMaterialDesc with_bad[2] = { table[0], bad[k] };
+        CHECK_INT(two_spheres(with_bad, 2, second, &err), PTR_STATUS_USAGE);
+        CHECK(strstr(err.message, "material 1") != NULL);
+    }
+}
+
+/* The command line's limits on a render's numbers and threads. */
+static void test_limits(void)
+{
+    PtrErrorInfo err;
+    PtrContext *many = NULL;
+    const PtrContextOptions threads = { .threads = 1025 };
+    CHECK_INT(ptr_context_new(&threads, &many, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "threads") != NULL);
+    CHECK(many == NULL);
+
+    PtrSceneHandle *scene = NULL;
+    const PtrSceneArrays arrays = { .count = 2, .centers = two_centers, .radii = two_radii };
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_OK);
+    PtrRenderOptions good;
+    ptr_render_options_default(&good);
+    good.width = 8;
+    good.samples = 1;
+    PtrRenderOptions o[10];
+    for (int k = 0; k < 10; k++)
+        o[k] = good;
+    o[0].samples = (1u << 30) + 1;
+    o[1].samples = 0;
+    o[2].max_depth = 0;
+    o[3].min_samples = 1;
+    o[4].threads = 1025;
+    o[5].width = 70000;
+    o[6].noise_threshold = 0.01f;
+    o[6].first_sample = 4;
+    o[7].noise_threshold = NAN;
+    o[8].first_sample = 1u << 30;
+    o[9].height = -1;
+    const char *named[10] = { "samples", "samples", "max_depth", "min_samples", "threads",
+                              "width", "samples", "noise_threshold", "samples", "height" };
+    PtrFrame *frame = NULL;
+    for (int k = 0; k < 10; k++) {
+        CHECK_INT(ptr_scene_render(context, scene, &o[k], NULL, NULL, &frame, &err),
+                  PTR_STATUS_USAGE);
+        CHECK(strstr(err.message, named[k]) != NULL);
+        CHECK(frame == NULL);
+    }
+    CHECK_INT(ptr_scene_render(context, scene, &good, NULL, NULL, &frame, &err), PTR_STATUS_OK);
+    ptr_frame_free(frame);
+    ptr_scene_handle_free(scene);
+}
+
+/* A NULL where an object or an out-parameter is needed: usage, no crash;
+ * the accessors answer 0 and NULL. */
+static void test_null_arguments(void)
+{
+    PtrErrorInfo err;
+    PtrSceneHandle *scene = NULL;
+    PtrFrame *frame = NULL;
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    const float pixels[3] = { 0 };
+    const PtrSceneArrays arrays = { .count = 2, .centers = two_centers, .radii = two_radii };
+    CHECK_INT(ptr_context_new(NULL, NULL, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_load(context, NULL, NULL, &scene, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_load(context, SCENE("seed.gltf"), NULL, NULL, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_from_arrays(context, NULL, &scene, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, NULL, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_OK);
+    CHECK_INT(ptr_scene_render(context, scene, NULL, NULL, NULL, &frame, &err),
+              PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_render(context, NULL, &options, NULL, NULL, &frame, &err),
+              PTR_STATUS_USAGE);
+    CHECK_INT(ptr_scene_render(context, scene, &options, NULL, NULL, NULL, &err),
+              PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_new(1, 1, 3, NULL, &frame, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_new(1, 1, 3, pixels, NULL, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_new(1, 1, 3, pixels, &frame, &err), PTR_STATUS_OK);
+    CHECK_INT(ptr_frame_save(context, NULL, frame, NULL, &err), PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_save(context, test_path("never.exr"), NULL, NULL, &err),
+              PTR_STATUS_USAGE);
+    CHECK(frame != NULL);
+    ptr_frame_free(frame);
+    ptr_scene_handle_free(scene);
+    CHECK_INT(ptr_frame_width(NULL), 0);
+    CHECK_INT(ptr_frame_height(NULL), 0);
+    CHECK_INT(ptr_frame_channels(NULL), 0);
+    CHECK(ptr_frame_pixels(NULL) == NULL && ptr_frame_albedo(NULL) == NULL &&
+          ptr_frame_normal(NULL) == NULL);
+    CHECK_INT((int)ptr_scene_sphere_count(NULL), 0);
+}
+
+/* A camera that is not finite is usage, where the scene is made too. */
+static void test_bad_camera(void)
+{
+    PtrErrorInfo err;
+    PtrSceneHandle *scene = NULL;
+    const PtrCameraDesc broken = { .lookfrom = { NAN, 0, 0 }, .up = { 0, 1, 0 },
+                                   .vfov_deg = 40 };
+    const PtrLoadOptions load = { .camera = &broken };
+    CHECK_INT(ptr_scene_load(context, SCENE("seed.gltf"), &load, &scene, &err),
+              PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "camera") != NULL);
+    const PtrSceneArrays arrays = { .count = 2, .centers = two_centers, .radii = two_radii,
+                                    .camera = &broken };
+    CHECK_INT(ptr_scene_from_arrays(context, &arrays, &scene, &err), PTR_STATUS_USAGE);
+    CHECK(strstr(err.message, "camera") != NULL);
+    CHECK(scene == NULL);
+}
+
+/* The scene_hash a render of scene saves with options. */
+static uint64_t saved_hash(PtrSceneHandle *scene, const PtrRenderOptions *options)
+{
+    PtrFrame *frame = NULL;
+    PtrErrorInfo err;
+    CHECK_INT(ptr_scene_render(context, scene, options, NULL, NULL, &frame, &err),
+              PTR_STATUS_OK);
+    const char *exr = test_path("hashed.exr");
+    CHECK_INT(ptr_frame_save(context, exr, frame, NULL, &err), PTR_STATUS_OK);
+    ptr_frame_free(frame);
+    PtrImage *image;
+    uint64_t hash = 0;
+    if (test_image_read(exr, &image, NULL) != PTR_OK)
+        return 0;
+    const char *text = ptr_image_attr(image, "ptr:scene_hash");
+    CHECK(text != NULL);
+    if (text)
+        hash = strtoull(text, NULL, 16);
+    ptr_image_free(image);
+    return hash;
+}
+
+/* A build that fails between two that succeed leaves the saved hash the
+ * first build's, the fresh scene's. */
+static void test_hash_after_failed_build(void)
+{
+    PtrSceneHandle *fresh = NULL, *scene = NULL;
+    CHECK_INT(ptr_scene_load(context, SCENE("final.gltf"), NULL, &fresh, NULL), PTR_STATUS_OK);
+    CHECK_INT(ptr_scene_load(context, SCENE("final.gltf"), NULL, &scene, NULL), PTR_STATUS_OK);
+    PtrRenderOptions options;
+    ptr_render_options_default(&options);
+    options.width = 16;
+    options.samples = 1;
+    const uint64_t expected = saved_hash(fresh, &options);
+    CHECK(expected != 0);
+    CHECK(saved_hash(scene, &options) == expected);
+    PtrRenderOptions failing = options;
+    failing.kernel = "asm";
+    failing.cpu_cap = "none"; /* no assembly there: the build fails */
+    PtrFrame *frame = NULL;
+    CHECK_INT(ptr_scene_render(context, scene, &failing, NULL, NULL, &frame, NULL),
+              PTR_STATUS_USAGE);
+    options.kernel = "c";
+    CHECK(saved_hash(scene, &options) == expected);
+    ptr_scene_handle_free(fresh);
+    ptr_scene_handle_free(scene);
+}
+
 static int calls;
 static int cancel_at_once(void *user, const PtrProgressInfo *progress)
 {
@@ -346,6 +541,47 @@ static void test_two_contexts(void)
     ptr_frame_free(alone.frame);
 }
 
+/* Two threads saving one path at once, many times: every save succeeds
+ * (each write has its own temporary file) and the file holds the pixels. */
+typedef struct SaveJob {
+    PtrContext *context;
+    const PtrFrame *frame;
+    const char *path;
+    int failed;
+} SaveJob;
+
+static void *save_job(void *arg)
+{
+    SaveJob *job = arg;
+    for (int k = 0; k < 40; k++)
+        job->failed += ptr_frame_save(job->context, job->path, job->frame, NULL, NULL) !=
+                       PTR_STATUS_OK;
+    return NULL;
+}
+
+static void test_saves_at_once(void)
+{
+    enum { SIDE = 64 };
+    static float pixels[SIDE * SIDE * 3];
+    for (size_t p = 0; p < sizeof pixels / sizeof pixels[0]; p++)
+        pixels[p] = (float)(p % 97) / 97.0f;
+    PtrFrame *frame = NULL;
+    CHECK_INT(ptr_frame_new(SIDE, SIDE, 3, pixels, &frame, NULL), PTR_STATUS_OK);
+    PtrContext *other = NULL;
+    CHECK_INT(ptr_context_new(NULL, &other, NULL), PTR_STATUS_OK);
+    const char *path = test_path("shared.exr");
+    SaveJob jobs[2] = { { context, frame, path, 0 }, { other, frame, path, 0 } };
+    pthread_t threads[2];
+    for (int i = 0; i < 2; i++)
+        CHECK_INT(pthread_create(&threads[i], NULL, save_job, &jobs[i]), 0);
+    for (int i = 0; i < 2; i++)
+        pthread_join(threads[i], NULL);
+    CHECK_INT(jobs[0].failed + jobs[1].failed, 0);
+    check_same_as_file(frame, path);
+    ptr_frame_free(frame);
+    ptr_context_free(other);
+}
+
 int main(void)
 {
     if (!test_dir_create("api"))
@@ -358,7 +594,9 @@ int main(void)
     static const TestCase cases[] = {
         TEST_CASE(test_same_as_command_line), TEST_CASE(test_arrays_same_as_file),
         TEST_CASE(test_bad_input), TEST_CASE(test_cancel), TEST_CASE(test_save),
-        TEST_CASE(test_two_contexts),
+        TEST_CASE(test_two_contexts), TEST_CASE(test_materials_checked),
+        TEST_CASE(test_limits), TEST_CASE(test_null_arguments), TEST_CASE(test_bad_camera),
+        TEST_CASE(test_hash_after_failed_build), TEST_CASE(test_saves_at_once),
     };
     test_run(cases, sizeof cases / sizeof cases[0]);
     ptr_context_free(context);
