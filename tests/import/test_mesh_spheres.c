@@ -62,12 +62,12 @@ static PtrMeshSource make_mesh(Mesh *m)
             for (int k = 0; k < 3; k++) {
                 const int c = face[f][k];
                 if (o % 2) {
-                    m->t[nt][k] = (uint32_t)nv;
+                    m->t[nt + (size_t)f][k] = (uint32_t)nv;
                     for (int j = 0; j < 3; j++)
                         m->v[nv][j] = (j == 0 ? x : 0.0) + radius * corner[c][j];
                     nv++;
                 } else {
-                    m->t[nt][k] = (uint32_t)(first + (size_t)c);
+                    m->t[nt + (size_t)f][k] = (uint32_t)(first + (size_t)c);
                 }
             }
         if (o % 2 == 0)
