@@ -1,6 +1,7 @@
 /* Connected components by union-find over the triangles' vertex indices and
  * the vertices' positions (unwelded exports: every triangle its own
- * vertices), each fitted and checked. Every pass is linear in the mesh's
+ * vertices; only the vertices of parts open by index are matched by
+ * position), each fitted and checked. Every pass is linear in the mesh's
  * size, reads it a block at a time through the mesh's callbacks, and runs on
  * all cores for a large mesh; what it finds does not depend on how the
  * passes are cut among threads. */
@@ -95,6 +96,10 @@ static uint64_t position_hash(const double p[3])
     return h ^ (h >> 33);
 }
 
+/* What the triangles make of a vertex, found before the positions are
+ * matched: only a vertex on a closed surface is left out of the matching. */
+enum { NO_TRIANGLE, IN_TRIANGLE, ON_CLOSED_SURFACE };
+
 /* A vertex and the low bits of its position's hash. */
 typedef struct Keyed {
     uint32_t key, vertex;
@@ -120,6 +125,7 @@ enum { MAX_SLICES = 32, MIN_BUCKET = 64, MAX_BUCKET = 512 };
 typedef struct PositionMatch {
     const PtrMeshSource *mesh;
     Link *parent;
+    const atomic_uchar *state; /* a vertex's, as above */
     Keyed *keyed;    /* the buckets, one after another */
     uint32_t *chain; /* a bucket's next in its chain */
     uint32_t *head;  /* slice s, partition p at [s * partitions + p]: its
@@ -149,19 +155,31 @@ static size_t partition_of(const PositionMatch *pm, uint64_t hash)
     return pm->bits ? (size_t)(hash >> (64 - pm->bits)) : 0;
 }
 
+/* Whether vertex v is matched by position. */
+static int matched(const PositionMatch *pm, size_t v)
+{
+    return atomic_load_explicit(&pm->state[v], memory_order_relaxed) != ON_CLOSED_SURFACE;
+}
+
 /* The vertices among v .. end - 1 (at most a block of them) that can equal
- * another, with their hashes: how many. A position with a NaN equals
- * nothing, so it is left out: kept, all NaNs of one bit pattern would
- * share a hash and every one would probe past all the earlier ones. */
+ * another, with their hashes: how many; a block of closed surfaces' is not
+ * read. A position with a NaN equals nothing, so it is left out: kept, all
+ * NaNs of one bit pattern would share a hash and every one would probe past
+ * all the earlier ones. */
 static size_t hash_block(const PositionMatch *pm, size_t v, size_t end, uint64_t *hash,
                          uint32_t *vertex)
 {
     double p[BLOCK][3];
     const size_t count = end - v < BLOCK ? end - v : BLOCK;
+    size_t open = 0;
+    for (size_t i = 0; i < count; i++)
+        open += matched(pm, v + i);
+    if (!open)
+        return 0;
     pm->mesh->positions(pm->mesh->user, v, count, p);
     size_t kept = 0;
     for (size_t i = 0; i < count; i++)
-        if (!isnan(p[i][0]) && !isnan(p[i][1]) && !isnan(p[i][2])) {
+        if (matched(pm, v + i) && !isnan(p[i][0]) && !isnan(p[i][1]) && !isnan(p[i][2])) {
             hash[kept] = position_hash(p[i]);
             vertex[kept++] = (uint32_t)(v + i);
         }
@@ -318,11 +336,13 @@ static size_t keyed_room(const PositionMatch *pm)
     return pool_start(pm, pm->slices) * pm->bucket;
 }
 
-/* Joins the vertices of equal positions as planned, keyed (keyed_room of
- * them) as scratch. */
-static int unite_positions(PositionMatch *pm, Link *parent, Keyed *keyed)
+/* Joins the vertices of equal positions, but for those on closed surfaces,
+ * as planned, keyed (keyed_room of them) as scratch. */
+static int unite_positions(PositionMatch *pm, Link *parent, const atomic_uchar *state,
+                           Keyed *keyed)
 {
     pm->parent = parent;
+    pm->state = state;
     pm->keyed = keyed;
     const size_t buckets = pool_start(pm, pm->slices);
     pm->chain = malloc(buckets * sizeof *pm->chain);
@@ -348,7 +368,12 @@ typedef struct Passes {
     Link *parent; /* a vertex's parent; from flatten on, its root; from
                    * bound_vertices on, its component, UNSET if no triangle
                    * uses it */
-    Link *label;  /* UNSET, or USED for a triangle's first corner and, from
+    atomic_uchar *state; /* a vertex's: NO_TRIANGLE, IN_TRIANGLE, or from
+                          * find_closed_surfaces on, ON_CLOSED_SURFACE */
+    Link *balance; /* until the positions are matched, in label's place:
+                    * at the root of a set by index, 2 V - F of its V
+                    * vertices and F triangles (modulo 2^32) */
+    Link *label;  /* UNSET, or USED for a triangle's corner and, from
                    * flatten on, for the root of its set; from number_roots
                    * on, a root's component */
     PtrMeshSphere *spheres;
@@ -367,15 +392,21 @@ enum { USED = UNSET - 1 };
 static void start_sets(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
-    for (size_t v = from; v < to; v++)
+    for (size_t v = from; v < to; v++) {
         atomic_init(&ps->parent[v], (uint32_t)v);
+        atomic_init(&ps->state[v], NO_TRIANGLE);
+        atomic_init(&ps->balance[v], 0);
+    }
 }
 
-static void clear_labels(void *arg, size_t from, size_t to)
+static void label_used(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++)
-        atomic_init(&ps->label[v], UNSET);
+    {
+        const int used = atomic_load_explicit(&ps->state[v], memory_order_relaxed) != NO_TRIANGLE;
+        atomic_init(&ps->label[v], used ? USED : UNSET);
+    }
 }
 
 static void unite_triangles(void *arg, size_t from, size_t to)
@@ -388,7 +419,8 @@ static void unite_triangles(void *arg, size_t from, size_t to)
         for (size_t i = 0; i < count; i++) {
             unite(ps->parent, tri[i][0], tri[i][1]);
             unite(ps->parent, tri[i][0], tri[i][2]);
-            atomic_store_explicit(&ps->label[tri[i][0]], USED, memory_order_relaxed);
+            for (int k = 0; k < 3; k++)
+                atomic_store_explicit(&ps->state[tri[i][k]], IN_TRIANGLE, memory_order_relaxed);
         }
     }
 }
@@ -412,6 +444,88 @@ static void flatten(void *arg, size_t from, size_t to)
         if (root != v && link_of(ps->label, (uint32_t)v) == USED)
             atomic_store_explicit(&ps->label[root], USED, memory_order_relaxed);
     }
+}
+
+/* Additions to the balance of a run of one set's vertices or triangles (a
+ * mesh's sets mostly lie in runs), added at the run's end. */
+typedef struct Tally {
+    uint32_t root; /* UNSET before the first */
+    uint32_t sum;
+} Tally;
+
+static void end_tally(const Passes *ps, const Tally *run)
+{
+    if (run->root != UNSET)
+        atomic_fetch_add_explicit(&ps->balance[run->root], run->sum, memory_order_relaxed);
+}
+
+static void tally(const Passes *ps, Tally *run, uint32_t root, uint32_t amount)
+{
+    if (root != run->root) {
+        end_tally(ps, run);
+        *run = (Tally){ root, 0 };
+    }
+    run->sum += amount;
+}
+
+/* Each vertex its root by index, and 2 a used vertex to its root's
+ * balance. */
+static void count_vertices(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    Tally run = { .root = UNSET };
+    for (size_t v = from; v < to; v++) {
+        const uint32_t root = near_root(ps->parent, (uint32_t)v);
+        atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
+        if (atomic_load_explicit(&ps->state[v], memory_order_relaxed) != NO_TRIANGLE)
+            tally(ps, &run, root, 2);
+    }
+    end_tally(ps, &run);
+}
+
+/* Takes 1 a triangle from its root's balance. */
+static void count_triangles(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    Tally run = { .root = UNSET };
+    uint32_t tri[BLOCK][3];
+    for (size_t t = from; t < to; t += BLOCK) {
+        const size_t count = to - t < BLOCK ? to - t : BLOCK;
+        ps->mesh->triangles(ps->mesh->user, t, count, tri);
+        for (size_t i = 0; i < count; i++)
+            tally(ps, &run, link_of(ps->parent, tri[i][0]), UINT32_MAX); /* -1 */
+    }
+    end_tally(ps, &run);
+}
+
+/* A surface where every edge is shared by two triangles and that is a
+ * sphere's (genus 0) has, by Euler's formula V - E + F = 2 with E = 3 F / 2,
+ * V = F / 2 + 2: balance 4. A border (a hole, a seam split, a piece cut off
+ * a sphere) leaves V larger, so a set of balance 4 is taken as closed: no
+ * other part can belong to its sphere, and its vertices are not matched by
+ * position. (The count does not look at edges: a set that is not a simple
+ * surface, a torus with a flap, can have balance 4 too; it is then fitted
+ * alone.) */
+static void mark_closed(void *arg, size_t from, size_t to)
+{
+    const Passes *ps = arg;
+    for (size_t v = from; v < to; v++)
+        if (atomic_load_explicit(&ps->state[v], memory_order_relaxed) == IN_TRIANGLE &&
+            link_of(ps->balance, link_of(ps->parent, (uint32_t)v)) == 4)
+            atomic_store_explicit(&ps->state[v], ON_CLOSED_SURFACE, memory_order_relaxed);
+}
+
+/* The vertices of the sets by index that are closed surfaces, on closed
+ * surfaces; for a mesh of 2^31 vertices or triangles, whose balances could
+ * wrap around to 4, none. */
+static void find_closed_surfaces(Passes *ps)
+{
+    const PtrMeshSource *mesh = ps->mesh;
+    if (mesh->vertex_count >= (size_t)1 << 31 || mesh->triangle_count >= (size_t)1 << 31)
+        return;
+    ptr_parallel_ranges(ps->threads, 0, mesh->vertex_count, count_vertices, ps);
+    ptr_parallel_ranges(ps->threads, 0, mesh->triangle_count, count_triangles, ps);
+    ptr_parallel_ranges(ps->threads, 0, mesh->vertex_count, mark_closed, ps);
 }
 
 /* The roots of sets that have triangles, numbered in order (each set's root
@@ -739,24 +853,28 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
     const int threads = threads_for(mesh);
     PositionMatch pm;
     plan_partitions(&pm, mesh, threads);
-    /* The positions' keys, then the labels: one allocation, its pages
-     * mapped once. */
+    /* The balances, the positions' keys, then the labels: one allocation,
+     * its pages mapped once (keyed_room is at least a key, 8 bytes, a
+     * vertex: room for a balance or a label, 4). */
     Keyed *scratch = malloc(keyed_room(&pm) * sizeof *scratch);
     Passes ps = { .mesh = mesh, .parent = malloc(n * sizeof *ps.parent),
-                  .label = (Link *)scratch,
+                  .state = malloc(n * sizeof *ps.state),
+                  .balance = (Link *)scratch, .label = (Link *)scratch,
                   .vertex_spheres = vertex_spheres ? malloc(n * sizeof *ps.vertex_spheres) : NULL,
                   .threads = threads };
     size_t components = 0;
-    int ok = ps.parent && scratch && (!vertex_spheres || ps.vertex_spheres);
-    if (ok)
-        ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
-    ok = ok && unite_positions(&pm, ps.parent, scratch);
+    int ok = ps.parent && ps.state && scratch && (!vertex_spheres || ps.vertex_spheres);
     if (ok) {
-        ptr_parallel_ranges(threads, 0, mesh->vertex_count, clear_labels, &ps);
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, start_sets, &ps);
         ptr_parallel_ranges(threads, 0, mesh->triangle_count, unite_triangles, &ps);
+        find_closed_surfaces(&ps);
     }
+    ok = ok && unite_positions(&pm, ps.parent, ps.state, scratch);
+    if (ok)
+        ptr_parallel_ranges(threads, 0, mesh->vertex_count, label_used, &ps);
     ok = ok && fit_components(&ps, &components);
     free(ps.parent);
+    free(ps.state);
     free(scratch);
     free(ps.first);
     free(ps.bounds);

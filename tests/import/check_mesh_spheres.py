@@ -8,6 +8,12 @@ Files from tests/support/mesh_files.py, each imported with --dump-scene:
   its sphere's), and two more in a second primitive of another material;
 - unwelded: every triangle its own vertices (components by position), and
   a sphere whose hemispheres meet at y = +0 on one side, -0 on the other;
+- touching: two welded (closed) spheres meeting at a pole's position, and a
+  welded one meeting an unwelded one there: two spheres each (a closed part
+  is not matched by position);
+- seam and hemispheres: a sphere whose seam's vertices are split (open by
+  index), and one of two welded hemispheres sharing the equator's positions
+  (each open): one sphere each;
 - many: 300 unwelded spheres and two cubes over two primitives, one sphere
   split across them, enough for the components to be found on all cores;
 - quantised: normalised 16-bit and plain 8-bit positions, scaled back by the
@@ -148,6 +154,22 @@ def at_tolerance(folder):
     expect(path, want, skipped)
 
 
+def cut_open(shape, axis, cut):
+    """The shape with the triangles whose centroid lies below 0 along axis
+    given their own copies of the vertices cut selects (a seam, or a cut
+    into pieces, welded each)."""
+    verts, tris = shape
+    verts = [list(v) for v in verts]
+    copies = {}
+    out = []
+    for t in tris:
+        if sum(verts[i][axis] for i in t) < 0:
+            t = tuple(copies.setdefault(i, len(verts) + len(copies)) if cut(verts[i]) else i
+                      for i in t)
+        out.append(t)
+    return verts + [list(verts[i]) for i in sorted(copies, key=copies.get)], out
+
+
 def main():
     with tempfile.TemporaryDirectory() as folder:
         # Joined, over two primitives of materials 1 and 2.
@@ -185,6 +207,30 @@ def main():
         path = os.path.join(folder, "signed_zeros.glb")
         w.write(path)
         expect(path, [((0, 0, 0), 1, 0)], 0)
+
+        # Touching at one position (the first's north pole, the second's
+        # south pole): a welded sphere is closed by index, so it is not
+        # matched by position, neither with another closed one nor with an
+        # unwelded one; each is its own sphere.
+        for name, second in (("touching_closed", mf.uv_sphere((0, 2, 0), 1)),
+                             ("touching_open", mf.unweld(mf.uv_sphere((0, 2, 0), 1)))):
+            w = mf.Writer()
+            w.node(name, w.mesh(name, [(mf.combine(mf.uv_sphere((0, 0, 0), 1), second), 0)]))
+            path = os.path.join(folder, name + ".glb")
+            w.write(path)
+            expect(path, [((0, 0, 0), 1, 0), ((0, 2, 0), 1, 0)], 0)
+
+        # Open by index, so still matched by position: the seam's vertices
+        # split (one part with a border), and two welded hemispheres sharing
+        # the equator's positions (two parts): one sphere each.
+        seam = cut_open(mf.uv_sphere((0, 0, 0), 1), 2, lambda v: v[2] == 0 and v[0] > 0)
+        halves = cut_open(mf.uv_sphere((0, 0, 0), 1), 1, lambda v: v[1] == 0)
+        for name, shape in (("seam", seam), ("hemispheres", halves)):
+            w = mf.Writer()
+            w.node(name, w.mesh(name, [(shape, 0)]))
+            path = os.path.join(folder, name + ".glb")
+            w.write(path)
+            expect(path, [((0, 0, 0), 1, 0)], 0)
 
         # Many: enough vertices and triangles that the components are found
         # on all cores; unwelded, over two primitives, with a cube among the
