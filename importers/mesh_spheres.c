@@ -96,9 +96,10 @@ static uint64_t position_hash(const double p[3])
     return h ^ (h >> 33);
 }
 
-/* What the triangles make of a vertex, found before the positions are
- * matched: only a vertex on a closed surface is left out of the matching. */
-enum { NO_TRIANGLE, IN_TRIANGLE, ON_CLOSED_SURFACE };
+/* What the triangles make of a vertex: a triangle's first corner (so its
+ * set has triangles), or, found before the positions are matched, on a
+ * closed surface (so it is left out of the matching); else neither. */
+enum { NEITHER, FIRST_CORNER, ON_CLOSED_SURFACE };
 
 /* A vertex and the low bits of its position's hash. */
 typedef struct Keyed {
@@ -368,14 +369,15 @@ typedef struct Passes {
     Link *parent; /* a vertex's parent; from flatten on, its root; from
                    * bound_vertices on, its component, UNSET if no triangle
                    * uses it */
-    atomic_uchar *state; /* a vertex's: NO_TRIANGLE, IN_TRIANGLE, or from
+    atomic_uchar *state; /* a vertex's: NEITHER, FIRST_CORNER, or from
                           * find_closed_surfaces on, ON_CLOSED_SURFACE */
     Link *balance; /* until the positions are matched, in label's place:
                     * at the root of a set by index, 2 V - F of its V
                     * vertices and F triangles (modulo 2^32) */
-    Link *label;  /* UNSET, or USED for a triangle's corner and, from
-                   * flatten on, for the root of its set; from number_roots
-                   * on, a root's component */
+    Link *label;  /* UNSET, or USED for a triangle's first corner or a
+                   * vertex on a closed surface and, from flatten on, for
+                   * the root of its set; from number_roots on, a root's
+                   * component */
     PtrMeshSphere *spheres;
     atomic_size_t *first;   /* a component's first triangle */
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
@@ -394,7 +396,7 @@ static void start_sets(void *arg, size_t from, size_t to)
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++) {
         atomic_init(&ps->parent[v], (uint32_t)v);
-        atomic_init(&ps->state[v], NO_TRIANGLE);
+        atomic_init(&ps->state[v], NEITHER);
         atomic_init(&ps->balance[v], 0);
     }
 }
@@ -404,7 +406,7 @@ static void label_used(void *arg, size_t from, size_t to)
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++)
     {
-        const int used = atomic_load_explicit(&ps->state[v], memory_order_relaxed) != NO_TRIANGLE;
+        const int used = atomic_load_explicit(&ps->state[v], memory_order_relaxed) != NEITHER;
         atomic_init(&ps->label[v], used ? USED : UNSET);
     }
 }
@@ -419,8 +421,7 @@ static void unite_triangles(void *arg, size_t from, size_t to)
         for (size_t i = 0; i < count; i++) {
             unite(ps->parent, tri[i][0], tri[i][1]);
             unite(ps->parent, tri[i][0], tri[i][2]);
-            for (int k = 0; k < 3; k++)
-                atomic_store_explicit(&ps->state[tri[i][k]], IN_TRIANGLE, memory_order_relaxed);
+            atomic_store_explicit(&ps->state[tri[i][0]], FIRST_CORNER, memory_order_relaxed);
         }
     }
 }
@@ -468,8 +469,9 @@ static void tally(const Passes *ps, Tally *run, uint32_t root, uint32_t amount)
     run->sum += amount;
 }
 
-/* Each vertex its root by index, and 2 a used vertex to its root's
- * balance. */
+/* Each vertex its root by index, and 2 to its root's balance (a set by
+ * index is a vertex no triangle uses, of balance 2, or triangles' corners
+ * only). */
 static void count_vertices(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
@@ -477,8 +479,7 @@ static void count_vertices(void *arg, size_t from, size_t to)
     for (size_t v = from; v < to; v++) {
         const uint32_t root = near_root(ps->parent, (uint32_t)v);
         atomic_store_explicit(&ps->parent[v], root, memory_order_relaxed);
-        if (atomic_load_explicit(&ps->state[v], memory_order_relaxed) != NO_TRIANGLE)
-            tally(ps, &run, root, 2);
+        tally(ps, &run, root, 2);
     }
     end_tally(ps, &run);
 }
@@ -510,8 +511,7 @@ static void mark_closed(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++)
-        if (atomic_load_explicit(&ps->state[v], memory_order_relaxed) == IN_TRIANGLE &&
-            link_of(ps->balance, link_of(ps->parent, (uint32_t)v)) == 4)
+        if (link_of(ps->balance, link_of(ps->parent, (uint32_t)v)) == 4)
             atomic_store_explicit(&ps->state[v], ON_CLOSED_SURFACE, memory_order_relaxed);
 }
 
