@@ -20,9 +20,10 @@ int __wrap_ptr_online_cpus(void)
     return script[at];
 }
 
-/* Octahedra along x, every other one welded (6 vertices shared by index),
- * the others unwelded (every triangle its own 3 vertices, joined by
- * position): about 10^5 vertices and triangles. */
+/* Octahedra along x, every other one welded (6 vertices shared by index:
+ * closed, so left out of the position matching), the others unwelded
+ * (every triangle its own 3 vertices, joined by position): about 10^5
+ * vertices and triangles. */
 enum { OCTAHEDRA = 4000, WELDED_VERTICES = 6, UNWELDED_VERTICES = 24, FACES = 8 };
 
 typedef struct Mesh {
