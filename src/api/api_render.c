@@ -1,5 +1,5 @@
-/* The public API's renders and frames (include/ptr/ptr.h), through the
- * command line's steps (api/pipeline.h, api/output.h). */
+/* The public API's renders and frames (include/ptr/ptr.h), over the
+ * entries the command line renders and writes through (api_internal.h). */
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,22 +8,9 @@
 #include "api/output.h"
 #include "builder.h"
 
-struct PtrFrame {
-    int width, height, channels;
-    /* rgb: the colour shown, denoised if asked for. */
-    PtrFrameBuffers buffers;
-    float *rgba;        /* the colour with alpha, with a transparent background; else NULL */
-    char *scene_name;   /* info.scene_path */
-    PtrOutputInfo info; /* the metadata of a saved image, without the pixels */
-};
-
-/* What a render's options choose, read and checked. */
+/* What a render's options choose beyond the request: the sky and the
+ * denoiser, which the request points to. */
 typedef struct Choices {
-    PtrKernel kernel;
-    PtrCpuLevel level;
-    PtrIntegrator integrator;
-    PtrAccelChoice accel;
-    PtrSamplerKind sampler;
     int has_sky;
     PtrSky sky;
     int denoise;
@@ -45,27 +32,37 @@ static PtrResult option_error(const char *name, const PtrError *problem, PtrErro
     return ptr_error_set(err, PTR_ERR_USAGE, "%s: %s", name, problem->message);
 }
 
-static PtrResult read_choices(const PtrContext *context, const PtrRenderOptions *o, Choices *c,
-                              PtrError *err)
+/* The request the options make, read and checked (its sky, camera and
+ * denoiser left for the render to point to). */
+static PtrResult read_request(const PtrContext *context, const PtrRenderOptions *o,
+                              PtrRenderRequest *r, Choices *c, PtrError *err)
 {
     PtrError problem;
-    *c = (Choices){ .level = context->cpu_level };
+    *c = (Choices){ 0 };
+    *r = (PtrRenderRequest){
+        .width = o->width, .height = o->height, .divisor = 1,
+        .first_sample = o->first_sample, .samples = o->samples, .seed = o->seed,
+        .max_depth = o->max_depth, .threads = o->threads ? o->threads : context->threads,
+        .level = context->cpu_level, .direct_lighting = o->direct_lighting ? PTR_ON : PTR_OFF,
+        .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
+        .transparent = o->transparent, .passes = o->passes,
+    };
     if (o->kernel && strcmp(o->kernel, "c") && strcmp(o->kernel, "asm"))
         return ptr_error_set(err, PTR_ERR_USAGE, "kernel: '%s' is not c or asm", o->kernel);
-    c->kernel = !o->kernel ? PTR_KERNEL_AUTO : o->kernel[0] == 'c' ? PTR_KERNEL_C : PTR_KERNEL_ASM;
+    r->kernel = !o->kernel ? PTR_KERNEL_AUTO : o->kernel[0] == 'c' ? PTR_KERNEL_C : PTR_KERNEL_ASM;
     PtrCpuLevel cap;
     if (o->cpu_cap && ptr_cpu_parse_level(o->cpu_cap, &cap, &problem) != PTR_OK)
         return option_error("cpu_cap", &problem, err);
-    if (o->cpu_cap && cap < c->level)
-        c->level = cap;
-    if (o->integrator && ptr_integrator_parse(o->integrator, &c->integrator, &problem) != PTR_OK)
+    if (o->cpu_cap && cap < r->level)
+        r->level = cap;
+    if (o->integrator && ptr_integrator_parse(o->integrator, &r->integrator, &problem) != PTR_OK)
         return option_error("integrator", &problem, err);
-    if (!ptr_integrator_available(c->integrator, c->level))
+    if (!ptr_integrator_available(r->integrator, r->level))
         return ptr_error_set(err, PTR_ERR_USAGE, "integrator: %s is not available at CPU level %s",
-                             ptr_integrator_name(c->integrator), ptr_cpu_level_name(c->level));
-    if (o->accel && ptr_accel_parse(o->accel, &c->accel, &problem) != PTR_OK)
+                             ptr_integrator_name(r->integrator), ptr_cpu_level_name(r->level));
+    if (o->accel && ptr_accel_parse(o->accel, &r->accel, &problem) != PTR_OK)
         return option_error("accel", &problem, err);
-    if (o->sampler && ptr_sampler_parse(o->sampler, &c->sampler, &problem) != PTR_OK)
+    if (o->sampler && ptr_sampler_parse(o->sampler, &r->sampler, &problem) != PTR_OK)
         return option_error("sampler", &problem, err);
     c->has_sky = o->sky != NULL;
     if (o->sky && ptr_sky_parse(o->sky, &c->sky, &problem) != PTR_OK)
@@ -73,6 +70,7 @@ static PtrResult read_choices(const PtrContext *context, const PtrRenderOptions 
     c->denoise = o->denoise != NULL;
     if (o->denoise && ptr_denoise_quality_parse(o->denoise, &c->denoise_quality, &problem) != PTR_OK)
         return option_error("denoise", &problem, err);
+    r->denoise_quality = o->denoise;
     /* The command line's ranges; 0 is the scene's size and the context's
      * threads. */
     const struct {
@@ -120,17 +118,17 @@ static PtrResult camera_at(const PtrCameraDesc *desc, const double origin[3], Pt
     return PTR_OK;
 }
 
-/* The scene's kernels and tree for these choices, built unless already. */
-static PtrResult prepare(PtrSceneHandle *h, const Choices *c, int threads, PtrError *err)
+/* The scene's kernels and tree for this request, built unless already. */
+static PtrResult prepare(PtrSceneHandle *h, const PtrRenderRequest *r, PtrError *err)
 {
-    const PtrPreparedFor wanted = { c->kernel, c->level, c->integrator, c->accel };
+    const PtrPreparedFor wanted = { r->kernel, r->level, r->integrator, r->accel };
     if (h->prepared_valid && !memcmp(&wanted, &h->prepared_for, sizeof wanted))
         return PTR_OK;
     if (h->prepared_valid)
         ptr_prepared_free(&h->prepared);
     h->prepared_valid = 0;
-    PtrResult res = ptr_prepare_render(&h->scene, c->kernel, c->level, c->integrator, c->accel,
-                                       threads, h->name, &h->prepared, err);
+    PtrResult res = ptr_prepare_render(&h->scene, r->kernel, r->level, r->integrator, r->accel,
+                                       r->threads, h->name, &h->prepared, err);
     if (res != PTR_OK)
         return res;
     if (h->hash_valid)
@@ -165,101 +163,174 @@ static void report_progress(void *user, const PtrProgress *p)
         progress->stop = 1;
 }
 
-/* Makes the frame's colour the denoised one, and with alpha its RGBA. */
-static PtrResult finish_frame(PtrFrame *f, PtrError *err)
+/* The settings of the request for the scene, its size chosen; PTR_ERR_USAGE
+ * if its region lies outside the image. */
+static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r,
+                              PtrRenderSettings *settings, PtrError *err)
 {
-    const PtrImageLayout layout = { f->width, f->height, 0, 0, f->width, f->height };
-    size_t pixels = (size_t)f->width * (size_t)f->height;
-    if (f->info.denoiser) {
-        float *denoised;
-        PtrResult res = ptr_output_denoise(f->scene_name, &layout, f->buffers.rgb, &f->info,
-                                           &denoised, err);
-        if (res != PTR_OK)
-            return res;
-        free(f->buffers.rgb);
-        f->buffers.rgb = denoised;
-        /* Saved as it is: it is denoised already. */
-        f->info.denoiser = NULL;
+    *settings = (PtrRenderSettings){
+        .region = r->region, .seed = r->seed, .max_depth = r->max_depth, .threads = r->threads,
+        .sampler = r->sampler, .direct_lighting = r->direct_lighting,
+        .noise_threshold = r->noise_threshold, .min_samples = r->min_samples,
+        .integrator = h->prepared.integrator, .transparent = r->transparent,
+        .passes = r->passes || r->denoiser, /* the denoiser's guides */
+    };
+    ptr_choose_size(&h->scene, r->width, r->height, r->divisor, &settings->width,
+                    &settings->height);
+    if (ptr_render_region(settings).x1 == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "--region %d,%d,%d,%d lies outside the %dx%d image",
+                             r->region.x0, r->region.y0, r->region.x1, r->region.y1,
+                             settings->width, settings->height);
+    return PTR_OK;
+}
+
+/* Renders into f, the scene's tree ready, with this render's sky and camera
+ * in the scene. */
+static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r,
+                             const PtrRenderHooks *hooks, PtrFrame *f, PtrError *err)
+{
+    PtrRenderSettings settings;
+    PtrResult res = settings_for(h, r, &settings, err);
+    if (res != PTR_OK)
+        return res;
+    const PtrRegion region = ptr_render_region(&settings);
+    f->layout = (PtrImageLayout){ region.x1 - region.x0, region.y1 - region.y0, region.x0,
+                                  region.y0, settings.width, settings.height };
+    f->channels = r->transparent ? 4 : 3;
+    PtrProgressiveOptions passes = {
+        .first_sample = r->first_sample, .samples = r->samples, .time_budget = r->time_budget,
+        .stop = hooks->stop, .report = hooks->report, .user = hooks->user,
+    };
+    const PtrAccel *accel = &h->prepared.accel;
+    if (hooks->begin)
+        hooks->begin(hooks->begin_user, &h->scene, accel, &settings, &passes);
+    res = ptr_render_frame(&h->scene, accel, &settings, &passes, h->name, &f->buffers, &f->done,
+                           err);
+    if (res != PTR_OK)
+        return res;
+    f->info = (PtrOutputInfo){
+        .scene_path = f->scene_name, .scene_hash = h->prepared.scene_hash,
+        .kernel = accel->isect.name, .accel = ptr_accel_name(accel),
+        .spheres = h->scene.spheres.count, .import_seconds = h->import_seconds,
+        .build_seconds = accel->build_seconds, .sample_first = r->first_sample,
+        .samples = f->done.samples_done, .interrupted = f->done.stopped, .seed = r->seed,
+        .max_depth = r->max_depth, .sampler = ptr_sampler_name(r->sampler),
+        .direct_lighting = r->direct_lighting == PTR_ON,
+        .noise_threshold = r->noise_threshold, .min_samples = r->min_samples,
+        .sample_counts = f->buffers.sample_counts, .albedo = f->buffers.albedo,
+        .normal = f->buffers.normal, .alpha = f->buffers.alpha, .denoiser = r->denoiser,
+        .denoise_quality = r->denoise_quality, .threads = r->threads,
+        .render_seconds = f->done.stats.seconds,
+    };
+    return PTR_OK;
+}
+
+PtrResult ptr_api_render(PtrSceneHandle *h, const PtrRenderRequest *r,
+                         const PtrRenderHooks *hooks, PtrFrame **out, PtrError *err)
+{
+    PtrResult res = prepare(h, r, err);
+    if (res != PTR_OK)
+        return res;
+    PtrFrame *f = calloc(1, sizeof *f);
+    if (!f || !(f->scene_name = strdup(h->name))) {
+        free(f);
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", h->name);
     }
-    if (f->buffers.alpha) {
-        f->rgba = malloc(pixels * 4 * sizeof *f->rgba);
-        if (!f->rgba)
-            return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", f->scene_name);
-        for (size_t p = 0; p < pixels; p++) {
-            memcpy(&f->rgba[4 * p], &f->buffers.rgb[3 * p], 3 * sizeof *f->rgba);
-            f->rgba[4 * p + 3] = f->buffers.alpha[p];
-        }
+    /* This render's sky and camera, the scene's own kept for the next. */
+    const PtrSky sky = h->scene.sky;
+    const PtrCamera camera = h->scene.camera;
+    if (r->sky)
+        h->scene.sky = *r->sky;
+    if (r->camera)
+        h->scene.camera = *r->camera;
+    res = render_into(h, r, hooks, f, err);
+    h->scene.sky = sky;
+    h->scene.camera = camera;
+    if (res != PTR_OK) {
+        ptr_frame_free(f);
+        return res;
+    }
+    *out = f;
+    return PTR_OK;
+}
+
+PtrResult ptr_api_frame_finish(PtrFrame *f, PtrError *err)
+{
+    if (!f->info.denoiser)
+        return PTR_OK;
+    float *denoised;
+    PtrResult res = ptr_output_denoise(f->scene_name, &f->layout, f->buffers.rgb, &f->info,
+                                       &denoised, err);
+    if (res != PTR_OK)
+        return res;
+    f->noisy = f->buffers.rgb;
+    f->buffers.rgb = denoised;
+    f->info.noisy = f->noisy;
+    f->info.denoiser = NULL; /* saved as it is: it is denoised already */
+    return PTR_OK;
+}
+
+PtrResult ptr_api_frame_write(PtrImageLoader *images, const char *path, const PtrFrame *frame,
+                              const PtrOutputSettings *output, PtrError *err)
+{
+    PtrOutputInfo info = frame->info;
+    info.output = *output;
+    return ptr_output_write(images, path, &frame->layout, frame->buffers.rgb, &info, err);
+}
+
+/* The frame's colour with alpha, for ptr_frame_pixels, with a transparent
+ * background. */
+static PtrResult make_rgba(PtrFrame *f, PtrError *err)
+{
+    if (!f->buffers.alpha)
+        return PTR_OK;
+    const size_t pixels = (size_t)f->layout.width * (size_t)f->layout.height;
+    f->rgba = malloc(pixels * 4 * sizeof *f->rgba);
+    if (!f->rgba)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", f->scene_name);
+    for (size_t p = 0; p < pixels; p++) {
+        memcpy(&f->rgba[4 * p], &f->buffers.rgb[3 * p], 3 * sizeof *f->rgba);
+        f->rgba[4 * p + 3] = f->buffers.alpha[p];
     }
     return PTR_OK;
 }
 
-/* Renders into a new frame, the choices read. */
+/* Renders into a new frame as the options say, read into request and
+ * choices: cancelled by progress, finished and with its RGBA. */
 static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderOptions *o,
-                        const Choices *c, Progress *progress, PtrFrame **out, PtrError *err)
+                        PtrRenderRequest *request, const Choices *c, Progress *progress,
+                        PtrFrame **out, PtrError *err)
 {
-    const int threads = o->threads ? o->threads : context->threads;
     if (c->denoise) {
         PtrResult res = denoiser(context, c->denoise_quality, err);
         if (res != PTR_OK)
             return res;
+        request->denoiser = context->denoisers[c->denoise_quality];
     }
-    PtrCamera camera = h->scene.camera;
-    PtrResult res = o->camera ? camera_at(o->camera, h->scene.origin, &camera, err) : PTR_OK;
-    if (res == PTR_OK)
-        res = prepare(h, c, threads, err);
+    PtrCamera camera;
+    if (o->camera) {
+        PtrResult res = camera_at(o->camera, h->scene.origin, &camera, err);
+        if (res != PTR_OK)
+            return res;
+        request->camera = &camera;
+    }
+    if (c->has_sky)
+        request->sky = &c->sky;
+    const PtrRenderHooks hooks = {
+        .stop = &progress->stop, .report = progress->callback ? report_progress : NULL,
+        .user = progress,
+    };
+    PtrFrame *f;
+    PtrResult res = ptr_api_render(h, request, &hooks, &f, err);
     if (res != PTR_OK)
         return res;
-    PtrRenderSettings settings = {
-        .seed = o->seed, .max_depth = o->max_depth, .threads = threads, .sampler = c->sampler,
-        .direct_lighting = o->direct_lighting ? PTR_ON : PTR_OFF,
-        .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = h->prepared.integrator, .transparent = o->transparent,
-        .passes = o->passes || c->denoise, /* the denoiser's guides */
-    };
-    /* This render's sky and camera, the scene's own kept for the next. */
-    const PtrSky sky = h->scene.sky;
-    const PtrCamera scene_camera = h->scene.camera;
-    if (c->has_sky)
-        h->scene.sky = c->sky;
-    h->scene.camera = camera;
-    ptr_choose_size(&h->scene, o->width, o->height, 1, &settings.width, &settings.height);
-    const PtrProgressiveOptions passes = {
-        .first_sample = o->first_sample, .samples = o->samples, .stop = &progress->stop,
-        .report = progress->callback ? report_progress : NULL, .user = progress,
-    };
-    PtrFrame *f = calloc(1, sizeof *f);
-    PtrProgressiveResult done = { 0 };
-    if (!f || !(f->scene_name = strdup(h->name)))
-        res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", h->name);
-    else
-        res = ptr_render_frame(&h->scene, &h->prepared.accel, &settings, &passes, h->name,
-                               &f->buffers, &done, err);
-    h->scene.sky = sky;
-    h->scene.camera = scene_camera;
-    if (!f)
-        return res;
-    f->width = settings.width;
-    f->height = settings.height;
-    f->channels = o->transparent ? 4 : 3;
-    f->info = (PtrOutputInfo){
-        .scene_path = f->scene_name, .scene_hash = h->prepared.scene_hash,
-        .kernel = h->prepared.accel.isect.name, .accel = ptr_accel_name(&h->prepared.accel),
-        .spheres = h->scene.spheres.count, .import_seconds = h->import_seconds,
-        .build_seconds = h->prepared.accel.build_seconds, .sample_first = o->first_sample,
-        .samples = done.samples_done, .seed = o->seed, .max_depth = o->max_depth,
-        .sampler = ptr_sampler_name(c->sampler), .direct_lighting = o->direct_lighting != 0,
-        .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .sample_counts = f->buffers.sample_counts, .albedo = f->buffers.albedo,
-        .normal = f->buffers.normal, .alpha = f->buffers.alpha,
-        .denoiser = c->denoise ? context->denoisers[c->denoise_quality] : NULL,
-        .threads = threads,
-        .render_seconds = done.stats.seconds,
-    };
-    if (res == PTR_OK && done.stopped)
+    if (f->done.stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED, "%s: cancelled after %u of %u samples",
-                            h->name, done.samples_done, o->samples);
+                            h->name, f->done.samples_done, o->samples);
     if (res == PTR_OK)
-        res = finish_frame(f, err);
+        res = ptr_api_frame_finish(f, err);
+    if (res == PTR_OK)
+        res = make_rgba(f, err);
     if (res != PTR_OK) {
         ptr_frame_free(f);
         return res;
@@ -273,18 +344,19 @@ PtrStatus ptr_scene_render(PtrContext *context, PtrSceneHandle *scene,
                            void *user, PtrFrame **out, PtrErrorInfo *err)
 {
     PtrError e;
+    PtrRenderRequest request;
     Choices choices;
     Progress progress = { callback, user, 0 };
     if (!context || !scene || !options || !out)
         return ptr_api_usage(err, "render: context, scene, options and out are needed, not NULL");
-    if (read_choices(context, options, &choices, &e) != PTR_OK ||
-        render(context, scene, options, &choices, &progress, out, &e) != PTR_OK)
+    if (read_request(context, options, &request, &choices, &e) != PTR_OK ||
+        render(context, scene, options, &request, &choices, &progress, out, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
     return PTR_STATUS_OK;
 }
 
-int ptr_frame_width(const PtrFrame *frame) { return frame ? frame->width : 0; }
-int ptr_frame_height(const PtrFrame *frame) { return frame ? frame->height : 0; }
+int ptr_frame_width(const PtrFrame *frame) { return frame ? frame->layout.width : 0; }
+int ptr_frame_height(const PtrFrame *frame) { return frame ? frame->layout.height : 0; }
 int ptr_frame_channels(const PtrFrame *frame) { return frame ? frame->channels : 0; }
 const float *ptr_frame_pixels(const PtrFrame *frame)
 {
@@ -330,8 +402,7 @@ PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels
     }
     if (channels == 4)
         memcpy(f->rgba, pixels, pixel_count * 4 * sizeof *pixels);
-    f->width = width;
-    f->height = height;
+    f->layout = (PtrImageLayout){ width, height, 0, 0, width, height };
     f->channels = channels;
     f->info = (PtrOutputInfo){
         .scene_path = f->scene_name, .kernel = "", .accel = "",
@@ -347,18 +418,11 @@ PtrStatus ptr_frame_save(PtrContext *context, const char *path, const PtrFrame *
     PtrError e;
     if (!context || !path || !frame)
         return ptr_api_usage(err, "save: context, path and frame are needed, not NULL");
-    const int exr = ptr_image_is_exr(path);
-    PtrOutputInfo info = frame->info;
-    info.color = context->color;
-    /* Only EXR names its channels: the passes go nowhere else. */
-    if (!exr)
-        info.albedo = info.normal = info.sample_counts = NULL;
-    const PtrImageLayout layout = { frame->width, frame->height, 0, 0, frame->width,
-                                    frame->height };
-    if (ptr_output_check(context->images, path, PTR_DEPTH_DEFAULT, info.alpha != NULL, 0, &e) !=
-            PTR_OK ||
-        ptr_color_select(context->color, NULL, view, NULL, 0.0f, &e) != PTR_OK ||
-        ptr_output_write(context->images, path, &layout, frame->buffers.rgb, &info, &e) != PTR_OK)
+    const PtrOutputSettings output = { .color = context->color };
+    if (ptr_output_check(context->images, path, output.depth, frame->buffers.alpha != NULL, 0,
+                         &e) != PTR_OK ||
+        ptr_color_select(context->color, NULL, view, NULL, output.exposure, &e) != PTR_OK ||
+        ptr_api_frame_write(context->images, path, frame, &output, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
     return PTR_STATUS_OK;
 }
@@ -368,6 +432,7 @@ void ptr_frame_free(PtrFrame *frame)
     if (!frame)
         return;
     ptr_frame_buffers_free(&frame->buffers);
+    free(frame->noisy);
     free(frame->rgba);
     free(frame->scene_name);
     free(frame);

@@ -108,21 +108,28 @@ void ptr_context_free(PtrContext *context)
     free(context);
 }
 
-/* A new handle for scene, named name; on failure the scene is freed. */
-static PtrStatus hand_scene(PtrScene *scene, const char *name, double import_seconds,
-                            PtrSceneHandle **out, PtrErrorInfo *err)
+PtrResult ptr_api_scene_adopt(PtrScene *scene, const char *name, double import_seconds,
+                              PtrSceneHandle **out, PtrError *err)
 {
     PtrSceneHandle *h = calloc(1, sizeof *h);
     if (!h || !(h->name = strdup(name))) {
         free(h);
         ptr_scene_free(scene);
-        PtrError e;
-        ptr_error_set(&e, PTR_ERR_NOMEM, "%s: out of memory", name);
-        return ptr_api_fail(err, &e);
+        return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", name);
     }
     h->scene = *scene;
     h->import_seconds = import_seconds;
     *out = h;
+    return PTR_OK;
+}
+
+/* The public side of ptr_api_scene_adopt. */
+static PtrStatus hand_scene(PtrScene *scene, const char *name, double import_seconds,
+                            PtrSceneHandle **out, PtrErrorInfo *err)
+{
+    PtrError e;
+    if (ptr_api_scene_adopt(scene, name, import_seconds, out, &e) != PTR_OK)
+        return ptr_api_fail(err, &e);
     return PTR_STATUS_OK;
 }
 

@@ -160,14 +160,15 @@ PtrResult ptr_output_denoise(const char *path, const PtrImageLayout *layout, con
 PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrImageLayout *layout,
                            const float *rgb, const PtrOutputInfo *info, PtrError *err)
 {
-    PtrDepth depth = resolve_depth(path, info->depth);
+    const PtrOutputSettings *output = &info->output;
+    PtrDepth depth = resolve_depth(path, output->depth);
     int is_float = depth == PTR_DEPTH_HALF || depth == PTR_DEPTH_FLOAT;
-    int display_referred = !is_float || info->bake_view;
+    int display_referred = !is_float || output->bake_view;
     size_t pixels = (size_t)layout->width * (size_t)layout->height;
 
     /* From here on rgb is the colour the file shows; an EXR keeps the noisy
      * one beside it. */
-    const float *noisy = NULL;
+    const float *noisy = info->noisy;
     float *denoised = NULL;
     if (info->denoiser) {
         if (!info->albedo || !info->normal)
@@ -192,7 +193,7 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         memcpy(viewed, rgb, pixels * 3 * sizeof *viewed);
         scale_by_alpha(viewed, alpha, pixels, 0);
         PtrError color_err;
-        if (display_referred && ptr_color_apply(info->color, viewed, pixels, &color_err) != PTR_OK) {
+        if (display_referred && ptr_color_apply(output->color, viewed, pixels, &color_err) != PTR_OK) {
             free(viewed);
             free(denoised);
             return ptr_error_set(err, color_err.code, "%s: %s", path, color_err.message);
@@ -206,8 +207,8 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
     snprintf(threshold, sizeof threshold, "%g", info->noise_threshold);
     snprintf(seed, sizeof seed, "%" PRIu64, info->seed);
     snprintf(hash, sizeof hash, "%016" PRIx64, info->scene_hash);
-    snprintf(exposure, sizeof exposure, "%g", info->exposure);
-    const char *space = display_referred ? ptr_color_view_space(info->color) : "lin_rec709";
+    snprintf(exposure, sizeof exposure, "%g", output->exposure);
+    const char *space = display_referred ? ptr_color_view_space(output->color) : "lin_rec709";
     const PtrImageAttr attrs[] = {
         { .name = "Software", .type = PTR_ATTR_STRING, .string_value = "ptr " PTR_VERSION },
         { .name = "oiio:ColorSpace", .type = PTR_ATTR_STRING, .string_value = space },
@@ -235,19 +236,19 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         { .name = "ptr:render_seconds", .type = PTR_ATTR_FLOAT,
           .float_value = (float)info->render_seconds },
         { .name = "ptr:ocio_config", .type = PTR_ATTR_STRING,
-          .string_value = ptr_color_source(info->color) },
+          .string_value = ptr_color_source(output->color) },
         /* What the pixels went through (when display-referred) or would go
          * through to be seen as intended. */
-        { .name = "ptr:display", .type = PTR_ATTR_STRING, .string_value = ptr_color_display(info->color) },
-        { .name = "ptr:view", .type = PTR_ATTR_STRING, .string_value = ptr_color_view(info->color) },
-        { .name = "ptr:look", .type = PTR_ATTR_STRING, .string_value = ptr_color_look(info->color) },
+        { .name = "ptr:display", .type = PTR_ATTR_STRING, .string_value = ptr_color_display(output->color) },
+        { .name = "ptr:view", .type = PTR_ATTR_STRING, .string_value = ptr_color_view(output->color) },
+        { .name = "ptr:look", .type = PTR_ATTR_STRING, .string_value = ptr_color_look(output->color) },
         { .name = "ptr:exposure", .type = PTR_ATTR_STRING, .string_value = exposure },
-        { .name = "oiio:dither", .type = PTR_ATTR_INT, .int_value = info->dither ? 1 : 0 },
+        { .name = "oiio:dither", .type = PTR_ATTR_INT, .int_value = output->dither ? 1 : 0 },
         /* Last, and only in a denoised image's header: the others' stay as
          * they were. */
         { .name = "ptr:denoised", .type = PTR_ATTR_STRING, .string_value = info->denoise_quality },
     };
-    const size_t attr_count = sizeof attrs / sizeof attrs[0] - (info->denoiser ? 0 : 1);
+    const size_t attr_count = sizeof attrs / sizeof attrs[0] - (noisy ? 0 : 1);
     static const PtrPixelFormat pixel_formats[] = {
         [PTR_DEPTH_8] = PTR_PIXEL_UINT8, [PTR_DEPTH_16] = PTR_PIXEL_UINT16,
         [PTR_DEPTH_HALF] = PTR_PIXEL_HALF, [PTR_DEPTH_FLOAT] = PTR_PIXEL_FLOAT,

@@ -20,6 +20,17 @@ typedef enum PtrDepth {
     PTR_DEPTH_FLOAT,
 } PtrDepth;
 
+/* How an image is stored and shown: the output's options (--depth,
+ * --dither, --bake-view; --display, --view, --look and --exposure through
+ * color). */
+typedef struct PtrOutputSettings {
+    PtrDepth depth;
+    const PtrColor *color; /* the display, view, look and exposure in force */
+    float exposure;        /* stops, as given to ptr_color_select (for metadata) */
+    int bake_view;         /* float depths too get the display-referred image */
+    int dither;            /* 8-bit: dither before rounding */
+} PtrOutputSettings;
+
 typedef struct PtrOutputInfo {
     const char *scene_path;
     uint64_t scene_hash;   /* ptr_scene_hash: merge refuses parts of other scenes */
@@ -43,17 +54,16 @@ typedef struct PtrOutputInfo {
     /* With a denoiser (and both passes), the file gets the denoised colour,
      * and an EXR the noisy one too, as a layer. */
     const PtrDenoiser *denoiser;
-    const char *denoise_quality; /* its name, for the metadata */
+    /* Without a denoiser: the colour before denoising, when the colour
+     * given is denoised already, for an EXR's layer (NULL: not denoised). */
+    const float *noisy;
+    const char *denoise_quality; /* the denoiser's name, for the metadata */
     int threads;           /* the denoiser's; 0: one per CPU */
     /* Per pixel, the share of its samples that were covered (may be NULL):
      * the image's alpha, the RGB given then premultiplied by it. */
     const float *alpha;
     double render_seconds;
-    PtrDepth depth;
-    const PtrColor *color; /* the display, view, look and exposure in force */
-    float exposure;        /* stops, as given to ptr_color_select (for metadata) */
-    int bake_view;         /* float depths too get the display-referred image */
-    int dither;            /* 8-bit: dither before rounding */
+    PtrOutputSettings output;
 } PtrOutputInfo;
 
 /* Parses "8", "16", "half" or "float"; PTR_ERR_USAGE for anything else. */

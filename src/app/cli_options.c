@@ -523,3 +523,8 @@ PtrImportOptions ptr_options_import(const PtrOptions *o, PtrStrings *dependencie
         .textures = ptr_texture_decoder(o->images),
     };
 }
+
+PtrOutputSettings ptr_options_output(const PtrOptions *o, const PtrColor *color)
+{
+    return (PtrOutputSettings){ o->depth, color, o->exposure, o->bake_view, o->dither };
+}

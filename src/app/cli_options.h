@@ -107,6 +107,10 @@ typedef struct PtrOptions {
 /* What the importers need of the options. */
 PtrImportOptions ptr_options_import(const PtrOptions *options, PtrStrings *dependencies);
 
+/* The output's settings the options give, color being the run's
+ * configuration with their display, view, look and exposure selected. */
+PtrOutputSettings ptr_options_output(const PtrOptions *options, const PtrColor *color);
+
 /* Parses argv: PTR_OK, with options->print saying whether to print something
  * instead of rendering, else PTR_ERR_USAGE with err saying what is wrong. */
 PtrResult ptr_options_parse(int argc, char **argv, PtrOptions *options, PtrError *err);

@@ -31,11 +31,11 @@ static PtrResult write_bar(const PtrOptions *o, const PtrColormap *map, const ch
         }
     }
     const PtrImageLayout layout = { BAR_WIDTH, BAR_HEIGHT, 0, 0, BAR_WIDTH, BAR_HEIGHT };
-    const PtrOutputInfo info = {
+    PtrOutputInfo info = {
         .scene_path = scene_path, .kernel = "", .accel = "", .sampler = "",
-        .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
-        .dither = o->dither,
+        .output = ptr_options_output(o, color),
     };
+    info.output.depth = PTR_DEPTH_DEFAULT;
     PtrResult res = ptr_output_write(o->images, o->color_bar, &layout, rgb, &info, err);
     free(rgb);
     return res;

@@ -3,10 +3,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/api_internal.h"
 #include "app/color_by.h"
 #include "app/live_view.h"
-#include "api/output.h"
-#include "api/pipeline.h"
 #include "app/signals.h"
 #include "base/cpu.h"
 #include "importer.h"
@@ -21,104 +20,100 @@ static PtrResult fail(PtrJobReport *report, const PtrError *err)
     return err->code;
 }
 
-/* Renders the prepared scene and writes the image. */
-static PtrResult render_prepared(const PtrOptions *o, const PtrScene *scene,
-                                 const PtrPrepared *prepared, const PtrColor *color,
-                                 PtrJobReport *report, PtrError *err)
+/* The request the options make of a render. */
+static PtrRenderRequest request_of(const PtrOptions *o, const PtrJobReport *report)
 {
-    PtrRenderSettings settings = {
-        .region = o->region, .seed = o->seed, .max_depth = o->max_depth, .threads = o->threads,
+    return (PtrRenderRequest){
+        .width = o->width, .height = o->height, .divisor = o->preview ? PREVIEW_SCALE : 1,
+        .region = o->region, .first_sample = report->sample_first,
+        .samples = report->samples_requested, .time_budget = o->time_budget, .seed = o->seed,
+        .max_depth = o->max_depth, .threads = o->threads, .kernel = o->kernel,
+        .level = o->cpu_level, .integrator = o->integrator, .accel = o->accel,
         .sampler = o->sampler, .direct_lighting = o->direct_lighting,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-        .integrator = prepared->integrator, .transparent = o->transparent,
-        .passes = o->passes || o->denoise, /* the denoiser's guides */
+        .transparent = o->transparent, .passes = o->passes, .denoiser = o->denoiser,
+        .denoise_quality = o->denoise,
     };
-    ptr_choose_size(scene, o->width, o->height, o->preview ? PREVIEW_SCALE : 1,
-                    &settings.width, &settings.height);
-    report->width = settings.width;
-    report->height = settings.height;
-    PtrRegion region = ptr_render_region(&settings);
-    if (region.x1 == 0)
-        return ptr_error_set(err, PTR_ERR_USAGE, "--region %d,%d,%d,%d lies outside the %dx%d image",
-                             o->region.x0, o->region.y0, o->region.x1, o->region.y1,
-                             settings.width, settings.height);
-    const PtrImageLayout layout = { region.x1 - region.x0, region.y1 - region.y0, region.x0,
-                                    region.y0, settings.width, settings.height };
+}
 
+/* The live view's part in a render (PtrRenderHooks.begin). */
+typedef struct LiveRender {
+    PtrLiveView *view;
+    const char *scene, *output;
+    int begun;
+} LiveRender;
+
+static void live_begin(void *user, const PtrScene *scene, const PtrAccel *accel,
+                       const PtrRenderSettings *settings, PtrProgressiveOptions *passes)
+{
+    LiveRender *live = user;
+    ptr_live_view_begin(live->view, live->scene, live->output, scene, accel, settings, passes);
+    live->begun = 1;
+}
+
+/* What the render chose and did, into the report. */
+static void report_render(const PtrSceneHandle *scene, const PtrFrame *frame,
+                          PtrJobReport *report)
+{
+    if (scene->prepared_valid) {
+        const PtrPrepared *prepared = &scene->prepared;
+        snprintf(report->kernel, sizeof report->kernel, "%s", prepared->isect.name);
+        snprintf(report->integrator, sizeof report->integrator, "%s",
+                 ptr_integrator_name(prepared->integrator));
+        snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&prepared->accel));
+        report->spheres = scene->scene.spheres.count;
+        report->build_seconds = prepared->accel.build_seconds;
+    }
+    if (!frame)
+        return;
+    report->width = frame->layout.full_width;
+    report->height = frame->layout.full_height;
+    report->samples = frame->done.samples_done;
+    report->seconds = frame->done.stats.seconds;
+    report->rays = frame->done.stats.rays;
+    report->interrupted = frame->done.stopped;
+}
+
+/* Renders the imported scene (the tree's build reorders its spheres, for
+ * either structure) and writes the image. */
+static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
+                                  const PtrColor *color, PtrJobReport *report, PtrError *err)
+{
+    const PtrRenderRequest request = request_of(o, report);
     PtrProgressPrinter printer;
     ptr_progress_printer_init(&printer, report->output);
-    PtrProgressiveOptions passes = {
-        .first_sample = report->sample_first, .samples = report->samples_requested,
-        .time_budget = o->time_budget, .stop = &ptr_stop_requested,
-        .report = o->quiet ? NULL : ptr_progress_print, .user = &printer,
+    LiveRender live = { o->live_view, report->scene, report->output, 0 };
+    const PtrRenderHooks hooks = {
+        .stop = &ptr_stop_requested, .report = o->quiet ? NULL : ptr_progress_print,
+        .user = &printer, .begin = live_begin, .begin_user = &live,
     };
-    const PtrAccel *accel = &prepared->accel;
-    ptr_live_view_begin(o->live_view, report->scene, report->output, scene, accel, &settings,
-                        &passes);
-    PtrFrameBuffers frame;
-    PtrProgressiveResult done = { 0 };
-    PtrResult res = ptr_render_frame(scene, accel, &settings, &passes, report->scene, &frame,
-                                     &done, err);
+    PtrFrame *frame = NULL;
+    /* The kernel was checked before any scene was read: only the tree and
+     * the region can fail before the render. */
+    PtrResult res = ptr_api_render(scene, &request, &hooks, &frame, err);
     ptr_progress_done(&printer);
-    if (res == PTR_OK) {
-        report->samples = done.samples_done;
-        report->seconds = done.stats.seconds;
-        report->rays = done.stats.rays;
-        report->interrupted = done.stopped;
-        PtrOutputInfo info = {
-            .scene_path = report->scene, .scene_hash = prepared->scene_hash,
-            .kernel = accel->isect.name, .accel = report->accel, .spheres = report->spheres,
-            .import_seconds = report->import_seconds, .build_seconds = report->build_seconds, .sample_first = report->sample_first,
-            .samples = done.samples_done, .interrupted = done.stopped, .seed = o->seed,
-            .max_depth = o->max_depth, .sampler = ptr_sampler_name(o->sampler),
-            .direct_lighting = o->direct_lighting == PTR_ON,
-            .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
-            .sample_counts = frame.sample_counts, .albedo = frame.albedo,
-            .normal = frame.normal, .alpha = frame.alpha,
-            .denoiser = o->denoiser, .denoise_quality = o->denoise, .threads = o->threads,
-            .render_seconds = done.stats.seconds, .depth = o->depth,
-            .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
-            .dither = o->dither,
-        };
-        /* A frame of a sequence that --skip-existing resumes is written
-         * whole or not at all: an output that exists is never rendered again. */
-        if (!(done.stopped && o->skip_existing))
-            res = ptr_output_write(o->images, report->output, &layout, frame.rgb, &info, err);
-        ptr_frame_buffers_free(&frame);
+    report_render(scene, frame, report);
+    const int stopped = frame && frame->done.stopped;
+    /* A frame of a sequence that --skip-existing resumes is written
+     * whole or not at all: an output that exists is never rendered again. */
+    if (res == PTR_OK && !(stopped && o->skip_existing)) {
+        const PtrOutputSettings output = ptr_options_output(o, color);
+        res = ptr_api_frame_finish(frame, err);
+        if (res == PTR_OK)
+            res = ptr_api_frame_write(o->images, report->output, frame, &output, err);
     }
-    ptr_live_view_end(o->live_view, res == PTR_OK && !done.stopped);
-    if (res == PTR_OK && done.stopped && o->skip_existing)
+    if (live.begun)
+        ptr_live_view_end(o->live_view, res == PTR_OK && !stopped);
+    if (res == PTR_OK && stopped && o->skip_existing)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted after %u of %u samples; not written, so that "
                             "--skip-existing renders it again", report->output,
-                            done.samples_done, report->samples_requested);
-    else if (res == PTR_OK && done.stopped)
+                            report->samples, report->samples_requested);
+    else if (res == PTR_OK && stopped)
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED,
                             "%s: interrupted; wrote the %u samples done of %u",
-                            report->output, done.samples_done, report->samples_requested);
-    return res;
-}
-
-/* Chooses the kernels and the structure for the imported scene (the tree's
- * build reorders its spheres, for either), renders and writes the image. */
-static PtrResult render_and_write(const PtrOptions *o, PtrScene *scene, const PtrColor *color,
-                                  PtrJobReport *report, PtrError *err)
-{
-    PtrPrepared prepared;
-    /* The kernel was checked before any scene was read: only the tree can
-     * fail here. */
-    PtrResult res = ptr_prepare_render(scene, o->kernel, o->cpu_level, o->integrator, o->accel,
-                                       o->threads, report->scene, &prepared, err);
-    if (res != PTR_OK)
-        return res;
-    snprintf(report->kernel, sizeof report->kernel, "%s", prepared.isect.name);
-    snprintf(report->integrator, sizeof report->integrator, "%s",
-             ptr_integrator_name(prepared.integrator));
-    snprintf(report->accel, sizeof report->accel, "%s", ptr_accel_name(&prepared.accel));
-    report->spheres = scene->spheres.count;
-    report->build_seconds = prepared.accel.build_seconds;
-    res = render_prepared(o, scene, &prepared, color, report, err);
-    ptr_prepared_free(&prepared);
+                            report->output, report->samples, report->samples_requested);
+    ptr_frame_free(frame);
     return res;
 }
 
@@ -130,23 +125,27 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
         .samples_requested = o->preview && o->samples > PREVIEW_SAMPLES ? PREVIEW_SAMPLES : o->samples,
     };
     PtrError err = { 0 };
-    PtrScene scene;
+    PtrScene imported;
     PtrImportOptions import = ptr_options_import(o, dependencies);
     double import_start = ptr_now_seconds();
-    PtrResult res = ptr_import_scene(scene_path, &import, &scene, &report->warnings, &err);
+    PtrResult res = ptr_import_scene(scene_path, &import, &imported, &report->warnings, &err);
     report->import_seconds = ptr_now_seconds() - import_start;
     /* A file that failed gets its one line of error, nothing more. */
     for (size_t i = 0; res == PTR_OK && i < report->warnings.count; i++)
         fprintf(stderr, "ptr: warning: %s\n", report->warnings.lines[i]);
     if (res == PTR_OK) {
         if (o->has_sky)
-            scene.sky = o->sky;
-        res = ptr_color_by_apply(o, scene_path, &scene, color, &err);
+            imported.sky = o->sky;
+        res = ptr_color_by_apply(o, scene_path, &imported, color, &err);
+        if (res != PTR_OK)
+            ptr_scene_free(&imported);
     }
-    if (res == PTR_OK) {
-        res = render_and_write(o, &scene, color, report, &err);
-    }
-    ptr_scene_free(&scene);
+    PtrSceneHandle *scene = NULL;
+    if (res == PTR_OK)
+        res = ptr_api_scene_adopt(&imported, scene_path, report->import_seconds, &scene, &err);
+    if (res == PTR_OK)
+        res = render_and_write(o, scene, color, report, &err);
+    ptr_scene_handle_free(scene);
     if (res != PTR_OK && res != PTR_ERR_INTERRUPTED)
         return fail(report, &err);
     report->result = res;

@@ -234,14 +234,14 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
         .scene_path = parts[0].scene, .scene_hash = strtoull(parts[0].hash, NULL, 16),
         .kernel = report->kernel, .accel = report->accel, .spheres = report->spheres,
         .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
-        .seed = report->seed, .max_depth = (int)parts[0].max_depth, .depth = o->depth,
+        .seed = report->seed, .max_depth = (int)parts[0].max_depth,
         .sampler = parts[0].sampler, .direct_lighting = !strcmp(parts[0].direct_lighting, "on"),
         .noise_threshold = strtof(parts[0].noise_threshold, NULL),
         .min_samples = ptr_image_attr(parts[0].image, "ptr:min_samples")
                            ? (uint32_t)atol(ptr_image_attr(parts[0].image, "ptr:min_samples"))
                            : 0,
-        .alpha = alpha, .albedo = albedo, .normal = normal, .color = color, .exposure = o->exposure, .bake_view = o->bake_view,
-        .dither = o->dither,
+        .alpha = alpha, .albedo = albedo, .normal = normal,
+        .output = ptr_options_output(o, color),
         .denoiser = o->denoiser, .denoise_quality = o->denoise, .threads = o->threads,
     };
     res = ptr_output_write(o->images, output, &full, rgb, &info, err);

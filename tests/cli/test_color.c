@@ -34,7 +34,7 @@ static PtrImageLoader *images;
 static PtrOutputInfo info_for(const PtrColor *color)
 {
     return (PtrOutputInfo){ .scene_path = "test", .kernel = "c", .samples = 1, .seed = 1,
-                            .max_depth = 50, .color = color };
+                            .max_depth = 50, .output = { .color = color } };
 }
 
 static PtrImage *read_image(const char *path)
@@ -210,7 +210,7 @@ static void test_output_path(void)
     CHECK_INT(ptr_color_select(c, NULL, NULL, NULL, 0.0f, &err), 0);
     PtrOutputInfo info = info_for(c);
     PtrError perr = { 0 };
-    info.depth = PTR_DEPTH_16;
+    info.output.depth = PTR_DEPTH_16;
     CHECK_INT(ptr_output_write(images, test_path("grey16.png"), &one, grey, &info, &perr), PTR_OK);
     PtrImage *img = read_image(test_path("grey16.png"));
     CHECK_NEAR(ptr_image_pixels(img)[0] * 65535.0, 30235.0, 1.0);
@@ -219,13 +219,13 @@ static void test_output_path(void)
     ptr_image_free(img);
 
     /* EXR stays scene-linear; --bake-view stores the display-referred values. */
-    info.depth = PTR_DEPTH_DEFAULT;
+    info.output.depth = PTR_DEPTH_DEFAULT;
     CHECK_INT(ptr_output_write(images, test_path("linear.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(test_path("linear.exr"));
     CHECK_FLOAT_EQ(ptr_image_pixels(img)[0], 0.18f);
     CHECK_STR(ptr_image_attr(img, "ptr:colorspace"), "lin_rec709");
     ptr_image_free(img);
-    info.bake_view = 1;
+    info.output.bake_view = 1;
     CHECK_INT(ptr_output_write(images, test_path("baked.exr"), &one, grey, &info, &perr), PTR_OK);
     img = read_image(test_path("baked.exr"));
     CHECK_NEAR(ptr_image_pixels(img)[0], 0.461356, 1e-5);
