@@ -207,7 +207,8 @@ PTR_PUBLIC void ptr_scene_handle_free(PtrSceneHandle *scene);
  * ranges, a value outside them PTR_STATUS_USAGE: width and height 1 to
  * 65536 (or 0), samples 1 to 2^30 (first_sample + samples at most 2^30),
  * max_depth 1 to 100000, min_samples 2 to 2^30, threads at most 1024,
- * noise_threshold 0 or above 0 up to 10^6, and only with first_sample 0. */
+ * noise_threshold 0 or above 0 up to 10^6, and only with first_sample 0,
+ * a region inside the image, time_budget 0 or above 0 up to 10^7. */
 typedef struct PtrRenderOptions {
     int width, height;      /* 0: the scene's, else 800 wide (--width, --height) */
     uint32_t samples;       /* per pixel (--samples) */
@@ -235,6 +236,16 @@ typedef struct PtrRenderOptions {
      * where the scene is made (PtrLoadOptions.camera, PtrSceneArrays.camera),
      * which puts the coordinates relative to it. */
     const PtrCameraDesc *camera;
+    /* --region X0,Y0,X1,Y1: the pixels rendered, columns x0 to x1 - 1 and
+     * rows y0 to y1 - 1 of the image from its top left (0 <= x0 < x1,
+     * 0 <= y0 < y1); all 0: the whole image. The frame holds the region's
+     * pixels alone (ptr_frame_width and ptr_frame_height are its size;
+     * ptr_frame_placement says where it lies), as the command line's EXR
+     * holds them, and saves them as that part of the image. */
+    int region[4];
+    /* --time: seconds, after which the render stops at the end of the pass
+     * under way, with the samples done (ptr_frame_samples); 0: none. */
+    double time_budget;
 } PtrRenderOptions;
 
 PTR_PUBLIC void ptr_render_options_default(PtrRenderOptions *options);
@@ -250,7 +261,9 @@ typedef struct PtrProgressInfo {
  * which then fails with PTR_STATUS_CANCELLED. */
 typedef int (*PtrProgressCallback)(void *user, const PtrProgressInfo *progress);
 
-/* The image a render made: scene-linear floats, rows top to bottom. */
+/* The image a render made: scene-linear floats, rows top to bottom, with
+ * what the command line's EXR of it holds (the samples taken, the scene's
+ * name and hash, the import's and the tree's seconds, ...). */
 typedef struct PtrFrame PtrFrame;
 
 /* Renders the scene. progress may be NULL. The first render of a scene
@@ -273,6 +286,19 @@ PTR_PUBLIC const float *ptr_frame_pixels(const PtrFrame *frame);
  * render asked for passes or denoising. */
 PTR_PUBLIC const float *ptr_frame_albedo(const PtrFrame *frame);
 PTR_PUBLIC const float *ptr_frame_normal(const PtrFrame *frame);
+/* A denoised frame's colour before denoising, width x height x 3 floats,
+ * which an EXR keeps as the layer "noisy"; NULL unless denoised. */
+PTR_PUBLIC const float *ptr_frame_noisy(const PtrFrame *frame);
+/* The samples per pixel the render took: those asked for, or fewer when
+ * its time budget ran out (with adaptive sampling, a pixel may stop
+ * earlier still). */
+PTR_PUBLIC uint32_t ptr_frame_samples(const PtrFrame *frame);
+/* Where the frame's pixels lie in the image rendered: the column and row of
+ * their top left corner, and the image's width and height (0, 0 and the
+ * frame's own size without a region). Each pointer may be NULL; all are
+ * set to 0 for a NULL frame. */
+PTR_PUBLIC void ptr_frame_placement(const PtrFrame *frame, int *x, int *y, int *image_width,
+                                    int *image_height);
 
 /* A frame of pixels given (width x height x channels floats, 3: RGB, 4:
  * RGBA with the colour premultiplied), copied: an image made elsewhere, or
@@ -280,13 +306,34 @@ PTR_PUBLIC const float *ptr_frame_normal(const PtrFrame *frame);
 PTR_PUBLIC PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
                                    PtrFrame **out, PtrErrorInfo *err);
 
+/* How a frame is stored and shown, as the command line's options of the
+ * same names; zero for each (and NULL for the strings) is the command
+ * line's default. */
+typedef struct PtrSaveOptions {
+    /* --depth: "8", "16", "half" or "float", which the format must store;
+     * NULL: float for EXR and HDR, else 8 bits. */
+    const char *depth;
+    int dither;            /* --dither: 8 bits dithered before rounding */
+    /* --display, --view, --look: of the context's OpenColorIO config; NULL:
+     * its default display, that display's default view, no look. */
+    const char *display;
+    const char *view;
+    const char *look;
+    float exposure;        /* --exposure: stops before the view, -64 to 64 */
+    int bake_view;         /* --bake-view: float formats too get the view applied */
+} PtrSaveOptions;
+
 /* Writes the frame through ptr's writers, by the path's extension: EXR
- * (float, with the passes as layers) directly, any other format through the
- * OpenImageIO module, the view applied (integer formats). view is an
- * OpenColorIO view of the context's config's default display; NULL: its
- * default view. The file is replaced atomically. */
+ * (scene-linear floats, with the passes, the noisy colour of a denoised
+ * frame and the render's metadata) directly, any other format through the
+ * OpenImageIO module, the view applied (integer formats, and float ones
+ * with bake_view). options may be NULL: all defaults; a value outside its
+ * range, or a depth the format cannot store, is PTR_STATUS_USAGE, a
+ * display, view or look the config lacks too. The file is replaced
+ * atomically. */
 PTR_PUBLIC PtrStatus ptr_frame_save(PtrContext *context, const char *path,
-                                    const PtrFrame *frame, const char *view, PtrErrorInfo *err);
+                                    const PtrFrame *frame, const PtrSaveOptions *options,
+                                    PtrErrorInfo *err);
 
 PTR_PUBLIC void ptr_frame_free(PtrFrame *frame);
 

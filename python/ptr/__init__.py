@@ -320,7 +320,7 @@ class Scene:
                denoise=None, progress=None, transparent=False, passes=False, max_depth=None,
                integrator=None, kernel=None, cpu_cap=None, accel=None, sampler=None,
                direct_lighting=True, noise_threshold=0.0, min_samples=None, first_sample=0,
-               sky=None):
+               sky=None, region=None, time_budget=0.0):
         """Renders the scene into a numpy array of shape (height, width, 3),
         or (height, width, 4) with transparent=True, float32, scene-linear.
 
@@ -330,7 +330,11 @@ class Scene:
         ptr's defaults (the command line's); denoise: "fast", "balanced" or "high"; progress: a
         function of (samples_done, samples_total), called about ten times a
         second, that returns True to cancel (then ptr.Cancelled is raised);
-        passes=True returns (image, albedo, normal), each pass (H, W, 3).
+        passes=True returns (image, albedo, normal), each pass (H, W, 3);
+        region: (x0, y0, x1, y1), the pixels rendered (columns x0 to x1 - 1,
+        rows y0 to y1 - 1 of the image), returned alone as an array of
+        shape (y1 - y0, x1 - x0, 3); time_budget: seconds after which the
+        render stops at the end of the pass under way (0: none).
         The other options are the command line's of the same names.
 
         Ctrl-C (SIGINT) stops the render after the pass under way and raises
@@ -339,7 +343,8 @@ class Scene:
             return self._remake(camera).render(
                 width, height, samples, seed, None, threads, denoise, progress, transparent,
                 passes, max_depth, integrator, kernel, cpu_cap, accel, sampler,
-                direct_lighting, noise_threshold, min_samples, first_sample, sky)
+                direct_lighting, noise_threshold, min_samples, first_sample, sky, region,
+                time_budget)
         options = _native.RenderOptions()
         lib.ptr_render_options_default(ctypes.byref(options))
         for name, value in (("width", width), ("height", height), ("samples", samples),
@@ -350,6 +355,9 @@ class Scene:
         options.transparent, options.passes = int(bool(transparent)), int(bool(passes))
         options.direct_lighting = int(bool(direct_lighting))
         options.noise_threshold = float(noise_threshold)
+        options.time_budget = float(time_budget)
+        if region is not None:
+            options.region = _native.whole_numbers("region", region, 4)
         for name, value in (("integrator", integrator), ("kernel", kernel),
                             ("cpu_cap", cpu_cap), ("accel", accel), ("sampler", sampler),
                             ("denoise", denoise), ("sky", sky)):
@@ -413,17 +421,25 @@ def _frame_array(pointer, frame, channels=None):
     return np.ctypeslib.as_array(pointer, shape=(height, width, channels)).copy()
 
 
-def save(path, image, view=None, context=None):
+def save(path, image, view=None, context=None, depth=None, dither=False, display=None,
+         look=None, exposure=0.0, bake_view=False):
     """Writes an image (an array (H, W, 3) or (H, W, 4), scene-linear, RGBA
     premultiplied) through ptr's writers, by the path's extension: EXR as
     floats; other formats (PNG, JPEG, TIFF, ...) through OpenImageIO with
-    the OpenColorIO view applied (view: a view of the config's default
-    display, such as "Standard" or "Raw"; None: its default)."""
+    the OpenColorIO view applied. The options are the command line's of the
+    same names: depth ("8", "16", "half" or "float"; None: the format's
+    default), dither (8 bits), display, view (such as "Standard" or "Raw")
+    and look of the context's OpenColorIO config (None: its defaults, no
+    look), exposure (stops before the view, -64 to 64) and bake_view (the
+    view applied to a float format too)."""
     context = _context(context)
     image = np.asarray(image)
     if image.ndim != 3 or image.shape[2] not in (3, 4):
         raise ValueError("image: shape %s, not (H, W, 3) or (H, W, 4)" % (image.shape,))
     pixels = _contiguous(image, np.float32)
+    options = _native.SaveOptions(_native.text(depth), int(bool(dither)), _native.text(display),
+                                  _native.text(view), _native.text(look), float(exposure),
+                                  int(bool(bake_view)))
     frame = ctypes.c_void_p()
     err = _native.ErrorInfo()
     _check(lib.ptr_frame_new(pixels.shape[1], pixels.shape[0], pixels.shape[2],
@@ -431,7 +447,7 @@ def save(path, image, view=None, context=None):
     try:
         with context._lock:
             status = lib.ptr_frame_save(context._handle, _native.text(path), frame,
-                                        _native.text(view), ctypes.byref(err))
+                                        ctypes.byref(options), ctypes.byref(err))
         _check(status, err)
     finally:
         lib.ptr_frame_free(frame)

@@ -98,7 +98,15 @@ class RenderOptions(ctypes.Structure):
                 ("direct_lighting", ctypes.c_int), ("noise_threshold", ctypes.c_float),
                 ("min_samples", ctypes.c_uint32), ("transparent", ctypes.c_int),
                 ("passes", ctypes.c_int), ("denoise", ctypes.c_char_p),
-                ("sky", ctypes.c_char_p), ("camera", ctypes.POINTER(CameraDesc))]
+                ("sky", ctypes.c_char_p), ("camera", ctypes.POINTER(CameraDesc)),
+                ("region", ctypes.c_int * 4), ("time_budget", ctypes.c_double)]
+
+
+class SaveOptions(ctypes.Structure):
+    _fields_ = [("depth", ctypes.c_char_p), ("dither", ctypes.c_int),
+                ("display", ctypes.c_char_p), ("view", ctypes.c_char_p),
+                ("look", ctypes.c_char_p), ("exposure", ctypes.c_float),
+                ("bake_view", ctypes.c_int)]
 
 
 class ProgressInfo(ctypes.Structure):
@@ -131,9 +139,13 @@ _SIGNATURES = {
     "ptr_frame_pixels": (ctypes.POINTER(ctypes.c_float), [_P]),
     "ptr_frame_albedo": (ctypes.POINTER(ctypes.c_float), [_P]),
     "ptr_frame_normal": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_noisy": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_samples": (ctypes.c_uint32, [_P]),
+    "ptr_frame_placement": (None, [_P] + [ctypes.POINTER(ctypes.c_int)] * 4),
     "ptr_frame_new": (ctypes.c_int, [ctypes.c_int, ctypes.c_int, ctypes.c_int, _P,
                                      ctypes.POINTER(_P), _ERR]),
-    "ptr_frame_save": (ctypes.c_int, [_P, ctypes.c_char_p, _P, ctypes.c_char_p, _ERR]),
+    "ptr_frame_save": (ctypes.c_int, [_P, ctypes.c_char_p, _P, ctypes.POINTER(SaveOptions),
+                                      _ERR]),
     "ptr_frame_free": (None, [_P]),
 }
 for _name, (_result, _arguments) in _SIGNATURES.items():
@@ -159,3 +171,13 @@ def set_whole(structure, name, value):
     if number != value or not low <= number <= high:
         raise ValueError("%s: %r is not a whole number from %d to %d" % (name, value, low, high))
     setattr(structure, name, number)
+
+
+def whole_numbers(name, values, count):
+    """count whole numbers as a C int array, refusing (ValueError) another
+    count or a value a C int cannot hold rather than letting it wrap."""
+    numbers = list(values)
+    if len(numbers) != count or not all(int(v) == v and -2 ** 31 <= v < 2 ** 31
+                                        for v in numbers):
+        raise ValueError("%s: %r is not %d whole numbers" % (name, values, count))
+    return (ctypes.c_int * count)(*[int(v) for v in numbers])

@@ -6,6 +6,7 @@ Run by ctest (python_tests) with PTR_LIBRARY, PTR_EXECUTABLE and
 PTR_SOURCE_DIR set; by hand: PTR_LIBRARY=build/lib/libptr.so.1
 PTR_EXECUTABLE=build/src/ptr python3 -m pytest python/tests."""
 
+import ctypes
 import math
 import os
 import pathlib
@@ -273,3 +274,61 @@ def test_interrupted_load_frees_the_scene(monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         ptr.load(SEED)
     assert len(freed) == 1
+
+
+def test_structures_agree_with_header():
+    """Every structure's ctypes copy has the header's fields at the
+    compiler's offsets, and its size (PTR_API_LAYOUT: tests/api's
+    print_api_layout, which prints them)."""
+    program = os.environ.get("PTR_API_LAYOUT")
+    if not program:
+        pytest.skip("PTR_API_LAYOUT (the build's print_api_layout) is not set")
+    header = {}
+    for line in subprocess.run([program], check=True, capture_output=True,
+                               text=True).stdout.splitlines():
+        words = line.split()
+        entry = header.setdefault(words[0], {"fields": {}})
+        if len(words) == 2:
+            entry["size"] = int(words[1])
+        else:
+            entry["fields"][words[1]] = int(words[2])
+    assert len(header) == 9
+    for name, entry in header.items():
+        copy = getattr(ptr._native, name[len("Ptr"):])
+        assert ctypes.sizeof(copy) == entry["size"], name
+        assert [field for field, _ in copy._fields_] == list(entry["fields"]), name
+        for field, offset in entry["fields"].items():
+            assert getattr(copy, field).offset == offset, (name, field)
+
+
+def test_region_and_time_budget():
+    scene = ptr.load(SEED)
+    full = scene.render(80, 60, samples=4)
+    part = scene.render(80, 60, samples=4, region=(10, 5, 50, 30))
+    assert part.shape == (25, 40, 3)
+    assert np.array_equal(part, full[5:30, 10:50])
+    # Time enough for every sample: the same image; too little for all
+    # 2^30: what was done, without an error.
+    assert np.array_equal(scene.render(80, 60, samples=4, time_budget=600), full)
+    assert scene.render(16, 16, samples=2 ** 30, time_budget=0.1).shape == (16, 16, 3)
+    for bad in ({"region": (1, 2, 3)}, {"region": (5, 0, 5, 4)}, {"region": (0, 0, 81, 4)},
+                {"region": (0, 0, 2 ** 40, 4)}, {"time_budget": -1}, {"time_budget": 1e8}):
+        with pytest.raises(ValueError):
+            scene.render(80, 60, samples=1, **bad)
+
+
+def test_save_options_as_command_line(tmp_path):
+    cli = str(tmp_path / "cli.exr")
+    options = ["--depth", "half", "--exposure", "1.5", "--view", "Raw", "--bake-view"]
+    subprocess.run([os.environ["PTR_EXECUTABLE"], FINAL, "-o", cli, "--width", "80",
+                    "--samples", "4", "--quiet"] + options, check=True)
+    image = ptr.load(FINAL).render(80, samples=4)
+    ours = str(tmp_path / "ours.exr")
+    ptr.save(ours, image, depth="half", exposure=1.5, view="Raw", bake_view=True)
+    assert same_pixels(cli, ours)
+    png = tmp_path / "deep.png"
+    ptr.save(png, image, depth="16", dither=True, look=None, display=None)
+    assert png.stat().st_size > 0
+    for bad in ({"depth": "12"}, {"depth": "16"}, {"exposure": 65}, {"look": "no such look"}):
+        with pytest.raises(ValueError):
+            ptr.save(ours, image, **bad)

@@ -46,6 +46,8 @@ static PtrResult read_request(const PtrContext *context, const PtrRenderOptions 
         .level = context->cpu_level, .direct_lighting = o->direct_lighting ? PTR_ON : PTR_OFF,
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
         .transparent = o->transparent, .passes = o->passes,
+        .region = { o->region[0], o->region[1], o->region[2], o->region[3] },
+        .time_budget = o->time_budget,
     };
     if (o->kernel && strcmp(o->kernel, "c") && strcmp(o->kernel, "asm"))
         return ptr_error_set(err, PTR_ERR_USAGE, "kernel: '%s' is not c or asm", o->kernel);
@@ -96,6 +98,14 @@ static PtrResult read_request(const PtrContext *context, const PtrRenderOptions 
     const char *wrong = ptr_sample_range_problem(o->noise_threshold, o->first_sample, o->samples);
     if (wrong)
         return ptr_error_set(err, PTR_ERR_USAGE, "samples: %s", wrong);
+    const PtrRegion whole = { 0 };
+    if (memcmp(&r->region, &whole, sizeof whole) && !ptr_region_ok(r->region))
+        return ptr_error_set(err, PTR_ERR_USAGE, "region: %d,%d,%d,%d is not " PTR_REGION_WORDS,
+                             r->region.x0, r->region.y0, r->region.x1, r->region.y1);
+    if (o->time_budget != 0 && !ptr_time_budget_ok(o->time_budget))
+        return ptr_error_set(err, PTR_ERR_USAGE,
+                             "time_budget: %g is not 0 (none) or above 0 and at most 10^7",
+                             o->time_budget);
     return PTR_OK;
 }
 
@@ -364,6 +374,22 @@ const float *ptr_frame_pixels(const PtrFrame *frame)
 }
 const float *ptr_frame_albedo(const PtrFrame *frame) { return frame ? frame->buffers.albedo : NULL; }
 const float *ptr_frame_normal(const PtrFrame *frame) { return frame ? frame->buffers.normal : NULL; }
+const float *ptr_frame_noisy(const PtrFrame *frame) { return frame ? frame->noisy : NULL; }
+uint32_t ptr_frame_samples(const PtrFrame *frame) { return frame ? frame->info.samples : 0; }
+
+void ptr_frame_placement(const PtrFrame *frame, int *x, int *y, int *image_width,
+                         int *image_height)
+{
+    const PtrImageLayout none = { 0 }, *layout = frame ? &frame->layout : &none;
+    if (x)
+        *x = layout->x;
+    if (y)
+        *y = layout->y;
+    if (image_width)
+        *image_width = layout->full_width;
+    if (image_height)
+        *image_height = layout->full_height;
+}
 
 PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
                         PtrFrame **out, PtrErrorInfo *err)
@@ -412,16 +438,34 @@ PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels
     return PTR_STATUS_OK;
 }
 
+/* The output's settings the save options give, read and checked, with
+ * the context's colour configuration selected as they say. */
+static PtrResult read_save_options(PtrContext *context, const PtrSaveOptions *o,
+                                   PtrOutputSettings *output, PtrError *err)
+{
+    PtrError problem;
+    *output = (PtrOutputSettings){ .depth = PTR_DEPTH_DEFAULT, .color = context->color,
+                                   .exposure = o->exposure, .bake_view = o->bake_view != 0,
+                                   .dither = o->dither != 0 };
+    if (o->depth && ptr_depth_parse(o->depth, &output->depth, &problem) != PTR_OK)
+        return option_error("depth", &problem, err);
+    if (!ptr_exposure_ok(o->exposure))
+        return ptr_error_set(err, PTR_ERR_USAGE, "exposure: %g is not a number of stops "
+                             "from -64 to 64", (double)o->exposure);
+    return ptr_color_select(context->color, o->display, o->view, o->look, o->exposure, err);
+}
+
 PtrStatus ptr_frame_save(PtrContext *context, const char *path, const PtrFrame *frame,
-                         const char *view, PtrErrorInfo *err)
+                         const PtrSaveOptions *options, PtrErrorInfo *err)
 {
     PtrError e;
+    const PtrSaveOptions defaults = { 0 };
+    PtrOutputSettings output;
     if (!context || !path || !frame)
         return ptr_api_usage(err, "save: context, path and frame are needed, not NULL");
-    const PtrOutputSettings output = { .color = context->color };
-    if (ptr_output_check(context->images, path, output.depth, frame->buffers.alpha != NULL, 0,
+    if (read_save_options(context, options ? options : &defaults, &output, &e) != PTR_OK ||
+        ptr_output_check(context->images, path, output.depth, frame->buffers.alpha != NULL, 0,
                          &e) != PTR_OK ||
-        ptr_color_select(context->color, NULL, view, NULL, output.exposure, &e) != PTR_OK ||
         ptr_api_frame_write(context->images, path, frame, &output, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
     return PTR_STATUS_OK;

@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,6 +55,11 @@ PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err)
             return PTR_OK;
         }
     return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not 8, 16, half or float", text);
+}
+
+int ptr_exposure_ok(double stops)
+{
+    return fabs(stops) <= 64; /* NaN too is refused */
 }
 
 /* The depth a file gets, or PTR_DEPTH_DEFAULT if its format cannot store the

@@ -69,6 +69,9 @@ typedef struct PtrOutputInfo {
 /* Parses "8", "16", "half" or "float"; PTR_ERR_USAGE for anything else. */
 PtrResult ptr_depth_parse(const char *text, PtrDepth *depth, PtrError *err);
 
+/* Whether an exposure (--exposure) is one: -64 to 64 stops. */
+int ptr_exposure_ok(double stops);
+
 /* Fails early, before any rendering, if no writer exists for the output's
  * extension or it cannot store that depth, or an alpha channel if alpha is
  * set, or passes if passes is set (EXR only) (PTR_ERR_USAGE), or its folder

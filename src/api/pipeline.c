@@ -58,6 +58,16 @@ int ptr_noise_threshold_ok(double threshold)
     return threshold > 0 && threshold <= 1e6;
 }
 
+int ptr_region_ok(PtrRegion r)
+{
+    return r.x0 >= 0 && r.y0 >= 0 && r.x1 > r.x0 && r.y1 > r.y0;
+}
+
+int ptr_time_budget_ok(double seconds)
+{
+    return seconds > 0 && seconds <= 1e7;
+}
+
 const char *ptr_sample_range_problem(float noise_threshold, uint64_t first_sample,
                                      uint64_t samples)
 {

@@ -41,6 +41,12 @@ const char *ptr_render_number_range(PtrRenderNumber number);
 /* Whether a noise threshold (--noise-threshold) is one: above 0, at most
  * 10^6. */
 int ptr_noise_threshold_ok(double threshold);
+/* Whether a region (--region) is one, whatever the image: 0 <= x0 < x1
+ * and 0 <= y0 < y1; PTR_REGION_WORDS says so in messages. */
+int ptr_region_ok(PtrRegion region);
+#define PTR_REGION_WORDS "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1"
+/* Whether a time budget (--time) is one: above 0 seconds, at most 10^7. */
+int ptr_time_budget_ok(double seconds);
 /* What is wrong with a render's samples taken together: adaptive sampling
  * (noise_threshold above 0) from a first sample other than 0, or a range
  * ending past 2^30; NULL if nothing. */

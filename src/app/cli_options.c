@@ -190,9 +190,9 @@ static PtrResult set_region(OptionId id, const char *value, PtrOptions *o, PtrEr
 {
     int x0, y0, x1, y1;
     char tail;
-    if (sscanf(value, "%d,%d,%d,%d%c", &x0, &y0, &x1, &y1, &tail) != 4 || x0 < 0 || y0 < 0 ||
-        x1 <= x0 || y1 <= y0)
-        return bad_value(id, value, "X0,Y0,X1,Y1 with 0 <= X0 < X1 and 0 <= Y0 < Y1", err);
+    if (sscanf(value, "%d,%d,%d,%d%c", &x0, &y0, &x1, &y1, &tail) != 4 ||
+        !ptr_region_ok((PtrRegion){ x0, y0, x1, y1 }))
+        return bad_value(id, value, PTR_REGION_WORDS, err);
     o->region = (PtrRegion){ x0, y0, x1, y1 };
     return PTR_OK;
 }
@@ -369,14 +369,14 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     case OPT_view: o->view = value; break;
     case OPT_look: o->look = value; break;
     case OPT_exposure:
-        if (!parse_number(value, &x) || !(fabs(x) <= 64))
+        if (!parse_number(value, &x) || !ptr_exposure_ok(x))
             return bad_value(id, value, "a number of stops from -64 to 64", err);
         o->exposure = (float)x;
         break;
     case OPT_bake_view: o->bake_view = 1; break;
     case OPT_list_views: o->list_views = 1; break;
     case OPT_time:
-        if (!parse_number(value, &x) || !(x > 0 && x <= 1e7))
+        if (!parse_number(value, &x) || !ptr_time_budget_ok(x))
             return bad_value(id, value, "a number of seconds above 0", err);
         o->time_budget = x;
         break;

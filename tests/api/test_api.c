@@ -302,8 +302,8 @@ static void test_limits(void)
     ptr_render_options_default(&good);
     good.width = 8;
     good.samples = 1;
-    PtrRenderOptions o[10];
-    for (int k = 0; k < 10; k++)
+    PtrRenderOptions o[14];
+    for (int k = 0; k < 14; k++)
         o[k] = good;
     o[0].samples = (1u << 30) + 1;
     o[1].samples = 0;
@@ -316,10 +316,18 @@ static void test_limits(void)
     o[7].noise_threshold = NAN;
     o[8].first_sample = 1u << 30;
     o[9].height = -1;
-    const char *named[10] = { "samples", "samples", "max_depth", "min_samples", "threads",
-                              "width", "samples", "noise_threshold", "samples", "height" };
+    o[10].region[2] = 4; /* x1 without y1 */
+    o[11].region[0] = 6; /* x0 past x1 */
+    o[11].region[2] = 5;
+    o[11].region[3] = 4;
+    o[12].region[2] = 9; /* outside the 8 wide image */
+    o[12].region[3] = 4;
+    o[13].time_budget = -1;
+    const char *named[14] = { "samples", "samples", "max_depth", "min_samples", "threads",
+                              "width", "samples", "noise_threshold", "samples", "height",
+                              "region", "region", "region", "time_budget" };
     PtrFrame *frame = NULL;
-    for (int k = 0; k < 10; k++) {
+    for (int k = 0; k < 14; k++) {
         CHECK_INT(ptr_scene_render(context, scene, &o[k], NULL, NULL, &frame, &err),
                   PTR_STATUS_USAGE);
         CHECK(strstr(err.message, named[k]) != NULL);
@@ -445,22 +453,32 @@ static int cancel_at_once(void *user, const PtrProgressInfo *progress)
     return 1;
 }
 
-static void test_cancel(void)
+/* A long render of final.gltf (400 wide, 2^30 samples, or time_budget
+ * seconds) with progress: its status, the frame into *frame. */
+static PtrStatus render_long(double time_budget, PtrProgressCallback progress, PtrFrame **frame,
+                             PtrErrorInfo *err)
 {
     PtrSceneHandle *scene = NULL;
-    PtrErrorInfo err;
-    CHECK_INT(ptr_scene_load(context, SCENE("final.gltf"), NULL, &scene, &err), PTR_STATUS_OK);
+    CHECK_INT(ptr_scene_load(context, SCENE("final.gltf"), NULL, &scene, err), PTR_STATUS_OK);
     PtrRenderOptions options;
     ptr_render_options_default(&options);
     options.width = 400;
-    options.samples = 100000;
+    options.samples = 1u << 30;
+    options.time_budget = time_budget;
+    const PtrStatus status = ptr_scene_render(context, scene, &options, progress, NULL, frame,
+                                              err);
+    ptr_scene_handle_free(scene);
+    return status;
+}
+
+static void test_cancel(void)
+{
+    PtrErrorInfo err;
     PtrFrame *frame = NULL;
-    CHECK_INT(ptr_scene_render(context, scene, &options, cancel_at_once, NULL, &frame, &err),
-              PTR_STATUS_CANCELLED);
+    CHECK_INT(render_long(0, cancel_at_once, &frame, &err), PTR_STATUS_CANCELLED);
     CHECK(calls > 0);
     CHECK(frame == NULL);
     CHECK(strstr(err.message, "cancelled") != NULL);
-    ptr_scene_handle_free(scene);
 }
 
 static void test_save(void)
@@ -470,9 +488,11 @@ static void test_save(void)
     PtrErrorInfo err;
     CHECK_INT(ptr_frame_save(context, exr, frame, NULL, &err), PTR_STATUS_OK);
     check_same_as_file(frame, exr);
-    CHECK_INT(ptr_frame_save(context, png, frame, "Raw", &err), PTR_STATUS_OK);
+    PtrSaveOptions raw = { .view = "Raw" };
+    CHECK_INT(ptr_frame_save(context, png, frame, &raw, &err), PTR_STATUS_OK);
     CHECK(access(png, F_OK) == 0);
-    CHECK_INT(ptr_frame_save(context, test_path("saved.png"), frame, "no such view", &err),
+    raw.view = "no such view";
+    CHECK_INT(ptr_frame_save(context, test_path("saved.png"), frame, &raw, &err),
               PTR_STATUS_USAGE);
     CHECK_INT(ptr_frame_save(context, "/nonexistent/dir/x.exr", frame, NULL, &err),
               PTR_STATUS_OUTPUT);
@@ -491,6 +511,143 @@ static void test_save(void)
     ptr_frame_free(copy);
     CHECK_INT(ptr_frame_new(0, 4, 3, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
     CHECK_INT(ptr_frame_new(4, 4, 2, ptr_frame_pixels(frame), &copy, &err), PTR_STATUS_USAGE);
+    ptr_frame_free(frame);
+}
+
+/* The EXR at path, read; NULL (a failed check) if it cannot be. */
+static PtrImage *read_exr(const char *path)
+{
+    PtrImage *image = NULL;
+    PtrError err;
+    CHECK_INT(test_image_read(path, &image, &err), PTR_OK);
+    return image;
+}
+
+/* Whether two files hold the same pixels, alpha and noisy colour, and the
+ * same values of the attributes named (or both lack one). */
+static void check_same_files(const char *a, const char *b, const char *const *attrs)
+{
+    PtrImage *x = read_exr(a), *y = read_exr(b);
+    if (x && y) {
+        const PtrImageLayout lx = ptr_image_layout(x), ly = ptr_image_layout(y);
+        CHECK(!memcmp(&lx, &ly, sizeof lx));
+        const size_t pixels = (size_t)lx.width * (size_t)lx.height;
+        CHECK(!memcmp(ptr_image_pixels(x), ptr_image_pixels(y), pixels * 3 * sizeof(float)));
+        CHECK_INT(ptr_image_alpha(x) != NULL, ptr_image_alpha(y) != NULL);
+        if (ptr_image_alpha(x) && ptr_image_alpha(y))
+            CHECK(!memcmp(ptr_image_alpha(x), ptr_image_alpha(y), pixels * sizeof(float)));
+        CHECK_INT(ptr_image_noisy(x) != NULL, ptr_image_noisy(y) != NULL);
+        if (ptr_image_noisy(x) && ptr_image_noisy(y))
+            CHECK(!memcmp(ptr_image_noisy(x), ptr_image_noisy(y), pixels * 3 * sizeof(float)));
+        for (size_t k = 0; attrs[k]; k++) {
+            const char *u = ptr_image_attr(x, attrs[k]), *v = ptr_image_attr(y, attrs[k]);
+            CHECK(u ? v && !strcmp(u, v) : !v);
+        }
+    }
+    ptr_image_free(x);
+    ptr_image_free(y);
+}
+
+static void region_and_budget(PtrRenderOptions *o)
+{
+    o->transparent = 1;
+    o->region[0] = 10;
+    o->region[1] = 5;
+    o->region[2] = 70;
+    o->region[3] = 40;
+    o->time_budget = 600; /* ample: all the samples */
+}
+
+static void denoised(PtrRenderOptions *o) { o->denoise = "fast"; }
+
+/* A region, a time budget and denoising: the frame and the file it saves
+ * are the command line's, its metadata and noisy layer too. */
+static void test_region_budget_denoise_as_command_line(void)
+{
+    static const char *const attrs[] = {
+        "ptr:scene", "ptr:scene_hash", "ptr:samples", "ptr:interrupted", "ptr:kernel",
+        "ptr:accel", "ptr:spheres", "ptr:denoised", "ptr:view", "ptr:exposure", NULL,
+    };
+    struct {
+        void (*change)(PtrRenderOptions *);
+        const char *extra[6];
+    } cases[] = {
+        { region_and_budget, { "--transparent", "--region", "10,5,70,40", "--time", "600" } },
+        { denoised, { "--denoise", "fast" } },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *cli = test_path("cli.exr"), *ours = test_path("ours.exr");
+        const char *const *e = cases[i].extra;
+        CHECK_INT(test_ptr(SCENE("seed.gltf"), "-o", cli, "--width", "96", "--samples", "6",
+                           "--quiet", e[0], e[1], e[2], e[3], e[4], e[5], (char *)NULL),
+                  0);
+        PtrFrame *frame = render_file(SCENE("seed.gltf"), NULL, cases[i].change);
+        check_same_as_file(frame, cli);
+        PtrErrorInfo err;
+        if (frame)
+            CHECK_INT(ptr_frame_save(context, ours, frame, NULL, &err), PTR_STATUS_OK);
+        check_same_files(cli, ours, attrs);
+        CHECK_INT((int)ptr_frame_samples(frame), 6);
+        ptr_frame_free(frame);
+    }
+    /* Where the region lies, and the noisy colour kept. */
+    PtrFrame *region = render_file(SCENE("seed.gltf"), NULL, region_and_budget);
+    int x, y, w, h;
+    ptr_frame_placement(region, &x, &y, &w, &h);
+    CHECK(ptr_frame_width(region) == 60 && ptr_frame_height(region) == 35);
+    CHECK(x == 10 && y == 5 && w == 96 && h == 96); /* the scene is square */
+    CHECK(ptr_frame_noisy(region) == NULL);
+    ptr_frame_free(region);
+    PtrFrame *clean = render_file(SCENE("seed.gltf"), NULL, denoised);
+    CHECK(ptr_frame_noisy(clean) != NULL && ptr_frame_albedo(clean) != NULL);
+    ptr_frame_placement(clean, &x, &y, &w, &h);
+    CHECK(x == 0 && y == 0 && w == ptr_frame_width(clean) && h == ptr_frame_height(clean));
+    ptr_frame_free(clean);
+    ptr_frame_placement(NULL, &x, NULL, NULL, &h);
+    CHECK(x == 0 && h == 0);
+    CHECK(ptr_frame_noisy(NULL) == NULL && ptr_frame_samples(NULL) == 0);
+}
+
+/* A time budget that runs out: the samples done, fewer than asked. */
+static void test_time_budget(void)
+{
+    PtrErrorInfo err;
+    PtrFrame *frame = NULL;
+    CHECK_INT(render_long(0.2, NULL, &frame, &err), PTR_STATUS_OK);
+    CHECK(ptr_frame_samples(frame) >= 1 && ptr_frame_samples(frame) < 1u << 30);
+    ptr_frame_free(frame);
+}
+
+/* The save options as the command line's: the same file for the same
+ * depth, exposure, view and baking; values out of range refused. */
+static void test_save_options(void)
+{
+    const char *cli = test_path("cli_baked.exr"), *ours = test_path("ours_baked.exr");
+    CHECK_INT(test_ptr(SCENE("final.gltf"), "-o", cli, "--width", "96", "--samples", "6",
+                       "--quiet", "--depth", "half", "--exposure", "1.5", "--view", "Raw",
+                       "--bake-view", (char *)NULL),
+              0);
+    PtrFrame *frame = render_file(SCENE("final.gltf"), NULL, NULL);
+    PtrSaveOptions save = { .depth = "half", .exposure = 1.5f, .view = "Raw", .bake_view = 1 };
+    PtrErrorInfo err;
+    CHECK_INT(ptr_frame_save(context, ours, frame, &save, &err), PTR_STATUS_OK);
+    static const char *const attrs[] = { "ptr:view", "ptr:exposure", "ptr:colorspace", NULL };
+    check_same_files(cli, ours, attrs);
+    PtrSaveOptions bad[4] = { save, save, save, save };
+    bad[0].depth = "12";
+    bad[1].exposure = 65;
+    bad[2].exposure = NAN;
+    bad[3].look = "no such look";
+    const char *named[4] = { "depth", "exposure", "exposure", "no such look" };
+    for (int k = 0; k < 4; k++) {
+        CHECK_INT(ptr_frame_save(context, ours, frame, &bad[k], &err), PTR_STATUS_USAGE);
+        CHECK(strstr(err.message, named[k]) != NULL);
+    }
+    save.depth = "16"; /* EXR stores half or float */
+    CHECK_INT(ptr_frame_save(context, ours, frame, &save, &err), PTR_STATUS_USAGE);
+    const PtrSaveOptions png16 = { .depth = "16", .dither = 1 };
+    CHECK_INT(ptr_frame_save(context, test_path("deep.png"), frame, &png16, &err),
+              PTR_STATUS_OK);
     ptr_frame_free(frame);
 }
 
@@ -597,6 +754,8 @@ int main(void)
         TEST_CASE(test_two_contexts), TEST_CASE(test_materials_checked),
         TEST_CASE(test_limits), TEST_CASE(test_null_arguments), TEST_CASE(test_bad_camera),
         TEST_CASE(test_hash_after_failed_build), TEST_CASE(test_saves_at_once),
+        TEST_CASE(test_region_budget_denoise_as_command_line), TEST_CASE(test_time_budget),
+        TEST_CASE(test_save_options),
     };
     test_run(cases, sizeof cases / sizeof cases[0]);
     ptr_context_free(context);
