@@ -35,6 +35,10 @@ typedef struct PtrCameraSpec {
 typedef struct PtrTexels {
     int width, height;
     float *rgba; /* malloc'd: the importer frees it */
+    /* 8 where the file holds bytes, each value then n / 255 for a byte n
+     * (in float, n times 1 / 255, as OpenImageIO converts); else the bits
+     * of its integers, or 0 (floats, or not known). */
+    int bits_per_channel;
 } PtrTexels;
 
 /* Decodes an image file held in memory, size bytes (a texture a glTF

@@ -51,20 +51,21 @@ static uint32_t find(Link *parent, uint32_t v)
     return v;
 }
 
-static void unite(Link *parent, uint32_t a, uint32_t b)
+/* Joins a's set and b's: 1 if they were two, 0 if they were one already. */
+static int unite(Link *parent, uint32_t a, uint32_t b)
 {
     if (link_of(parent, a) == link_of(parent, b)) /* most often, once paths are short */
-        return;
+        return 0;
     for (;;) {
         a = find(parent, a);
         b = find(parent, b);
         if (a == b)
-            return;
+            return 0;
         uint32_t high = a > b ? a : b;
         const uint32_t low = a > b ? b : a;
         if (atomic_compare_exchange_weak_explicit(&parent[high], &high, low,
                                                   memory_order_relaxed, memory_order_relaxed))
-            return;
+            return 1;
     }
 }
 
@@ -387,6 +388,8 @@ typedef struct Passes {
     uint32_t *order;        /* a component's place among the sorted spheres */
     uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
     int threads;
+    atomic_size_t rejoined; /* the triangles' unions that found their two
+                             * vertices in one set already */
 } Passes;
 
 enum { USED = UNSET - 1 };
@@ -411,19 +414,23 @@ static void label_used(void *arg, size_t from, size_t to)
     }
 }
 
+/* Joins each triangle's corners, counting the unions that join nothing (for
+ * find_closed_surfaces). */
 static void unite_triangles(void *arg, size_t from, size_t to)
 {
-    const Passes *ps = arg;
+    Passes *ps = arg;
     uint32_t tri[BLOCK][3];
+    size_t rejoined = 0;
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
         for (size_t i = 0; i < count; i++) {
-            unite(ps->parent, tri[i][0], tri[i][1]);
-            unite(ps->parent, tri[i][0], tri[i][2]);
+            rejoined += !unite(ps->parent, tri[i][0], tri[i][1]);
+            rejoined += !unite(ps->parent, tri[i][0], tri[i][2]);
             atomic_store_explicit(&ps->state[tri[i][0]], FIRST_CORNER, memory_order_relaxed);
         }
     }
+    atomic_fetch_add_explicit(&ps->rejoined, rejoined, memory_order_relaxed);
 }
 
 /* v's root where it is at most two links up, as it mostly is once the
@@ -517,11 +524,17 @@ static void mark_closed(void *arg, size_t from, size_t to)
 
 /* The vertices of the sets by index that are closed surfaces, on closed
  * surfaces; for a mesh of 2^31 vertices or triangles, whose balances could
- * wrap around to 4, none. */
+ * wrap around to 4, none. A set of F triangles whose 2 F unions found their
+ * vertices joined already R times has 2 F - R + 1 vertices (every other
+ * union added one), so balance 3 F - 2 R + 2: 4 needs 2 R = 3 F - 2, at
+ * least R = 2 (F = 2: two triangles over the same three vertices). Where
+ * the unions of the whole mesh found that fewer than twice (an unwelded
+ * mesh: never), no set is closed, and the passes are not run. */
 static void find_closed_surfaces(Passes *ps)
 {
     const PtrMeshSource *mesh = ps->mesh;
-    if (mesh->vertex_count >= (size_t)1 << 31 || mesh->triangle_count >= (size_t)1 << 31)
+    if (mesh->vertex_count >= (size_t)1 << 31 || mesh->triangle_count >= (size_t)1 << 31 ||
+        atomic_load(&ps->rejoined) < 2)
         return;
     ptr_parallel_ranges(ps->threads, 0, mesh->vertex_count, count_vertices, ps);
     ptr_parallel_ranges(ps->threads, 0, mesh->triangle_count, count_triangles, ps);

@@ -11,9 +11,8 @@ typedef struct Decoded {
     int state; /* UNREAD, READ or FAILED */
     GltfTexture info;
     PtrTexels texels; /* rgba NULL where bytes holds them */
-    /* Where every value is one of the 256 an 8-bit file decodes to (palettes'
-     * are): the texels as those bytes, RGBA, read through the tables of
-     * GltfTextures; else NULL. */
+    /* Where the file holds bytes (palettes too): the texels as those bytes,
+     * RGBA, read through the tables of GltfTextures; else NULL. */
     unsigned char *bytes;
     PtrError error; /* FAILED: the message, given again at each sample */
 } Decoded;
@@ -66,23 +65,19 @@ void gltf_textures_free(GltfTextures *textures)
     free(textures);
 }
 
-/* The texture's texels as bytes (d->bytes) if every value is a byte's value,
- * the floats then freed; else, or if memory is short, as they are. */
-static void keep_bytes(const GltfTextures *t, Decoded *d)
+/* An 8-bit texture's texels as bytes (d->bytes), a quarter of the floats'
+ * memory, the floats then freed; if memory is short, the floats as they
+ * are. */
+static void keep_bytes(Decoded *d)
 {
+    if (d->texels.bits_per_channel != 8)
+        return;
     const size_t values = 4 * (size_t)d->texels.width * (size_t)d->texels.height;
     unsigned char *bytes = malloc(values);
-    for (size_t i = 0; bytes && i < values; i++) {
-        const float v = d->texels.rgba[i];
-        const int n = v >= 0.0f && v <= 1.0f ? (int)(v * 255.0f + 0.5f) : 0; /* not NaN */
-        if (t->byte_value[n] != v) {
-            free(bytes);
-            return;
-        }
-        bytes[i] = (unsigned char)n;
-    }
     if (!bytes)
         return;
+    for (size_t i = 0; i < values; i++) /* n times 1 / 255 back to n */
+        bytes[i] = (unsigned char)(d->texels.rgba[i] * 255.0f + 0.5f);
     free(d->texels.rgba);
     d->texels.rgba = NULL;
     d->bytes = bytes;
@@ -111,7 +106,7 @@ static PtrResult decode(GltfTextures *t, int index, const Decoded **out, PtrErro
             res = ptr_error_set(&d->error, PTR_ERR_SCENE_INVALID, "%s: texture %d is empty",
                                 t->path, index);
         else
-            keep_bytes(t, d);
+            keep_bytes(d);
         d->state = res == PTR_OK ? READ : FAILED;
     }
     if (d->state == FAILED)

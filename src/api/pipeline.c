@@ -26,6 +26,7 @@ static PtrResult decode_texture(void *context, const char *name, const unsigned 
     }
     out->width = ptr_image_width(image);
     out->height = ptr_image_height(image);
+    out->bits_per_channel = ptr_image_bits_per_channel(image);
     ptr_image_free(image);
     return PTR_OK;
 }

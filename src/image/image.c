@@ -134,6 +134,7 @@ const float *ptr_image_alpha(const PtrImage *image) { return image->alpha; }
 const float *ptr_image_albedo(const PtrImage *image) { return image->albedo; }
 const float *ptr_image_normal(const PtrImage *image) { return image->normal; }
 const float *ptr_image_noisy(const PtrImage *image) { return image->noisy; }
+int ptr_image_bits_per_channel(const PtrImage *image) { return image->bits_per_channel; }
 
 const char *ptr_image_attr(const PtrImage *image, const char *name)
 {

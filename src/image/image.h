@@ -136,6 +136,11 @@ const float *ptr_image_albedo(const PtrImage *image);
 const float *ptr_image_normal(const PtrImage *image);
 /* Three floats a pixel, as stored; NULL unless the image was denoised. */
 const float *ptr_image_noisy(const PtrImage *image);
+/* The bits of each channel where the file stores unsigned integers, all of
+ * one size (8 for a PNG, JPEG or WebP of bytes, palettes' too: every value
+ * is then a byte n read as n / 255; 16: n / 65535); 0 for floats (EXR) and
+ * any other types. */
+int ptr_image_bits_per_channel(const PtrImage *image);
 
 /* A header attribute as text (numbers formatted), or NULL if absent. The
  * string lives as long as the image. */

@@ -23,6 +23,7 @@ struct PtrImage {
     float *alpha;        /* one float a pixel, or NULL: no alpha channel */
     float *albedo, *normal; /* three floats a pixel each, or NULL: no passes (EXR) */
     float *noisy;        /* three floats a pixel, or NULL: not denoised (EXR) */
+    int bits_per_channel; /* see ptr_image_bits_per_channel */
     size_t attr_count;
     char **attr_names;   /* as the file names them */
     char **attr_values;  /* as text: numbers formatted */

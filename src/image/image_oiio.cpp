@@ -139,6 +139,21 @@ OIIO::ImageInput::unique_ptr open_memory(const char *path, OIIO::Filesystem::IOP
     return nullptr;
 }
 
+// The bits of the channels' one unsigned integer type, as
+// ptr_image_bits_per_channel says; else 0.
+int unsigned_bits(const OIIO::ImageSpec &spec)
+{
+    for (const OIIO::TypeDesc &channel : spec.channelformats)
+        if (channel != spec.format)
+            return 0;
+    switch (spec.format.basetype) {
+    case OIIO::TypeDesc::UINT8: return 8;
+    case OIIO::TypeDesc::UINT16: return 16;
+    case OIIO::TypeDesc::UINT32: return 32;
+    default: return 0;
+    }
+}
+
 PtrResult read_image(const char *path, const unsigned char *bytes, size_t size, PtrImage **out,
                      PtrError *err)
 {
@@ -164,6 +179,7 @@ PtrResult read_image(const char *path, const unsigned char *bytes, size_t size, 
         if (!image)
             throw std::bad_alloc();
         image->layout = { spec.width, spec.height, spec.x, spec.y, spec.full_width, spec.full_height };
+        image->bits_per_channel = unsigned_bits(spec);
         const int alpha = spec.alpha_channel;
         if (alpha >= 0 && !ptr_image_alloc_alpha(image))
             throw std::bad_alloc();

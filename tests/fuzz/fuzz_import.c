@@ -45,7 +45,8 @@ static PtrResult decode_texels(void *context, const char *name, const unsigned c
     if (!out->rgba)
         return ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", name);
     for (size_t i = 0; i < values; i++)
-        out->rgba[i] = bytes[2 + i % (size - 2)] / 255.0f;
+        out->rgba[i] = bytes[2 + i % (size - 2)] * (1.0f / 255.0f);
+    out->bits_per_channel = 8;
     return PTR_OK;
 }
 

@@ -133,10 +133,38 @@ static void test_online_cpus(void)
     free(m.t);
 }
 
+/* The least closed set by index: two triangles over the same three vertices
+ * (2 vertices a triangle, less 4: balance 4), kept out of the position
+ * matching, so a triangle with vertices of its own at the same positions is
+ * a component apart; turned open (its second triangle with vertices of its
+ * own too), all three are joined by position. */
+static void test_least_closed(void)
+{
+    double v[9][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
+    for (int i = 3; i < 9; i++)
+        memcpy(v[i], v[i % 3], sizeof v[i]);
+    uint32_t closed[3][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 3, 4, 5 } };
+    uint32_t open[3][3] = { { 0, 1, 2 }, { 6, 8, 7 }, { 3, 4, 5 } };
+    static const int one[] = { 1 };
+    script = one, script_length = 1, asked = 0;
+    for (int opened = 0; opened < 2; opened++) {
+        Mesh m = { v, opened ? open : closed };
+        const PtrMeshSource mesh = { .vertex_count = 9, .triangle_count = 3,
+                                     .positions = positions, .gather = gather,
+                                     .triangles = triangles, .user = &m };
+        PtrMeshSphere *found = NULL;
+        size_t count = 0;
+        CHECK_INT(ptr_mesh_spheres(&mesh, "triangles", &found, &count, NULL, NULL), PTR_OK);
+        CHECK_INT(count, opened ? 1 : 2);
+        free(found);
+    }
+}
+
 int main(void)
 {
     const TestCase cases[] = {
         TEST_CASE(test_online_cpus),
+        TEST_CASE(test_least_closed),
     };
     TEST_RUN(cases);
     return test_report();
