@@ -65,6 +65,9 @@ typedef struct Task {
 
 typedef struct Build {
     BvhPrimSet set;
+    /* The same prims for the tasks, which run one a thread: one thread
+     * each, for the threads are all at work. */
+    BvhPrimSet task_set;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
     size_t task_spheres;
     Task *tasks;
@@ -133,8 +136,8 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         }
         if (pick < 0)
             break;
-        r = bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch,
-                      &child[pick], &child[n], err);
+        r = bvh_split(top ? &build->set : &build->task_set, &child[pick],
+                      level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick], &child[n], err);
         if (r != PTR_OK)
             return r;
     }
@@ -203,7 +206,7 @@ static void *task_worker(void *arg)
         if (!scratch)
             scratch = malloc(build->task_spheres * sizeof *scratch);
         t->failed = !scratch ||
-                    bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL,
+                    bvh_candidate_init(&build->task_set, &range, t->begin, t->end, NULL, NULL,
                                        NULL) != PTR_OK ||
                     build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
                                &t->nodes.depth, NULL) != PTR_OK;
@@ -365,6 +368,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         r = ptr_bvh_prims(&tree_part, build.set.threads, huge, &bvh->huge_count,
                           build.set.prims, &prim_count, &build.set.magnitude, err);
     }
+    build.task_set = build.set;
+    build.task_set.threads = 1;
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
