@@ -65,6 +65,9 @@ typedef struct Task {
 
 typedef struct Build {
     BvhPrimSet set;
+    /* The same prims for the tasks, which run one a thread: one thread
+     * each, for the threads are all at work. */
+    BvhPrimSet task_set;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
     size_t task_spheres;
     Task *tasks;
@@ -133,8 +136,8 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         }
         if (pick < 0)
             break;
-        r = bvh_split(&build->set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch,
-                      &child[pick], &child[n], err);
+        r = bvh_split(top ? &build->set : &build->task_set, &child[pick],
+                      level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick], &child[n], err);
         if (r != PTR_OK)
             return r;
     }
@@ -203,7 +206,7 @@ static void *task_worker(void *arg)
         if (!scratch)
             scratch = malloc(build->task_spheres * sizeof *scratch);
         t->failed = !scratch ||
-                    bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL,
+                    bvh_candidate_init(&build->task_set, &range, t->begin, t->end, NULL, NULL,
                                        NULL) != PTR_OK ||
                     build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
                                &t->nodes.depth, NULL) != PTR_OK;
@@ -232,38 +235,63 @@ static PtrResult run_tasks(Build *build, PtrError *err)
     return PTR_OK;
 }
 
+/* Freed node arrays are trimmed from the heap each time this many bytes
+ * have been freed: glibc keeps freed blocks of a few megabytes for itself,
+ * and the tree must not be in memory twice. */
+enum { TRIM_BYTES = 32 << 20 };
+
+typedef struct LayOut {
+    Build *build;
+    PtrBvhNode *nodes;
+    const size_t *start; /* where each task's nodes go */
+} LayOut;
+
+/* Moves tasks begin .. end - 1 to their places, each inner child index by
+ * its task's start, freeing each task's array as it goes. */
+static void lay_out_tasks(void *arg, size_t begin, size_t end)
+{
+    const LayOut *l = arg;
+    size_t freed = 0;
+    for (size_t i = begin; i < end; i++) {
+        NodeArray *a = &l->build->tasks[i].nodes;
+        PtrBvhNode *nodes = l->nodes + l->start[i];
+        memcpy(nodes, a->nodes, a->count * sizeof *nodes);
+        free(a->nodes);
+        a->nodes = NULL;
+        freed += a->count * sizeof *nodes;
+        if (freed >= TRIM_BYTES) {
+            malloc_trim(0);
+            freed = 0;
+        }
+        for (size_t j = 0; j < a->count; j++)
+            for (int k = 0; k < PTR_BVH_WIDTH; k++)
+                if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
+                    nodes[j].child[k] += (uint32_t)l->start[i];
+    }
+    if (freed)
+        malloc_trim(0);
+}
+
 /* One node array: the top level's first, then each task's, with every task
  * reference and every inner child index moved to its final place. */
 static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *err)
 {
-    size_t total = top->count;
-    for (size_t i = 0; i < build->task_count; i++)
-        total += build->tasks[i].nodes.count;
-    PtrBvhNode *nodes = aligned_alloc(64, total * sizeof *nodes);
-    if (!nodes)
-        return bvh_out_of_memory(err);
-    memcpy(nodes, top->nodes, top->count * sizeof *nodes);
     size_t *start = malloc((build->task_count + 1) * sizeof *start);
-    if (!start) {
-        free(nodes);
+    if (!start)
+        return bvh_out_of_memory(err);
+    size_t total = top->count;
+    for (size_t i = 0; i < build->task_count; i++) {
+        start[i] = total;
+        total += build->tasks[i].nodes.count;
+    }
+    PtrBvhNode *nodes = aligned_alloc(64, total * sizeof *nodes);
+    if (!nodes) {
+        free(start);
         return bvh_out_of_memory(err);
     }
-    size_t at = top->count;
-    for (size_t i = 0; i < build->task_count; i++) {
-        NodeArray *a = &build->tasks[i].nodes;
-        start[i] = at;
-        memcpy(nodes + at, a->nodes, a->count * sizeof *nodes);
-        /* As it goes, so that the tree is not in memory twice; trimmed, for
-         * glibc keeps freed blocks of a few megabytes for itself. */
-        free(a->nodes);
-        a->nodes = NULL;
-        malloc_trim(0);
-        for (size_t j = at; j < at + a->count; j++)
-            for (int k = 0; k < PTR_BVH_WIDTH; k++)
-                if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
-                    nodes[j].child[k] += (uint32_t)at;
-        at += a->count;
-    }
+    memcpy(nodes, top->nodes, top->count * sizeof *nodes);
+    LayOut l = { build, nodes, start };
+    ptr_parallel_ranges(build->set.threads, 0, build->task_count, lay_out_tasks, &l);
     /* The depth of the top level counts a task as one level; add the rest. */
     int depth = 0;
     for (size_t j = 0; j < top->count; j++)
@@ -337,9 +365,11 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        r = ptr_bvh_prims(&tree_part, huge, &bvh->huge_count, build.set.prims,
-                          &prim_count, &build.set.magnitude, err);
+        r = ptr_bvh_prims(&tree_part, build.set.threads, huge, &bvh->huge_count,
+                          build.set.prims, &prim_count, &build.set.magnitude, err);
     }
+    build.task_set = build.set;
+    build.task_set.threads = 1;
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;

@@ -1,8 +1,12 @@
 #include "accel/bvh_prims.h"
 
 #include <math.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "base/threads.h"
 
 /* The tree keeps the huge spheres among its own (scene.h's rule) out of its
  * boxes, with a limit of HUGE_RATIO times the median radius: a ground of
@@ -88,8 +92,45 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
  * float array. */
 enum { RELEASE_STEP = 1 << 20 };
 
-PtrResult ptr_bvh_prims(PtrSpheres *s, BvhPrim *huge, size_t *huge_count, BvhPrim *prims,
-                        size_t *prim_count, float *magnitude_out, PtrError *err)
+/* The copy of spheres into prims, in pieces on all threads: a piece's first
+ * prim is its first sphere's index less the huge spheres before it, so the
+ * pieces need nothing of each other. */
+typedef struct PrimCopy {
+    const PtrSpheres *spheres;
+    BvhPrim *prims;
+    const size_t *huge_index; /* ascending, then SIZE_MAX */
+    /* The largest magnitude so far, as the bits of a float that is never
+     * negative: such floats order as their bits do. */
+    atomic_uint_least32_t magnitude;
+} PrimCopy;
+
+static void copy_prims(void *arg, size_t begin, size_t end)
+{
+    PrimCopy *c = arg;
+    size_t k = 0;
+    while (c->huge_index[k] < begin)
+        k++;
+    BvhPrim *out = c->prims + (begin - k);
+    float magnitude = 0.0f;
+    for (size_t i = begin; i < end; i++) {
+        if (c->huge_index[k] == i) {
+            k++;
+            continue;
+        }
+        const float m = v3_max_abs(ptr_sphere_centre(c->spheres, i)) + c->spheres->radius[i];
+        if (m > magnitude)
+            magnitude = m;
+        *out++ = bvh_prim_of(c->spheres, i);
+    }
+    uint32_t bits;
+    memcpy(&bits, &magnitude, sizeof bits);
+    uint_least32_t seen = atomic_load(&c->magnitude);
+    while (bits > seen && !atomic_compare_exchange_weak(&c->magnitude, &seen, bits))
+        ;
+}
+
+PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_count,
+                        BvhPrim *prims, size_t *prim_count, float *magnitude_out, PtrError *err)
 {
     *huge_count = *prim_count = 0;
     *magnitude_out = 0.0f;
@@ -111,25 +152,17 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, BvhPrim *huge, size_t *huge_count, BvhPri
         out[at] = choice.sphere[k].index;
     }
     out[choice.count] = SIZE_MAX;
-    float magnitude = 0.0f;
-    size_t n = 0, k = 0;
+    PrimCopy copy = { .spheres = s, .prims = prims, .huge_index = out };
+    atomic_init(&copy.magnitude, 0);
     for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
         const size_t end = s->count - begin > RELEASE_STEP ? begin + RELEASE_STEP : s->count;
-        for (size_t i = begin; i < end; i++) {
-            if (out[k] == i) {
-                k++;
-                continue;
-            }
-            const float m = v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
-            if (m > magnitude)
-                magnitude = m;
-            prims[n++] = bvh_prim_of(s, i);
-        }
+        ptr_parallel_ranges(threads, begin, end, copy_prims, &copy);
         ptr_spheres_release(s, begin, end);
     }
+    const uint32_t bits = (uint32_t)atomic_load(&copy.magnitude);
+    memcpy(magnitude_out, &bits, sizeof bits);
     *huge_count = choice.count;
-    *prim_count = n;
-    *magnitude_out = magnitude;
+    *prim_count = s->count - choice.count;
     return PTR_OK;
 }
 

@@ -48,6 +48,7 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     double pass_seconds = options->time_budget > 0 ? fmin(1.0, fmax(0.05, options->time_budget / 8))
                                                    : 1.0;
     uint32_t done = 0, pass = 1;
+    double passes_seconds = 0.0; /* in ptr_render_samples, the threads at work */
     while (done < options->samples) {
         watch.pass_samples = pass;
         PtrRenderStats stats;
@@ -56,8 +57,10 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
         if (res != PTR_OK)
             break;
         done += pass;
+        passes_seconds += stats.seconds;
         result->stats.rays += stats.rays;
         result->stats.threads = stats.threads;
+        result->stats.idle_seconds += stats.idle_seconds;
         double elapsed = ptr_now_seconds() - watch.start;
         watch.progress.samples_done = done;
         watch.progress.rays = result->stats.rays;
@@ -82,6 +85,9 @@ PtrResult ptr_render_progressive(const PtrScene *scene, const PtrAccel *accel,
     }
     result->samples_done = done;
     result->stats.seconds = ptr_now_seconds() - watch.start;
+    /* Between passes (the pass's set-up, pass_done, sizing the next) every
+     * thread waits. */
+    result->stats.idle_seconds += (result->stats.seconds - passes_seconds) * result->stats.threads;
     if (res == PTR_OK) {
         ptr_accum_resolve(acc, pixels, stride, rgb, alpha, sample_counts);
         if (settings->passes)

@@ -112,6 +112,7 @@ typedef struct Worker {
     RenderJob *job;
     PtrThread *thread;
     uint64_t rays;
+    double finished; /* when it found no tile left */
 } Worker;
 
 static const char *const integrator_names[] = {
@@ -193,6 +194,7 @@ static void *render_worker(void *arg)
         atomic_fetch_add(&job->tiles_done, 1);
     }
     w->rays = rays;
+    w->finished = ptr_now_seconds();
     pthread_mutex_lock(&job->lock);
     if (--job->workers_running == 0)
         pthread_cond_signal(&job->all_done);
@@ -300,7 +302,10 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
         ptr_thread_join(workers[i].thread);
         rays += workers[i].rays;
     }
-    double seconds = ptr_now_seconds() - start;
+    const double end = ptr_now_seconds(), seconds = end - start;
+    double idle = 0.0;
+    for (int i = 0; i < started; i++)
+        idle += end - workers[i].finished;
     free(workers);
     ptr_lights_free(&job.paths.lights);
     pthread_cond_destroy(&job.all_done);
@@ -309,7 +314,7 @@ PtrResult ptr_render_samples(const PtrScene *scene, const PtrAccel *accel,
         tick(user, 1.0);
     if (stats)
         *stats = (PtrRenderStats){ .seconds = seconds, .rays = rays,
-                                   .threads = started ? started : 1 };
+                                   .threads = started ? started : 1, .idle_seconds = idle };
     return PTR_OK;
 }
 

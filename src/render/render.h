@@ -15,6 +15,10 @@ typedef struct PtrRenderStats {
     double seconds;
     uint64_t rays; /* closest-hit queries: camera, scattered and shadow rays */
     int threads;
+    /* Thread-seconds the threads sat idle: each from its last tile to the
+     * call's end and, over passes (progressive.h), all between two passes.
+     * Over threads x seconds, the share of the cores a render left unused. */
+    double idle_seconds;
 } PtrRenderStats;
 
 /* Called on the rendering call's own thread about ten times a second while

@@ -1,0 +1,141 @@
+/* How ptr's two parallel stages scale from one thread to two, in one run,
+ * the thread counts taking turns so that both see the same machine:
+ *
+ *   scaling SCENE [WIDTH HEIGHT SPP [RUNS]]   (defaults: 640 360 8, 5 runs)
+ *
+ * Each run imports the scene afresh (the build reorders it), builds the tree
+ * as ptr does (ptr_accel_init, the kernels of this CPU) and renders in
+ * passes as ptr does (ptr_render_progressive: passes of about a second),
+ * on 1 thread and then on 2. Prints per run the build's and the render's
+ * seconds and the share of the render threads' time spent idle (waiting for
+ * the last tile of a pass, or between passes: PtrRenderStats.idle_seconds);
+ * then the medians, and the speed-ups 1 thread / 2 threads. Every render
+ * must give the first one's pixels bit for bit: otherwise it says so and
+ * exits 1. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "base/cpu.h"
+#include "importer.h"
+#include "render/progressive.h"
+
+enum { MAX_THREADS = 2, MAX_RUNS = 99 };
+
+typedef struct Measure {
+    double build, render, idle; /* seconds, seconds, share of threads x seconds */
+} Measure;
+
+static void fail(const char *what, const PtrError *err)
+{
+    fprintf(stderr, "scaling: %s: %s\n", what, err->message[0] ? err->message : "out of memory");
+    exit(2);
+}
+
+static Measure measure(const char *path, PtrRenderSettings settings, float *rgb)
+{
+    PtrScene scene;
+    PtrStrings warnings = { 0 };
+    PtrError err = { 0 };
+    PtrImportOptions options = { 0 };
+    if (ptr_import_scene(path, &options, &scene, &warnings, &err) != PTR_OK)
+        fail(path, &err);
+    ptr_strings_free(&warnings);
+    const PtrCpuLevel level = ptr_cpu_level();
+    PtrIsectTable isect;
+    PtrAccel accel;
+    ptr_isect_init(&isect, PTR_KERNEL_AUTO, level, scene.spheres.count, NULL);
+    settings.integrator = ptr_integrator_resolve(PTR_INTEGRATOR_AUTO, level);
+    if (ptr_accel_init(&accel, PTR_ACCEL_AUTO, &isect,
+                       settings.integrator == PTR_INTEGRATOR_BUNDLES, &scene, settings.threads,
+                       &err) != PTR_OK)
+        fail("build", &err);
+    const PtrProgressiveOptions passes = { .samples = settings.samples };
+    const size_t pixels = (size_t)settings.width * (size_t)settings.height;
+    float *alpha = malloc(pixels * sizeof *alpha), *counts = malloc(pixels * sizeof *counts);
+    PtrProgressiveResult done;
+    if (!alpha || !counts ||
+        ptr_render_progressive(&scene, &accel, &settings, &passes, rgb, alpha, counts, NULL,
+                               NULL, &done, &err) != PTR_OK)
+        fail("render", &err);
+    const Measure m = { accel.build_seconds, done.stats.seconds,
+                        done.stats.idle_seconds / (done.stats.threads * done.stats.seconds) };
+    free(alpha);
+    free(counts);
+    ptr_accel_free(&accel);
+    ptr_scene_free(&scene);
+    return m;
+}
+
+static int by_value(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *values, int count)
+{
+    qsort(values, (size_t)count, sizeof *values, by_value);
+    return values[count / 2];
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2 && argc != 5 && argc != 6) {
+        fprintf(stderr, "usage: scaling SCENE [WIDTH HEIGHT SPP [RUNS]]\n");
+        return 2;
+    }
+    PtrRenderSettings settings = { .width = 640, .height = 360, .samples = 8, .seed = 1,
+                                   .max_depth = 50 };
+    int runs = 5;
+    if (argc >= 5) {
+        settings.width = atoi(argv[2]);
+        settings.height = atoi(argv[3]);
+        settings.samples = (uint32_t)atoi(argv[4]);
+        runs = argc == 6 ? atoi(argv[5]) : runs;
+    }
+    if (runs < 1 || runs > MAX_RUNS || settings.width < 1 || settings.height < 1 ||
+        settings.samples < 1) {
+        fprintf(stderr, "scaling: a size, samples and 1 to %d runs\n", MAX_RUNS);
+        return 2;
+    }
+    const size_t floats = (size_t)settings.width * (size_t)settings.height * 3;
+    float *first = malloc(floats * sizeof *first), *rgb = malloc(floats * sizeof *rgb);
+    if (!first || !rgb)
+        return 2;
+    double build[MAX_THREADS + 1][MAX_RUNS], render[MAX_THREADS + 1][MAX_RUNS],
+        idle[MAX_THREADS + 1][MAX_RUNS];
+    int differ = 0;
+    printf("run  threads  build s  render s  idle\n");
+    for (int run = 0; run < runs; run++)
+        for (int threads = 1; threads <= MAX_THREADS; threads++) {
+            settings.threads = threads;
+            const int is_first = run == 0 && threads == 1;
+            const Measure m = measure(argv[1], settings, is_first ? first : rgb);
+            if (!is_first && memcmp(first, rgb, floats * sizeof *rgb)) {
+                fprintf(stderr, "scaling: run %d on %d threads: the image differs\n", run + 1,
+                        threads);
+                differ = 1;
+            }
+            build[threads][run] = m.build;
+            render[threads][run] = m.render;
+            idle[threads][run] = m.idle;
+            printf("%3d  %7d  %7.3f  %8.3f  %5.2f%%\n", run + 1, threads, m.build, m.render,
+                   100 * m.idle);
+            fflush(stdout);
+        }
+    double b[MAX_THREADS + 1], r[MAX_THREADS + 1], i[MAX_THREADS + 1];
+    for (int threads = 1; threads <= MAX_THREADS; threads++) {
+        b[threads] = median(build[threads], runs);
+        r[threads] = median(render[threads], runs);
+        i[threads] = median(idle[threads], runs);
+    }
+    printf("\nmedian of %d runs   1 thread   2 threads   1/2 threads\n", runs);
+    printf("build s           %8.3f   %9.3f   %10.2fx\n", b[1], b[2], b[1] / b[2]);
+    printf("render s          %8.3f   %9.3f   %10.2fx\n", r[1], r[2], r[1] / r[2]);
+    printf("render idle       %7.2f%%   %8.2f%%\n", 100 * i[1], 100 * i[2]);
+    free(first);
+    free(rgb);
+    return differ;
+}
