@@ -59,6 +59,7 @@ typedef struct PtrRenderRequest {
     int width, height;     /* asked; 0: the scene's (ptr_choose_size) */
     int divisor;           /* the size divided by this (--preview); 1: none */
     PtrRegion region;      /* all zero: the whole image */
+    const char *region_name; /* what messages call it: the option, or the field */
     uint32_t first_sample, samples;
     double time_budget;    /* seconds; 0: none */
     uint64_t seed;
@@ -112,8 +113,8 @@ struct PtrFrame {
 PtrResult ptr_api_render(PtrSceneHandle *scene, const PtrRenderRequest *request,
                          const PtrRenderHooks *hooks, PtrFrame **out, PtrError *err);
 /* Denoises the frame's colour if its render asked for it, keeping the
- * noisy one. */
-PtrResult ptr_api_frame_finish(PtrFrame *frame, PtrError *err);
+ * noisy one; name: what a message names (the output, or the scene). */
+PtrResult ptr_api_frame_finish(PtrFrame *frame, const char *name, PtrError *err);
 /* Writes the frame to path as output says; an EXR keeps the passes, the
  * noisy colour and the samples counts the frame has. */
 PtrResult ptr_api_frame_write(PtrImageLoader *images, const char *path, const PtrFrame *frame,

@@ -47,6 +47,7 @@ static PtrResult read_request(const PtrContext *context, const PtrRenderOptions 
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
         .transparent = o->transparent, .passes = o->passes,
         .region = { o->region[0], o->region[1], o->region[2], o->region[3] },
+        .region_name = "region",
         .time_budget = o->time_budget,
     };
     if (o->kernel && strcmp(o->kernel, "c") && strcmp(o->kernel, "asm"))
@@ -72,7 +73,8 @@ static PtrResult read_request(const PtrContext *context, const PtrRenderOptions 
     c->denoise = o->denoise != NULL;
     if (o->denoise && ptr_denoise_quality_parse(o->denoise, &c->denoise_quality, &problem) != PTR_OK)
         return option_error("denoise", &problem, err);
-    r->denoise_quality = o->denoise;
+    /* The name, not the caller's string: the frame keeps it for its save. */
+    r->denoise_quality = c->denoise ? ptr_denoise_quality_name(c->denoise_quality) : NULL;
     /* The command line's ranges; 0 is the scene's size and the context's
      * threads. */
     const struct {
@@ -188,9 +190,9 @@ static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r
     ptr_choose_size(&h->scene, r->width, r->height, r->divisor, &settings->width,
                     &settings->height);
     if (ptr_render_region(settings).x1 == 0)
-        return ptr_error_set(err, PTR_ERR_USAGE, "--region %d,%d,%d,%d lies outside the %dx%d image",
-                             r->region.x0, r->region.y0, r->region.x1, r->region.y1,
-                             settings->width, settings->height);
+        return ptr_error_set(err, PTR_ERR_USAGE, "%s %d,%d,%d,%d lies outside the %dx%d image",
+                             r->region_name, r->region.x0, r->region.y0, r->region.x1,
+                             r->region.y1, settings->width, settings->height);
     return PTR_OK;
 }
 
@@ -254,8 +256,11 @@ PtrResult ptr_api_render(PtrSceneHandle *h, const PtrRenderRequest *r,
     if (r->camera)
         h->scene.camera = *r->camera;
     res = render_into(h, r, hooks, f, err);
-    h->scene.sky = sky;
-    h->scene.camera = camera;
+    /* Only what was changed: a live view may still be reading the scene. */
+    if (r->sky)
+        h->scene.sky = sky;
+    if (r->camera)
+        h->scene.camera = camera;
     if (res != PTR_OK) {
         ptr_frame_free(f);
         return res;
@@ -264,12 +269,12 @@ PtrResult ptr_api_render(PtrSceneHandle *h, const PtrRenderRequest *r,
     return PTR_OK;
 }
 
-PtrResult ptr_api_frame_finish(PtrFrame *f, PtrError *err)
+PtrResult ptr_api_frame_finish(PtrFrame *f, const char *name, PtrError *err)
 {
     if (!f->info.denoiser)
         return PTR_OK;
     float *denoised;
-    PtrResult res = ptr_output_denoise(f->scene_name, &f->layout, f->buffers.rgb, &f->info,
+    PtrResult res = ptr_output_denoise(name, &f->layout, f->buffers.rgb, &f->info,
                                        &denoised, err);
     if (res != PTR_OK)
         return res;
@@ -338,7 +343,7 @@ static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderO
         res = ptr_error_set(err, PTR_ERR_INTERRUPTED, "%s: cancelled after %u of %u samples",
                             h->name, f->done.samples_done, o->samples);
     if (res == PTR_OK)
-        res = ptr_api_frame_finish(f, err);
+        res = ptr_api_frame_finish(f, f->scene_name, err);
     if (res == PTR_OK)
         res = make_rgba(f, err);
     if (res != PTR_OK) {

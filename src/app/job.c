@@ -25,7 +25,7 @@ static PtrRenderRequest request_of(const PtrOptions *o, const PtrJobReport *repo
 {
     return (PtrRenderRequest){
         .width = o->width, .height = o->height, .divisor = o->preview ? PREVIEW_SCALE : 1,
-        .region = o->region, .first_sample = report->sample_first,
+        .region = o->region, .region_name = "--region", .first_sample = report->sample_first,
         .samples = report->samples_requested, .time_budget = o->time_budget, .seed = o->seed,
         .max_depth = o->max_depth, .threads = o->threads, .kernel = o->kernel,
         .level = o->cpu_level, .integrator = o->integrator, .accel = o->accel,
@@ -66,8 +66,6 @@ static void report_render(const PtrSceneHandle *scene, const PtrFrame *frame,
     }
     if (!frame)
         return;
-    report->width = frame->layout.full_width;
-    report->height = frame->layout.full_height;
     report->samples = frame->done.samples_done;
     report->seconds = frame->done.stats.seconds;
     report->rays = frame->done.stats.rays;
@@ -80,6 +78,9 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
                                   const PtrColor *color, PtrJobReport *report, PtrError *err)
 {
     const PtrRenderRequest request = request_of(o, report);
+    /* The image's size, reported even when its region lies outside it. */
+    ptr_choose_size(&scene->scene, request.width, request.height, request.divisor,
+                    &report->width, &report->height);
     PtrProgressPrinter printer;
     ptr_progress_printer_init(&printer, report->output);
     LiveRender live = { o->live_view, report->scene, report->output, 0 };
@@ -98,7 +99,7 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
      * whole or not at all: an output that exists is never rendered again. */
     if (res == PTR_OK && !(stopped && o->skip_existing)) {
         const PtrOutputSettings output = ptr_options_output(o, color);
-        res = ptr_api_frame_finish(frame, err);
+        res = ptr_api_frame_finish(frame, report->output, err);
         if (res == PTR_OK)
             res = ptr_api_frame_write(o->images, report->output, frame, &output, err);
     }

@@ -17,11 +17,19 @@ struct PtrDenoiser {
     PtrUnet *color, *albedo, *normal;
 };
 
+static const char *const quality_names[] = {
+    [PTR_DENOISE_FAST] = "fast", [PTR_DENOISE_BALANCED] = "balanced", [PTR_DENOISE_HIGH] = "high",
+};
+
+const char *ptr_denoise_quality_name(PtrDenoiseQuality quality)
+{
+    return quality_names[quality];
+}
+
 PtrResult ptr_denoise_quality_parse(const char *text, PtrDenoiseQuality *out, PtrError *err)
 {
-    static const char *const names[] = { "fast", "balanced", "high" };
-    for (int q = 0; q < 3; q++)
-        if (!strcmp(text, names[q])) {
+    for (int q = PTR_DENOISE_FAST; q <= PTR_DENOISE_HIGH; q++)
+        if (!strcmp(text, quality_names[q])) {
             *out = (PtrDenoiseQuality)q;
             return PTR_OK;
         }

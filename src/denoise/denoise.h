@@ -21,6 +21,8 @@ typedef enum PtrDenoiseQuality {
 
 /* Parses "fast", "balanced" or "high" (the option-value convention). */
 PtrResult ptr_denoise_quality_parse(const char *text, PtrDenoiseQuality *out, PtrError *err);
+/* The quality's name, as parsed: a string that lives as long as the process. */
+const char *ptr_denoise_quality_name(PtrDenoiseQuality quality);
 
 typedef struct PtrDenoiser PtrDenoiser;
 
