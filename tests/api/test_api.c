@@ -608,6 +608,30 @@ static void test_region_budget_denoise_as_command_line(void)
     CHECK(ptr_frame_noisy(NULL) == NULL && ptr_frame_samples(NULL) == 0);
 }
 
+static char caller_quality[16];
+static void denoised_by_caller(PtrRenderOptions *o)
+{
+    strcpy(caller_quality, "fast");
+    o->denoise = caller_quality;
+}
+
+/* A frame keeps nothing of the options it was rendered with: the caller's
+ * string, changed before the save, is not what the file names. */
+static void test_frame_keeps_no_option_string(void)
+{
+    PtrFrame *frame = render_file(SCENE("seed.gltf"), NULL, denoised_by_caller);
+    strcpy(caller_quality, "changed");
+    const char *path = test_path("quality.exr");
+    PtrErrorInfo err;
+    if (frame)
+        CHECK_INT(ptr_frame_save(context, path, frame, NULL, &err), PTR_STATUS_OK);
+    PtrImage *image = read_exr(path);
+    const char *quality = image ? ptr_image_attr(image, "ptr:denoised") : NULL;
+    CHECK(quality && !strcmp(quality, "fast"));
+    ptr_image_free(image);
+    ptr_frame_free(frame);
+}
+
 /* A time budget that runs out: the samples done, fewer than asked. */
 static void test_time_budget(void)
 {
@@ -754,7 +778,8 @@ int main(void)
         TEST_CASE(test_two_contexts), TEST_CASE(test_materials_checked),
         TEST_CASE(test_limits), TEST_CASE(test_null_arguments), TEST_CASE(test_bad_camera),
         TEST_CASE(test_hash_after_failed_build), TEST_CASE(test_saves_at_once),
-        TEST_CASE(test_region_budget_denoise_as_command_line), TEST_CASE(test_time_budget),
+        TEST_CASE(test_region_budget_denoise_as_command_line),
+        TEST_CASE(test_frame_keeps_no_option_string), TEST_CASE(test_time_budget),
         TEST_CASE(test_save_options),
     };
     test_run(cases, sizeof cases / sizeof cases[0]);
