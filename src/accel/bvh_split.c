@@ -105,11 +105,13 @@ static void bins_merge(Bins *into, const Bins *b, int bins)
 }
 
 /* Runs of this many prims are bounded, binned and partitioned by all threads
- * together; smaller ones by the calling thread. Runs of more than
+ * together; smaller ones by the calling thread (handing a piece to a kept
+ * thread and back takes about 12 microseconds, a run of 16,384 prims some
+ * hundred). Runs of more than
  * SAMPLED_ABOVE prims choose their split from about SAMPLES of them, evenly
  * spaced: at the top of a tree of 10^7 spheres, binning every prim took a
  * third of the build and chose much the same splits. */
-enum { PARALLEL_PRIMS = 1 << 16, SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
+enum { PARALLEL_PRIMS = 1 << 14, SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
 
 typedef struct ParallelRun {
     const BvhPrimSet *set;
