@@ -235,9 +235,11 @@ static PtrResult run_tasks(Build *build, PtrError *err)
     return PTR_OK;
 }
 
-/* Freed node arrays are trimmed from the heap each time this many bytes
- * have been freed: glibc keeps freed blocks of a few megabytes for itself,
- * and the tree must not be in memory twice. */
+/* The tasks' arrays are laid out in batches of about this many bytes, each
+ * on all threads, the heap trimmed after each: glibc keeps freed blocks of a
+ * few megabytes for itself, and the tree must not be in memory twice. (Only
+ * on the calling thread: glibc's malloc_trim on two threads at once is not
+ * safe where another allocator serves malloc, as under AddressSanitizer.) */
 enum { TRIM_BYTES = 32 << 20 };
 
 typedef struct LayOut {
@@ -247,29 +249,21 @@ typedef struct LayOut {
 } LayOut;
 
 /* Moves tasks begin .. end - 1 to their places, each inner child index by
- * its task's start, freeing each task's array as it goes. */
+ * its task's start, freeing each task's array. */
 static void lay_out_tasks(void *arg, size_t begin, size_t end)
 {
     const LayOut *l = arg;
-    size_t freed = 0;
     for (size_t i = begin; i < end; i++) {
         NodeArray *a = &l->build->tasks[i].nodes;
         PtrBvhNode *nodes = l->nodes + l->start[i];
         memcpy(nodes, a->nodes, a->count * sizeof *nodes);
         free(a->nodes);
         a->nodes = NULL;
-        freed += a->count * sizeof *nodes;
-        if (freed >= TRIM_BYTES) {
-            malloc_trim(0);
-            freed = 0;
-        }
         for (size_t j = 0; j < a->count; j++)
             for (int k = 0; k < PTR_BVH_WIDTH; k++)
                 if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
                     nodes[j].child[k] += (uint32_t)l->start[i];
     }
-    if (freed)
-        malloc_trim(0);
 }
 
 /* One node array: the top level's first, then each task's, with every task
@@ -291,7 +285,14 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
     }
     memcpy(nodes, top->nodes, top->count * sizeof *nodes);
     LayOut l = { build, nodes, start };
-    ptr_parallel_ranges(build->set.threads, 0, build->task_count, lay_out_tasks, &l);
+    for (size_t first = 0; first < build->task_count;) {
+        size_t last = first, bytes = 0;
+        while (last < build->task_count && bytes < TRIM_BYTES)
+            bytes += build->tasks[last++].nodes.count * sizeof *nodes;
+        ptr_parallel_ranges(build->set.threads, first, last, lay_out_tasks, &l);
+        malloc_trim(0);
+        first = last;
+    }
     /* The depth of the top level counts a task as one level; add the rest. */
     int depth = 0;
     for (size_t j = 0; j < top->count; j++)
