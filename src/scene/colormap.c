@@ -68,3 +68,21 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
     free(white);
     return res;
 }
+
+PtrResult ptr_scene_color_by_range(PtrScene *scene, const PtrColormap *map, const double *range,
+                                   PtrColorMapping *mapping, PtrError *err)
+{
+    const PtrSpheres *s = &scene->spheres;
+    PtrColorMapping m = { .map = map ? map : &ptr_colormaps[0], .lo = INFINITY, .hi = -INFINITY };
+    for (size_t i = 0; s->value && i < s->count; i++) {
+        if (isnan(s->value[i]))
+            continue;
+        m.lo = fmin(m.lo, s->value[i]);
+        m.hi = fmax(m.hi, s->value[i]);
+        m.valued++;
+    }
+    m.from = range ? range[0] : m.lo;
+    m.to = range ? range[1] : m.hi;
+    *mapping = m;
+    return ptr_scene_color_by_value(scene, m.map, m.from, m.to, err);
+}
