@@ -326,8 +326,8 @@ PTR_PUBLIC const float *ptr_frame_noisy(const PtrFrame *frame);
 PTR_PUBLIC uint32_t ptr_frame_samples(const PtrFrame *frame);
 /* Where the frame's pixels lie in the image rendered: the column and row of
  * their top left corner, and the image's width and height (0, 0 and the
- * frame's own size without a region). Each pointer may be NULL; all are
- * set to 0 for a NULL frame. */
+ * frame's own size without a region, or as ptr_frame_set_placement put
+ * them). Each pointer may be NULL; all are set to 0 for a NULL frame. */
 PTR_PUBLIC void ptr_frame_placement(const PtrFrame *frame, int *x, int *y, int *image_width,
                                     int *image_height);
 

@@ -483,14 +483,28 @@ Placement.__doc__ = """Where a frame's pixels lie in the image rendered: the col
 row of their top left corner, and the whole image's width and height."""
 
 
+class _FrameMemory:
+    """A C frame, freed when nothing holds it: neither its Frame nor an
+    array of its buffers (a Frame and its arrays hold this, not each other,
+    so that no cycle waits for the garbage collector to free the pixels)."""
+
+    def __init__(self, handle):
+        self.handle = handle
+
+    def __del__(self):
+        if getattr(self, "handle", None):
+            lib.ptr_frame_free(self.handle)
+            self.handle = None
+
+
 class _Buffer:
     """A frame's buffer as numpy reads it, in place and read-only: it keeps
-    the frame, which owns the memory, alive while an array uses it."""
+    the frame's memory alive while an array uses it."""
 
-    def __init__(self, frame, pointer, channels):
-        self.frame = frame
+    def __init__(self, memory, pointer, channels):
+        self.memory = memory
         self.__array_interface__ = {
-            "shape": (lib.ptr_frame_height(frame._handle), lib.ptr_frame_width(frame._handle),
+            "shape": (lib.ptr_frame_height(memory.handle), lib.ptr_frame_width(memory.handle),
                       channels),
             "typestr": np.dtype(np.float32).str,
             "data": (ctypes.cast(pointer, ctypes.c_void_p).value, True),
@@ -516,22 +530,17 @@ class Frame:
     region's place in the image."""
 
     def __init__(self, handle):
-        self._handle = handle
+        self._memory = memory = _FrameMemory(handle)
         buffer = lib.ptr_frame_pixels(handle)
-        self.image = np.asarray(_Buffer(self, buffer, lib.ptr_frame_channels(handle)))
+        self.image = np.asarray(_Buffer(memory, buffer, lib.ptr_frame_channels(handle)))
         self.albedo, self.normal, self.noisy = (
-            np.asarray(_Buffer(self, pointer, 3)) if pointer else None
+            np.asarray(_Buffer(memory, pointer, 3)) if pointer else None
             for pointer in (lib.ptr_frame_albedo(handle), lib.ptr_frame_normal(handle),
                             lib.ptr_frame_noisy(handle)))
         self.samples = lib.ptr_frame_samples(handle)
         corner = [ctypes.c_int() for _ in range(4)]
         lib.ptr_frame_placement(handle, *[ctypes.byref(c) for c in corner])
         self.placement = Placement(*[c.value for c in corner])
-
-    def __del__(self):
-        if getattr(self, "_handle", None):
-            lib.ptr_frame_free(self._handle)
-            self._handle = None
 
 
 def _frame_array(pointer, frame, channels=None):
@@ -567,7 +576,7 @@ def save(path, image, view=None, context=None, depth=None, dither=False, display
     if isinstance(image, Frame):
         if placement is not None:
             raise ValueError("placement: a Frame keeps its own")
-        _write(context, path, image._handle, options, err)
+        _write(context, path, image._memory.handle, options, err)
         return
     image = np.asarray(image)
     if image.ndim != 3 or image.shape[2] not in (3, 4):

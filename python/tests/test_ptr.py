@@ -15,6 +15,7 @@ import shutil
 import signal
 import subprocess
 import threading
+import weakref
 
 import numpy as np
 import pytest
@@ -411,10 +412,13 @@ def test_full_frame_and_placed_save(tmp_path):
             ptr.save(placed, frame.image, placement=bad)
     with pytest.raises(ValueError):
         ptr.save(saved, frame, placement=(0, 0, 40, 25))
-    # The arrays keep the frame they read alive.
-    image = frame.image
+    # The arrays keep the frame they read alive, and it is freed with the
+    # last of them, not later by the garbage collector.
+    image, memory = frame.image, weakref.ref(frame._memory)
     del frame
     assert np.array_equal(image, whole[5:30, 10:50])
+    del image
+    assert memory() is None
     whole_frame = scene.render(80, 60, samples=4, full=True, passes=True)
     assert whole_frame.placement == (0, 0, 80, 60)
     assert whole_frame.albedo.shape == whole_frame.normal.shape == (60, 80, 3)
