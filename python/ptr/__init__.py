@@ -213,13 +213,13 @@ def _load_options(options):
         _native.text(options.get("color_by")), _native.text(options.get("colormap")))
     color_range = options.get("color_range")
     if color_range is not None:
-        low, high = (float(v) for v in color_range)
+        values = [float(v) for v in color_range]
         # (0, 0) is the C API's "the values' own range": refused as the
         # empty range it is.
-        if not low < high:
+        if len(values) != 2 or not values[0] < values[1]:
             raise ValueError("color_range: %r is not (min, max), min below max"
                              % (color_range,))
-        load_options.color_range[:] = [low, high]
+        load_options.color_range[:] = values
     return load_options, desc
 
 

@@ -362,6 +362,7 @@ def test_color_range_and_bad_colors():
     for bad in ({"colormap": "magma"}, {"color_by": "bfactor", "colormap": "jet"},
                 {"color_by": "bfactor", "color_range": (2, 1)},
                 {"color_by": "bfactor", "color_range": (0, 0)},
+                {"color_by": "bfactor", "color_range": (1, 2, 3)},
                 {"color_by": "bfactor", "color_range": (0, math.inf)},
                 {"color_by": "chain", "colormap": "magma"}):
         with pytest.raises(ValueError):

@@ -172,9 +172,9 @@ static PtrResult read_color_options(const PtrLoadOptions *o, const PtrColormap *
     if (!o->color_by && (o->colormap || *range))
         return ptr_error_set(err, PTR_ERR_USAGE, "colormap and color_range need color_by");
     if (o->colormap && !(*map = ptr_colormap_find(o->colormap)))
-        return ptr_error_set(err, PTR_ERR_USAGE, "colormap: '%s' is not viridis, magma, "
-                             "inferno, plasma, cividis or coolwarm", o->colormap);
-    if (*range && !(isfinite(r[0]) && isfinite(r[1]) && r[0] < r[1]))
+        return ptr_error_set(err, PTR_ERR_USAGE, "colormap: '%s' is not " PTR_COLORMAP_NAMES,
+                             o->colormap);
+    if (*range && !ptr_color_range_ok(r))
         return ptr_error_set(err, PTR_ERR_USAGE, "color_range: %g,%g is not MIN,MAX (finite "
                              "numbers, MIN below MAX)", r[0], r[1]);
     return PTR_OK;
@@ -182,13 +182,13 @@ static PtrResult read_color_options(const PtrLoadOptions *o, const PtrColormap *
 
 /* color_by's quantity, if the import read one, onto the colormap (as the
  * command line's --color-by); a colour scheme, which the importer applied,
- * takes no colormap or range. */
+ * takes no colormap or range (map and range are NULL without color_by). */
 static PtrResult apply_color_by(const char *path, const PtrLoadOptions *o,
                                 const PtrColormap *map, const double *range, PtrScene *scene,
                                 PtrColorMapping *mapping, PtrError *err)
 {
     if (!scene->spheres.value)
-        return o->color_by && (map || range)
+        return map || range
                    ? ptr_error_set(err, PTR_ERR_USAGE, "%s: color_by %s is a colour scheme, "
                                    "not a quantity: it takes no colormap or color_range",
                                    path, o->color_by)

@@ -12,6 +12,11 @@ const PtrColormap *ptr_colormap_find(const char *name)
     return NULL;
 }
 
+int ptr_color_range_ok(const double range[2])
+{
+    return isfinite(range[0]) && isfinite(range[1]) && range[0] < range[1];
+}
+
 PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, double hi)
 {
     double t = hi > lo ? (value - lo) / (hi - lo) : 0.0;

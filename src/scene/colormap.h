@@ -16,8 +16,14 @@ typedef struct PtrColormap {
  * scripts/make_colormaps.py); ends with a NULL name. */
 extern const PtrColormap ptr_colormaps[];
 
+/* The maps' names, as messages list them. */
+#define PTR_COLORMAP_NAMES "viridis, magma, inferno, plasma, cividis or coolwarm"
+
 /* The map of that name, or NULL. */
 const PtrColormap *ptr_colormap_find(const char *name);
+
+/* Whether range (--color-range MIN,MAX) is one: both finite, MIN below MAX. */
+int ptr_color_range_ok(const double range[2]);
 
 /* IEC 61966-2-1's decoding of an sRGB-encoded channel (0 to 1) to linear
  * light. */
