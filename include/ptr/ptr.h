@@ -132,13 +132,44 @@ typedef struct PtrLoadOptions {
      * scene's. */
     int width, height;
     const char *sky;              /* --sky: "gradient", "black" or "R,G,B"; NULL: the file's */
+    /* --color-by: a quantity each sphere has, mapped through the colormap
+     * onto the colour that replaces its base colour (a glTF instance or
+     * point attribute such as _BFACTOR, any case, _ optional; a structure's
+     * bfactor or occupancy), or a structure's colour scheme (element,
+     * chain, entity, residue, secondary), which takes no colormap or range.
+     * NULL: none (a structure's elements). A file without the quantity is
+     * PTR_STATUS_SCENE_INVALID. The colour bar (--color-bar) is the command
+     * line's alone: ptr_scene_color_range says what range was mapped. */
+    const char *color_by;
+    /* --colormap: "viridis", "magma", "inferno", "plasma", "cividis" or
+     * "coolwarm"; NULL: viridis. */
+    const char *colormap;
+    /* --color-range MIN,MAX (finite, MIN below MAX): the values mapped to
+     * the colormap's ends, others clamped; both 0: the values' own range. */
+    double color_range[2];
 } PtrLoadOptions;
 
 /* Reads a scene file of any format ptr reads (glTF, OBJ, PDB, mmCIF, ...,
- * by its extension; docs/scenes.md). options may be NULL. */
+ * by its extension; docs/scenes.md). options may be NULL. The import's
+ * warnings (what of the file was left out or guessed), which the command
+ * line prints as "ptr: warning: ...", stay with the scene:
+ * ptr_scene_warning. */
 PTR_PUBLIC PtrStatus ptr_scene_load(PtrContext *context, const char *path,
                                     const PtrLoadOptions *options, PtrSceneHandle **out,
                                     PtrErrorInfo *err);
+
+/* The number of warnings the scene's import gave (0 for a scene of
+ * arrays), and warning index (0 first), one line kept by the scene; NULL
+ * for an index beyond them. */
+PTR_PUBLIC size_t ptr_scene_warning_count(const PtrSceneHandle *scene);
+PTR_PUBLIC const char *ptr_scene_warning(const PtrSceneHandle *scene, size_t index);
+
+/* The range a load with color_by mapped onto the colormap's ends
+ * (PtrLoadOptions.color_range, or the values' own range, which the
+ * command line prints), for a colour bar of the caller's: 1 with *from and
+ * *to set; 0, leaving them, for a scene without a quantity mapped (no
+ * color_by, or a colour scheme). from and to may be NULL. */
+PTR_PUBLIC int ptr_scene_color_range(const PtrSceneHandle *scene, double *from, double *to);
 
 typedef enum PtrMaterialType {
     PTR_MATERIAL_TYPE_DIFFUSE,    /* albedo */
@@ -295,8 +326,8 @@ PTR_PUBLIC const float *ptr_frame_noisy(const PtrFrame *frame);
 PTR_PUBLIC uint32_t ptr_frame_samples(const PtrFrame *frame);
 /* Where the frame's pixels lie in the image rendered: the column and row of
  * their top left corner, and the image's width and height (0, 0 and the
- * frame's own size without a region). Each pointer may be NULL; all are
- * set to 0 for a NULL frame. */
+ * frame's own size without a region, or as ptr_frame_set_placement put
+ * them). Each pointer may be NULL; all are set to 0 for a NULL frame. */
 PTR_PUBLIC void ptr_frame_placement(const PtrFrame *frame, int *x, int *y, int *image_width,
                                     int *image_height);
 
@@ -305,6 +336,16 @@ PTR_PUBLIC void ptr_frame_placement(const PtrFrame *frame, int *x, int *y, int *
  * changed after a render, to save. Its metadata name no scene. */
 PTR_PUBLIC PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels,
                                    PtrFrame **out, PtrErrorInfo *err);
+
+/* Places the frame's pixels in a larger image, as a render of a region is
+ * (ptr_frame_placement): their top left corner at column x and row y of an
+ * image image_width by image_height, which a saved EXR records (its data window
+ * within that display window) as the command line's EXR of --region does;
+ * a format without windows, such as PNG, holds the pixels alone. The frame
+ * must lie inside the image (0 <= x, x + ptr_frame_width <= image_width,
+ * likewise down), of at most 65536 pixels a side: else PTR_STATUS_USAGE. */
+PTR_PUBLIC PtrStatus ptr_frame_set_placement(PtrFrame *frame, int x, int y, int image_width,
+                                             int image_height, PtrErrorInfo *err);
 
 /* How a frame is stored and shown, as the command line's options of the
  * same names; zero for each (and NULL for the strings) is the command

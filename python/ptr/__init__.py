@@ -6,6 +6,10 @@
     image = scene.render(640, 480, samples=64)    # (480, 640, 3) float32
     ptr.save("molecule.png", image)               # through ptr's writers
 
+    chains = ptr.load("molecule.cif", color_by="chain")   # as --color-by chain
+    frame = chains.render(640, 480, region=(0, 0, 320, 240), full=True)
+    ptr.save("corner.exr", frame)                 # the region, placed in the image
+
     centers = np.random.rand(1000, 3).astype(np.float32)
     radii = np.full(1000, 0.02, np.float32)
     image = ptr.Scene.from_arrays(centers, radii).render(320, 240)
@@ -14,6 +18,11 @@ Images are scene-linear floats (the command line's EXR pixels, float for
 float, for the same scene and options); with transparent=True they have a
 fourth channel, alpha, the colour premultiplied by it. ptr.save applies an
 OpenColorIO view for the integer formats (PNG, JPEG, ...).
+
+What an import warns of (a part of the file left out or guessed) is each
+scene's `warnings`, and ptr.load also issues each line through Python's
+warnings module as a ptr.SceneWarning, which warnings.simplefilter("ignore",
+ptr.SceneWarning) silences.
 
 Each scene belongs to a Context, which holds the CPU level, the threads,
 the loaded modules and the colour configuration; one is made for the
@@ -26,18 +35,20 @@ $PTR_LIBRARY, else where this package was installed beside it, the build
 tree, /usr/local/lib or /usr/lib.
 """
 
+import collections
 import ctypes
 import math
 import signal
 import threading
+import warnings
 
 import numpy as np
 
 from . import _native
 from ._native import lib
 
-__all__ = ["Camera", "Material", "Context", "Scene", "Error", "Cancelled", "load", "save",
-           "version"]
+__all__ = ["Camera", "Material", "Context", "Scene", "Frame", "Placement", "Error", "Cancelled",
+           "SceneWarning", "load", "save", "version"]
 
 
 class Error(Exception):
@@ -55,6 +66,11 @@ class UsageError(Error, ValueError):
 
 class Cancelled(Error):
     """A render stopped because its progress callback returned True."""
+
+
+class SceneWarning(UserWarning):
+    """A warning of a scene's import, which the command line prints as
+    "ptr: warning: ..." (ptr.load issues one a line)."""
 
 
 def _check(status, err):
@@ -157,14 +173,30 @@ def load(path, context=None, **options):
     (a Camera, replacing the file's), camera_name, orthographic,
     fit_all_objects, select, drop_hydrogens, assembly, model, orbit_degrees,
     width and height (framing the automatic camera), sky ("gradient",
-    "black" or "R,G,B")."""
+    "black" or "R,G,B"), and the colours of --color-by: color_by (a
+    quantity such as a glTF attribute "_BFACTOR" or a structure's
+    "bfactor" or "occupancy", mapped through the colormap; or a structure's
+    colour scheme: "element", "chain", "entity", "residue", "secondary"),
+    colormap ("viridis", the default, "magma", "inferno", "plasma",
+    "cividis" or "coolwarm") and color_range ((min, max), the values mapped
+    to its ends; None: the values' own range, which Scene.color_range then
+    gives). The pixels are the command line's for the same options; its
+    colour bar (--color-bar) is not drawn here: matplotlib's colormaps of
+    the same names draw it from Scene.color_range.
+
+    Each warning of the import (Scene.warnings) is issued as a
+    ptr.SceneWarning."""
     context = _context(context)
-    return Scene._load(context, path, options)
+    scene = Scene._load(context, path, options)
+    for line in scene.warnings:
+        warnings.warn(line, SceneWarning, stacklevel=2)
+    return scene
 
 
 def _load_options(options):
     known = {"camera", "camera_name", "orthographic", "fit_all_objects", "select",
-             "drop_hydrogens", "assembly", "model", "orbit_degrees", "width", "height", "sky"}
+             "drop_hydrogens", "assembly", "model", "orbit_degrees", "width", "height", "sky",
+             "color_by", "colormap", "color_range"}
     unknown = set(options) - known
     if unknown:
         raise TypeError("load: unknown options %s" % ", ".join(sorted(unknown)))
@@ -177,7 +209,17 @@ def _load_options(options):
         _native.text(options.get("select")), int(bool(options.get("drop_hydrogens"))),
         _native.text(options.get("assembly")), int(options.get("model", 0)),
         float(options.get("orbit_degrees", 0.0)), int(options.get("width", 0)),
-        int(options.get("height", 0)), _native.text(options.get("sky")))
+        int(options.get("height", 0)), _native.text(options.get("sky")),
+        _native.text(options.get("color_by")), _native.text(options.get("colormap")))
+    color_range = options.get("color_range")
+    if color_range is not None:
+        values = [float(v) for v in color_range]
+        # (0, 0) is the C API's "the values' own range": refused as the
+        # empty range it is.
+        if len(values) != 2 or not values[0] < values[1]:
+            raise ValueError("color_range: %r is not (min, max), min below max"
+                             % (color_range,))
+        load_options.color_range[:] = values
     return load_options, desc
 
 
@@ -313,6 +355,23 @@ class Scene:
         """The number of spheres."""
         return lib.ptr_scene_sphere_count(self._handle)
 
+    @property
+    def warnings(self):
+        """The warnings of the scene's import, a list of str, one a line
+        (empty for a scene of arrays)."""
+        return [lib.ptr_scene_warning(self._handle, i).decode(errors="replace")
+                for i in range(lib.ptr_scene_warning_count(self._handle))]
+
+    @property
+    def color_range(self):
+        """(min, max), the range of values a load with color_by mapped onto
+        the colormap's ends (color_range, else the values' own); None
+        without a quantity mapped (no color_by, or a colour scheme)."""
+        low, high = ctypes.c_double(), ctypes.c_double()
+        if not lib.ptr_scene_color_range(self._handle, ctypes.byref(low), ctypes.byref(high)):
+            return None
+        return low.value, high.value
+
     def __del__(self):
         self._free()
 
@@ -320,7 +379,7 @@ class Scene:
                denoise=None, progress=None, transparent=False, passes=False, max_depth=None,
                integrator=None, kernel=None, cpu_cap=None, accel=None, sampler=None,
                direct_lighting=True, noise_threshold=0.0, min_samples=None, first_sample=0,
-               sky=None, region=None, time_budget=0.0):
+               sky=None, region=None, time_budget=0.0, full=False):
         """Renders the scene into a numpy array of shape (height, width, 3),
         or (height, width, 4) with transparent=True, float32, scene-linear.
 
@@ -334,7 +393,10 @@ class Scene:
         region: (x0, y0, x1, y1), the pixels rendered (columns x0 to x1 - 1,
         rows y0 to y1 - 1 of the image), returned alone as an array of
         shape (y1 - y0, x1 - x0, 3); time_budget: seconds after which the
-        render stops at the end of the pass under way (0: none).
+        render stops at the end of the pass under way (0: none);
+        full=True returns a ptr.Frame instead: the image with its passes,
+        its colour before denoising, the samples taken and where a region
+        lies, which ptr.save writes as the command line writes its EXR.
         The other options are the command line's of the same names.
 
         Ctrl-C (SIGINT) stops the render after the pass under way and raises
@@ -344,7 +406,7 @@ class Scene:
                 width, height, samples, seed, None, threads, denoise, progress, transparent,
                 passes, max_depth, integrator, kernel, cpu_cap, accel, sampler,
                 direct_lighting, noise_threshold, min_samples, first_sample, sky, region,
-                time_budget)
+                time_budget, full)
         options = _native.RenderOptions()
         lib.ptr_render_options_default(ctypes.byref(options))
         for name, value in (("width", width), ("height", height), ("samples", samples),
@@ -363,6 +425,8 @@ class Scene:
                             ("denoise", denoise), ("sky", sky)):
             setattr(options, name, _native.text(value))
         frame = self._render_frame(options, progress)
+        if full:
+            return Frame(frame)
         try:
             image = _frame_array(lib.ptr_frame_pixels(frame), frame)
             if not passes:
@@ -414,6 +478,71 @@ class Scene:
         return frame
 
 
+Placement = collections.namedtuple("Placement", "x y image_width image_height")
+Placement.__doc__ = """Where a frame's pixels lie in the image rendered: the column and
+row of their top left corner, and the whole image's width and height."""
+
+
+class _FrameMemory:
+    """A C frame, freed when nothing holds it: neither its Frame nor an
+    array of its buffers (a Frame and its arrays hold this, not each other,
+    so that no cycle waits for the garbage collector to free the pixels)."""
+
+    def __init__(self, handle):
+        self.handle = handle
+
+    def __del__(self):
+        if getattr(self, "handle", None):
+            lib.ptr_frame_free(self.handle)
+            self.handle = None
+
+
+class _Buffer:
+    """A frame's buffer as numpy reads it, in place and read-only: it keeps
+    the frame's memory alive while an array uses it."""
+
+    def __init__(self, memory, pointer, channels):
+        self.memory = memory
+        self.__array_interface__ = {
+            "shape": (lib.ptr_frame_height(memory.handle), lib.ptr_frame_width(memory.handle),
+                      channels),
+            "typestr": np.dtype(np.float32).str,
+            "data": (ctypes.cast(pointer, ctypes.c_void_p).value, True),
+            "version": 3,
+        }
+
+
+class Frame:
+    """A render's result, from Scene.render(..., full=True). Its arrays are
+    float32, scene-linear, read in place (read-only: copy one to change it):
+
+    image: (H, W, 3), or (H, W, 4) with transparent=True (premultiplied);
+    albedo, normal: the passes, (H, W, 3), with passes=True or a denoise;
+    else None;
+    noisy: a denoised image's colour before denoising, (H, W, 3); else None;
+    samples: the samples per pixel taken (fewer than asked when a
+    time_budget ran out);
+    placement: a ptr.Placement, where the pixels lie in the image (with a
+    region, its corner and the whole image's size; else 0, 0 and their own).
+
+    ptr.save(path, frame) writes it as the command line writes the same
+    render: an EXR keeps the passes, the noisy colour, the metadata and the
+    region's place in the image."""
+
+    def __init__(self, handle):
+        self._memory = memory = _FrameMemory(handle)
+        buffer = lib.ptr_frame_pixels(handle)
+        self.image = np.asarray(_Buffer(memory, buffer, lib.ptr_frame_channels(handle)))
+        self.albedo, self.normal, self.noisy = (
+            np.asarray(_Buffer(memory, pointer, 3)) if pointer else None
+            for pointer in (lib.ptr_frame_albedo(handle), lib.ptr_frame_normal(handle),
+                            lib.ptr_frame_noisy(handle)))
+        self.samples = lib.ptr_frame_samples(handle)
+        corner = [ctypes.c_int() for _ in range(4)]
+        lib.ptr_frame_placement(handle, *[ctypes.byref(c) for c in corner])
+        self.placement = Placement(*[c.value for c in corner])
+
+
 def _frame_array(pointer, frame, channels=None):
     """A copy of a frame's buffer as an (H, W, channels) float32 array."""
     height, width = lib.ptr_frame_height(frame), lib.ptr_frame_width(frame)
@@ -422,32 +551,52 @@ def _frame_array(pointer, frame, channels=None):
 
 
 def save(path, image, view=None, context=None, depth=None, dither=False, display=None,
-         look=None, exposure=0.0, bake_view=False):
+         look=None, exposure=0.0, bake_view=False, placement=None):
     """Writes an image (an array (H, W, 3) or (H, W, 4), scene-linear, RGBA
-    premultiplied) through ptr's writers, by the path's extension: EXR as
-    floats; other formats (PNG, JPEG, TIFF, ...) through OpenImageIO with
-    the OpenColorIO view applied. The options are the command line's of the
-    same names: depth ("8", "16", "half" or "float"; None: the format's
-    default), dither (8 bits), display, view (such as "Standard" or "Raw")
-    and look of the context's OpenColorIO config (None: its defaults, no
-    look), exposure (stops before the view, -64 to 64) and bake_view (the
-    view applied to a float format too)."""
+    premultiplied, or a ptr.Frame) through ptr's writers, by the path's
+    extension: EXR as floats; other formats (PNG, JPEG, TIFF, ...) through
+    OpenImageIO with the OpenColorIO view applied. The options are the
+    command line's of the same names: depth ("8", "16", "half" or "float";
+    None: the format's default), dither (8 bits), display, view (such as
+    "Standard" or "Raw") and look of the context's OpenColorIO config
+    (None: its defaults, no look), exposure (stops before the view, -64 to
+    64) and bake_view (the view applied to a float format too).
+
+    A Frame is written as the command line writes the same render: its
+    passes, noisy colour and metadata in an EXR, a region as its part of
+    the image. An array is the pixels alone, placed by placement (a
+    ptr.Placement or (x, y, image_width, image_height): the array as that
+    part of a larger image, as a Frame's placement says; an EXR records it,
+    a PNG holds the pixels alone); None: the whole image."""
     context = _context(context)
+    options = _native.SaveOptions(_native.text(depth), int(bool(dither)), _native.text(display),
+                                  _native.text(view), _native.text(look), float(exposure),
+                                  int(bool(bake_view)))
+    err = _native.ErrorInfo()
+    if isinstance(image, Frame):
+        if placement is not None:
+            raise ValueError("placement: a Frame keeps its own")
+        _write(context, path, image._memory.handle, options, err)
+        return
     image = np.asarray(image)
     if image.ndim != 3 or image.shape[2] not in (3, 4):
         raise ValueError("image: shape %s, not (H, W, 3) or (H, W, 4)" % (image.shape,))
     pixels = _contiguous(image, np.float32)
-    options = _native.SaveOptions(_native.text(depth), int(bool(dither)), _native.text(display),
-                                  _native.text(view), _native.text(look), float(exposure),
-                                  int(bool(bake_view)))
+    corner = _native.whole_numbers("placement", placement, 4) if placement is not None else None
     frame = ctypes.c_void_p()
-    err = _native.ErrorInfo()
     _check(lib.ptr_frame_new(pixels.shape[1], pixels.shape[0], pixels.shape[2],
                              pixels.ctypes.data, ctypes.byref(frame), ctypes.byref(err)), err)
     try:
-        with context._lock:
-            status = lib.ptr_frame_save(context._handle, _native.text(path), frame,
-                                        ctypes.byref(options), ctypes.byref(err))
-        _check(status, err)
+        if corner is not None:
+            _check(lib.ptr_frame_set_placement(frame, *corner, ctypes.byref(err)), err)
+        _write(context, path, frame, options, err)
     finally:
         lib.ptr_frame_free(frame)
+
+
+def _write(context, path, frame, options, err):
+    """Saves a C frame through the context, one call of it at a time."""
+    with context._lock:
+        status = lib.ptr_frame_save(context._handle, _native.text(path), frame,
+                                    ctypes.byref(options), ctypes.byref(err))
+    _check(status, err)

@@ -70,7 +70,9 @@ class LoadOptions(ctypes.Structure):
                 ("select", ctypes.c_char_p), ("drop_hydrogens", ctypes.c_int),
                 ("assembly", ctypes.c_char_p), ("model", ctypes.c_size_t),
                 ("orbit_degrees", ctypes.c_double), ("width", ctypes.c_int),
-                ("height", ctypes.c_int), ("sky", ctypes.c_char_p)]
+                ("height", ctypes.c_int), ("sky", ctypes.c_char_p),
+                ("color_by", ctypes.c_char_p), ("colormap", ctypes.c_char_p),
+                ("color_range", ctypes.c_double * 2)]
 
 
 class MaterialDesc(ctypes.Structure):
@@ -129,6 +131,10 @@ _SIGNATURES = {
     "ptr_scene_from_arrays": (ctypes.c_int, [_P, ctypes.POINTER(SceneArrays),
                                              ctypes.POINTER(_P), _ERR]),
     "ptr_scene_sphere_count": (ctypes.c_size_t, [_P]),
+    "ptr_scene_warning_count": (ctypes.c_size_t, [_P]),
+    "ptr_scene_warning": (ctypes.c_char_p, [_P, ctypes.c_size_t]),
+    "ptr_scene_color_range": (ctypes.c_int, [_P, ctypes.POINTER(ctypes.c_double),
+                                             ctypes.POINTER(ctypes.c_double)]),
     "ptr_scene_handle_free": (None, [_P]),
     "ptr_render_options_default": (None, [ctypes.POINTER(RenderOptions)]),
     "ptr_scene_render": (ctypes.c_int, [_P, _P, ctypes.POINTER(RenderOptions), ProgressCallback,
@@ -139,8 +145,12 @@ _SIGNATURES = {
     "ptr_frame_pixels": (ctypes.POINTER(ctypes.c_float), [_P]),
     "ptr_frame_albedo": (ctypes.POINTER(ctypes.c_float), [_P]),
     "ptr_frame_normal": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_noisy": (ctypes.POINTER(ctypes.c_float), [_P]),
+    "ptr_frame_samples": (ctypes.c_uint32, [_P]),
+    "ptr_frame_placement": (None, [_P] + [ctypes.POINTER(ctypes.c_int)] * 4),
     "ptr_frame_new": (ctypes.c_int, [ctypes.c_int, ctypes.c_int, ctypes.c_int, _P,
                                      ctypes.POINTER(_P), _ERR]),
+    "ptr_frame_set_placement": (ctypes.c_int, [_P] + [ctypes.c_int] * 4 + [_ERR]),
     "ptr_frame_save": (ctypes.c_int, [_P, ctypes.c_char_p, _P, ctypes.POINTER(SaveOptions),
                                       _ERR]),
     "ptr_frame_free": (None, [_P]),

@@ -1,5 +1,6 @@
 """The Python module against the command line and on bad input: shapes and
-dtypes, errors as ValueError, the CLI's EXR pixels float for float,
+dtypes, errors as ValueError, the CLI's EXR pixels float for float (with
+--color-by, and a region's frame saved in place), import warnings,
 contexts rendering at once, cancellation by callback and by SIGINT.
 
 Run by ctest (python_tests) with PTR_LIBRARY, PTR_EXECUTABLE and
@@ -14,6 +15,7 @@ import shutil
 import signal
 import subprocess
 import threading
+import weakref
 
 import numpy as np
 import pytest
@@ -332,3 +334,99 @@ def test_save_options_as_command_line(tmp_path):
     for bad in ({"depth": "12"}, {"depth": "16"}, {"exposure": 65}, {"look": "no such look"}):
         with pytest.raises(ValueError):
             ptr.save(ours, image, **bad)
+
+
+STRUCTURE = os.path.join(SOURCE, "tests", "fixtures", "structures", "1tii.cif")
+
+
+@pytest.mark.parametrize("options, kwargs", [
+    (["--color-by", "chain"], {"color_by": "chain"}),
+    (["--color-by", "bfactor", "--colormap", "magma", "--color-range", "10,60"],
+     {"color_by": "bfactor", "colormap": "magma", "color_range": (10, 60)}),
+])
+def test_color_by_as_command_line(tmp_path, options, kwargs):
+    cli = str(tmp_path / "cli.exr")
+    subprocess.run([os.environ["PTR_EXECUTABLE"], STRUCTURE, "-o", cli, "--width", "80",
+                    "--samples", "4", "--quiet"] + options, check=True)
+    ours = str(tmp_path / "ours.exr")
+    ptr.save(ours, ptr.load(STRUCTURE, **kwargs).render(80, samples=4))
+    assert same_pixels(cli, ours)
+
+
+def test_color_range_and_bad_colors():
+    assert ptr.load(STRUCTURE, color_by="bfactor", color_range=(10, 60)).color_range == (10, 60)
+    low, high = ptr.load(STRUCTURE, color_by="bfactor").color_range
+    assert 0 < low < high
+    assert ptr.load(STRUCTURE, color_by="chain").color_range is None
+    assert ptr.load(STRUCTURE).color_range is None
+    for bad in ({"colormap": "magma"}, {"color_by": "bfactor", "colormap": "jet"},
+                {"color_by": "bfactor", "color_range": (2, 1)},
+                {"color_by": "bfactor", "color_range": (0, 0)},
+                {"color_by": "bfactor", "color_range": (1, 2, 3)},
+                {"color_by": "bfactor", "color_range": (0, math.inf)},
+                {"color_by": "chain", "colormap": "magma"}):
+        with pytest.raises(ValueError):
+            ptr.load(STRUCTURE, **bad)
+    with pytest.raises(ptr.Error) as error:
+        ptr.load(STRUCTURE, color_by="temperature")
+    assert error.value.code == 4
+
+
+def test_import_warnings():
+    path = os.path.join(SOURCE, "tests", "fixtures", "orthographic.gltf")
+    with pytest.warns(ptr.SceneWarning) as issued:
+        scene = ptr.load(path)
+    assert len(scene.warnings) == 2
+    assert [str(w.message) for w in issued] == scene.warnings
+    assert "extras.aperture is ignored" in scene.warnings[0]
+    assert ptr.Scene.from_arrays(*spheres()).warnings == []
+    assert ptr.load(SEED).warnings == []
+
+
+def test_full_frame_and_placed_save(tmp_path):
+    scene = ptr.load(SEED)
+    whole = scene.render(80, 60, samples=4)
+    frame = scene.render(80, 60, samples=4, region=(10, 5, 50, 30), full=True)
+    assert isinstance(frame, ptr.Frame)
+    assert frame.image.shape == (25, 40, 3) and frame.image.dtype == np.float32
+    assert np.array_equal(frame.image, whole[5:30, 10:50])
+    assert frame.placement == ptr.Placement(10, 5, 80, 60)
+    assert frame.samples == 4
+    assert frame.albedo is None and frame.normal is None and frame.noisy is None
+    with pytest.raises(ValueError):
+        frame.image[0, 0, 0] = 1  # read in place: the frame's own
+    # The frame, or its pixels placed where it says, save as the command
+    # line's EXR of the region; without the placement, as an image of their
+    # own, they do not.
+    cli = str(tmp_path / "cli.exr")
+    subprocess.run([os.environ["PTR_EXECUTABLE"], SEED, "-o", cli, "--width", "80", "--height",
+                    "60", "--samples", "4", "--quiet", "--region", "10,5,50,30"], check=True)
+    saved, placed, alone = (str(tmp_path / name) for name in ("saved.exr", "placed.exr",
+                                                              "alone.exr"))
+    ptr.save(saved, frame)
+    ptr.save(placed, frame.image.copy(), placement=frame.placement)
+    ptr.save(alone, frame.image)
+    assert same_pixels(cli, saved) and same_pixels(cli, placed)
+    assert not same_pixels(cli, alone)
+    for bad in ((41, 5, 80, 60), (10, 5, 80), (-1, 0, 80, 60), (0, 0, 70000, 60)):
+        with pytest.raises(ValueError):
+            ptr.save(placed, frame.image, placement=bad)
+    with pytest.raises(ValueError):
+        ptr.save(saved, frame, placement=(0, 0, 40, 25))
+    # The arrays keep the frame they read alive, and it is freed with the
+    # last of them, not later by the garbage collector.
+    image, memory = frame.image, weakref.ref(frame._memory)
+    del frame
+    assert np.array_equal(image, whole[5:30, 10:50])
+    del image
+    assert memory() is None
+    whole_frame = scene.render(80, 60, samples=4, full=True, passes=True)
+    assert whole_frame.placement == (0, 0, 80, 60)
+    assert whole_frame.albedo.shape == whole_frame.normal.shape == (60, 80, 3)
+
+
+def test_full_frame_denoised():
+    frame = ptr.load(SEED).render(32, 24, samples=2, denoise="fast", full=True)
+    assert frame.noisy.shape == frame.image.shape == (24, 32, 3)
+    assert frame.albedo is not None
+    assert not np.array_equal(frame.noisy, frame.image)

@@ -38,6 +38,10 @@ struct PtrSceneHandle {
     PtrScene scene;
     char *name;            /* the file, or "arrays": what messages and metadata name */
     double import_seconds;
+    PtrStrings warnings;   /* the import's, for the caller to read */
+    /* Whether a quantity was mapped onto a colormap, and from what to what. */
+    int color_mapped;
+    double color_from, color_to;
     /* The hash of the first build, taken in the file's order: later builds
      * see the tree's, even after one that failed. */
     int hash_valid;

@@ -443,6 +443,29 @@ PtrStatus ptr_frame_new(int width, int height, int channels, const float *pixels
     return PTR_STATUS_OK;
 }
 
+PtrStatus ptr_frame_set_placement(PtrFrame *frame, int x, int y, int image_width,
+                                  int image_height, PtrErrorInfo *err)
+{
+    PtrError e;
+    if (!frame)
+        return ptr_api_usage(err, "placement: frame is needed, not NULL");
+    PtrImageLayout *layout = &frame->layout;
+    /* In long long: x + width cannot overflow. */
+    if (x < 0 || y < 0 || (long long)x + layout->width > image_width ||
+        (long long)y + layout->height > image_height || image_width > PTR_MAX_IMAGE_SIZE ||
+        image_height > PTR_MAX_IMAGE_SIZE) {
+        ptr_error_set(&e, PTR_ERR_USAGE, "placement: %dx%d pixels at %d,%d do not lie inside "
+                      "an image of %dx%d of at most %d pixels a side", layout->width,
+                      layout->height, x, y, image_width, image_height, PTR_MAX_IMAGE_SIZE);
+        return ptr_api_fail(err, &e);
+    }
+    layout->x = x;
+    layout->y = y;
+    layout->full_width = image_width;
+    layout->full_height = image_height;
+    return PTR_STATUS_OK;
+}
+
 /* The output's settings the save options give, read and checked, with
  * the context's colour configuration selected as they say. */
 static PtrResult read_save_options(PtrContext *context, const PtrSaveOptions *o,

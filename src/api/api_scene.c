@@ -10,6 +10,7 @@
 #include "base/version.h"
 #include "builder.h"
 #include "importer.h"
+#include "scene/colormap.h"
 
 /* The public codes are the internal ones, number for number. */
 #define SAME_CODE(status, result) _Static_assert((int)status == (int)result, #status)
@@ -160,6 +161,45 @@ static PtrResult apply_sky(const char *sky, PtrScene *scene, PtrError *err)
     return PTR_OK;
 }
 
+/* The colormap and range a load asks for, checked: *map NULL for the
+ * default, *range NULL for the values' own. */
+static PtrResult read_color_options(const PtrLoadOptions *o, const PtrColormap **map,
+                                    const double **range, PtrError *err)
+{
+    const double *r = o->color_range;
+    *map = NULL;
+    *range = r[0] != 0.0 || r[1] != 0.0 ? r : NULL;
+    if (!o->color_by && (o->colormap || *range))
+        return ptr_error_set(err, PTR_ERR_USAGE, "colormap and color_range need color_by");
+    if (o->colormap && !(*map = ptr_colormap_find(o->colormap)))
+        return ptr_error_set(err, PTR_ERR_USAGE, "colormap: '%s' is not " PTR_COLORMAP_NAMES,
+                             o->colormap);
+    if (*range && !ptr_color_range_ok(r))
+        return ptr_error_set(err, PTR_ERR_USAGE, "color_range: %g,%g is not MIN,MAX (finite "
+                             "numbers, MIN below MAX)", r[0], r[1]);
+    return PTR_OK;
+}
+
+/* color_by's quantity, if the import read one, onto the colormap (as the
+ * command line's --color-by); a colour scheme, which the importer applied,
+ * takes no colormap or range (map and range are NULL without color_by). */
+static PtrResult apply_color_by(const char *path, const PtrLoadOptions *o,
+                                const PtrColormap *map, const double *range, PtrScene *scene,
+                                PtrColorMapping *mapping, PtrError *err)
+{
+    if (!scene->spheres.value)
+        return map || range
+                   ? ptr_error_set(err, PTR_ERR_USAGE, "%s: color_by %s is a colour scheme, "
+                                   "not a quantity: it takes no colormap or color_range",
+                                   path, o->color_by)
+                   : PTR_OK;
+    PtrError problem;
+    PtrResult res = ptr_scene_color_by_range(scene, map, range, mapping, &problem);
+    if (res != PTR_OK)
+        return ptr_error_set(err, res, "%s: color_by: %s", path, problem.message);
+    return PTR_OK;
+}
+
 PtrStatus ptr_scene_load(PtrContext *context, const char *path, const PtrLoadOptions *options,
                          PtrSceneHandle **out, PtrErrorInfo *err)
 {
@@ -171,12 +211,17 @@ PtrStatus ptr_scene_load(PtrContext *context, const char *path, const PtrLoadOpt
     PtrCameraSpec camera;
     if (o->camera && ptr_api_camera_spec(o->camera, &camera, &e) != PTR_OK)
         return ptr_api_fail(err, &e);
+    const PtrColormap *map;
+    const double *range;
+    if (read_color_options(o, &map, &range, &e) != PTR_OK)
+        return ptr_api_fail(err, &e);
     PtrImportOptions import = {
         .camera_name = o->camera_name,
         .camera = o->camera ? &camera : NULL,
         .fit_all_objects = o->fit_all_objects,
         .drop_hydrogens = o->drop_hydrogens,
         .structure_assembly = o->assembly,
+        .value_attribute = o->color_by,
         .auto_projection = o->orthographic ? PTR_PROJECTION_ORTHOGRAPHIC
                                            : PTR_PROJECTION_PERSPECTIVE,
         .auto_aspect = o->width && o->height ? (double)o->width / o->height : 0,
@@ -195,14 +240,27 @@ PtrStatus ptr_scene_load(PtrContext *context, const char *path, const PtrLoadOpt
     double start = ptr_now_seconds();
     PtrResult res = ptr_import_scene(path, &import, &scene, &warnings, &e);
     double seconds = ptr_now_seconds() - start;
-    ptr_strings_free(&warnings);
+    /* In the command line's order: the sky, then the colours. */
+    PtrColorMapping mapping = { 0 };
     if (res == PTR_OK)
         res = apply_sky(o->sky, &scene, &e);
+    if (res == PTR_OK)
+        res = apply_color_by(path, o, map, range, &scene, &mapping, &e);
     if (res != PTR_OK) {
+        ptr_strings_free(&warnings);
         ptr_scene_free(&scene);
         return ptr_api_fail(err, &e);
     }
-    return hand_scene(&scene, path, seconds, out, err);
+    PtrStatus status = hand_scene(&scene, path, seconds, out, err);
+    if (status != PTR_STATUS_OK) {
+        ptr_strings_free(&warnings);
+        return status;
+    }
+    (*out)->warnings = warnings;
+    (*out)->color_mapped = mapping.map != NULL;
+    (*out)->color_from = mapping.from;
+    (*out)->color_to = mapping.to;
+    return PTR_STATUS_OK;
 }
 
 /* Checks sphere i of the arrays: PTR_ERR_USAGE naming it if it cannot be
@@ -329,10 +387,32 @@ size_t ptr_scene_sphere_count(const PtrSceneHandle *scene)
     return scene ? scene->scene.spheres.count : 0;
 }
 
+size_t ptr_scene_warning_count(const PtrSceneHandle *scene)
+{
+    return scene ? scene->warnings.count : 0;
+}
+
+const char *ptr_scene_warning(const PtrSceneHandle *scene, size_t index)
+{
+    return scene && index < scene->warnings.count ? scene->warnings.lines[index] : NULL;
+}
+
+int ptr_scene_color_range(const PtrSceneHandle *scene, double *from, double *to)
+{
+    if (!scene || !scene->color_mapped)
+        return 0;
+    if (from)
+        *from = scene->color_from;
+    if (to)
+        *to = scene->color_to;
+    return 1;
+}
+
 void ptr_scene_handle_free(PtrSceneHandle *scene)
 {
     if (!scene)
         return;
+    ptr_strings_free(&scene->warnings);
     if (scene->prepared_valid)
         ptr_prepared_free(&scene->prepared);
     ptr_scene_free(&scene->scene);

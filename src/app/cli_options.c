@@ -327,14 +327,12 @@ static PtrResult apply_option(OptionId id, const char *value, PtrOptions *o, Ptr
     case OPT_colormap:
         o->colormap = ptr_colormap_find(value);
         if (!o->colormap)
-            return bad_value(id, value, "viridis, magma, inferno, plasma, cividis or coolwarm",
-                             err);
+            return bad_value(id, value, PTR_COLORMAP_NAMES, err);
         break;
     case OPT_color_range: {
         char tail;
         double *r = o->color_range;
-        if (sscanf(value, "%lf,%lf%c", &r[0], &r[1], &tail) != 2 || !isfinite(r[0]) ||
-            !isfinite(r[1]) || !(r[0] < r[1]))
+        if (sscanf(value, "%lf,%lf%c", &r[0], &r[1], &tail) != 2 || !ptr_color_range_ok(r))
             return bad_value(id, value, "MIN,MAX (finite numbers, MIN below MAX)", err);
         o->has_color_range = 1;
         break;

@@ -1,6 +1,5 @@
 #include "app/color_by.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -46,36 +45,26 @@ PtrResult ptr_color_by_apply(const PtrOptions *o, const char *scene_path, PtrSce
 {
     if (!o->color_by)
         return PTR_OK;
-    const PtrSpheres *s = &scene->spheres;
     /* Only a structure's colour scheme (chain, entity, ...) gets here
      * without values: the importer coloured the spheres, and no colormap
      * takes part. */
-    if (!s->value)
+    if (!scene->spheres.value)
         return o->colormap || o->has_color_range || o->color_bar
                    ? ptr_error_set(err, PTR_ERR_USAGE,
                                    "%s: --color-by %s is a colour scheme, not a quantity: it "
                                    "takes no --colormap, --color-range or --color-bar",
                                    scene_path, o->color_by)
                    : PTR_OK;
-    const PtrColormap *map = o->colormap ? o->colormap : &ptr_colormaps[0];
-    double lo = INFINITY, hi = -INFINITY;
-    size_t valued = 0;
-    for (size_t i = 0; i < s->count; i++) {
-        if (isnan(s->value[i]))
-            continue;
-        lo = fmin(lo, s->value[i]);
-        hi = fmax(hi, s->value[i]);
-        valued++;
-    }
-    const double from = o->has_color_range ? o->color_range[0] : lo;
-    const double to = o->has_color_range ? o->color_range[1] : hi;
-    if (!o->quiet)
-        fprintf(stderr, "ptr: %s: --color-by %s: %zu spheres, values %.9g to %.9g, mapped from "
-                        "%.9g to %.9g through %s\n", scene_path, o->color_by, valued, lo, hi,
-                from, to, map->name);
+    PtrColorMapping mapping;
     PtrError problem;
-    PtrResult res = ptr_scene_color_by_value(scene, map, from, to, &problem);
+    PtrResult res = ptr_scene_color_by_range(scene, o->colormap,
+                                             o->has_color_range ? o->color_range : NULL,
+                                             &mapping, &problem);
     if (res != PTR_OK)
         return ptr_error_set(err, res, "%s: --color-by: %s", scene_path, problem.message);
-    return o->color_bar && color ? write_bar(o, map, scene_path, color, err) : PTR_OK;
+    if (!o->quiet)
+        fprintf(stderr, "ptr: %s: --color-by %s: %zu spheres, values %.9g to %.9g, mapped from "
+                        "%.9g to %.9g through %s\n", scene_path, o->color_by, mapping.valued,
+                mapping.lo, mapping.hi, mapping.from, mapping.to, mapping.map->name);
+    return o->color_bar && color ? write_bar(o, mapping.map, scene_path, color, err) : PTR_OK;
 }

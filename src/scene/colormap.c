@@ -12,6 +12,11 @@ const PtrColormap *ptr_colormap_find(const char *name)
     return NULL;
 }
 
+int ptr_color_range_ok(const double range[2])
+{
+    return isfinite(range[0]) && isfinite(range[1]) && range[0] < range[1];
+}
+
 PtrVec3 ptr_colormap_srgb(const PtrColormap *map, double value, double lo, double hi)
 {
     double t = hi > lo ? (value - lo) / (hi - lo) : 0.0;
@@ -67,4 +72,22 @@ PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, doub
     }
     free(white);
     return res;
+}
+
+PtrResult ptr_scene_color_by_range(PtrScene *scene, const PtrColormap *map, const double *range,
+                                   PtrColorMapping *mapping, PtrError *err)
+{
+    const PtrSpheres *s = &scene->spheres;
+    PtrColorMapping m = { .map = map ? map : &ptr_colormaps[0], .lo = INFINITY, .hi = -INFINITY };
+    for (size_t i = 0; s->value && i < s->count; i++) {
+        if (isnan(s->value[i]))
+            continue;
+        m.lo = fmin(m.lo, s->value[i]);
+        m.hi = fmax(m.hi, s->value[i]);
+        m.valued++;
+    }
+    m.from = range ? range[0] : m.lo;
+    m.to = range ? range[1] : m.hi;
+    *mapping = m;
+    return ptr_scene_color_by_value(scene, m.map, m.from, m.to, err);
 }

@@ -16,8 +16,14 @@ typedef struct PtrColormap {
  * scripts/make_colormaps.py); ends with a NULL name. */
 extern const PtrColormap ptr_colormaps[];
 
+/* The maps' names, as messages list them. */
+#define PTR_COLORMAP_NAMES "viridis, magma, inferno, plasma, cividis or coolwarm"
+
 /* The map of that name, or NULL. */
 const PtrColormap *ptr_colormap_find(const char *name);
+
+/* Whether range (--color-range MIN,MAX) is one: both finite, MIN below MAX. */
+int ptr_color_range_ok(const double range[2]);
 
 /* IEC 61966-2-1's decoding of an sRGB-encoded channel (0 to 1) to linear
  * light. */
@@ -41,5 +47,23 @@ PtrVec3 ptr_colormap_linear(const PtrColormap *map, double value, double lo, dou
  * be NULL). */
 PtrResult ptr_scene_color_by_value(PtrScene *scene, const PtrColormap *map, double lo,
                                    double hi, PtrError *err);
+
+/* What ptr_scene_color_by_range mapped: the spheres with a value, the range
+ * of their values (lo above hi when none has one), and the range mapped
+ * onto the colormap's ends through map. */
+typedef struct PtrColorMapping {
+    const PtrColormap *map;
+    size_t valued;
+    double lo, hi;
+    double from, to;
+} PtrColorMapping;
+
+/* --color-by of a scene with values (PtrSpheres.value): maps them through
+ * map (NULL: viridis, the first) from range[0] to range[1], or, range NULL,
+ * over their own range, by ptr_scene_color_by_value; says in *mapping what
+ * it mapped. The command line and the library's loads colour through this
+ * alone. Fails only for memory. */
+PtrResult ptr_scene_color_by_range(PtrScene *scene, const PtrColormap *map, const double *range,
+                                   PtrColorMapping *mapping, PtrError *err);
 
 #endif /* PTR_COLORMAP_H */

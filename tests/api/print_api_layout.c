@@ -41,6 +41,9 @@ int main(void)
     FIELD(PtrLoadOptions, width);
     FIELD(PtrLoadOptions, height);
     FIELD(PtrLoadOptions, sky);
+    FIELD(PtrLoadOptions, color_by);
+    FIELD(PtrLoadOptions, colormap);
+    FIELD(PtrLoadOptions, color_range);
     SIZE(PtrMaterialDesc);
     FIELD(PtrMaterialDesc, type);
     FIELD(PtrMaterialDesc, albedo);

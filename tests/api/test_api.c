@@ -1,8 +1,10 @@
 /* The public API (include/ptr/ptr.h) against the command line: the image
  * ptr_scene_render returns equals, float for float, the EXR `ptr` writes for
  * the same scene and options (a glTF, the seed scene with a transparent
- * background, a molecule); a scene from arrays equals the file it came from;
- * and the errors, cancellation, saving and contexts side by side. */
+ * background, a molecule, a structure coloured by --color-by); a scene from
+ * arrays equals the file it came from; a region's pixels placed as a frame
+ * of their own save as the command line's EXR of it; and the errors,
+ * warnings, cancellation, saving and contexts side by side. */
 #include <math.h>
 #include <pthread.h>
 #include <string.h>
@@ -608,6 +610,134 @@ static void test_region_budget_denoise_as_command_line(void)
     CHECK(ptr_frame_noisy(NULL) == NULL && ptr_frame_samples(NULL) == 0);
 }
 
+#define FIXTURE(name) PTR_SOURCE_DIR "/tests/fixtures/" name
+
+/* --color-by, --colormap and --color-range as load options: the command
+ * line's pixels, a structure's colour scheme and a quantity mapped alike. */
+static void test_color_by_as_command_line(void)
+{
+    struct {
+        PtrLoadOptions load;
+        const char *extra[6];
+    } cases[] = {
+        { { .color_by = "chain" }, { "--color-by", "chain" } },
+        { { .color_by = "bfactor" }, { "--color-by", "bfactor" } },
+        { { .color_by = "bfactor", .colormap = "magma", .color_range = { 10, 60 } },
+          { "--color-by", "bfactor", "--colormap", "magma", "--color-range", "10,60" } },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *out = test_path("cli.exr");
+        const char *const *e = cases[i].extra;
+        CHECK_INT(test_ptr(FIXTURE("structures/1tii.cif"), "-o", out, "--width", "96",
+                           "--samples", "6", "--quiet", e[0], e[1], e[2], e[3], e[4], e[5],
+                           (char *)NULL),
+                  0);
+        PtrFrame *frame = render_file(FIXTURE("structures/1tii.cif"), &cases[i].load, NULL);
+        check_same_as_file(frame, out);
+        ptr_frame_free(frame);
+    }
+    /* The range mapped: the one given, else the values' own; none for a
+     * colour scheme or without color_by. */
+    PtrSceneHandle *scene = NULL;
+    double from = 0, to = 0;
+    CHECK_INT(ptr_scene_load(context, FIXTURE("structures/1tii.cif"), &cases[2].load, &scene,
+                             NULL),
+              PTR_STATUS_OK);
+    CHECK(ptr_scene_color_range(scene, &from, &to) == 1 && from == 10 && to == 60);
+    ptr_scene_handle_free(scene);
+    CHECK_INT(ptr_scene_load(context, FIXTURE("structures/1tii.cif"), &cases[1].load, &scene,
+                             NULL),
+              PTR_STATUS_OK);
+    CHECK(ptr_scene_color_range(scene, &from, &to) == 1 && from > 0 && to > from);
+    ptr_scene_handle_free(scene);
+    CHECK_INT(ptr_scene_load(context, FIXTURE("structures/1tii.cif"), &cases[0].load, &scene,
+                             NULL),
+              PTR_STATUS_OK);
+    CHECK(ptr_scene_color_range(scene, NULL, NULL) == 0);
+    ptr_scene_handle_free(scene);
+    CHECK(ptr_scene_color_range(NULL, &from, &to) == 0);
+
+    const struct {
+        PtrLoadOptions load;
+        PtrStatus status;
+    } bad[] = {
+        { { .colormap = "magma" }, PTR_STATUS_USAGE },
+        { { .color_range = { 0, 1 } }, PTR_STATUS_USAGE },
+        { { .color_by = "bfactor", .colormap = "jet" }, PTR_STATUS_USAGE },
+        { { .color_by = "bfactor", .color_range = { 2, 1 } }, PTR_STATUS_USAGE },
+        { { .color_by = "bfactor", .color_range = { 0, INFINITY } }, PTR_STATUS_USAGE },
+        { { .color_by = "chain", .colormap = "magma" }, PTR_STATUS_USAGE },
+        { { .color_by = "chain", .color_range = { 0, 1 } }, PTR_STATUS_USAGE },
+        { { .color_by = "temperature" }, PTR_STATUS_SCENE_INVALID },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        PtrErrorInfo err = { 0 };
+        scene = NULL;
+        CHECK_INT(ptr_scene_load(context, FIXTURE("structures/1tii.cif"), &bad[i].load, &scene,
+                                 &err),
+                  bad[i].status);
+        CHECK(scene == NULL && err.code == bad[i].status && err.message[0]);
+    }
+}
+
+/* The import's warnings stay with the scene, in the command line's words. */
+static void test_warnings(void)
+{
+    PtrSceneHandle *scene = NULL;
+    CHECK_INT(ptr_scene_load(context, FIXTURE("orthographic.gltf"), NULL, &scene, NULL),
+              PTR_STATUS_OK);
+    CHECK_INT((int)ptr_scene_warning_count(scene), 2);
+    const char *first = ptr_scene_warning(scene, 0), *second = ptr_scene_warning(scene, 1);
+    CHECK(first && strstr(first, "orthographic.gltf: camera 'Ortho' is orthographic"));
+    CHECK(second && strstr(second, "does not clip at zfar"));
+    CHECK(ptr_scene_warning(scene, 2) == NULL);
+    ptr_scene_handle_free(scene);
+    CHECK_INT(ptr_scene_load(context, SCENE("seed.gltf"), NULL, &scene, NULL), PTR_STATUS_OK);
+    CHECK_INT((int)ptr_scene_warning_count(scene), 0);
+    ptr_scene_handle_free(scene);
+    CHECK_INT((int)ptr_scene_warning_count(NULL), 0);
+    CHECK(ptr_scene_warning(NULL, 0) == NULL);
+}
+
+/* A region's pixels as a frame of their own, placed where the region lies,
+ * save as the command line's EXR of --region: the same windows and pixels. */
+static void test_placement(void)
+{
+    const char *cli = test_path("cli.exr"), *ours = test_path("placed.exr");
+    CHECK_INT(test_ptr(SCENE("seed.gltf"), "-o", cli, "--width", "96", "--samples", "6",
+                       "--quiet", "--transparent", "--region", "10,5,70,40", (char *)NULL),
+              0);
+    PtrFrame *region = render_file(SCENE("seed.gltf"), NULL, region_and_budget);
+    PtrFrame *copy = NULL;
+    PtrErrorInfo err;
+    if (region)
+        CHECK_INT(ptr_frame_new(ptr_frame_width(region), ptr_frame_height(region), 4,
+                                ptr_frame_pixels(region), &copy, &err),
+                  PTR_STATUS_OK);
+    ptr_frame_free(region);
+    if (!copy)
+        return;
+    const int bad[][4] = {
+        { -1, 0, 96, 96 }, { 0, -1, 96, 96 }, { 37, 5, 96, 96 }, { 10, 62, 96, 96 },
+        { 10, 5, 65537, 96 }, { 0, 0, 59, 35 }, { 2147483647, 0, 96, 96 },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        CHECK_INT(ptr_frame_set_placement(copy, bad[i][0], bad[i][1], bad[i][2], bad[i][3],
+                                          &err),
+                  PTR_STATUS_USAGE);
+    CHECK_INT(ptr_frame_set_placement(NULL, 0, 0, 60, 35, &err), PTR_STATUS_USAGE);
+    int x, y, w, h;
+    ptr_frame_placement(copy, &x, &y, &w, &h);
+    CHECK(x == 0 && y == 0 && w == 60 && h == 35); /* a refused placement changes nothing */
+    CHECK_INT(ptr_frame_set_placement(copy, 10, 5, 96, 96, &err), PTR_STATUS_OK);
+    ptr_frame_placement(copy, &x, &y, &w, &h);
+    CHECK(x == 10 && y == 5 && w == 96 && h == 96);
+    CHECK_INT(ptr_frame_save(context, ours, copy, NULL, &err), PTR_STATUS_OK);
+    static const char *const none[] = { NULL };
+    check_same_files(cli, ours, none);
+    ptr_frame_free(copy);
+}
+
 static char caller_quality[16];
 static void denoised_by_caller(PtrRenderOptions *o)
 {
@@ -780,7 +910,8 @@ int main(void)
         TEST_CASE(test_hash_after_failed_build), TEST_CASE(test_saves_at_once),
         TEST_CASE(test_region_budget_denoise_as_command_line),
         TEST_CASE(test_frame_keeps_no_option_string), TEST_CASE(test_time_budget),
-        TEST_CASE(test_save_options),
+        TEST_CASE(test_save_options), TEST_CASE(test_color_by_as_command_line),
+        TEST_CASE(test_warnings), TEST_CASE(test_placement),
     };
     test_run(cases, sizeof cases / sizeof cases[0]);
     ptr_context_free(context);

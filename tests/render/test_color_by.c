@@ -5,6 +5,7 @@
  * times its albedo, with no noise: the albedo being the map's colour, L
  * times map(value). */
 #include <math.h>
+#include <string.h>
 
 #include "importer.h"
 #include "render/render.h"
@@ -186,6 +187,46 @@ static void test_materials(void)
     ptr_scene_free(&s);
 }
 
+/* The range mapped: the values' own without one given (spheres without a
+ * value left out), viridis without a map; a range given is the one mapped.
+ * And which ranges --color-range takes. */
+static void test_range_mapped(void)
+{
+    for (int given = 0; given < 2; given++) {
+        PtrScene s;
+        ptr_scene_init(&s);
+        const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.5f) };
+        uint32_t m;
+        CHECK_INT(ptr_scene_add_material(&s, &grey, &m, NULL), PTR_OK);
+        for (int i = 0; i < 3; i++)
+            CHECK_INT(ptr_scene_add_sphere(&s, v3((float)i, 0, 0), 0.4f, m, NULL), PTR_OK);
+        CHECK_INT(ptr_scene_set_sphere_value(&s, 0, 4.0f, NULL), PTR_OK);
+        CHECK_INT(ptr_scene_set_sphere_value(&s, 2, -2.0f, NULL), PTR_OK);
+        const double range[2] = { 0.0, 8.0 };
+        PtrColorMapping mapping;
+        CHECK_INT(ptr_scene_color_by_range(&s, given ? ptr_colormap_find("magma") : NULL,
+                                           given ? range : NULL, &mapping, NULL),
+                  PTR_OK);
+        CHECK(!strcmp(mapping.map->name, given ? "magma" : "viridis"));
+        CHECK_INT((int)mapping.valued, 2);
+        CHECK(mapping.lo == -2.0 && mapping.hi == 4.0);
+        CHECK(given ? mapping.from == 0.0 && mapping.to == 8.0
+                    : mapping.from == -2.0 && mapping.to == 4.0);
+        /* The highest value, 4: the top of its own range, the middle of 0 to 8. */
+        const PtrVec3 high = ptr_sphere_color(&s.spheres, 0);
+        const PtrVec3 expected = ptr_colormap_linear(mapping.map, given ? 0.5 : 1.0, 0.0, 1.0);
+        CHECK_NEAR(high.x, expected.x, 1.0 / 65535); /* colours are kept in 16 bits */
+        CHECK_NEAR(high.y, expected.y, 1.0 / 65535);
+        CHECK_NEAR(high.z, expected.z, 1.0 / 65535);
+        ptr_scene_free(&s);
+    }
+    const double ok[2] = { -1.0, 1.0 }, empty[2] = { 1.0, 1.0 }, reversed[2] = { 2.0, 1.0 },
+                 infinite[2] = { 0.0, INFINITY }, nan[2] = { NAN, 1.0 };
+    CHECK(ptr_color_range_ok(ok));
+    CHECK(!ptr_color_range_ok(empty) && !ptr_color_range_ok(reversed));
+    CHECK(!ptr_color_range_ok(infinite) && !ptr_color_range_ok(nan));
+}
+
 /* The values take memory only when asked for: a file with instance
  * attributes imports without a value array unless --color-by names one. */
 static void test_values_only_when_asked(void)
@@ -213,6 +254,7 @@ int main(void)
         TEST_CASE(test_furnace_shows_the_map),
         TEST_CASE(test_furnace_clamps),
         TEST_CASE(test_materials),
+        TEST_CASE(test_range_mapped),
     };
     TEST_RUN(cases);
     return test_report();
