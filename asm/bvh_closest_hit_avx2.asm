@@ -200,7 +200,9 @@ FUNCTION ptr_bvh_closest_hit_avx2
     test        edx, edx
     jz          .pop
     ; One child entered: enter it. Several: push them all, swap the nearest
-    ; (its lowest lane on a tie) onto the top, and pop it at once.
+    ; (its lowest lane on a tie) onto the top, and pop it at once. The
+    ; nearest so far is kept without a branch on the distances, which no
+    ; predictor learns: a mispredicted branch throws away the steps after it.
     lea         ecx, [rdx - 1]
     test        edx, ecx
     jz          .one
@@ -217,10 +219,8 @@ FUNCTION ptr_bvh_closest_hit_avx2
     vmovss      xmm8, [rbp + ENTRY + rcx*4]
     vmovss      [r14 + 8], xmm8
     vucomiss    xmm8, xmm15
-    jae         .farther
-    vmovaps     xmm15, xmm8
-    mov         rbx, r14
-.farther:
+    cmovb       rbx, r14                        ; nearer than the nearest so far
+    vminss      xmm15, xmm8, xmm15              ; (never NaN: tmin is maxps's last operand)
     add         r14, 16
     test        edx, edx
     jnz         .push
