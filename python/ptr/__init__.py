@@ -213,12 +213,15 @@ def _load_options(options):
         _native.text(options.get("color_by")), _native.text(options.get("colormap")))
     color_range = options.get("color_range")
     if color_range is not None:
-        values = [float(v) for v in color_range]
+        wrong = ValueError("color_range: %r is not (min, max), min below max" % (color_range,))
+        try:
+            values = [float(v) for v in color_range]
+        except (TypeError, ValueError):
+            raise wrong from None
         # (0, 0) is the C API's "the values' own range": refused as the
         # empty range it is.
         if len(values) != 2 or not values[0] < values[1]:
-            raise ValueError("color_range: %r is not (min, max), min below max"
-                             % (color_range,))
+            raise wrong
         load_options.color_range[:] = values
     return load_options, desc
 
@@ -426,7 +429,7 @@ class Scene:
             setattr(options, name, _native.text(value))
         frame = self._render_frame(options, progress)
         if full:
-            return Frame(frame)
+            return Frame._of(frame)
         try:
             image = _frame_array(lib.ptr_frame_pixels(frame), frame)
             if not passes:
@@ -529,18 +532,34 @@ class Frame:
     render: an EXR keeps the passes, the noisy colour, the metadata and the
     region's place in the image."""
 
-    def __init__(self, handle):
+    def __init__(self, *args, **kwargs):
+        raise TypeError("a ptr.Frame comes from Scene.render(..., full=True)")
+
+    @classmethod
+    def _of(cls, handle):
+        """The Frame that owns the C frame handle (freed with its last array)."""
+        self = object.__new__(cls)
         self._memory = memory = _FrameMemory(handle)
         buffer = lib.ptr_frame_pixels(handle)
-        self.image = np.asarray(_Buffer(memory, buffer, lib.ptr_frame_channels(handle)))
-        self.albedo, self.normal, self.noisy = (
+        self._image = np.asarray(_Buffer(memory, buffer, lib.ptr_frame_channels(handle)))
+        self._albedo, self._normal, self._noisy = (
             np.asarray(_Buffer(memory, pointer, 3)) if pointer else None
             for pointer in (lib.ptr_frame_albedo(handle), lib.ptr_frame_normal(handle),
                             lib.ptr_frame_noisy(handle)))
-        self.samples = lib.ptr_frame_samples(handle)
+        self._samples = lib.ptr_frame_samples(handle)
         corner = [ctypes.c_int() for _ in range(4)]
         lib.ptr_frame_placement(handle, *[ctypes.byref(c) for c in corner])
-        self.placement = Placement(*[c.value for c in corner])
+        self._placement = Placement(*[c.value for c in corner])
+        return self
+
+    # Read-only: ptr.save(path, frame) writes the frame as rendered, which
+    # an assignment here would not change.
+    image = property(lambda self: self._image)
+    albedo = property(lambda self: self._albedo)
+    normal = property(lambda self: self._normal)
+    noisy = property(lambda self: self._noisy)
+    samples = property(lambda self: self._samples)
+    placement = property(lambda self: self._placement)
 
 
 def _frame_array(pointer, frame, channels=None):

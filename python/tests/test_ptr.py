@@ -364,7 +364,9 @@ def test_color_range_and_bad_colors():
                 {"color_by": "bfactor", "color_range": (0, 0)},
                 {"color_by": "bfactor", "color_range": (1, 2, 3)},
                 {"color_by": "bfactor", "color_range": (0, math.inf)},
-                {"color_by": "chain", "colormap": "magma"}):
+                {"color_by": "chain", "colormap": "magma"}, {"color_by": ""},
+                {"color_by": "bfactor", "color_range": 5},
+                {"color_by": "bfactor", "color_range": "1,2"}):
         with pytest.raises(ValueError):
             ptr.load(STRUCTURE, **bad)
     with pytest.raises(ptr.Error) as error:
@@ -395,6 +397,11 @@ def test_full_frame_and_placed_save(tmp_path):
     assert frame.albedo is None and frame.normal is None and frame.noisy is None
     with pytest.raises(ValueError):
         frame.image[0, 0, 0] = 1  # read in place: the frame's own
+    for name in ("image", "placement", "samples"):
+        with pytest.raises(AttributeError):  # saved as rendered: not to be changed
+            setattr(frame, name, None)
+    with pytest.raises(TypeError):
+        ptr.Frame(0x1000)  # only a render makes one
     # The frame, or its pixels placed where it says, save as the command
     # line's EXR of the region; without the placement, as an image of their
     # own, they do not.

@@ -169,6 +169,8 @@ static PtrResult read_color_options(const PtrLoadOptions *o, const PtrColormap *
     const double *r = o->color_range;
     *map = NULL;
     *range = r[0] != 0.0 || r[1] != 0.0 ? r : NULL;
+    if (o->color_by && !*o->color_by)
+        return ptr_error_set(err, PTR_ERR_USAGE, "color_by: '' is not an attribute name");
     if (!o->color_by && (o->colormap || *range))
         return ptr_error_set(err, PTR_ERR_USAGE, "colormap and color_range need color_by");
     if (o->colormap && !(*map = ptr_colormap_find(o->colormap)))
