@@ -105,9 +105,10 @@ static void bins_merge(Bins *into, const Bins *b, int bins)
 }
 
 /* Runs of this many prims are bounded, binned and partitioned by all threads
- * together; smaller ones by the calling thread (handing a piece to a kept
- * thread and back takes about 12 microseconds, a run of 16,384 prims some
- * hundred). Runs of more than
+ * together; smaller ones by the calling thread (a run of 16,384 prims takes
+ * some hundred microseconds; handing a piece to a kept thread and back, 12
+ * while the cores are busy, up to 140 on an idle virtual machine:
+ * docs/intersectors.md, "From one thread to two"). Runs of more than
  * SAMPLED_ABOVE prims choose their split from about SAMPLES of them, evenly
  * spaced: at the top of a tree of 10^7 spheres, binning every prim took a
  * third of the build and chose much the same splits. */
