@@ -112,10 +112,12 @@ struct PtrFrame {
 
 /* Renders the scene as asked into a new frame (the scene's kernels and tree
  * built for the request unless already): a render stopped by hooks->stop
- * is a frame too, with done.stopped set. PTR_ERR_USAGE for a region outside
- * the image. */
+ * is a frame too, with done.stopped set. The image's size chosen
+ * (ptr_choose_size) goes to *width and *height first, so that a caller can
+ * report it whatever fails. PTR_ERR_USAGE for a region outside the image. */
 PtrResult ptr_api_render(PtrSceneHandle *scene, const PtrRenderRequest *request,
-                         const PtrRenderHooks *hooks, PtrFrame **out, PtrError *err);
+                         const PtrRenderHooks *hooks, int *width, int *height, PtrFrame **out,
+                         PtrError *err);
 /* Denoises the frame's colour if its render asked for it, keeping the
  * noisy one; name: what a message names (the output, or the scene). */
 PtrResult ptr_api_frame_finish(PtrFrame *frame, const char *name, PtrError *err);

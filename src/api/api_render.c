@@ -175,20 +175,19 @@ static void report_progress(void *user, const PtrProgress *p)
         progress->stop = 1;
 }
 
-/* The settings of the request for the scene, its size chosen; PTR_ERR_USAGE
- * if its region lies outside the image. */
-static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r,
-                              PtrRenderSettings *settings, PtrError *err)
+/* The settings of the request for the scene at the size chosen;
+ * PTR_ERR_USAGE if its region lies outside the image. */
+static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r, int width,
+                              int height, PtrRenderSettings *settings, PtrError *err)
 {
     *settings = (PtrRenderSettings){
-        .region = r->region, .seed = r->seed, .max_depth = r->max_depth, .threads = r->threads,
-        .sampler = r->sampler, .direct_lighting = r->direct_lighting,
-        .noise_threshold = r->noise_threshold, .min_samples = r->min_samples,
-        .integrator = h->prepared.integrator, .transparent = r->transparent,
+        .width = width, .height = height, .region = r->region, .seed = r->seed,
+        .max_depth = r->max_depth, .threads = r->threads, .sampler = r->sampler,
+        .direct_lighting = r->direct_lighting, .noise_threshold = r->noise_threshold,
+        .min_samples = r->min_samples, .integrator = h->prepared.integrator,
+        .transparent = r->transparent,
         .passes = r->passes || r->denoiser, /* the denoiser's guides */
     };
-    ptr_choose_size(&h->scene, r->width, r->height, r->divisor, &settings->width,
-                    &settings->height);
     if (ptr_render_region(settings).x1 == 0)
         return ptr_error_set(err, PTR_ERR_USAGE, "%s %d,%d,%d,%d lies outside the %dx%d image",
                              r->region_name, r->region.x0, r->region.y0, r->region.x1,
@@ -198,11 +197,11 @@ static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r
 
 /* Renders into f, the scene's tree ready, with this render's sky and camera
  * in the scene. */
-static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r,
-                             const PtrRenderHooks *hooks, PtrFrame *f, PtrError *err)
+static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r, int width,
+                             int height, const PtrRenderHooks *hooks, PtrFrame *f, PtrError *err)
 {
     PtrRenderSettings settings;
-    PtrResult res = settings_for(h, r, &settings, err);
+    PtrResult res = settings_for(h, r, width, height, &settings, err);
     if (res != PTR_OK)
         return res;
     const PtrRegion region = ptr_render_region(&settings);
@@ -238,8 +237,14 @@ static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r,
 }
 
 PtrResult ptr_api_render(PtrSceneHandle *h, const PtrRenderRequest *r,
-                         const PtrRenderHooks *hooks, PtrFrame **out, PtrError *err)
+                         const PtrRenderHooks *hooks, int *width, int *height, PtrFrame **out,
+                         PtrError *err)
 {
+    /* The size before anything can fail, from this render's camera, which
+     * takes the scene's place only after the build (the scene's hash is of
+     * its own). */
+    ptr_choose_size(&h->scene, r->camera ? r->camera : &h->scene.camera, r->width, r->height,
+                    r->divisor, width, height);
     PtrResult res = prepare(h, r, err);
     if (res != PTR_OK)
         return res;
@@ -255,7 +260,7 @@ PtrResult ptr_api_render(PtrSceneHandle *h, const PtrRenderRequest *r,
         h->scene.sky = *r->sky;
     if (r->camera)
         h->scene.camera = *r->camera;
-    res = render_into(h, r, hooks, f, err);
+    res = render_into(h, r, *width, *height, hooks, f, err);
     /* Only what was changed: a live view may still be reading the scene. */
     if (r->sky)
         h->scene.sky = sky;
@@ -335,8 +340,9 @@ static PtrResult render(PtrContext *context, PtrSceneHandle *h, const PtrRenderO
         .stop = &progress->stop, .report = progress->callback ? report_progress : NULL,
         .user = progress,
     };
+    int width, height; /* the frame's layout has them */
     PtrFrame *f;
-    PtrResult res = ptr_api_render(h, request, &hooks, &f, err);
+    PtrResult res = ptr_api_render(h, request, &hooks, &width, &height, &f, err);
     if (res != PTR_OK)
         return res;
     if (f->done.stopped)

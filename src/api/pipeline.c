@@ -86,10 +86,10 @@ PtrTextureDecoder ptr_texture_decoder(PtrImageLoader *images)
     return (PtrTextureDecoder){ decode_texture, images };
 }
 
-void ptr_choose_size(const PtrScene *scene, int width, int height, int divisor, int *out_width,
-                     int *out_height)
+void ptr_choose_size(const PtrScene *scene, const PtrCamera *camera, int width, int height,
+                     int divisor, int *out_width, int *out_height)
 {
-    float aspect = scene->camera.aspect > 0.0f ? scene->camera.aspect
+    float aspect = camera->aspect > 0.0f ? camera->aspect
                    : scene->width > 0          ? (float)scene->width / (float)scene->height
                                                : 16.0f / 9.0f;
     int w = width, h = height;

@@ -78,9 +78,6 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
                                   const PtrColor *color, PtrJobReport *report, PtrError *err)
 {
     const PtrRenderRequest request = request_of(o, report);
-    /* The image's size, reported even when its region lies outside it. */
-    ptr_choose_size(&scene->scene, request.width, request.height, request.divisor,
-                    &report->width, &report->height);
     PtrProgressPrinter printer;
     ptr_progress_printer_init(&printer, report->output);
     LiveRender live = { o->live_view, report->scene, report->output, 0 };
@@ -91,7 +88,9 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
     PtrFrame *frame = NULL;
     /* The kernel was checked before any scene was read: only the tree and
      * the region can fail before the render. */
-    PtrResult res = ptr_api_render(scene, &request, &hooks, &frame, err);
+    /* The image's size is reported even when its region lies outside it. */
+    PtrResult res = ptr_api_render(scene, &request, &hooks, &report->width, &report->height,
+                                   &frame, err);
     ptr_progress_done(&printer);
     report_render(scene, frame, report);
     const int stopped = frame && frame->done.stopped;
