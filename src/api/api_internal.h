@@ -63,7 +63,6 @@ typedef struct PtrRenderRequest {
     int width, height;     /* asked; 0: the scene's (ptr_choose_size) */
     int divisor;           /* the size divided by this (--preview); 1: none */
     PtrRegion region;      /* all zero: the whole image */
-    const char *region_name; /* what messages call it: the option, or the field */
     uint32_t first_sample, samples;
     double time_budget;    /* seconds; 0: none */
     uint64_t seed;

@@ -47,7 +47,6 @@ static PtrResult read_request(const PtrContext *context, const PtrRenderOptions 
         .noise_threshold = o->noise_threshold, .min_samples = o->min_samples,
         .transparent = o->transparent, .passes = o->passes,
         .region = { o->region[0], o->region[1], o->region[2], o->region[3] },
-        .region_name = "region",
         .time_budget = o->time_budget,
     };
     if (o->kernel && strcmp(o->kernel, "c") && strcmp(o->kernel, "asm"))
@@ -189,9 +188,9 @@ static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r
         .passes = r->passes || r->denoiser, /* the denoiser's guides */
     };
     if (ptr_render_region(settings).x1 == 0)
-        return ptr_error_set(err, PTR_ERR_USAGE, "%s %d,%d,%d,%d lies outside the %dx%d image",
-                             r->region_name, r->region.x0, r->region.y0, r->region.x1,
-                             r->region.y1, settings->width, settings->height);
+        return ptr_error_set(err, PTR_ERR_USAGE, "region %d,%d,%d,%d lies outside the %dx%d image",
+                             r->region.x0, r->region.y0, r->region.x1, r->region.y1,
+                             settings->width, settings->height);
     return PTR_OK;
 }
 

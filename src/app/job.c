@@ -25,7 +25,7 @@ static PtrRenderRequest request_of(const PtrOptions *o, const PtrJobReport *repo
 {
     return (PtrRenderRequest){
         .width = o->width, .height = o->height, .divisor = o->preview ? PREVIEW_SCALE : 1,
-        .region = o->region, .region_name = "--region", .first_sample = report->sample_first,
+        .region = o->region, .first_sample = report->sample_first,
         .samples = report->samples_requested, .time_budget = o->time_budget, .seed = o->seed,
         .max_depth = o->max_depth, .threads = o->threads, .kernel = o->kernel,
         .level = o->cpu_level, .integrator = o->integrator, .accel = o->accel,
@@ -86,11 +86,17 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
         .user = &printer, .begin = live_begin, .begin_user = &live,
     };
     PtrFrame *frame = NULL;
-    /* The kernel was checked before any scene was read: only the tree and
-     * the region can fail before the render. */
+    PtrError problem;
     /* The image's size is reported even when its region lies outside it. */
     PtrResult res = ptr_api_render(scene, &request, &hooks, &report->width, &report->height,
-                                   &frame, err);
+                                   &frame, &problem);
+    /* The kernel and the integrator were checked before any scene was read:
+     * the region is the one option the render can refuse, which the command
+     * line names by its option. */
+    if (res == PTR_ERR_USAGE)
+        ptr_error_set(err, res, "--region: %s", problem.message);
+    else if (res != PTR_OK)
+        ptr_error_set(err, res, "%s", problem.message);
     ptr_progress_done(&printer);
     report_render(scene, frame, report);
     const int stopped = frame && frame->done.stopped;
