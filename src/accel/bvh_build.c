@@ -65,9 +65,10 @@ typedef struct Task {
 
 typedef struct Build {
     BvhPrimSet set;
-    /* The same prims for the tasks, which run one a thread: one thread
-     * each, for the threads are all at work. */
-    BvhPrimSet task_set;
+    /* The build's threads: all of them split the top level's large ranges;
+     * a task, run on one of them while the others run theirs, splits on
+     * its thread alone. */
+    int threads;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
     size_t task_spheres;
     Task *tasks;
@@ -110,8 +111,8 @@ static PtrResult add_task(Build *build, size_t begin, size_t end, int level, uin
 
 /* Builds the node at this level over c's range into nodes (its index in
  * *index), and its inner children below it; depth: levels below the node. In
- * the top level (top set), inner children of at most task_spheres spheres
- * become tasks. scratch: see bvh_split (tasks have it, the top level not). */
+ * the top level (top set), split on all threads, inner children of at most
+ * task_spheres spheres become tasks. scratch: see bvh_split (tasks have it, the top level not). */
 static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
                             const BvhCandidate *range, int top, int level, size_t *index,
                             int *depth, PtrError *err)
@@ -136,7 +137,7 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         }
         if (pick < 0)
             break;
-        r = bvh_split(top ? &build->set : &build->task_set, &child[pick],
+        r = bvh_split(&build->set, top ? build->threads : 1, &child[pick],
                       level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick], &child[n], err);
         if (r != PTR_OK)
             return r;
@@ -206,7 +207,7 @@ static void *task_worker(void *arg)
         if (!scratch)
             scratch = malloc(build->task_spheres * sizeof *scratch);
         t->failed = !scratch ||
-                    bvh_candidate_init(&build->task_set, &range, t->begin, t->end, NULL, NULL,
+                    bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL,
                                        NULL) != PTR_OK ||
                     build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
                                &t->nodes.depth, NULL) != PTR_OK;
@@ -217,7 +218,7 @@ static void *task_worker(void *arg)
 
 static PtrResult run_tasks(Build *build, PtrError *err)
 {
-    int threads = build->set.threads;
+    int threads = build->threads;
     PtrThread **ids = malloc((size_t)threads * sizeof *ids);
     if (!ids)
         return bvh_out_of_memory(err);
@@ -289,7 +290,7 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
         size_t last = first, bytes = 0;
         while (last < build->task_count && bytes < TRIM_BYTES)
             bytes += build->tasks[last++].nodes.count * sizeof *nodes;
-        ptr_parallel_ranges(build->set.threads, first, last, lay_out_tasks, &l);
+        ptr_parallel_ranges(build->threads, first, last, lay_out_tasks, &l);
         malloc_trim(0);
         first = last;
     }
@@ -355,7 +356,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
-    Build build = { .set.threads = ptr_thread_count(threads) };
+    Build build = { .threads = ptr_thread_count(threads) };
     /* The prims and huge take the tree's spheres, whose memory the
      * scene's arrays give back meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
@@ -366,26 +367,24 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK) {
         PtrSpheres tree_part = *spheres;
         tree_part.count = count;
-        r = ptr_bvh_prims(&tree_part, build.set.threads, huge, &bvh->huge_count,
+        r = ptr_bvh_prims(&tree_part, build.threads, huge, &bvh->huge_count,
                           build.set.prims, &prim_count, &build.set.magnitude, err);
     }
-    build.task_set = build.set;
-    build.task_set.threads = 1;
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
     if (r == PTR_OK && prim_count > 0) {
         BvhCandidate root;
         size_t index;
-        r = bvh_candidate_init(&build.set, &root, 0, prim_count, NULL, NULL, err);
+        r = bvh_candidate_init(&build.set, build.threads, &root, 0, prim_count, NULL, NULL,
+                               err);
         if (r == PTR_OK)
             r = build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth, err);
         if (r == PTR_OK)
             r = run_tasks(&build, err);
     }
     if (r == PTR_OK) {
-        write_back(spheres, build.set.prims, prim_count, bvh->huge_count,
-                   build.set.threads);
+        write_back(spheres, build.set.prims, prim_count, bvh->huge_count, build.threads);
         build.set.prims = NULL;
         SphereWrite first = { spheres, huge, 0 };
         write_spheres(&first, 0, bvh->huge_count);

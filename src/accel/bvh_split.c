@@ -136,13 +136,14 @@ static void *parallel_bin_worker(void *arg)
     return NULL;
 }
 
-/* Bins (or, with c NULL, only bounds) prims begin .. end - 1 into *out.
- * Counts add and boxes take minima and maxima, so the result does not depend
- * on how the run is shared between threads. */
-static PtrResult bin_range(const BvhPrimSet *set, size_t begin, size_t end, const BvhCandidate *c,
-                           Bins *out, PtrError *err)
+/* Bins (or, with c NULL, only bounds) prims begin .. end - 1 into *out, on
+ * up to max_threads threads if the run is large. Counts add and boxes take
+ * minima and maxima, so the result does not depend on how the run is shared
+ * between threads. */
+static PtrResult bin_range(const BvhPrimSet *set, int max_threads, size_t begin, size_t end,
+                           const BvhCandidate *c, Bins *out, PtrError *err)
 {
-    int threads = end - begin >= PARALLEL_PRIMS ? set->threads : 1;
+    int threads = end - begin >= PARALLEL_PRIMS ? max_threads : 1;
     int bins = c ? c->bins : 0;
     if (threads == 1) {
         bins_clear(out, bins);
@@ -180,8 +181,9 @@ static PtrResult bin_range(const BvhPrimSet *set, size_t begin, size_t end, cons
     return PTR_OK;
 }
 
-PtrResult bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
-                             const float lower[3], const float upper[3], PtrError *err)
+PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c, size_t begin,
+                             size_t end, const float lower[3], const float upper[3],
+                             PtrError *err)
 {
     Bins bins;
     c->begin = begin;
@@ -189,7 +191,7 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begi
     c->axis = -1;
     c->sampled = 0;
     if (!lower) {
-        PtrResult r = bin_range(set, begin, end, NULL, &bins, err);
+        PtrResult r = bin_range(set, threads, begin, end, NULL, &bins, err);
         if (r != PTR_OK)
             return r;
         lower = bins.box_lo;
@@ -219,7 +221,7 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begi
         bins_clear(&bins, c->bins);
         bin_run(set, begin, end, (end - begin) / SAMPLES, c, &bins);
     } else {
-        PtrResult r = bin_range(set, begin, end, c, &bins, err);
+        PtrResult r = bin_range(set, threads, begin, end, c, &bins, err);
         if (r != PTR_OK)
             return r;
     }
@@ -427,8 +429,8 @@ static void swap_runs(void *arg, size_t begin, size_t end)
  * of the first half swapped with the left part of the second (the smaller
  * of the two moves): the same moves whatever the thread count, so the tree
  * is too. */
-static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch,
-                        SideBoxes *sides)
+static size_t partition(const BvhPrimSet *set, int threads, const BvhCandidate *c,
+                        BvhPrim *scratch, SideBoxes *sides)
 {
     size_t begin = c->begin, end = c->end;
     if (sides)
@@ -440,7 +442,7 @@ static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *s
     size_t mid = begin + (end - begin) / 2;
     PartitionHalf half[2] = { { .set = set, .begin = begin, .end = mid, .c = c, .want_sides = sides },
                               { .set = set, .begin = mid, .end = end, .c = c, .want_sides = sides } };
-    PtrThread *other = set->threads > 1 ? ptr_thread_start(partition_half, &half[1]) : NULL;
+    PtrThread *other = threads > 1 ? ptr_thread_start(partition_half, &half[1]) : NULL;
     partition_half(&half[0]);
     if (other)
         ptr_thread_join(other);
@@ -455,12 +457,12 @@ static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *s
     size_t right_a = mid - half[0].first_right, left_b = half[1].first_right - mid;
     size_t moved = right_a < left_b ? right_a : left_b;
     SwapRuns swap = { set->prims + half[0].first_right, set->prims + half[1].first_right - moved };
-    ptr_parallel_ranges(set->threads, 0, moved, swap_runs, &swap);
+    ptr_parallel_ranges(threads, 0, moved, swap_runs, &swap);
     return half[0].first_right + left_b;
 }
 
-PtrResult bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
-                    BvhCandidate *left, BvhCandidate *right, PtrError *err)
+PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, int middle,
+                    BvhPrim *scratch, BvhCandidate *left, BvhCandidate *right, PtrError *err)
 {
     const size_t begin = c->begin, end = c->end;
     size_t mid = begin + (end - begin) / 2;
@@ -471,7 +473,7 @@ PtrResult bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, Bv
     SideBoxes sides;
     const BvhCandidate whole = *c;
     if (!middle && whole.axis >= 0) {
-        mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
+        mid = partition(set, threads, &whole, scratch, whole.sampled ? &sides : NULL);
         for (int side = 0; side < 2; side++) {
             box[side][0] = whole.sampled ? sides.lower[side]
                                          : side ? whole.right_lower : whole.left_lower;
@@ -479,6 +481,8 @@ PtrResult bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, Bv
                                          : side ? whole.right_upper : whole.left_upper;
         }
     }
-    PtrResult r = bvh_candidate_init(set, left, begin, mid, box[0][0], box[0][1], err);
-    return r != PTR_OK ? r : bvh_candidate_init(set, right, mid, end, box[1][0], box[1][1], err);
+    PtrResult r = bvh_candidate_init(set, threads, left, begin, mid, box[0][0], box[0][1], err);
+    if (r != PTR_OK)
+        return r;
+    return bvh_candidate_init(set, threads, right, mid, end, box[1][0], box[1][1], err);
 }
