@@ -174,12 +174,11 @@ static void report_progress(void *user, const PtrProgress *p)
         progress->stop = 1;
 }
 
-/* The settings of the request for the scene at the size chosen;
- * PTR_ERR_USAGE if its region lies outside the image. */
-static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r, int width,
-                              int height, PtrRenderSettings *settings, PtrError *err)
+/* The settings of the request for the scene at the size chosen. */
+static PtrRenderSettings settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r,
+                                      int width, int height)
 {
-    *settings = (PtrRenderSettings){
+    return (PtrRenderSettings){
         .width = width, .height = height, .region = r->region, .seed = r->seed,
         .max_depth = r->max_depth, .threads = r->threads, .sampler = r->sampler,
         .direct_lighting = r->direct_lighting, .noise_threshold = r->noise_threshold,
@@ -187,23 +186,20 @@ static PtrResult settings_for(const PtrSceneHandle *h, const PtrRenderRequest *r
         .transparent = r->transparent,
         .passes = r->passes || r->denoiser, /* the denoiser's guides */
     };
-    if (ptr_render_region(settings).x1 == 0)
-        return ptr_error_set(err, PTR_ERR_USAGE, "region %d,%d,%d,%d lies outside the %dx%d image",
-                             r->region.x0, r->region.y0, r->region.x1, r->region.y1,
-                             settings->width, settings->height);
-    return PTR_OK;
 }
 
-/* Renders into f, the scene's tree ready, with this render's sky and camera
- * in the scene. */
+/* Renders into f at the size chosen, the scene's tree ready, with this
+ * render's sky and camera in the scene; PTR_ERR_USAGE if the region lies
+ * outside the image. */
 static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r, int width,
                              int height, const PtrRenderHooks *hooks, PtrFrame *f, PtrError *err)
 {
-    PtrRenderSettings settings;
-    PtrResult res = settings_for(h, r, width, height, &settings, err);
-    if (res != PTR_OK)
-        return res;
+    const PtrRenderSettings settings = settings_for(h, r, width, height);
     const PtrRegion region = ptr_render_region(&settings);
+    if (region.x1 == 0)
+        return ptr_error_set(err, PTR_ERR_USAGE, "region %d,%d,%d,%d lies outside the %dx%d image",
+                             r->region.x0, r->region.y0, r->region.x1, r->region.y1, width,
+                             height);
     f->layout = (PtrImageLayout){ region.x1 - region.x0, region.y1 - region.y0, region.x0,
                                   region.y0, settings.width, settings.height };
     f->channels = r->transparent ? 4 : 3;
@@ -214,8 +210,8 @@ static PtrResult render_into(PtrSceneHandle *h, const PtrRenderRequest *r, int w
     const PtrAccel *accel = &h->prepared.accel;
     if (hooks->begin)
         hooks->begin(hooks->begin_user, &h->scene, accel, &settings, &passes);
-    res = ptr_render_frame(&h->scene, accel, &settings, &passes, h->name, &f->buffers, &f->done,
-                           err);
+    PtrResult res = ptr_render_frame(&h->scene, accel, &settings, &passes, h->name, &f->buffers,
+                                     &f->done, err);
     if (res != PTR_OK)
         return res;
     f->info = (PtrOutputInfo){
