@@ -19,6 +19,7 @@
 
 #include "accel/accel.h"
 #include "base/cpu.h"
+#include "bench_args.h"
 #include "importer.h"
 #include "render/render.h"
 
@@ -57,10 +58,11 @@ static double render(PtrScene *scene, const Config *c, PtrRenderSettings setting
 
 int main(int argc, char **argv)
 {
-    if (argc != 2 && argc != 5 && argc != 6) {
-        fprintf(stderr, "usage: paths SCENE [WIDTH HEIGHT SPP [RUNS]]\n");
+    PtrRenderSettings settings = { .width = 400, .height = 225, .samples = 20, .seed = 1,
+                                   .max_depth = 50 };
+    int runs = 3;
+    if (!bench_read_args(argc, argv, "paths", &settings, &runs))
         return 2;
-    }
     PtrScene scene;
     PtrStrings warnings = { 0 };
     PtrError err = { 0 };
@@ -70,15 +72,6 @@ int main(int argc, char **argv)
         return 2;
     }
     ptr_strings_free(&warnings);
-    PtrRenderSettings settings = { .width = 400, .height = 225, .samples = 20, .seed = 1,
-                                   .max_depth = 50 };
-    int runs = 3;
-    if (argc >= 5) {
-        settings.width = atoi(argv[2]);
-        settings.height = atoi(argv[3]);
-        settings.samples = (uint32_t)atoi(argv[4]);
-        runs = argc == 6 ? atoi(argv[5]) : runs;
-    }
     size_t floats = (size_t)settings.width * (size_t)settings.height * 3;
     float *first = malloc(floats * sizeof *first), *rgb = malloc(floats * sizeof *rgb);
     double best[CONFIGS][MAX_THREADS + 1] = { { 0 } };

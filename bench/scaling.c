@@ -18,6 +18,7 @@
 
 #include "accel/accel.h"
 #include "base/cpu.h"
+#include "bench_args.h"
 #include "importer.h"
 #include "render/progressive.h"
 
@@ -82,19 +83,11 @@ static double median(double *values, int count)
 
 int main(int argc, char **argv)
 {
-    if (argc != 2 && argc != 5 && argc != 6) {
-        fprintf(stderr, "usage: scaling SCENE [WIDTH HEIGHT SPP [RUNS]]\n");
-        return 2;
-    }
     PtrRenderSettings settings = { .width = 640, .height = 360, .samples = 8, .seed = 1,
                                    .max_depth = 50 };
     int runs = 5;
-    if (argc >= 5) {
-        settings.width = atoi(argv[2]);
-        settings.height = atoi(argv[3]);
-        settings.samples = (uint32_t)atoi(argv[4]);
-        runs = argc == 6 ? atoi(argv[5]) : runs;
-    }
+    if (!bench_read_args(argc, argv, "scaling", &settings, &runs))
+        return 2;
     if (runs < 1 || runs > MAX_RUNS || settings.width < 1 || settings.height < 1 ||
         settings.samples < 1) {
         fprintf(stderr, "scaling: a size, samples and 1 to %d runs\n", MAX_RUNS);
