@@ -11,13 +11,19 @@
  * the last tile of a pass, or between passes: PtrRenderStats.idle_seconds);
  * then the medians, and the speed-ups 1 thread / 2 threads. Every render
  * must give the first one's pixels bit for bit: otherwise it says so and
- * exits 1. */
+ * exits 1.
+ *
+ * First it prints what handing work to a kept thread and back costs (a
+ * ptr_parallel_ranges of a few microseconds' work on 2 threads, as the
+ * build's top levels and the passes hand work over): back to back, and
+ * after the calling thread worked alone for 50 microseconds. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "accel/accel.h"
 #include "base/cpu.h"
+#include "base/threads.h"
 #include "bench_args.h"
 #include "importer.h"
 #include "render/progressive.h"
@@ -69,6 +75,35 @@ static Measure measure(const char *path, PtrRenderSettings settings, float *rgb)
     return m;
 }
 
+static void add_up(void *arg, size_t from, size_t to)
+{
+    size_t sum = 0;
+    for (size_t i = from; i < to; i++)
+        sum += i * i;
+    *(volatile size_t *)arg = sum;
+}
+
+/* Microseconds a handoff takes, less the work alone takes, over count
+ * handoffs each after alone seconds of the calling thread's own work. */
+static double handoff_microseconds(int count, double alone)
+{
+    enum { WORK = 20000 };
+    size_t sink = 0;
+    double start = ptr_now_seconds(), spent_alone = 0.0;
+    for (int i = 0; i < count; i++) {
+        const double from = ptr_now_seconds();
+        while (ptr_now_seconds() - from < alone)
+            ;
+        spent_alone += ptr_now_seconds() - from;
+        ptr_parallel_ranges(2, 0, WORK, add_up, &sink);
+    }
+    const double handed = ptr_now_seconds() - start - spent_alone;
+    start = ptr_now_seconds();
+    for (int i = 0; i < count; i++)
+        add_up(&sink, 0, WORK / 2);
+    return 1e6 * (handed - (ptr_now_seconds() - start)) / count;
+}
+
 static int by_value(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -100,6 +135,9 @@ int main(int argc, char **argv)
     double build[MAX_THREADS + 1][MAX_RUNS], render[MAX_THREADS + 1][MAX_RUNS],
         idle[MAX_THREADS + 1][MAX_RUNS];
     int differ = 0;
+    ptr_threads_keep(MAX_THREADS);
+    printf("handoff to a thread and back: %.1f us back to back, %.1f us after 50 us alone\n\n",
+           handoff_microseconds(2000, 0.0), handoff_microseconds(500, 50e-6));
     printf("run  threads  build s  render s  idle\n");
     for (int run = 0; run < runs; run++)
         for (int threads = 1; threads <= MAX_THREADS; threads++) {
