@@ -6,7 +6,7 @@
  * image library's load (on a thread of its own in `ptr`) does not share the
  * cores with the render.
  *
- *   paths SCENE [WIDTH HEIGHT SPP [RUNS]]      (defaults: the scene's size, 20 spp, 3 runs)
+ *   paths SCENE [WIDTH HEIGHT SPP [RUNS]]      (defaults: 400 225 20, 3 runs)
  *
  * Prints each run's Mrays/s (camera, scattered and shadow rays over render
  * seconds), then per configuration the best run and its ratio to paths one
