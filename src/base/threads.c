@@ -27,10 +27,11 @@ static int kept; /* threads started, waiting or working */
 /* How long a thread that waits for work or for another thread's end
  * watches for it before it sleeps on the condition. A sleeping thread is
  * woken through the kernel, and on a virtual machine whose other vCPU has
- * gone idle through the hypervisor too: 70 to 140 microseconds measured,
- * against well under one while both watch. Work handed over in quick
- * succession (the tree build's top levels, passes) then goes at the
- * memory's pace; a thread that waits longer first spends this long of a core. */
+ * gone idle through the hypervisor too: a handoff and back took 100 to 200
+ * microseconds so, and about 20 while both watch (bench/scaling prints
+ * it). Work handed over in quick succession (the tree build's top levels)
+ * then waits far less; a thread that waits longer first spends this long
+ * of a core. */
 static const double spin_seconds = 200e-6;
 
 static int has_work(const PtrThread *t)
