@@ -90,8 +90,8 @@ void ptr_choose_size(const PtrScene *scene, const PtrCamera *camera, int width, 
                      int divisor, int *out_width, int *out_height)
 {
     float aspect = camera->aspect > 0.0f ? camera->aspect
-                   : scene->width > 0          ? (float)scene->width / (float)scene->height
-                                               : 16.0f / 9.0f;
+                   : scene->width > 0    ? (float)scene->width / (float)scene->height
+                                         : 16.0f / 9.0f;
     int w = width, h = height;
     if (!w && !h && scene->width > 0) {
         w = scene->width;

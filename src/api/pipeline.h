@@ -57,10 +57,11 @@ const char *ptr_sample_range_problem(float noise_threshold, uint64_t first_sampl
  * images, the image module's loader, which must outlive the import. */
 PtrTextureDecoder ptr_texture_decoder(PtrImageLoader *images);
 
-/* The image's width and height: those asked for, else the scene's, filling
- * a missing one from the aspect ratio of camera (the render's, which may be
- * other than the scene's; else the scene's, else 16:9), then divided by
- * divisor (1: none), within 1 .. PTR_MAX_IMAGE_SIZE. */
+/* The image's width and height: those asked for, else the scene's own size
+ * (scene->width, height), filling a missing one from the aspect ratio of
+ * camera (the render's, which may be other than the scene's), else from the
+ * scene's size, else 16:9; then divided by divisor (1: none), within
+ * 1 .. PTR_MAX_IMAGE_SIZE. */
 void ptr_choose_size(const PtrScene *scene, const PtrCamera *camera, int width, int height,
                      int divisor, int *out_width, int *out_height);
 
