@@ -112,7 +112,8 @@ static PtrResult add_task(Build *build, size_t begin, size_t end, int level, uin
 /* Builds the node at this level over c's range into nodes (its index in
  * *index), and its inner children below it; depth: levels below the node. In
  * the top level (top set), split on all threads, inner children of at most
- * task_spheres spheres become tasks. scratch: see bvh_split (tasks have it, the top level not). */
+ * task_spheres spheres become tasks. scratch: see bvh_split (tasks have it,
+ * the top level not). */
 static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
                             const BvhCandidate *range, int top, int level, size_t *index,
                             int *depth, PtrError *err)

@@ -3,35 +3,43 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "base/cpu.h"
 
 typedef void *(*Work)(void *);
 
 /* fn and done are written under the lock, and read without it only by a
- * thread that spins before it sleeps. */
+ * thread that spins before it sleeps; each thread on a cache line of its
+ * own, so that one's spin does not fetch the line another's writes. */
 struct PtrThread {
-    _Atomic(Work) fn; /* the work given, NULL while it waits for some */
+    _Alignas(64) _Atomic(Work) fn; /* the work given, NULL while it waits for some */
     void *arg;
-    atomic_int done;  /* fn has returned; cleared by ptr_thread_join */
-    PtrThread *next;  /* in the list of waiting threads */
+    atomic_int done; /* fn has returned; cleared by ptr_thread_start */
+    PtrThread *next; /* in the list of waiting threads */
 };
 
-/* One lock and one condition for every kept thread: work is handed over a
- * few times a pass, never in a loop that would contend. */
+/* One lock and one condition for every kept thread: work is handed over at
+ * most a few thousand times a second (the tree build's top levels), never
+ * in a loop that would contend. */
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t changed = PTHREAD_COND_INITIALIZER;
 static PtrThread *waiting;
 static int kept; /* threads started, waiting or working */
+/* Whether a thread may spin before it sleeps: only while the kept threads
+ * fit the CPUs (a render's or a build's threads are at most the threads
+ * kept, the caller among them), for a spinning thread would take a core
+ * from one at work otherwise. */
+static atomic_int spin_fits;
 
 /* How long a thread that waits for work or for another thread's end
  * watches for it before it sleeps on the condition. A sleeping thread is
  * woken through the kernel, and on a virtual machine whose other vCPU has
- * gone idle through the hypervisor too: a handoff and back took 100 to 200
- * microseconds so, and about 20 while both watch (bench/scaling prints
- * it). Work handed over in quick succession (the tree build's top levels)
- * then waits far less; a thread that waits longer first spends this long
- * of a core. */
+ * gone idle through the hypervisor too: that made a handoff and back some
+ * five times slower (docs/intersectors.md, "From one thread to two";
+ * bench/scaling prints it). Work handed over in quick succession (the tree
+ * build's top levels) then waits far less; a thread that waits longer
+ * first spends this long of a core. */
 static const double spin_seconds = 200e-6;
 
 static int has_work(const PtrThread *t)
@@ -47,6 +55,8 @@ static int has_ended(const PtrThread *t)
 /* Watches t, without the lock, until it is ready or the spin is over. */
 static void spin_until(int (*ready)(const PtrThread *), const PtrThread *t)
 {
+    if (!atomic_load_explicit(&spin_fits, memory_order_relaxed))
+        return;
     const double until = ptr_now_seconds() + spin_seconds;
     for (int i = 1; !ready(t); i++) {
 #if defined(__x86_64__) || defined(__i386__)
@@ -80,16 +90,18 @@ static void *run(void *self)
 /* A new thread, waiting for work; with the lock held. */
 static PtrThread *spawn_locked(void)
 {
-    PtrThread *t = calloc(1, sizeof *t);
+    PtrThread *t = aligned_alloc(_Alignof(PtrThread), sizeof *t);
     pthread_t id;
     if (!t)
         return NULL;
+    memset(t, 0, sizeof *t);
     if (pthread_create(&id, NULL, run, t)) {
         free(t);
         return NULL;
     }
     pthread_detach(id);
     kept++;
+    atomic_store_explicit(&spin_fits, kept <= ptr_online_cpus(), memory_order_relaxed);
     return t;
 }
 
