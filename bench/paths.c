@@ -13,6 +13,7 @@
  * at a time on one thread, and each configuration's 2-thread over 1-thread
  * speed-up. Every render must give the first one's pixels bit for bit:
  * otherwise it says which differ and exits 1. */
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,7 +62,7 @@ int main(int argc, char **argv)
     PtrRenderSettings settings = { .width = 400, .height = 225, .samples = 20, .seed = 1,
                                    .max_depth = 50 };
     int runs = 3;
-    if (!bench_read_args(argc, argv, "paths", &settings, &runs))
+    if (!bench_read_args(argc, argv, "paths", &settings, &runs, INT_MAX))
         return 2;
     PtrScene scene;
     PtrStrings warnings = { 0 };

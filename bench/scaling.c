@@ -15,8 +15,10 @@
  *
  * First it prints what handing work to a kept thread and back costs (a
  * ptr_parallel_ranges of a few microseconds' work on 2 threads, as the
- * build's top levels and the passes hand work over): back to back, and
- * after the calling thread worked alone for 50 microseconds. */
+ * build's top levels hand work over): back to back, after the calling
+ * thread worked alone for 50 microseconds (the kept thread still watches
+ * for work), and after 1 millisecond (it has gone to sleep). */
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -80,15 +82,17 @@ static void add_up(void *arg, size_t from, size_t to)
     size_t sum = 0;
     for (size_t i = from; i < to; i++)
         sum += i * i;
-    *(volatile size_t *)arg = sum;
+    atomic_store_explicit((atomic_size_t *)arg, sum, memory_order_relaxed); /* the sum used */
 }
 
-/* Microseconds a handoff takes, less the work alone takes, over count
+/* Microseconds a handoff and back takes (the time of the parallel call
+ * less the half of the work the calling thread does itself), over count
  * handoffs each after alone seconds of the calling thread's own work. */
 static double handoff_microseconds(int count, double alone)
 {
     enum { WORK = 20000 };
-    size_t sink = 0;
+    atomic_size_t sink;
+    atomic_init(&sink, 0);
     double start = ptr_now_seconds(), spent_alone = 0.0;
     for (int i = 0; i < count; i++) {
         const double from = ptr_now_seconds();
@@ -121,13 +125,8 @@ int main(int argc, char **argv)
     PtrRenderSettings settings = { .width = 640, .height = 360, .samples = 8, .seed = 1,
                                    .max_depth = 50 };
     int runs = 5;
-    if (!bench_read_args(argc, argv, "scaling", &settings, &runs))
+    if (!bench_read_args(argc, argv, "scaling", &settings, &runs, MAX_RUNS))
         return 2;
-    if (runs < 1 || runs > MAX_RUNS || settings.width < 1 || settings.height < 1 ||
-        settings.samples < 1) {
-        fprintf(stderr, "scaling: a size, samples and 1 to %d runs\n", MAX_RUNS);
-        return 2;
-    }
     const size_t floats = (size_t)settings.width * (size_t)settings.height * 3;
     float *first = malloc(floats * sizeof *first), *rgb = malloc(floats * sizeof *rgb);
     if (!first || !rgb)
@@ -136,8 +135,10 @@ int main(int argc, char **argv)
         idle[MAX_THREADS + 1][MAX_RUNS];
     int differ = 0;
     ptr_threads_keep(MAX_THREADS);
-    printf("handoff to a thread and back: %.1f us back to back, %.1f us after 50 us alone\n\n",
-           handoff_microseconds(2000, 0.0), handoff_microseconds(500, 50e-6));
+    printf("handoff to a thread and back: %.1f us back to back, %.1f us after 50 us alone, "
+           "%.1f us after 1 ms alone\n\n",
+           handoff_microseconds(2000, 0.0), handoff_microseconds(500, 50e-6),
+           handoff_microseconds(200, 1e-3));
     printf("run  threads  build s  render s  idle\n");
     for (int run = 0; run < runs; run++)
         for (int threads = 1; threads <= MAX_THREADS; threads++) {
