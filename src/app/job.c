@@ -86,7 +86,7 @@ static PtrResult render_and_write(const PtrOptions *o, PtrSceneHandle *scene,
         .user = &printer, .begin = live_begin, .begin_user = &live,
     };
     PtrFrame *frame = NULL;
-    PtrError problem;
+    PtrError problem = { 0 };
     /* The image's size is reported even when its region lies outside it. */
     PtrResult res = ptr_api_render(scene, &request, &hooks, &report->width, &report->height,
                                    &frame, &problem);
