@@ -14,6 +14,8 @@
 
 #include "base/cpu.h"
 #include "base/threads.h"
+#include "mesh_fit.h"
+#include "mesh_runs.h"
 
 enum {
     UNSET = UINT32_MAX,
@@ -645,60 +647,18 @@ static void bound_vertices(void *arg, size_t from, size_t to)
         merge_bounds(ps, run.component, run.lo, run.hi);
 }
 
-/* The checks below compare distances, a square root each; most distances
- * are far from the checks' limits, and their squares show it without the
- * root. sure[0] .. sure[1]: a vertex's squared distance from the centre
- * that passes the vertex check for certain; sure[2] and above: three times
- * a centroid's from three times the centre that passes the centroid check.
- * Each band is narrower than its check by a billionth of the distances
- * compared, far more than the roundings of either test, so a distance the
- * band passes is one the check passes: anything else (NaN too) is checked
- * as before, and the result is the same. Radii so small or large that their
- * squares would underflow or overflow get empty bands (NaN: no distance
- * passes). */
-static void sure_bands(double radius, double slack, double sure[3])
-{
-    const double within = PTR_SPHERE_VERTEX_TOLERANCE * radius + slack;
-    const double margin = 1e-9 * (radius + within);
-    const double near = fmax(radius - within + margin, 0.0), far = radius + within - margin;
-    const double deep = fmax(3 * PTR_SPHERE_CENTROID_DEPTH * radius - 3 * slack + 3 * margin, 0.0);
-    const int sane = radius + within > 1e-100 && radius + within < 1e100;
-    sure[0] = sane ? near * near : NAN;
-    sure[1] = sane ? far * far : NAN;
-    sure[2] = sane ? deep * deep : NAN;
-}
-
 /* The fit of components from .. to - 1 to their bounds. */
 static void fit(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t c = from; c < to; c++) {
-        double extent = 0.0, smallest = HUGE_VAL;
+        double lo[3], hi[3];
         for (int k = 0; k < 3; k++) {
-            const double lo = atomic_load_explicit(&ps->bounds[6 * c + k], memory_order_relaxed);
-            const double hi =
-                atomic_load_explicit(&ps->bounds[6 * c + 3 + k], memory_order_relaxed);
-            ps->spheres[c].centre[k] = 0.5 * (lo + hi);
-            extent = fmax(extent, hi - lo);
-            smallest = fmin(smallest, hi - lo);
+            lo[k] = atomic_load_explicit(&ps->bounds[6 * c + k], memory_order_relaxed);
+            hi[k] = atomic_load_explicit(&ps->bounds[6 * c + 3 + k], memory_order_relaxed);
         }
-        ps->spheres[c].radius = 0.5 * extent;
-        ps->spheres[c].is_sphere =
-            extent > 0.0 && isfinite(extent) &&
-            smallest + 2 * ps->mesh->quantum >= PTR_SPHERE_EXTENT_RATIO * extent;
-        sure_bands(ps->spheres[c].radius, 2 * ps->mesh->quantum, ps->sure[c]);
+        mesh_fit(lo, hi, ps->mesh->quantum, &ps->spheres[c], ps->sure[c]);
     }
-}
-
-static double squared_distance(const double a[3], const double b[3])
-{
-    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-           (a[2] - b[2]) * (a[2] - b[2]);
-}
-
-static double distance(const double a[3], const double b[3])
-{
-    return sqrt(squared_distance(a, b));
 }
 
 static void mark_off(const Passes *ps, uint32_t c)
@@ -709,14 +669,7 @@ static void mark_off(const Passes *ps, uint32_t c)
 /* Marks vertex p's component c (if any) if p lies off its sphere. */
 static void check_vertex(const Passes *ps, uint32_t c, const double p[3])
 {
-    if (c == UNSET)
-        return;
-    const PtrMeshSphere *s = &ps->spheres[c];
-    const double d2 = squared_distance(p, s->centre);
-    if (d2 >= ps->sure[c][0] && d2 <= ps->sure[c][1])
-        return;
-    if (!(fabs(distance(p, s->centre) - s->radius) <=
-          PTR_SPHERE_VERTEX_TOLERANCE * s->radius + 2 * ps->mesh->quantum))
+    if (c != UNSET && mesh_vertex_off(&ps->spheres[c], ps->sure[c], ps->mesh->quantum, p))
         mark_off(ps, c);
 }
 
@@ -754,9 +707,8 @@ static uint32_t read_corners(const PtrMeshSource *mesh, uint32_t (*tri)[3], size
 static void check_triangles(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
-    const double slack = 2 * ps->mesh->quantum;
     uint32_t tri[BLOCK][3], last = UNSET;
-    double corner[3 * BLOCK][3], centre[3] = { 0, 0, 0 }, deep = 0.0; /* last's, times 3 */
+    double corner[3 * BLOCK][3], centre3[3] = { 0, 0, 0 }; /* last's centre, times 3 */
     for (size_t t = from; t < to; t += BLOCK) {
         const size_t count = to - t < BLOCK ? to - t : BLOCK;
         ps->mesh->triangles(ps->mesh->user, t, count, tri);
@@ -776,17 +728,13 @@ static void check_triangles(void *arg, size_t from, size_t to)
                                            memory_order_relaxed))
                     ;
                 for (int k = 0; k < 3; k++)
-                    centre[k] = 3 * ps->spheres[c].centre[k];
-                deep = 3 * PTR_SPHERE_CENTROID_DEPTH * ps->spheres[c].radius;
+                    centre3[k] = 3 * ps->spheres[c].centre[k];
             }
-            double sum[3] = { 0, 0, 0 };
-            for (int j = 0; j < 3; j++) {
-                const double *p = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
-                for (int k = 0; k < 3; k++)
-                    sum[k] += p[k];
-            }
-            if (!(squared_distance(sum, centre) >= ps->sure[c][2]) &&
-                !(distance(sum, centre) + 3 * slack >= deep))
+            const double *p[3];
+            for (int j = 0; j < 3; j++)
+                p[j] = corner[first == UNSET ? 3 * i + j : tri[i][j] - first];
+            if (mesh_centroid_off(&ps->spheres[c], centre3, ps->sure[c], ps->mesh->quantum, p[0],
+                                  p[1], p[2]))
                 mark_off(ps, c);
         }
     }
@@ -859,11 +807,11 @@ static int fit_components(Passes *ps, size_t *count)
     return !ps->vertex_spheres || sort_labels(ps, components);
 }
 
-PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
-                           size_t *count, uint32_t **vertex_spheres, PtrError *err)
+static PtrResult by_union(const PtrMeshSource *mesh, int threads, const char *path,
+                          PtrMeshSphere **out, size_t *count, uint32_t **vertex_spheres,
+                          PtrError *err)
 {
     const size_t n = mesh->vertex_count ? mesh->vertex_count : 1;
-    const int threads = threads_for(mesh);
     PositionMatch pm;
     plan_partitions(&pm, mesh, threads);
     /* The balances, the positions' keys, then the labels: one allocation,
@@ -904,4 +852,23 @@ PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshS
     *out = ps.spheres;
     *count = components;
     return PTR_OK;
+}
+
+PtrResult ptr_mesh_spheres_by_union(const PtrMeshSource *mesh, const char *path,
+                                    PtrMeshSphere **out, size_t *count,
+                                    uint32_t **vertex_spheres, PtrError *err)
+{
+    return by_union(mesh, threads_for(mesh), path, out, count, vertex_spheres, err);
+}
+
+PtrResult ptr_mesh_spheres(const PtrMeshSource *mesh, const char *path, PtrMeshSphere **out,
+                           size_t *count, uint32_t **vertex_spheres, PtrError *err)
+{
+    const int threads = threads_for(mesh);
+    int found = 0;
+    const PtrResult res =
+        ptr_mesh_spheres_by_runs(mesh, threads, path, out, count, vertex_spheres, &found, err);
+    if (res != PTR_OK || found)
+        return res;
+    return by_union(mesh, threads, path, out, count, vertex_spheres, err);
 }

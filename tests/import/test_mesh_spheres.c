@@ -2,9 +2,11 @@
  * same whatever the number of CPUs online, even where it changes while they
  * are found (CPUs taken on or off line): ptr_online_cpus is replaced here
  * (the test links with --wrap) by a script of answers. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mesh_runs.h"
 #include "mesh_spheres.h"
 #include "test.h"
 
@@ -160,11 +162,246 @@ static void test_least_closed(void)
     }
 }
 
+/* A joined mesh as the tools write one: welded UV spheres of several sizes,
+ * each's triangles in a shuffled order, with closed parts that are not
+ * spheres (cubes), vertices no triangle uses between parts, and pairs of
+ * spheres whose vertices interleave (two components in one run of
+ * vertices). Grown a part at a time. */
+typedef struct Joined {
+    Mesh m;
+    size_t nv, nt, vertex_room, triangle_room;
+    size_t components, spheres; /* expected: all, and those that are spheres */
+    uint32_t seed;
+} Joined;
+
+static uint32_t next_random(Joined *j)
+{
+    j->seed = j->seed * 1664525u + 1013904223u;
+    return j->seed >> 8;
+}
+
+static void room_for(Joined *j, size_t vertices, size_t triangles)
+{
+    if (j->nv + vertices > j->vertex_room) {
+        j->vertex_room = 2 * (j->nv + vertices);
+        j->m.v = realloc(j->m.v, j->vertex_room * sizeof *j->m.v);
+    }
+    if (j->nt + triangles > j->triangle_room) {
+        j->triangle_room = 2 * (j->nt + triangles);
+        j->m.t = realloc(j->m.t, j->triangle_room * sizeof *j->m.t);
+    }
+}
+
+/* Triangles first .. first + count - 1 in a shuffled order. */
+static void shuffle_triangles(Joined *j, size_t first, size_t count)
+{
+    for (size_t i = count; i > 1; i--) {
+        const size_t k = next_random(j) % i;
+        uint32_t held[3];
+        memcpy(held, j->m.t[first + i - 1], sizeof held);
+        memcpy(j->m.t[first + i - 1], j->m.t[first + k], sizeof held);
+        memcpy(j->m.t[first + k], held, sizeof held);
+    }
+}
+
+/* A UV sphere's vertices at first + stride * i (poles, then rings) and its
+ * triangles, shuffled. */
+static void add_uv_sphere(Joined *j, size_t first, size_t stride, int segments, int rings)
+{
+    const size_t nv = 2 + (size_t)(rings - 1) * segments, nt = 2 * (size_t)segments * (rings - 1);
+    const double centre[3] = { next_random(j) % 1000 * 0.1, next_random(j) % 1000 * 0.1,
+                               next_random(j) % 1000 * 0.1 };
+    const double radius = 0.5 + next_random(j) % 100 * 0.01, pi = acos(-1.0);
+    room_for(j, first + stride * nv - j->nv, nt);
+    for (size_t i = 0; i < nv; i++) {
+        const int ring = i == 0 ? 0 : i == 1 ? rings : 1 + (int)((i - 2) / segments);
+        const int segment = i < 2 ? 0 : (int)((i - 2) % segments);
+        const double theta = pi * ring / rings, phi = 2 * pi * segment / segments;
+        double *v = j->m.v[first + stride * i];
+        v[0] = centre[0] + radius * sin(theta) * cos(phi);
+        v[1] = centre[1] + radius * cos(theta);
+        v[2] = centre[2] + radius * sin(theta) * sin(phi);
+    }
+    const size_t t0 = j->nt;
+#define AT(ring, s) ((uint32_t)(first + stride * (2 + (size_t)((ring) - 1) * segments + \
+                                                  (size_t)((s) % segments))))
+    for (int s = 0; s < segments; s++) {
+        uint32_t *top = j->m.t[j->nt++], *bottom = j->m.t[j->nt++];
+        top[0] = (uint32_t)first, top[1] = AT(1, s + 1), top[2] = AT(1, s);
+        bottom[0] = (uint32_t)(first + stride), bottom[1] = AT(rings - 1, s);
+        bottom[2] = AT(rings - 1, s + 1);
+        for (int ring = 1; ring < rings - 1; ring++) {
+            uint32_t *a = j->m.t[j->nt++], *b = j->m.t[j->nt++];
+            a[0] = AT(ring, s), a[1] = AT(ring, s + 1), a[2] = AT(ring + 1, s);
+            b[0] = AT(ring + 1, s), b[1] = AT(ring, s + 1), b[2] = AT(ring + 1, s + 1);
+        }
+    }
+#undef AT
+    shuffle_triangles(j, t0, nt);
+}
+
+static void add_cube(Joined *j)
+{
+    static const uint32_t face[12][3] = { { 0, 2, 1 }, { 1, 2, 3 }, { 4, 5, 6 }, { 5, 7, 6 },
+                                          { 0, 1, 4 }, { 1, 5, 4 }, { 2, 6, 3 }, { 3, 6, 7 },
+                                          { 0, 4, 2 }, { 2, 4, 6 }, { 1, 3, 5 }, { 3, 7, 5 } };
+    room_for(j, 8, 12);
+    const size_t first = j->nv;
+    for (int c = 0; c < 8; c++)
+        for (int k = 0; k < 3; k++)
+            j->m.v[first + c][k] = 40.0 + (c >> k & 1);
+    for (int f = 0; f < 12; f++)
+        for (int k = 0; k < 3; k++)
+            j->m.t[j->nt + f][k] = (uint32_t)first + face[f][k];
+    shuffle_triangles(j, j->nt, 12);
+    j->nv += 8, j->nt += 12;
+}
+
+static void make_joined(Joined *j, int parts)
+{
+    *j = (Joined){ .seed = 7 };
+    for (int p = 0; p < parts; p++) {
+        const int segments = 8 + (int)(next_random(j) % 9), rings = 6 + (int)(next_random(j) % 5);
+        const size_t nv = 2 + (size_t)(rings - 1) * segments;
+        if (p % 17 == 5) {
+            add_cube(j);
+            j->components++;
+            continue;
+        }
+        if (p % 29 == 11) { /* two spheres over every other vertex */
+            add_uv_sphere(j, j->nv, 2, segments, rings);
+            add_uv_sphere(j, j->nv + 1, 2, segments, rings);
+            j->nv += 2 * nv;
+            j->components += 2, j->spheres += 2;
+            continue;
+        }
+        add_uv_sphere(j, j->nv, 1, segments, rings);
+        j->nv += nv;
+        j->components++, j->spheres++;
+        if (p % 23 == 3) { /* a vertex no triangle uses */
+            room_for(j, 1, 0);
+            j->m.v[j->nv][0] = j->m.v[j->nv][1] = j->m.v[j->nv][2] = -5.0;
+            j->nv++;
+        }
+    }
+}
+
+static PtrMeshSource joined_source(Joined *j)
+{
+    return (PtrMeshSource){ .vertex_count = j->nv, .triangle_count = j->nt,
+                            .positions = positions, .gather = gather,
+                            .triangles = triangles, .user = &j->m };
+}
+
+/* Two results the same: spheres field by field, labels word by word. */
+static void check_same(const PtrMeshSphere *a, const uint32_t *a_labels, size_t a_count,
+                       const PtrMeshSphere *b, const uint32_t *b_labels, size_t b_count,
+                       size_t vertices)
+{
+    CHECK_INT(a_count, b_count);
+    if (a_count != b_count)
+        return;
+    size_t differ = 0;
+    for (size_t c = 0; c < a_count; c++)
+        differ += !same_sphere(&a[c], &b[c]);
+    CHECK_INT(differ, 0);
+    CHECK(!memcmp(a_labels, b_labels, vertices * sizeof *a_labels));
+}
+
+/* Found run by run, on any number of threads (so with runs cut by the
+ * slices' bounds anywhere, pieces of one run across several slices at 256),
+ * a joined mesh's components are the union's to the bit. */
+static void test_runs_match_union(void)
+{
+    Joined j;
+    make_joined(&j, 60);
+    const PtrMeshSource mesh = joined_source(&j);
+    static const int one[] = { 1 };
+    script = one, script_length = 1, asked = 0;
+    PtrMeshSphere *expected = NULL;
+    uint32_t *expected_labels = NULL;
+    size_t expected_count = 0;
+    CHECK_INT(ptr_mesh_spheres_by_union(&mesh, "joined", &expected, &expected_count,
+                                        &expected_labels, NULL),
+              PTR_OK);
+    CHECK_INT(expected_count, j.components);
+    size_t spheres = 0;
+    for (size_t c = 0; c < expected_count; c++)
+        spheres += expected[c].is_sphere != 0;
+    CHECK_INT(spheres, j.spheres);
+    static const int threads[] = { 1, 2, 3, 5, 8, 13, 64, 256 };
+    for (size_t i = 0; i < sizeof threads / sizeof *threads; i++) {
+        PtrMeshSphere *found = NULL;
+        uint32_t *labels = NULL;
+        size_t count = 0;
+        int by_runs = 0;
+        CHECK_INT(ptr_mesh_spheres_by_runs(&mesh, threads[i], "joined", &found, &count, &labels,
+                                           &by_runs, NULL),
+                  PTR_OK);
+        CHECK_INT(by_runs, 1);
+        if (by_runs)
+            check_same(found, labels, count, expected, expected_labels, expected_count, j.nv);
+        free(found);
+        free(labels);
+    }
+    free(expected);
+    free(expected_labels);
+    free(j.m.v);
+    free(j.m.t);
+}
+
+/* Where a mesh is not in runs of closed surfaces, the runs give way, and
+ * ptr_mesh_spheres finds what the union finds: a last triangle reaching
+ * back into the first sphere (on one thread, and where the slices put it
+ * apart from that sphere), the octahedra of test_online_cpus (half of them
+ * open), and a run larger than a run may be. */
+static void test_runs_give_way(void)
+{
+    Joined back;
+    make_joined(&back, 30);
+    room_for(&back, 0, 1);
+    memcpy(back.m.t[back.nt++], back.m.t[0], sizeof *back.m.t);
+    Mesh octahedra;
+    const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra) };
+    static const int one[] = { 1 };
+    for (size_t m = 0; m < sizeof meshes / sizeof *meshes; m++)
+        for (int threads = 1; threads <= 4; threads *= 2) {
+            script = one, script_length = 1, asked = 0;
+            PtrMeshSphere *found = NULL;
+            size_t count = 0;
+            int by_runs = 1;
+            CHECK_INT(ptr_mesh_spheres_by_runs(&meshes[m], threads, "mesh", &found, &count, NULL,
+                                               &by_runs, NULL),
+                      PTR_OK);
+            CHECK_INT(by_runs, 0);
+            PtrMeshSphere *expected = NULL;
+            uint32_t *labels = NULL, *expected_labels = NULL;
+            size_t expected_count = 0;
+            CHECK_INT(ptr_mesh_spheres(&meshes[m], "mesh", &found, &count, &labels, NULL),
+                      PTR_OK);
+            CHECK_INT(ptr_mesh_spheres_by_union(&meshes[m], "mesh", &expected, &expected_count,
+                                                &expected_labels, NULL),
+                      PTR_OK);
+            check_same(found, labels, count, expected, expected_labels, expected_count,
+                       meshes[m].vertex_count);
+            free(found);
+            free(labels);
+            free(expected);
+            free(expected_labels);
+        }
+    free(back.m.v);
+    free(back.m.t);
+    free(octahedra.v);
+    free(octahedra.t);
+}
+
 int main(void)
 {
     const TestCase cases[] = {
         TEST_CASE(test_online_cpus),
         TEST_CASE(test_least_closed),
+        TEST_CASE(test_runs_match_union),
+        TEST_CASE(test_runs_give_way),
     };
     TEST_RUN(cases);
     return test_report();
