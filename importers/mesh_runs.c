@@ -55,6 +55,13 @@ typedef struct Fit {
     int off;
 } Fit;
 
+/* BLOCK triangles from t on (fewer at the mesh's end), each's least vertex
+ * and greatest plus 1; past the mesh's end, none (its least UINT32_MAX). */
+typedef struct Block {
+    uint32_t tri[BLOCK][3], lo[BLOCK], hi1[BLOCK];
+    size_t count;
+} Block;
+
 /* A thread's: the arrays of the run it finds, grown to the largest run
  * (indexed by a vertex's place in its run), and what its slice found. */
 typedef struct Work {
@@ -67,6 +74,7 @@ typedef struct Work {
     size_t vertex_room;
     Fit *fit;
     size_t fit_room;
+    Block *blocks; /* 3, while the slice is scanned */
     Run *runs;
     size_t run_count, run_room;
     PtrMeshSphere *spheres;
@@ -81,7 +89,7 @@ typedef struct Runs {
      * run's first sphere in the result. */
     Run *all;
     size_t *slice_of, *base;
-    size_t all_count;
+    size_t all_count, sphere_count;
     PtrMeshSphere *out;
     uint32_t *vertex_spheres; /* or NULL */
     atomic_int not_runs, no_memory;
@@ -116,11 +124,11 @@ static int grow(void **items, size_t *room, size_t need, size_t size)
     return 1;
 }
 
-/* w's arrays of a run's vertices and components, for nv vertices. */
+/* w's arrays of a run's vertices and components, for nv vertices (a
+ * closed surface has 3 vertices or more). */
 static int grow_vertices(Work *w, size_t nv)
 {
-    if (!grow((void **)&w->fit, &w->fit_room, nv / 3 + 1, sizeof *w->fit)) /* a closed
-                                                  * surface has 3 vertices or more */
+    if (!grow((void **)&w->fit, &w->fit_room, nv / 3 + 1, sizeof *w->fit))
         return 0;
     if (nv <= w->vertex_room)
         return 1;
@@ -169,7 +177,7 @@ static uint32_t join(uint32_t *parent, uint32_t a, uint32_t b)
  * triangles, each checked to be closed: how many, or 0 where one is not
  * closed. A run's sets started as its nv vertices and joined made them
  * fewer. */
-static size_t number_components(const Work *w, const Run *run, uint32_t joined,
+static size_t number_components(Work *w, const Run *run, uint32_t joined,
                                 PtrMeshSphere *spheres)
 {
     const uint32_t nv = run->high - run->low + 1;
@@ -277,7 +285,8 @@ static int find_run(const Runs *r, Work *w, Run *run)
 static int end_run(Runs *r, size_t s, Run *run)
 {
     Work *w = &r->work[s];
-    int found = w->run_count && run->low <= w->runs[w->run_count - 1].high ? 0 : find_run(r, w, run);
+    const int reaches_back = w->run_count && run->low <= w->runs[w->run_count - 1].high;
+    int found = reaches_back ? 0 : find_run(r, w, run);
     if (found > 0 && !grow((void **)&w->runs, &w->run_room, w->run_count + 1, sizeof *w->runs))
         found = -1;
     if (found <= 0) {
@@ -307,13 +316,7 @@ static int add_triangles(Runs *r, size_t s, Run *run, const uint32_t (*tri)[3], 
     return 1;
 }
 
-/* BLOCK triangles from t on (fewer at the mesh's end), each's least vertex
- * and greatest plus 1; past the mesh's end, none (its least UINT32_MAX). */
-typedef struct Block {
-    uint32_t tri[BLOCK][3], lo[BLOCK], hi1[BLOCK];
-    size_t count;
-} Block;
-
+/* The block of triangles from t on into b. */
 static void read_block(const PtrMeshSource *mesh, size_t t, Block *b)
 {
     b->count = t < mesh->triangle_count ? mesh->triangle_count - t : 0;
@@ -333,7 +336,7 @@ static void read_block(const PtrMeshSource *mesh, size_t t, Block *b)
 /* Where runs may start among block cur's triangles: a run can start at
  * triangle t where the BLOCK triangles before t use no vertex that the
  * BLOCK triangles from t on use, every vertex before below every vertex
- * after (mesh_runs.h: the runs' ranges rise). That is decided from those
+ * after (the runs' ranges rise). That is decided from those
  * triangles alone, the same in every slice; a sphere of fewer triangles
  * (whatever their order) is never cut, and a later triangle that reaches
  * back into an ended run leaves the mesh to the union. */
@@ -365,7 +368,11 @@ static void scan_slice(Runs *r, size_t s)
     const size_t from = n * s / r->slices, to = n * (s + 1) / r->slices;
     if (from == to)
         return;
-    Block blocks[3];
+    Block *blocks = r->work[s].blocks = malloc(3 * sizeof *blocks);
+    if (!blocks) {
+        give_up(r, -1);
+        return;
+    }
     unsigned char start[BLOCK];
     Block *prev = &blocks[0], *cur = &blocks[1], *next = &blocks[2];
     read_block(r->mesh, from >= BLOCK ? from - BLOCK : 0, prev);
@@ -425,15 +432,15 @@ static int join_slices(Runs *r)
     r->base = malloc((total ? total : 1) * sizeof *r->base);
     if (!r->all || !r->slice_of || !r->base)
         return -1;
-    size_t k = 0, spheres = 0;
+    size_t k = 0;
     for (size_t s = 0; s < r->slices; s++)
         for (size_t i = 0; i < r->work[s].run_count; i++, k++) {
             r->all[k] = r->work[s].runs[i];
             if (k && r->all[k - 1].high >= r->all[k].low)
                 return 0;
             r->slice_of[k] = s;
-            r->base[k] = spheres;
-            spheres += r->all[k].count;
+            r->base[k] = r->sphere_count;
+            r->sphere_count += r->all[k].count;
         }
     r->all_count = k;
     return 1;
@@ -471,19 +478,18 @@ static void free_work(Work *w)
     free(w->component);
     free(w->balance);
     free(w->fit);
+    free(w->blocks);
     free(w->runs);
     free(w->spheres);
 }
 
 /* The runs' spheres in order into r->out: 1, or -1 for memory. */
-static int place(Runs *r, int threads, size_t *count)
+static int place(Runs *r, int threads)
 {
-    const size_t total = r->all_count ? r->base[r->all_count - 1] + r->all[r->all_count - 1].count : 0;
-    r->out = malloc((total ? total : 1) * sizeof *r->out);
+    r->out = malloc((r->sphere_count ? r->sphere_count : 1) * sizeof *r->out);
     if (!r->out)
         return -1;
     ptr_parallel_ranges(threads, 0, r->all_count, place_runs, r);
-    *count = total;
     return 1;
 }
 
@@ -510,7 +516,7 @@ PtrResult ptr_mesh_spheres_by_runs(const PtrMeshSource *mesh, int threads, const
     if (outcome > 0)
         outcome = join_slices(&r);
     if (outcome > 0)
-        outcome = place(&r, threads, count);
+        outcome = place(&r, threads);
     for (size_t s = 0; r.work && s < r.slices; s++)
         free_work(&r.work[s]);
     free(r.work);
@@ -524,6 +530,7 @@ PtrResult ptr_mesh_spheres_by_runs(const PtrMeshSource *mesh, int threads, const
                            : PTR_OK;
     }
     *out = r.out;
+    *count = r.sphere_count;
     if (vertex_spheres)
         *vertex_spheres = r.vertex_spheres;
     *found = 1;
