@@ -362,7 +362,11 @@ static void test_runs_give_way(void)
     room_for(&back, 0, 1);
     memcpy(back.m.t[back.nt++], back.m.t[0], sizeof *back.m.t);
     Mesh octahedra;
-    const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra) };
+    Joined large = { .seed = 11 };
+    add_uv_sphere(&large, 0, 1, 300, 220); /* 65,702 vertices */
+    large.nv = 2 + 219 * 300;
+    const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra),
+                                     joined_source(&large) };
     static const int one[] = { 1 };
     for (size_t m = 0; m < sizeof meshes / sizeof *meshes; m++)
         for (int threads = 1; threads <= 4; threads *= 2) {
@@ -393,6 +397,8 @@ static void test_runs_give_way(void)
     free(back.m.t);
     free(octahedra.v);
     free(octahedra.t);
+    free(large.m.v);
+    free(large.m.t);
 }
 
 int main(void)
