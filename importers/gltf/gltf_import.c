@@ -333,7 +333,7 @@ PtrResult ptr_import_gltf(const char *path, const PtrImportOptions *options,
         check_far_plane(&im);
     if (res == PTR_OK && im.skipped)
         ptr_warn(warnings, "%s: %zu mesh part%s not drawn: %s not a sphere (docs/scenes.md, "
-                 "\"Spheres\"): %s%s", path, im.skipped, im.skipped == 1 ? "" : "s",
+                 "\"What becomes a sphere\"): %s%s", path, im.skipped, im.skipped == 1 ? "" : "s",
                  im.skipped == 1 ? "it is" : "they are", im.skipped_names,
                  im.skipped_more ? ", ..." : "");
     if (res == PTR_OK && im.varying)

@@ -15,7 +15,7 @@
 #include "gltf_textures.h"
 #include "importer_internal.h"
 
-/* A mesh's surface spheres (docs/scenes.md "Spheres"), found once however
+/* A mesh's surface spheres (docs/scenes.md, "What becomes a sphere"), found once however
  * many nodes use the mesh, and once for meshes of the same surface. */
 typedef struct SurfaceSpheres {
     int found;

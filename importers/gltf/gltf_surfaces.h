@@ -1,4 +1,4 @@
-/* The spheres of a mesh's surface (docs/scenes.md, "Spheres"): one a
+/* The spheres of a mesh's surface (docs/scenes.md, "What becomes a sphere"): one a
  * connected component, found once for meshes of the same surface. */
 #ifndef PTR_GLTF_SURFACES_H
 #define PTR_GLTF_SURFACES_H

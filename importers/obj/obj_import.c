@@ -672,7 +672,7 @@ static PtrResult build(Reader *r, const PtrImportOptions *options, PtrScene *sce
     free(local_of);
     if (res == PTR_OK && skipped)
         ptr_warn(r->warnings, "%s: %zu mesh part%s not drawn: %s not a sphere (docs/scenes.md, "
-                 "\"Spheres\"): %s%s", r->path, skipped, skipped == 1 ? "" : "s",
+                 "\"What becomes a sphere\"): %s%s", r->path, skipped, skipped == 1 ? "" : "s",
                  skipped == 1 ? "it is" : "they are", names, more ? ", ..." : "");
     if (res == PTR_OK && fitted == 0 && r->nv == 0)
         res = ptr_error_set(r->err, PTR_ERR_SCENE_INVALID, "%s: no vertices: not an OBJ file?",

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A mesh gives one sphere per connected component that is a sphere
-(docs/scenes.md, "Spheres"), and what is not one is skipped with one warning
+(docs/scenes.md, "What becomes a sphere"), and what is not one is skipped with one warning
 that counts and names it, never drawn as its bounding sphere.
 
 Files from tests/support/mesh_files.py, each imported with --dump-scene:

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """glTF files of triangle meshes for the sphere rule of docs/scenes.md
-("Spheres"): joined spheres, unwelded ones, quantised ones, and shapes that
+("What becomes a sphere"): joined spheres, unwelded ones, quantised ones, and shapes that
 are not spheres (cube, torus, plane, cylinder), each mesh a list of
 primitives of (positions, triangles, material).
 
