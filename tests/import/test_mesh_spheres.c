@@ -293,19 +293,30 @@ static PtrMeshSource joined_source(Joined *j)
                             .triangles = triangles, .user = &j->m };
 }
 
-/* Two results the same: spheres field by field, labels word by word. */
-static void check_same(const PtrMeshSphere *a, const uint32_t *a_labels, size_t a_count,
-                       const PtrMeshSphere *b, const uint32_t *b_labels, size_t b_count,
-                       size_t vertices)
+/* What a way of finding a mesh's components handed back. */
+typedef struct Found {
+    PtrMeshSphere *spheres;
+    uint32_t *labels;
+    size_t count;
+} Found;
+
+static void free_found(Found *f)
 {
-    CHECK_INT(a_count, b_count);
-    if (a_count != b_count)
+    free(f->spheres);
+    free(f->labels);
+}
+
+/* Two results the same: spheres field by field, labels word by word. */
+static void check_same(const Found *a, const Found *b, size_t vertices)
+{
+    CHECK_INT(a->count, b->count);
+    if (a->count != b->count)
         return;
     size_t differ = 0;
-    for (size_t c = 0; c < a_count; c++)
-        differ += !same_sphere(&a[c], &b[c]);
+    for (size_t c = 0; c < a->count; c++)
+        differ += !same_sphere(&a->spheres[c], &b->spheres[c]);
     CHECK_INT(differ, 0);
-    CHECK(!memcmp(a_labels, b_labels, vertices * sizeof *a_labels));
+    CHECK(!memcmp(a->labels, b->labels, vertices * sizeof *a->labels));
 }
 
 /* Found run by run, on any number of threads (so with runs cut by the
@@ -318,34 +329,28 @@ static void test_runs_match_union(void)
     const PtrMeshSource mesh = joined_source(&j);
     static const int one[] = { 1 };
     script = one, script_length = 1, asked = 0;
-    PtrMeshSphere *expected = NULL;
-    uint32_t *expected_labels = NULL;
-    size_t expected_count = 0;
-    CHECK_INT(ptr_mesh_spheres_by_union(&mesh, "joined", &expected, &expected_count,
-                                        &expected_labels, NULL),
+    Found expected = { 0 };
+    CHECK_INT(ptr_mesh_spheres_by_union(&mesh, "joined", &expected.spheres, &expected.count,
+                                        &expected.labels, NULL),
               PTR_OK);
-    CHECK_INT(expected_count, j.components);
+    CHECK_INT(expected.count, j.components);
     size_t spheres = 0;
-    for (size_t c = 0; c < expected_count; c++)
-        spheres += expected[c].is_sphere != 0;
+    for (size_t c = 0; c < expected.count; c++)
+        spheres += expected.spheres[c].is_sphere != 0;
     CHECK_INT(spheres, j.spheres);
     static const int threads[] = { 1, 2, 3, 5, 8, 13, 64, 256 };
     for (size_t i = 0; i < sizeof threads / sizeof *threads; i++) {
-        PtrMeshSphere *found = NULL;
-        uint32_t *labels = NULL;
-        size_t count = 0;
+        Found found = { 0 };
         int by_runs = 0;
-        CHECK_INT(ptr_mesh_spheres_by_runs(&mesh, threads[i], "joined", &found, &count, &labels,
-                                           &by_runs, NULL),
+        CHECK_INT(ptr_mesh_spheres_by_runs(&mesh, threads[i], "joined", &found.spheres,
+                                           &found.count, &found.labels, &by_runs, NULL),
                   PTR_OK);
         CHECK_INT(by_runs, 1);
         if (by_runs)
-            check_same(found, labels, count, expected, expected_labels, expected_count, j.nv);
-        free(found);
-        free(labels);
+            check_same(&found, &expected, j.nv);
+        free_found(&found);
     }
-    free(expected);
-    free(expected_labels);
+    free_found(&expected);
     free(j.m.v);
     free(j.m.t);
 }
@@ -368,31 +373,28 @@ static void test_runs_give_way(void)
     const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra),
                                      joined_source(&large) };
     static const int one[] = { 1 };
-    for (size_t m = 0; m < sizeof meshes / sizeof *meshes; m++)
+    script = one, script_length = 1, asked = 0;
+    for (size_t m = 0; m < sizeof meshes / sizeof *meshes; m++) {
         for (int threads = 1; threads <= 4; threads *= 2) {
-            script = one, script_length = 1, asked = 0;
-            PtrMeshSphere *found = NULL;
-            size_t count = 0;
+            Found none = { 0 };
             int by_runs = 1;
-            CHECK_INT(ptr_mesh_spheres_by_runs(&meshes[m], threads, "mesh", &found, &count, NULL,
-                                               &by_runs, NULL),
+            CHECK_INT(ptr_mesh_spheres_by_runs(&meshes[m], threads, "mesh", &none.spheres,
+                                               &none.count, NULL, &by_runs, NULL),
                       PTR_OK);
             CHECK_INT(by_runs, 0);
-            PtrMeshSphere *expected = NULL;
-            uint32_t *labels = NULL, *expected_labels = NULL;
-            size_t expected_count = 0;
-            CHECK_INT(ptr_mesh_spheres(&meshes[m], "mesh", &found, &count, &labels, NULL),
-                      PTR_OK);
-            CHECK_INT(ptr_mesh_spheres_by_union(&meshes[m], "mesh", &expected, &expected_count,
-                                                &expected_labels, NULL),
-                      PTR_OK);
-            check_same(found, labels, count, expected, expected_labels, expected_count,
-                       meshes[m].vertex_count);
-            free(found);
-            free(labels);
-            free(expected);
-            free(expected_labels);
+            CHECK(!none.spheres);
         }
+        Found found = { 0 }, expected = { 0 };
+        CHECK_INT(ptr_mesh_spheres(&meshes[m], "mesh", &found.spheres, &found.count,
+                                   &found.labels, NULL),
+                  PTR_OK);
+        CHECK_INT(ptr_mesh_spheres_by_union(&meshes[m], "mesh", &expected.spheres,
+                                            &expected.count, &expected.labels, NULL),
+                  PTR_OK);
+        check_same(&found, &expected, meshes[m].vertex_count);
+        free_found(&found);
+        free_found(&expected);
+    }
     free(back.m.v);
     free(back.m.t);
     free(octahedra.v);
