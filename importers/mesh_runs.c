@@ -26,13 +26,13 @@
 #include <string.h>
 
 #include "base/threads.h"
-#include "mesh_fit.h"
+#include "mesh_component.h"
 
 enum {
     UNSET = UINT32_MAX,
-    /* Triangles read at once, and how far before and after a place the
-     * triangles are looked at to end a run there. */
-    BLOCK = 1024,
+    /* How far before and after a place the triangles are looked at to start
+     * a run there, and how many are read at once. */
+    WINDOW = 1024,
     /* A run's vertices and triangles at most, so that its arrays stay
      * within a core's caches (a sphere of 40,962 vertices and 81,920
      * triangles, an icosphere divided six times, is one run). */
@@ -41,12 +41,14 @@ enum {
 };
 
 /* Triangles first .. end - 1, over vertices low .. high and no others;
- * once found, its components are spheres at .. at + count - 1 of the
- * spheres of its slice's work. */
+ * once found, its components are spheres at .. at + count - 1 of its
+ * slice's spheres, and its vertices' components, numbered in the run,
+ * labels from labels_at on of its slice's labels (where they are asked
+ * for). */
 typedef struct Run {
     size_t first, end;
     uint32_t low, high;
-    size_t at, count;
+    size_t at, count, labels_at;
 } Run;
 
 /* A component's bounds and checks while its run is found. */
@@ -55,15 +57,16 @@ typedef struct Fit {
     int off;
 } Fit;
 
-/* BLOCK triangles from t on (fewer at the mesh's end), each's least vertex
+/* WINDOW triangles from t on (fewer at the mesh's end), each's least vertex
  * and greatest plus 1; past the mesh's end, none (its least UINT32_MAX). */
 typedef struct Block {
-    uint32_t tri[BLOCK][3], lo[BLOCK], hi1[BLOCK];
+    uint32_t tri[WINDOW][3], lo[WINDOW], hi1[WINDOW];
     size_t count;
 } Block;
 
-/* A thread's: the arrays of the run it finds, grown to the largest run
- * (indexed by a vertex's place in its run), and what its slice found. */
+/* A slice's: the arrays of the run being found, grown to the largest run
+ * (indexed by a vertex's place in its run) and freed when the slice is
+ * through, and what the slice found. */
 typedef struct Work {
     uint32_t (*tri)[3];
     size_t triangle_room;
@@ -74,11 +77,13 @@ typedef struct Work {
     size_t vertex_room;
     Fit *fit;
     size_t fit_room;
-    Block *blocks; /* 3, while the slice is scanned */
+    Block *blocks; /* 3 */
     Run *runs;
     size_t run_count, run_room;
     PtrMeshSphere *spheres;
     size_t sphere_count, sphere_room;
+    uint32_t *labels;
+    size_t label_count, label_room;
 } Work;
 
 typedef struct Runs {
@@ -183,7 +188,8 @@ static size_t number_components(Work *w, const Run *run, uint32_t joined,
     const uint32_t nv = run->high - run->low + 1;
     const size_t nt = run->end - run->first;
     uint32_t *parent = w->parent;
-    if (joined + 1 == nv && 2 * (size_t)nv == nt + 4) { /* one closed surface: most often */
+    /* Most often, one closed surface over every vertex. */
+    if (joined + 1 == nv && 2 * (size_t)nv == nt + MESH_CLOSED_BALANCE) {
         for (uint32_t v = 0; v < nv; v++)
             parent[v] = 0;
         spheres[0].first_triangle = run->first;
@@ -203,7 +209,7 @@ static size_t number_components(Work *w, const Run *run, uint32_t joined,
         const uint32_t root = parent[w->tri[t][0]];
         if (w->component[root] != UNSET)
             continue;
-        if (w->balance[root] != 4)
+        if (w->balance[root] != MESH_CLOSED_BALANCE)
             return 0;
         w->component[root] = (uint32_t)count;
         spheres[count++].first_triangle = run->first + t;
@@ -213,8 +219,9 @@ static size_t number_components(Work *w, const Run *run, uint32_t joined,
     return count;
 }
 
-/* Run's components into w's spheres, found with w's arrays, the run's
- * triangles in w->tri: 1, or 0 where one is not closed, or -1 for memory. */
+/* Run's components into w's spheres (and their labels into w's), found
+ * with w's arrays, the run's triangles in w->tri: 1, or 0 where one is not
+ * closed or the run has too many vertices, or -1 for memory. */
 static int find_run(const Runs *r, Work *w, Run *run)
 {
     const PtrMeshSource *mesh = r->mesh;
@@ -244,15 +251,9 @@ static int find_run(const Runs *r, Work *w, Run *run)
     for (size_t c = 0; c < count; c++)
         for (int k = 0; k < 3; k++)
             fit[c].lo[k] = HUGE_VAL, fit[c].hi[k] = -HUGE_VAL;
-    for (uint32_t v = 0; v < nv; v++) { /* a position that is not a number is left out */
-        const uint32_t c = label[v];
-        if (c != UNSET)
-            for (int k = 0; k < 3; k++) {
-                const double p = pos[v][k];
-                fit[c].lo[k] = p < fit[c].lo[k] ? p : fit[c].lo[k];
-                fit[c].hi[k] = p > fit[c].hi[k] ? p : fit[c].hi[k];
-            }
-    }
+    for (uint32_t v = 0; v < nv; v++)
+        if (label[v] != UNSET)
+            mesh_bound_add(fit[label[v]].lo, fit[label[v]].hi, pos[v]);
     for (size_t c = 0; c < count; c++) {
         mesh_fit(fit[c].lo, fit[c].hi, mesh->quantum, &spheres[c], fit[c].sure);
         for (int k = 0; k < 3; k++)
@@ -271,17 +272,35 @@ static int find_run(const Runs *r, Work *w, Run *run)
     }
     for (size_t c = 0; c < count; c++)
         spheres[c].is_sphere = spheres[c].is_sphere && !fit[c].off;
-    if (r->vertex_spheres) /* numbered in the run until every run is found */
-        memcpy(&r->vertex_spheres[run->low], label, nv * sizeof *label);
+    if (r->vertex_spheres) { /* kept until the slices' runs are known to fit together */
+        if (!grow((void **)&w->labels, &w->label_room, w->label_count + nv, sizeof *w->labels))
+            return -1;
+        memcpy(&w->labels[w->label_count], label, nv * sizeof *label);
+        run->labels_at = w->label_count;
+        w->label_count += nv;
+    }
     run->at = w->sphere_count;
     run->count = count;
     w->sphere_count += count;
     return 1;
 }
 
+/* The arrays of the run being found, once the slice is through. */
+static void free_run_arrays(Work *w)
+{
+    free(w->tri);
+    free(w->pos);
+    free(w->parent);
+    free(w->component);
+    free(w->balance);
+    free(w->fit);
+    free(w->blocks);
+}
+
 /* Keeps a run that ended in slice s and finds it. Returns 0 where the mesh
- * is not in runs (a component is not closed, or the run reaches back into
- * the slice's last: a triangle joins them) or memory ran out. */
+ * is not in runs (a component is not closed; or the run reaches back into
+ * the slice's last, which join_slices would find too, but only once every
+ * slice is through) or memory ran out. */
 static int end_run(Runs *r, size_t s, Run *run)
 {
     Work *w = &r->work[s];
@@ -320,7 +339,7 @@ static int add_triangles(Runs *r, size_t s, Run *run, const uint32_t (*tri)[3], 
 static void read_block(const PtrMeshSource *mesh, size_t t, Block *b)
 {
     b->count = t < mesh->triangle_count ? mesh->triangle_count - t : 0;
-    b->count = b->count < BLOCK ? b->count : BLOCK;
+    b->count = b->count < WINDOW ? b->count : WINDOW;
     if (b->count)
         mesh->triangles(mesh->user, t, b->count, b->tri);
     for (size_t i = 0; i < b->count; i++) {
@@ -329,13 +348,13 @@ static void read_block(const PtrMeshSource *mesh, size_t t, Block *b)
         b->lo[i] = v[2] < ab_lo ? v[2] : ab_lo;
         b->hi1[i] = (v[2] > ab_hi ? v[2] : ab_hi) + 1;
     }
-    for (size_t i = b->count; i < BLOCK; i++)
+    for (size_t i = b->count; i < WINDOW; i++)
         b->lo[i] = UINT32_MAX, b->hi1[i] = 0;
 }
 
 /* Where runs may start among block cur's triangles: a run can start at
- * triangle t where the BLOCK triangles before t use no vertex that the
- * BLOCK triangles from t on use, every vertex before below every vertex
+ * triangle t where the WINDOW triangles before t use no vertex that the
+ * WINDOW triangles from t on use, every vertex before below every vertex
  * after (the runs' ranges rise). That is decided from those
  * triangles alone, the same in every slice; a sphere of fewer triangles
  * (whatever their order) is never cut, and a later triangle that reaches
@@ -343,10 +362,10 @@ static void read_block(const PtrMeshSource *mesh, size_t t, Block *b)
 static void find_starts(const Block *prev, const Block *cur, const Block *next,
                         unsigned char *start)
 {
-    uint32_t before[BLOCK + 1], after[BLOCK + 1]; /* of prev's i .. and of cur's i .. */
-    before[BLOCK] = 0;
-    after[BLOCK] = UINT32_MAX;
-    for (size_t i = BLOCK; i-- > 0;) {
+    uint32_t before[WINDOW + 1], after[WINDOW + 1]; /* of prev's i .. and of cur's i .. */
+    before[WINDOW] = 0;
+    after[WINDOW] = UINT32_MAX;
+    for (size_t i = WINDOW; i-- > 0;) {
         before[i] = prev->hi1[i] > before[i + 1] ? prev->hi1[i] : before[i + 1];
         after[i] = cur->lo[i] < after[i + 1] ? cur->lo[i] : after[i + 1];
     }
@@ -373,18 +392,18 @@ static void scan_slice(Runs *r, size_t s)
         give_up(r, -1);
         return;
     }
-    unsigned char start[BLOCK];
+    unsigned char start[WINDOW];
     Block *prev = &blocks[0], *cur = &blocks[1], *next = &blocks[2];
-    read_block(r->mesh, from >= BLOCK ? from - BLOCK : 0, prev);
-    if (from < BLOCK) { /* the triangles before the first, at prev's end */
-        memmove(prev->hi1 + BLOCK - from, prev->hi1, from * sizeof *prev->hi1);
-        memset(prev->hi1, 0, (BLOCK - from) * sizeof *prev->hi1);
+    read_block(r->mesh, from >= WINDOW ? from - WINDOW : 0, prev);
+    if (from < WINDOW) { /* the triangles before the first, at prev's end */
+        memmove(prev->hi1 + WINDOW - from, prev->hi1, from * sizeof *prev->hi1);
+        memset(prev->hi1, 0, (WINDOW - from) * sizeof *prev->hi1);
     }
     read_block(r->mesh, from, cur);
     Run run;
     int open = 0;
-    for (size_t t = from; t < n && going_on(r); t += BLOCK) {
-        read_block(r->mesh, t + BLOCK, next);
+    for (size_t t = from; t < n && going_on(r); t += WINDOW) {
+        read_block(r->mesh, t + WINDOW, next);
         find_starts(prev, cur, next, start);
         size_t begin = 0; /* the block's first triangle of the open run */
         for (size_t i = 0; i < cur->count; i++) {
@@ -416,8 +435,11 @@ static void scan_slice(Runs *r, size_t s)
 
 static void scan_slices(void *arg, size_t from, size_t to)
 {
-    for (size_t s = from; s < to; s++)
-        scan_slice(arg, s);
+    Runs *r = arg;
+    for (size_t s = from; s < to; s++) {
+        scan_slice(r, s);
+        free_run_arrays(&r->work[s]);
+    }
 }
 
 /* Every slice's runs in order into r->all: 0 where a run reaches back into
@@ -460,28 +482,17 @@ static void place_runs(void *arg, size_t from, size_t to)
         if (!labels)
             continue;
         const size_t base = r->base[i];
+        const uint32_t *in_run = &r->work[r->slice_of[i]].labels[run->labels_at] - run->low;
         for (size_t v = i ? run->low : 0; v < run->low; v++)
             labels[v] = UNSET;
         for (size_t v = run->low; v <= run->high; v++)
-            labels[v] = labels[v] == UNSET ? UNSET : (uint32_t)(base + labels[v]);
+            labels[v] = in_run[v] == UNSET ? UNSET : (uint32_t)(base + in_run[v]);
         const size_t next = i + 1 < r->all_count ? r->all[i + 1].low : r->mesh->vertex_count;
         for (size_t v = (size_t)run->high + 1; v < next; v++)
             labels[v] = UNSET;
     }
 }
 
-static void free_work(Work *w)
-{
-    free(w->tri);
-    free(w->pos);
-    free(w->parent);
-    free(w->component);
-    free(w->balance);
-    free(w->fit);
-    free(w->blocks);
-    free(w->runs);
-    free(w->spheres);
-}
 
 /* The runs' spheres in order into r->out: 1, or -1 for memory. */
 static int place(Runs *r, int threads)
@@ -498,11 +509,13 @@ PtrResult ptr_mesh_spheres_by_runs(const PtrMeshSource *mesh, int threads, const
                                    uint32_t **vertex_spheres, int *found, PtrError *err)
 {
     *found = 0;
-    /* As the union: no set of a mesh this large is taken as closed. */
-    if (!mesh->triangle_count || mesh->vertex_count >= (size_t)1 << 31 ||
-        mesh->triangle_count >= (size_t)1 << 31)
+    if (!mesh->triangle_count || !mesh_may_close(mesh))
         return PTR_OK;
-    Runs r = { .mesh = mesh, .slices = (size_t)threads };
+    /* A slice of 8 windows at least: each reads a window before it and
+     * after it besides its own. */
+    const size_t most = mesh->triangle_count / (8 * WINDOW);
+    Runs r = { .mesh = mesh };
+    r.slices = threads < 1 ? 1 : (size_t)threads < most ? (size_t)threads : most ? most : 1;
     r.work = calloc(r.slices, sizeof *r.work);
     int outcome = r.work ? 1 : -1;
     if (outcome > 0 && vertex_spheres) {
@@ -517,8 +530,11 @@ PtrResult ptr_mesh_spheres_by_runs(const PtrMeshSource *mesh, int threads, const
         outcome = join_slices(&r);
     if (outcome > 0)
         outcome = place(&r, threads);
-    for (size_t s = 0; r.work && s < r.slices; s++)
-        free_work(&r.work[s]);
+    for (size_t s = 0; r.work && s < r.slices; s++) {
+        free(r.work[s].runs);
+        free(r.work[s].spheres);
+        free(r.work[s].labels);
+    }
     free(r.work);
     free(r.all);
     free(r.slice_of);

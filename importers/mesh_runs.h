@@ -4,7 +4,7 @@
 #define PTR_MESH_RUNS_H
 
 #include "base/result.h"
-#include "mesh_fit.h"
+#include "mesh_component.h"
 
 /* As ptr_mesh_spheres, on threads threads, where the mesh lies in runs of
  * closed surfaces by index (mesh_runs.c says what that is): *found is then

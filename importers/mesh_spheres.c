@@ -14,7 +14,7 @@
 
 #include "base/cpu.h"
 #include "base/threads.h"
-#include "mesh_fit.h"
+#include "mesh_component.h"
 #include "mesh_runs.h"
 
 enum {
@@ -386,7 +386,7 @@ typedef struct Passes {
     _Atomic double *bounds; /* 6 a component: the least x, y, z, the greatest */
     atomic_uchar *off;      /* whether a component lies off its sphere */
     double (*sure)[3];      /* a component's squared distances that pass its
-                             * checks for certain (see sure_bands) */
+                             * checks for certain (see mesh_sure_bands) */
     uint32_t *order;        /* a component's place among the sorted spheres */
     uint32_t *vertex_spheres; /* the caller's: each vertex's sphere, or NULL */
     int threads;
@@ -456,8 +456,8 @@ static void flatten(void *arg, size_t from, size_t to)
     }
 }
 
-/* Additions to the balance of a run of one set's vertices or triangles (a
- * mesh's sets mostly lie in runs), added at the run's end. */
+/* Additions to the balance of a stretch of one set's vertices or triangles
+ * (a mesh's sets mostly lie in stretches), added at the stretch's end. */
 typedef struct Tally {
     uint32_t root; /* UNSET before the first */
     uint32_t sum;
@@ -520,7 +520,7 @@ static void mark_closed(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
     for (size_t v = from; v < to; v++)
-        if (link_of(ps->balance, link_of(ps->parent, (uint32_t)v)) == 4)
+        if (link_of(ps->balance, link_of(ps->parent, (uint32_t)v)) == MESH_CLOSED_BALANCE)
             atomic_store_explicit(&ps->state[v], ON_CLOSED_SURFACE, memory_order_relaxed);
 }
 
@@ -535,8 +535,7 @@ static void mark_closed(void *arg, size_t from, size_t to)
 static void find_closed_surfaces(Passes *ps)
 {
     const PtrMeshSource *mesh = ps->mesh;
-    if (mesh->vertex_count >= (size_t)1 << 31 || mesh->triangle_count >= (size_t)1 << 31 ||
-        atomic_load(&ps->rejoined) < 2)
+    if (!mesh_may_close(mesh) || atomic_load(&ps->rejoined) < 2)
         return;
     ptr_parallel_ranges(ps->threads, 0, mesh->vertex_count, count_vertices, ps);
     ptr_parallel_ranges(ps->threads, 0, mesh->triangle_count, count_triangles, ps);
@@ -608,15 +607,15 @@ static size_t relabel_block(const Passes *ps, size_t v, size_t to, double (*p)[3
     return count;
 }
 
-/* The bounds of a run of vertices of one component (a mesh's components
- * mostly lie in runs), merged into the component's at the run's end. */
-typedef struct Run {
+/* The bounds of a stretch of vertices of one component (a mesh's
+ * components mostly lie in stretches), merged into the component's at the
+ * stretch's end. */
+typedef struct Stretch {
     uint32_t component; /* UNSET before the first */
     double lo[3], hi[3];
-} Run;
+} Stretch;
 
-/* A position that is not a number is left out. */
-static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[3])
+static void bound_vertex(const Passes *ps, Stretch *run, uint32_t c, const double p[3])
 {
     if (c != run->component) {
         if (run->component != UNSET)
@@ -625,10 +624,7 @@ static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[
         for (int k = 0; k < 3; k++)
             run->lo[k] = HUGE_VAL, run->hi[k] = -HUGE_VAL;
     }
-    for (int k = 0; k < 3; k++) {
-        run->lo[k] = p[k] < run->lo[k] ? p[k] : run->lo[k];
-        run->hi[k] = p[k] > run->hi[k] ? p[k] : run->hi[k];
-    }
+    mesh_bound_add(run->lo, run->hi, p);
 }
 
 /* Relabels vertices from .. to - 1 with their components and adds them to
@@ -636,7 +632,7 @@ static void bound_vertex(const Passes *ps, Run *run, uint32_t c, const double p[
 static void bound_vertices(void *arg, size_t from, size_t to)
 {
     const Passes *ps = arg;
-    Run run = { .component = UNSET };
+    Stretch run = { .component = UNSET };
     double p[BLOCK][3];
     uint32_t c[BLOCK];
     for (size_t v = from; v < to; v += BLOCK)

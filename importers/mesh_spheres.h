@@ -4,7 +4,7 @@
 #define PTR_MESH_SPHERES_H
 
 #include "base/result.h"
-#include "mesh_fit.h"
+#include "mesh_component.h"
 
 /* The mesh's components (triangles sharing a vertex, by index or by equal
  * position), in the order of their first triangles, into *out (malloc'd,

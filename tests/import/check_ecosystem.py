@@ -205,7 +205,8 @@ def check_blender(name, part):
     naming part."""
     scene = dump(name)
     problems = compare(flatten(scene), blender_reference(name.endswith(".obj")), False)
-    skipped = f'1 mesh part not drawn: it is not a sphere (docs/scenes.md, "What becomes a sphere"): {part}'
+    skipped = ('1 mesh part not drawn: it is not a sphere'
+               f' (docs/scenes.md, "What becomes a sphere"): {part}')
     if len(scene["warnings"]) != 1 or not scene["warnings"][0].endswith(skipped):
         problems.append(f"warnings {scene['warnings']}, not one ending in: {skipped}")
     return problems

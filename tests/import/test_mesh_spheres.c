@@ -257,14 +257,57 @@ static void add_cube(Joined *j)
     j->nv += 8, j->nt += 12;
 }
 
+/* A closed flat disc (a fan on either side of one rim): not a sphere, and
+ * its bounds in z both zero, of either sign. */
+static void add_pillow(Joined *j)
+{
+    enum { RIM = 12 };
+    room_for(j, RIM + 2, 2 * RIM);
+    const size_t first = j->nv;
+    for (int i = 0; i < RIM + 2; i++) {
+        const double angle = 2 * acos(-1.0) * i / RIM;
+        j->m.v[first + i][0] = i < RIM ? cos(angle) : 0.0;
+        j->m.v[first + i][1] = i < RIM ? sin(angle) : 0.0;
+        j->m.v[first + i][2] = i % 2 ? -0.0 : 0.0;
+    }
+    for (uint32_t i = 0; i < RIM; i++) {
+        const uint32_t a = (uint32_t)first + i, b = (uint32_t)first + (i + 1) % RIM;
+        uint32_t *top = j->m.t[j->nt++], *bottom = j->m.t[j->nt++];
+        top[0] = (uint32_t)first + RIM, top[1] = a, top[2] = b;
+        bottom[0] = (uint32_t)first + RIM + 1, bottom[1] = b, bottom[2] = a;
+    }
+    j->nv += RIM + 2;
+}
+
 static void make_joined(Joined *j, int parts)
 {
     *j = (Joined){ .seed = 7 };
     for (int p = 0; p < parts; p++) {
         const int segments = 8 + (int)(next_random(j) % 9), rings = 6 + (int)(next_random(j) % 5);
         const size_t nv = 2 + (size_t)(rings - 1) * segments;
-        if (p % 17 == 5) {
-            add_cube(j);
+        if (p % 17 == 5 || p % 31 == 7) {
+            p % 17 == 5 ? add_cube(j) : add_pillow(j);
+            j->components++;
+            continue;
+        }
+        if (p % 19 == 2) { /* more triangles than a window, shuffled */
+            add_uv_sphere(j, j->nv, 1, 40, 30);
+            j->nv += 2 + 29 * 40;
+            j->components++, j->spheres++;
+            continue;
+        }
+        if (p % 13 == 4) { /* every other vertex one no triangle uses, at the same position */
+            add_uv_sphere(j, j->nv, 2, segments, rings);
+            for (size_t i = 0; i + 1 < nv; i++)
+                memcpy(j->m.v[j->nv + 2 * i + 1], j->m.v[j->nv + 2 * i], sizeof *j->m.v);
+            j->nv += 2 * nv - 1;
+            j->components++, j->spheres++;
+            continue;
+        }
+        if (p % 37 == 9) { /* a vertex not a number: not a sphere */
+            add_uv_sphere(j, j->nv, 1, segments, rings);
+            j->m.v[j->nv + 3][1] = NAN;
+            j->nv += nv;
             j->components++;
             continue;
         }
@@ -368,8 +411,8 @@ static void test_runs_give_way(void)
     memcpy(back.m.t[back.nt++], back.m.t[0], sizeof *back.m.t);
     Mesh octahedra;
     Joined large = { .seed = 11 };
-    add_uv_sphere(&large, 0, 1, 300, 220); /* 65,702 vertices */
-    large.nv = 2 + 219 * 300;
+    add_uv_sphere(&large, 0, 1, 256, 257); /* 65,538 vertices, 131,072 triangles */
+    large.nv = 2 + 256 * 256;
     const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra),
                                      joined_source(&large) };
     static const int one[] = { 1 };

@@ -3,8 +3,8 @@
  * it (docs/scenes.md, "What becomes a sphere"): one definition for both
  * ways a mesh's components are found (mesh_spheres.c, mesh_runs.c), so that
  * both find the same spheres to the bit. */
-#ifndef PTR_MESH_FIT_H
-#define PTR_MESH_FIT_H
+#ifndef PTR_MESH_COMPONENT_H
+#define PTR_MESH_COMPONENT_H
 
 #include <math.h>
 #include <stddef.h>
@@ -45,6 +45,27 @@ typedef struct PtrMeshSphere {
 #define PTR_SPHERE_CENTROID_DEPTH 0.88
 #define PTR_SPHERE_EXTENT_RATIO 0.75
 
+/* A set of V vertices and F triangles joined by index is a closed surface
+ * where 2 V - F is this (mesh_spheres.c, find_closed_surfaces, says why);
+ * its vertices are then not matched by position. */
+enum { MESH_CLOSED_BALANCE = 4 };
+
+/* Whether the sets of a mesh can be told closed: their balances are kept
+ * in 32 bits, so a mesh of 2^31 vertices or triangles or more has none. */
+static inline int mesh_may_close(const PtrMeshSource *mesh)
+{
+    return mesh->vertex_count < (size_t)1 << 31 && mesh->triangle_count < (size_t)1 << 31;
+}
+
+/* Bounds lo .. hi grown by position p; a coordinate that is not a number
+ * is left out. */
+static inline void mesh_bound_add(double lo[3], double hi[3], const double p[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = p[k] < lo[k] ? p[k] : lo[k];
+        hi[k] = p[k] > hi[k] ? p[k] : hi[k];
+    }
+}
 
 /* The checks below compare distances, a square root each; most distances
  * are far from the checks' limits, and their squares show it without the
@@ -53,8 +74,8 @@ typedef struct PtrMeshSphere {
  * a centroid's from three times the centre that passes the centroid check.
  * Each band is narrower than its check by a billionth of the distances
  * compared, far more than the roundings of either test, so a distance the
- * band passes is one the check passes: anything else (NaN too) is checked
- * as before, and the result is the same. Radii so small or large that their
+ * band passes is one the check passes: anything else (NaN too) goes to the
+ * check itself, so the answer is the check's. Radii so small or large that their
  * squares would underflow or overflow get empty bands (NaN: no distance
  * passes). */
 static inline void mesh_sure_bands(double radius, double slack, double sure[3])
@@ -70,15 +91,18 @@ static inline void mesh_sure_bands(double radius, double slack, double sure[3])
 }
 
 /* The sphere of bounds lo .. hi (its centre, half their largest extent),
- * whether they are round enough to be one, and its sure bands. */
+ * whether they are round enough to be one, and its sure bands. A bound of
+ * -0 counts as +0: which of two equal zeros came first is no part of the
+ * sphere (nor, for the union's threads, fixed). */
 static inline void mesh_fit(const double lo[3], const double hi[3], double quantum,
                             PtrMeshSphere *s, double sure[3])
 {
     double extent = 0.0, smallest = HUGE_VAL;
     for (int k = 0; k < 3; k++) {
-        s->centre[k] = 0.5 * (lo[k] + hi[k]);
-        extent = fmax(extent, hi[k] - lo[k]);
-        smallest = fmin(smallest, hi[k] - lo[k]);
+        const double low = lo[k] + 0.0, high = hi[k] + 0.0;
+        s->centre[k] = 0.5 * (low + high);
+        extent = fmax(extent, high - low);
+        smallest = fmin(smallest, high - low);
     }
     s->radius = 0.5 * extent;
     s->is_sphere = extent > 0.0 && isfinite(extent) &&
@@ -117,4 +141,4 @@ static inline int mesh_centroid_off(const PtrMeshSphere *s, const double centre3
            !(sqrt(d2) + 3 * (2 * quantum) >= 3 * PTR_SPHERE_CENTROID_DEPTH * s->radius);
 }
 
-#endif /* PTR_MESH_FIT_H */
+#endif /* PTR_MESH_COMPONENT_H */
