@@ -290,9 +290,11 @@ static void make_joined(Joined *j, int parts)
             j->components++;
             continue;
         }
-        if (p % 19 == 2) { /* more triangles than a window, shuffled */
-            add_uv_sphere(j, j->nv, 1, 40, 30);
-            j->nv += 2 + 29 * 40;
+        /* More triangles than a window, shuffled; one over several slices. */
+        if (p % 19 == 2 || p == parts / 2) {
+            const int around = p == parts / 2 ? 200 : 40, down = p == parts / 2 ? 150 : 30;
+            add_uv_sphere(j, j->nv, 1, around, down);
+            j->nv += 2 + (size_t)(down - 1) * around;
             j->components++, j->spheres++;
             continue;
         }
@@ -362,13 +364,14 @@ static void check_same(const Found *a, const Found *b, size_t vertices)
     CHECK(!memcmp(a->labels, b->labels, vertices * sizeof *a->labels));
 }
 
-/* Found run by run, on any number of threads (so with runs cut by the
- * slices' bounds anywhere, pieces of one run across several slices at 256),
- * a joined mesh's components are the union's to the bit. */
+/* Found run by run, on any number of threads (slices of 8,192 triangles
+ * and more: up to about 70 slices here, with slices' bounds in runs
+ * anywhere, and a run over several slices), a joined mesh's components are
+ * the union's to the bit. */
 static void test_runs_match_union(void)
 {
     Joined j;
-    make_joined(&j, 60);
+    make_joined(&j, 4000);
     const PtrMeshSource mesh = joined_source(&j);
     static const int one[] = { 1 };
     script = one, script_length = 1, asked = 0;
