@@ -229,8 +229,8 @@ static int find_run(const Runs *r, Work *w, Run *run)
         return 0;
     const uint32_t nv = run->high - run->low + 1;
     const size_t nt = run->end - run->first;
-    if (!grow_vertices(w, nv) ||
-        !grow((void **)&w->spheres, &w->sphere_room, w->sphere_count + nv / 3, sizeof *w->spheres))
+    if (!grow_vertices(w, nv) || !grow((void **)&w->spheres, &w->sphere_room,
+                                       w->sphere_count + nv / 3 + 1, sizeof *w->spheres))
         return -1;
     mesh->positions(mesh->user, run->low, nv, w->pos);
     uint32_t *label = w->parent, (*tri)[3] = w->tri, joined = 0;
@@ -322,6 +322,8 @@ static int add_triangles(Runs *r, size_t s, Run *run, const uint32_t (*tri)[3], 
 {
     const size_t held = run->end - run->first;
     Work *w = &r->work[s];
+    if (!count)
+        return 1;
     if (held + count > RUN_TRIANGLES) {
         give_up(r, 0);
         return 0;
@@ -482,11 +484,13 @@ static void place_runs(void *arg, size_t from, size_t to)
         if (!labels)
             continue;
         const size_t base = r->base[i];
-        const uint32_t *in_run = &r->work[r->slice_of[i]].labels[run->labels_at] - run->low;
+        const uint32_t *in_run = &r->work[r->slice_of[i]].labels[run->labels_at];
         for (size_t v = i ? run->low : 0; v < run->low; v++)
             labels[v] = UNSET;
-        for (size_t v = run->low; v <= run->high; v++)
-            labels[v] = in_run[v] == UNSET ? UNSET : (uint32_t)(base + in_run[v]);
+        for (size_t v = run->low; v <= run->high; v++) {
+            const uint32_t c = in_run[v - run->low];
+            labels[v] = c == UNSET ? UNSET : (uint32_t)(base + c);
+        }
         const size_t next = i + 1 < r->all_count ? r->all[i + 1].low : r->mesh->vertex_count;
         for (size_t v = (size_t)run->high + 1; v < next; v++)
             labels[v] = UNSET;

@@ -64,7 +64,8 @@ void check_ascii(const std::string &path, const char *data, size_t size)
 // which the fixed columns read as empty, to its 80 columns; and the
 // connection records (SSBOND, LINK, CISPEP), whose columns gemmi reads past
 // the end of its own trimmed copy of a line, are left out: no sphere depends
-// on them.
+// on them. gemmi tells a record by its first four letters in any case
+// ("SSBOX" is an SSBOND to it), and so are they told here.
 std::string pdb_lines_for_gemmi(const char *data, size_t size)
 {
     std::string out;
@@ -78,7 +79,7 @@ std::string pdb_lines_for_gemmi(const char *data, size_t size)
             const size_t n = std::strlen(record);
             return length >= n && !strncasecmp(line, record, n);
         };
-        if (is("SSBOND") || is("LINK") || is("CISPEP")) {
+        if (is("SSBO") || is("LINK") || is("CISP")) {
             line = next ? next + 1 : end;
             continue;
         }

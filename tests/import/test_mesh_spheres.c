@@ -404,20 +404,31 @@ static void test_runs_match_union(void)
 /* Where a mesh is not in runs of closed surfaces, the runs give way, and
  * ptr_mesh_spheres finds what the union finds: a last triangle reaching
  * back into the first sphere (on one thread, and where the slices put it
- * apart from that sphere), the octahedra of test_online_cpus (half of them
- * open), and a run larger than a run may be. */
+ * apart from that sphere), a first triangle of one vertex (a run of one),
+ * the octahedra of test_online_cpus (half of them open), and a run larger
+ * than a run may be. */
 static void test_runs_give_way(void)
 {
     Joined back;
     make_joined(&back, 30);
     room_for(&back, 0, 1);
     memcpy(back.m.t[back.nt++], back.m.t[0], sizeof *back.m.t);
+    Joined point; /* a vertex of its own first, and a triangle of it alone */
+    make_joined(&point, 30);
+    room_for(&point, 1, 1);
+    memmove(point.m.v + 1, point.m.v, point.nv++ * sizeof *point.m.v);
+    memmove(point.m.t + 1, point.m.t, point.nt++ * sizeof *point.m.t);
+    for (size_t t = 1; t < point.nt; t++)
+        for (int k = 0; k < 3; k++)
+            point.m.t[t][k]++;
+    memset(point.m.v[0], 0, sizeof *point.m.v);
+    memset(point.m.t[0], 0, sizeof *point.m.t);
     Mesh octahedra;
     Joined large = { .seed = 11 };
     add_uv_sphere(&large, 0, 1, 256, 257); /* 65,538 vertices, 131,072 triangles */
     large.nv = 2 + 256 * 256;
-    const PtrMeshSource meshes[] = { joined_source(&back), make_mesh(&octahedra),
-                                     joined_source(&large) };
+    const PtrMeshSource meshes[] = { joined_source(&back), joined_source(&point),
+                                     make_mesh(&octahedra), joined_source(&large) };
     static const int one[] = { 1 };
     script = one, script_length = 1, asked = 0;
     for (size_t m = 0; m < sizeof meshes / sizeof *meshes; m++) {
@@ -443,6 +454,8 @@ static void test_runs_give_way(void)
     }
     free(back.m.v);
     free(back.m.t);
+    free(point.m.v);
+    free(point.m.t);
     free(octahedra.v);
     free(octahedra.t);
     free(large.m.v);
