@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "base/threads.h"
+#include "grow.h"
 #include "mesh_component.h"
 
 enum {
@@ -111,42 +112,24 @@ static void give_up(Runs *r, int found)
     atomic_store_explicit(found < 0 ? &r->no_memory : &r->not_runs, 1, memory_order_relaxed);
 }
 
-static size_t bigger_room(size_t room, size_t need)
-{
-    return need > 2 * room ? need : 2 * room;
-}
-
-static int grow(void **items, size_t *room, size_t need, size_t size)
-{
-    if (need <= *room)
-        return 1;
-    const size_t bigger = bigger_room(*room, need);
-    void *grown = realloc(*items, bigger * size);
-    if (!grown)
-        return 0;
-    *items = grown;
-    *room = bigger;
-    return 1;
-}
-
 /* w's arrays of a run's vertices and components, for nv vertices (a
- * closed surface has 3 vertices or more). */
+ * closed surface has 3 vertices or more): 0 for memory. The positions set
+ * the room; the other arrays of a vertex follow them. */
 static int grow_vertices(Work *w, size_t nv)
 {
-    if (!grow((void **)&w->fit, &w->fit_room, nv / 3 + 1, sizeof *w->fit))
+    size_t room = w->vertex_room;
+    if (ptr_grow((void **)&w->fit, &w->fit_room, nv / 3 + 1, sizeof *w->fit) != PTR_OK ||
+        ptr_grow((void **)&w->pos, &room, nv, sizeof *w->pos) != PTR_OK)
         return 0;
-    if (nv <= w->vertex_room)
+    if (room == w->vertex_room)
         return 1;
-    const size_t room = bigger_room(w->vertex_room, nv);
-    double(*pos)[3] = realloc(w->pos, room * sizeof *pos);
-    w->pos = pos ? pos : w->pos;
     uint32_t *parent = realloc(w->parent, room * sizeof *parent);
     w->parent = parent ? parent : w->parent;
     uint32_t *component = realloc(w->component, room * sizeof *component);
     w->component = component ? component : w->component;
     int32_t *balance = realloc(w->balance, room * sizeof *balance);
     w->balance = balance ? balance : w->balance;
-    if (!pos || !parent || !component || !balance)
+    if (!parent || !component || !balance)
         return 0;
     w->vertex_room = room;
     return 1;
@@ -229,8 +212,8 @@ static int find_run(const Runs *r, Work *w, Run *run)
         return 0;
     const uint32_t nv = run->high - run->low + 1;
     const size_t nt = run->end - run->first;
-    if (!grow_vertices(w, nv) || !grow((void **)&w->spheres, &w->sphere_room,
-                                       w->sphere_count + nv / 3 + 1, sizeof *w->spheres))
+    if (!grow_vertices(w, nv) || ptr_grow((void **)&w->spheres, &w->sphere_room,
+                                       w->sphere_count + nv / 3 + 1, sizeof *w->spheres) != PTR_OK)
         return -1;
     mesh->positions(mesh->user, run->low, nv, w->pos);
     uint32_t *label = w->parent, (*tri)[3] = w->tri, joined = 0;
@@ -273,7 +256,8 @@ static int find_run(const Runs *r, Work *w, Run *run)
     for (size_t c = 0; c < count; c++)
         spheres[c].is_sphere = spheres[c].is_sphere && !fit[c].off;
     if (r->vertex_spheres) { /* kept until the slices' runs are known to fit together */
-        if (!grow((void **)&w->labels, &w->label_room, w->label_count + nv, sizeof *w->labels))
+        if (ptr_grow((void **)&w->labels, &w->label_room, w->label_count + nv,
+                     sizeof *w->labels) != PTR_OK)
             return -1;
         memcpy(&w->labels[w->label_count], label, nv * sizeof *label);
         run->labels_at = w->label_count;
@@ -306,7 +290,8 @@ static int end_run(Runs *r, size_t s, Run *run)
     Work *w = &r->work[s];
     const int reaches_back = w->run_count && run->low <= w->runs[w->run_count - 1].high;
     int found = reaches_back ? 0 : find_run(r, w, run);
-    if (found > 0 && !grow((void **)&w->runs, &w->run_room, w->run_count + 1, sizeof *w->runs))
+    if (found > 0 && ptr_grow((void **)&w->runs, &w->run_room, w->run_count + 1,
+                              sizeof *w->runs) != PTR_OK)
         found = -1;
     if (found <= 0) {
         give_up(r, found);
@@ -328,7 +313,7 @@ static int add_triangles(Runs *r, size_t s, Run *run, const uint32_t (*tri)[3], 
         give_up(r, 0);
         return 0;
     }
-    if (!grow((void **)&w->tri, &w->triangle_room, held + count, sizeof *w->tri)) {
+    if (ptr_grow((void **)&w->tri, &w->triangle_room, held + count, sizeof *w->tri) != PTR_OK) {
         give_up(r, -1);
         return 0;
     }

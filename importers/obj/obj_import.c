@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 
 #include "builder.h"
+#include "grow.h"
 #include "importer_internal.h"
 #include "mesh_spheres.h"
 
@@ -148,24 +149,9 @@ static int numbers(const char *s, double *out, int max, int *bad)
     return n;
 }
 
-static PtrResult grow(void **items, size_t *capacity, size_t need, size_t size)
-{
-    if (need <= *capacity)
-        return PTR_OK;
-    size_t c = *capacity ? *capacity : 16;
-    while (c < need)
-        c *= 2;
-    void *p = realloc(*items, c * size);
-    if (!p)
-        return PTR_ERR_NOMEM;
-    *items = p;
-    *capacity = c;
-    return PTR_OK;
-}
-
 static PtrResult start_part(Reader *r, Parts *parts, const char *name, long line)
 {
-    if (grow((void **)&parts->items, &parts->capacity, parts->count + 1, sizeof(Part)))
+    if (ptr_grow((void **)&parts->items, &parts->capacity, parts->count + 1, sizeof(Part)))
         return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     Part *p = &parts->items[parts->count];
     *p = (Part){ .name = name ? copy(name) : NULL, .line = line };
@@ -190,7 +176,7 @@ static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int
     if (first_corner) {
         const MaterialRun *last = part->nruns ? &part->runs[part->nruns - 1] : NULL;
         if (!last || last->material != r->material) {
-            if (grow((void **)&part->runs, &part->runs_capacity, part->nruns + 1,
+            if (ptr_grow((void **)&part->runs, &part->runs_capacity, part->nruns + 1,
                      sizeof *part->runs))
                 return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
             part->runs[part->nruns++] =
@@ -206,7 +192,7 @@ static PtrResult add_to(Reader *r, Parts *parts, const double *p, long line, int
 static PtrResult add_triangles(Reader *r, Parts *parts, size_t n)
 {
     Part *part = &parts->items[parts->current];
-    if (grow((void **)&part->tris, &part->tris_capacity, 3 * (part->ntris + n - 2),
+    if (ptr_grow((void **)&part->tris, &part->tris_capacity, 3 * (part->ntris + n - 2),
              sizeof *part->tris))
         return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
     for (size_t c = 1; c + 1 < n; c++) {
@@ -241,7 +227,7 @@ static PtrResult face(Reader *r, char *s, long line)
         if (add_to(r, &r->objects, p, line, corners == 0) != PTR_OK ||
             add_to(r, &r->groups, p, line, corners == 0) != PTR_OK)
             return r->err->code;
-        if (grow((void **)&r->corners, &r->corners_capacity, corners + 1, sizeof *r->corners))
+        if (ptr_grow((void **)&r->corners, &r->corners_capacity, corners + 1, sizeof *r->corners))
             return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         r->corners[corners++] = (uint32_t)index;
     }
@@ -296,7 +282,7 @@ static PtrResult intern(Reader *r, const char *name, uint32_t *index)
     if (r->slots[slot] == UINT32_MAX) {
         char *text = copy(name);
         if (!text ||
-            grow((void **)&r->names, &r->names_capacity, r->nnames + 1, sizeof *r->names)) {
+            ptr_grow((void **)&r->names, &r->names_capacity, r->nnames + 1, sizeof *r->names)) {
             free(text);
             return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         }
@@ -335,7 +321,7 @@ static PtrResult obj_line(Reader *r, const char *path, char *line, long number)
         if (numbers(rest, p, 3, &bad) < 3 || bad)
             return ptr_error_set(r->err, PTR_ERR_SCENE_INVALID,
                                  "%s:%ld: a vertex needs three finite numbers", r->path, number);
-        if (grow((void **)&r->v, &r->capacity, 3 * (r->nv + 1), sizeof(double)))
+        if (ptr_grow((void **)&r->v, &r->capacity, 3 * (r->nv + 1), sizeof(double)))
             return ptr_error_set(r->err, PTR_ERR_NOMEM, "%s: out of memory", r->path);
         memcpy(&r->v[3 * r->nv++], p, sizeof p);
     } else if (!strcmp(s, "f")) {
