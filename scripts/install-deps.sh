@@ -7,7 +7,7 @@ run apt-get update -qq
 DEBIAN_FRONTEND=noninteractive run apt-get install -y -qq --no-install-recommends \
     build-essential cmake pkg-config python3 nasm \
     libopenexr-dev libopenimageio-dev openimageio-tools libopencolorio-dev opencolorio-tools \
-    libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev gemmi-dev tao-pegtl-dev zlib1g-dev parallel \
+    libtinygltf-dev libmeshoptimizer-dev libxxhash-dev nlohmann-json3-dev gemmi-dev tao-pegtl-dev zlib1g-dev parallel \
     libmicrohttpd-dev libpng-dev chromium chromium-driver python3-selenium python3-numpy python3-pytest >/dev/null
 
 

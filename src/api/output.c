@@ -221,7 +221,8 @@ PtrResult ptr_output_write(PtrImageLoader *images, const char *path, const PtrIm
         /* OpenImageIO reads every EXR back as "Linear": say it where it stays. */
         { .name = "ptr:colorspace", .type = PTR_ATTR_STRING, .string_value = space },
         { .name = "ptr:scene", .type = PTR_ATTR_STRING, .string_value = info->scene_path },
-        { .name = "ptr:scene_hash", .type = PTR_ATTR_STRING, .string_value = hash },
+        { .name = info->legacy_scene_hash ? "ptr:scene_hash" : "ptr:scene_xxh3",
+          .type = PTR_ATTR_STRING, .string_value = hash },
         { .name = "ptr:samples", .type = PTR_ATTR_INT, .int_value = (int)info->samples },
         { .name = "ptr:sample_first", .type = PTR_ATTR_INT, .int_value = (int)info->sample_first },
         { .name = "ptr:interrupted", .type = PTR_ATTR_INT, .int_value = info->interrupted },

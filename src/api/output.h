@@ -34,6 +34,9 @@ typedef struct PtrOutputSettings {
 typedef struct PtrOutputInfo {
     const char *scene_path;
     uint64_t scene_hash;   /* ptr_scene_hash: merge refuses parts of other scenes */
+    /* scene_hash is the older fingerprint of parts merged (FNV-1a), kept
+     * under its own name, ptr:scene_hash, not ptr:scene_xxh3. */
+    int legacy_scene_hash;
     const char *kernel;
     const char *accel;     /* "brute" or "bvh" */
     size_t spheres;

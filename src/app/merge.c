@@ -12,6 +12,7 @@ typedef struct Part {
     PtrImage *image;
     PtrImageLayout layout;
     const char *scene, *hash, *seed;
+    int legacy_hash; /* hash is ptr:scene_hash (see PtrOutputInfo) */
     const char *sampler, *direct_lighting, *noise_threshold;
     long first, samples, max_depth;
 } Part;
@@ -32,7 +33,10 @@ static PtrResult read_part(PtrImageLoader *images, Part *p, PtrError *err)
         return res;
     p->layout = ptr_image_layout(p->image);
     const char *first, *samples, *depth, *space;
-    if (!(p->scene = required(p, "ptr:scene", err)) || !(p->hash = required(p, "ptr:scene_hash", err)) ||
+    p->legacy_hash = !ptr_image_attr(p->image, "ptr:scene_xxh3") &&
+                     ptr_image_attr(p->image, "ptr:scene_hash");
+    if (!(p->scene = required(p, "ptr:scene", err)) ||
+        !(p->hash = required(p, p->legacy_hash ? "ptr:scene_hash" : "ptr:scene_xxh3", err)) ||
         !(p->seed = required(p, "ptr:seed", err)) || !required(p, "ptr:kernel", err) ||
         !(first = required(p, "ptr:sample_first", err)) ||
         !(samples = required(p, "ptr:samples", err)) || !(depth = required(p, "ptr:max_depth", err)) ||
@@ -112,6 +116,13 @@ static PtrResult check_parts(const Part *parts, int count, PtrError *err)
     const Part *a = &parts[0];
     for (int i = 1; i < count; i++) {
         const Part *b = &parts[i];
+        if (a->legacy_hash != b->legacy_hash) {
+            const Part *older = a->legacy_hash ? a : b, *newer = a->legacy_hash ? b : a;
+            return ptr_error_set(err, PTR_ERR_USAGE,
+                                 "%s: written by an older ptr than %s (its scene fingerprinted "
+                                 "as ptr:scene_hash, not ptr:scene_xxh3): render it again to "
+                                 "merge them", older->path, newer->path);
+        }
         const char *what = strcmp(a->hash, b->hash)    ? "scene"
                            : strcmp(a->seed, b->seed) ? "seed"
                            : a->max_depth != b->max_depth ? "depth limit"
@@ -232,6 +243,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     const PtrImageLayout full = { w, h, 0, 0, w, h };
     PtrOutputInfo info = {
         .scene_path = parts[0].scene, .scene_hash = strtoull(parts[0].hash, NULL, 16),
+        .legacy_scene_hash = parts[0].legacy_hash,
         .kernel = report->kernel, .accel = report->accel, .spheres = report->spheres,
         .sample_first = (uint32_t)first, .samples = (uint32_t)fewest,
         .seed = report->seed, .max_depth = (int)parts[0].max_depth,

@@ -6,6 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* xxHash's functions compiled here from its header (libxxhash-dev), as its
+ * documentation offers: nothing to link, in libptr.a too. */
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
 #include "base/memory.h"
 
 void ptr_scene_init(PtrScene *scene)
@@ -348,39 +353,59 @@ void ptr_huge_file_order(PtrHugeChoice *c)
     }
 }
 
-/* FNV-1a over the bytes of the values, field by field (never over structure
- * padding). */
-static uint64_t hash_bytes(uint64_t h, const void *data, size_t size)
+/* The scene's bytes, value by value (never structure padding), through
+ * XXH3 (64 bits) as one stream: how the updates cut the stream changes
+ * nothing. */
+static void hash_bytes(XXH3_state_t *h, const void *data, size_t size)
 {
-    const unsigned char *p = data;
-    for (size_t i = 0; i < size; i++)
-        h = (h ^ p[i]) * UINT64_C(0x100000001b3);
-    return h;
+    (void)XXH3_64bits_update(h, data, size);
 }
 
-static uint64_t hash_vec(uint64_t h, PtrVec3 v)
+static void hash_vec(XXH3_state_t *h, PtrVec3 v)
 {
     const float f[3] = { v.x, v.y, v.z };
-    return hash_bytes(h, f, sizeof f);
+    hash_bytes(h, f, sizeof f);
 }
 
-/* The entries (size bytes each) of a per-sphere array in file order: by_id[k]
- * is the position of the sphere whose id is k (NULL: the arrays are in file
- * order). */
-static uint64_t hash_in_file_order(uint64_t h, const void *array, size_t size,
-                                   const uint32_t *by_id, size_t count)
+/* Entries gathered into the stream at a time: one update a block, not one
+ * an entry. */
+enum { GATHER = 4096 };
+
+/* The entries (size bytes each, at most 8) of a per-sphere array in file
+ * order: by_id[k] is the position of the sphere whose id is k (NULL: the
+ * arrays are in file order). */
+static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
+                               const uint32_t *by_id, size_t count)
 {
     const unsigned char *a = array;
-    if (!by_id)
-        return hash_bytes(h, a, count * size);
-    for (size_t k = 0; k < count; k++)
-        h = hash_bytes(h, a + by_id[k] * size, size);
-    return h;
+    if (!by_id) {
+        hash_bytes(h, a, count * size);
+        return;
+    }
+    unsigned char block[GATHER * 8];
+    for (size_t k = 0; k < count; k += GATHER) {
+        const size_t n = count - k < GATHER ? count - k : GATHER;
+        for (size_t j = 0; j < n; j++)
+            memcpy(&block[j * size], a + by_id[k + j] * size, size);
+        hash_bytes(h, block, n * size);
+    }
+}
+
+/* Each sphere's material in file order, as a 4-byte index whatever its
+ * size in the arrays. */
+static void hash_materials(XXH3_state_t *h, const PtrSpheres *s, const uint32_t *by_id)
+{
+    uint32_t block[GATHER];
+    for (size_t k = 0; k < s->count; k += GATHER) {
+        const size_t n = s->count - k < GATHER ? s->count - k : GATHER;
+        for (size_t j = 0; j < n; j++)
+            block[j] = ptr_sphere_material(s, by_id ? by_id[k + j] : k + j);
+        hash_bytes(h, block, n * sizeof *block);
+    }
 }
 
 PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
 {
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
     const PtrSpheres *s = &scene->spheres;
     /* In the file's order, through the ids where the importer put the huge
      * spheres last (the renderer hashes before the build, while nothing
@@ -397,45 +422,47 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     }
     for (size_t j = 0; by_id && j < s->count; j++)
         by_id[s->id[j]] = (uint32_t)j;
-    h = hash_bytes(h, scene->origin, sizeof scene->origin);
-    h = hash_bytes(h, &s->count, sizeof s->count);
-    h = hash_in_file_order(h, s->cx, sizeof *s->cx, by_id, s->count);
-    h = hash_in_file_order(h, s->cy, sizeof *s->cy, by_id, s->count);
-    h = hash_in_file_order(h, s->cz, sizeof *s->cz, by_id, s->count);
-    h = hash_in_file_order(h, s->radius, sizeof *s->radius, by_id, s->count);
-    for (size_t k = 0; k < s->count; k++) { /* as 4-byte indices, whatever their size */
-        const uint32_t m = ptr_sphere_material(s, by_id ? by_id[k] : k);
-        h = hash_bytes(h, &m, sizeof m);
-    }
+    XXH3_state_t h;
+    (void)XXH3_64bits_reset(&h);
+    hash_bytes(&h, scene->origin, sizeof scene->origin);
+    hash_bytes(&h, &s->count, sizeof s->count);
+    hash_in_file_order(&h, s->cx, sizeof *s->cx, by_id, s->count);
+    hash_in_file_order(&h, s->cy, sizeof *s->cy, by_id, s->count);
+    hash_in_file_order(&h, s->cz, sizeof *s->cz, by_id, s->count);
+    hash_in_file_order(&h, s->radius, sizeof *s->radius, by_id, s->count);
+    hash_materials(&h, s, by_id);
 #define HASH_ATTRIBUTE(name, type, per_sphere, none)                                       \
     if (s->name)                                                                           \
-        h = hash_in_file_order(h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
+        hash_in_file_order(&h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
     PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)
 #undef HASH_ATTRIBUTE
     free(by_id);
-    h = hash_bytes(h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
+    hash_bytes(&h, scene->huge.centre_radius, 4 * scene->huge.count * sizeof(double));
     for (size_t i = 0; i < scene->material_count; i++) {
         const PtrMaterial *m = &scene->materials[i];
         const int kind = m->kind;
         const float scalars[2] = { m->fuzz, m->ior };
-        h = hash_bytes(h, &kind, sizeof kind);
-        h = hash_vec(hash_vec(h, m->albedo), m->emission);
-        h = hash_bytes(h, scalars, sizeof scalars);
+        hash_bytes(&h, &kind, sizeof kind);
+        hash_vec(&h, m->albedo);
+        hash_vec(&h, m->emission);
+        hash_bytes(&h, scalars, sizeof scalars);
     }
     const PtrCamera *c = &scene->camera;
     const float lens[4] = { c->vfov_deg, c->aperture, c->focus_distance, c->aspect };
-    h = hash_vec(hash_vec(hash_vec(h, c->lookfrom), c->lookat), c->up);
-    h = hash_bytes(h, lens, sizeof lens);
-    /* Only an orthographic camera adds its projection: a perspective scene
-     * keeps the fingerprint it had before there were projections, so parts
-     * rendered by either build still merge. */
+    hash_vec(&h, c->lookfrom);
+    hash_vec(&h, c->lookat);
+    hash_vec(&h, c->up);
+    hash_bytes(&h, lens, sizeof lens);
+    const int projection = c->projection;
+    hash_bytes(&h, &projection, sizeof projection);
     if (c->projection == PTR_PROJECTION_ORTHOGRAPHIC) {
         const float ortho[2] = { c->ymag, c->znear };
-        h = hash_bytes(h, ortho, sizeof ortho);
+        hash_bytes(&h, ortho, sizeof ortho);
     }
     const int sky = scene->sky.kind;
-    h = hash_bytes(h, &sky, sizeof sky);
-    *hash = hash_vec(h, scene->sky.radiance);
+    hash_bytes(&h, &sky, sizeof sky);
+    hash_vec(&h, scene->sky.radiance);
+    *hash = XXH3_64bits_digest(&h);
     return PTR_OK;
 }
 

@@ -398,7 +398,7 @@ static void test_bad_camera(void)
     CHECK(scene == NULL);
 }
 
-/* The scene_hash a render of scene saves with options. */
+/* The scene's fingerprint a render of scene saves with options. */
 static uint64_t saved_hash(PtrSceneHandle *scene, const PtrRenderOptions *options)
 {
     PtrFrame *frame = NULL;
@@ -412,7 +412,7 @@ static uint64_t saved_hash(PtrSceneHandle *scene, const PtrRenderOptions *option
     uint64_t hash = 0;
     if (test_image_read(exr, &image, NULL) != PTR_OK)
         return 0;
-    const char *text = ptr_image_attr(image, "ptr:scene_hash");
+    const char *text = ptr_image_attr(image, "ptr:scene_xxh3");
     CHECK(text != NULL);
     if (text)
         hash = strtoull(text, NULL, 16);
@@ -567,7 +567,7 @@ static void denoised(PtrRenderOptions *o) { o->denoise = "fast"; }
 static void test_region_budget_denoise_as_command_line(void)
 {
     static const char *const attrs[] = {
-        "ptr:scene", "ptr:scene_hash", "ptr:samples", "ptr:interrupted", "ptr:kernel",
+        "ptr:scene", "ptr:scene_xxh3", "ptr:samples", "ptr:interrupted", "ptr:kernel",
         "ptr:accel", "ptr:spheres", "ptr:denoised", "ptr:view", "ptr:exposure", NULL,
     };
     struct {

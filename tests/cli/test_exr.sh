@@ -31,10 +31,13 @@ if [ "${3:-}" = --write-fixtures ]; then
     exit 1
 fi
 
-# What OpenImageIO reads of a file's header, less what changes between runs.
+# What OpenImageIO reads of a file's header, less what changes between runs
+# and the scene's fingerprint, which the fixtures record as ptr did before
+# (ptr:scene_hash, FNV-1a; now ptr:scene_xxh3).
 header() {
     iinfo -v "$1" | tail -n +2 |
-        grep -v -e DateTime -e '_seconds:' -e 'ptr:kernel:' -e 'Software:'
+        grep -v -e DateTime -e '_seconds:' -e 'ptr:kernel:' -e 'Software:' \
+            -e 'ptr:scene_hash:' -e 'ptr:scene_xxh3:'
 }
 
 render_cases "$dir" || fail "render: exit code $?"
@@ -48,6 +51,8 @@ for file in "$fixtures"/*.exr; do
         fail "$name: the header reads differently: $(cat "$dir/diff")"
     iinfo -v "$dir/$name" | grep -q 'Software: "ptr ' || fail "$name: no Software attribute"
     iinfo -v "$dir/$name" | grep -q 'DateTime: "' || fail "$name: no DateTime attribute"
+    iinfo -v "$dir/$name" | grep -q 'ptr:scene_xxh3: "[0-9a-f]\{16\}"' ||
+        fail "$name: no ptr:scene_xxh3 attribute"
 done
 
 # Parts written by the OpenImageIO build merge into the render of all samples.
@@ -57,6 +62,20 @@ done
     fail "merge of new parts: exit code $?"
 idiff -q -a -fail 0 -failpercent 0 "$dir/merged.exr" "$dir/merged_new.exr" >/dev/null 2>&1 ||
     fail "old parts merge to other pixels than new ones"
+# Old parts merged keep their fingerprint under its own name.
+old_hash=$(iinfo -v "$fixtures/part0.exr" | grep 'ptr:scene_hash:')
+[ -n "$old_hash" ] && [ "$(iinfo -v "$dir/merged.exr" | grep 'ptr:scene_hash:')" = "$old_hash" ] &&
+    ! iinfo -v "$dir/merged.exr" | grep -q 'ptr:scene_xxh3:' ||
+    fail "old parts merged: not their own ptr:scene_hash"
+# An old part beside a new one cannot be matched to its scene: refused, one
+# line naming the old part, no output.
+"$ptr" merge "$dir/part0.exr" "$fixtures/part1.exr" -o "$dir/mixed.exr" --quiet 2>"$dir/err"
+code=$?
+[ $code = 2 ] || fail "merge of an old part with a new one: exit code $code, not 2"
+[ "$(wc -l <"$dir/err")" = 1 ] &&
+    grep -q "^ptr: $fixtures/part1.exr: written by an older ptr than $dir/part0.exr" "$dir/err" ||
+    fail "merge of an old part with a new one: not one line naming the old part: $(cat "$dir/err")"
+[ ! -e "$dir/mixed.exr" ] || fail "merge of an old part with a new one wrote an output"
 
 # Broken parts: exit 2 and one line naming the file, the output untouched.
 : >"$dir/empty.exr"

@@ -35,7 +35,7 @@ for scene in $scenes; do
         iinfo -v "$dir/$name-$accel.exr" | grep -q "ptr:accel: \"$accel\"" ||
             fail "$name: no ptr:accel \"$accel\" in the metadata"
     done
-    hashes=$(for accel in brute bvh; do iinfo -v "$dir/$name-$accel.exr" | grep scene_hash; done | sort -u | wc -l)
+    hashes=$(for accel in brute bvh; do iinfo -v "$dir/$name-$accel.exr" | grep scene_xxh3; done | sort -u | wc -l)
     [ "$hashes" = 1 ] || fail "$name: the scene hash depends on the structure"
 done
 # A part rendered with the tree merges with one rendered by brute force (the
