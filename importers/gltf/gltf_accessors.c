@@ -45,8 +45,15 @@ void gltf_element(const GltfAccessor *a, size_t i, double out[4])
 {
     const unsigned char *p = a->data + i * a->stride;
     if (a->component_type == GLTF_FLOAT) { /* the common case, without a switch a component */
+        /* Copies of a size the compiler knows are moves of registers; one
+         * of a size it does not is a call to memmove an element. */
         float f[4] = { 0, 0, 0, 0 };
-        memcpy(f, p, (size_t)a->components * sizeof *f);
+        switch (a->components) {
+        case 1: memcpy(f, p, 1 * sizeof *f); break;
+        case 2: memcpy(f, p, 2 * sizeof *f); break;
+        case 3: memcpy(f, p, 3 * sizeof *f); break;
+        case 4: memcpy(f, p, 4 * sizeof *f); break;
+        }
         for (int c = 0; c < 4; c++)
             out[c] = f[c];
         return;
