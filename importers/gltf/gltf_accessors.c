@@ -46,7 +46,7 @@ void gltf_element(const GltfAccessor *a, size_t i, double out[4])
     const unsigned char *p = a->data + i * a->stride;
     if (a->component_type == GLTF_FLOAT) { /* the common case, without a switch a component */
         /* Copies of a size the compiler knows are moves of registers; one
-         * of a size it does not is a call to memmove an element. */
+         * of a size it does not is a call to memcpy an element. */
         float f[4] = { 0, 0, 0, 0 };
         switch (a->components) {
         case 1: memcpy(f, p, 1 * sizeof *f); break;

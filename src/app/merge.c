@@ -109,20 +109,39 @@ static int overlap(const PtrImageLayout *a, const PtrImageLayout *b)
            b->y < a->y + a->height;
 }
 
+/* Parts of builds that fingerprint scenes two ways cannot be told parts of
+ * one scene: the older ones are to be rendered again, the first named. */
+static PtrResult check_fingerprints(const Part *parts, int count, PtrError *err)
+{
+    const Part *older = NULL, *newer = NULL;
+    int older_count = 0;
+    for (int i = 0; i < count; i++) {
+        const Part *p = &parts[i];
+        older_count += p->legacy_hash;
+        if (p->legacy_hash && !older)
+            older = p;
+        if (!p->legacy_hash && !newer)
+            newer = p;
+    }
+    if (!older || !newer)
+        return PTR_OK;
+    return ptr_error_set(err, PTR_ERR_USAGE,
+                         "%s: written by an older ptr than %s (its scene fingerprinted as "
+                         "ptr:scene_hash, not ptr:scene_xxh3), as are %d of the %d parts: "
+                         "render those again to merge them",
+                         older->path, newer->path, older_count, count);
+}
+
 /* Parts must come from one render, and never hold the same sample of the
  * same pixel twice. */
 static PtrResult check_parts(const Part *parts, int count, PtrError *err)
 {
+    PtrResult res = check_fingerprints(parts, count, err);
+    if (res != PTR_OK)
+        return res;
     const Part *a = &parts[0];
     for (int i = 1; i < count; i++) {
         const Part *b = &parts[i];
-        if (a->legacy_hash != b->legacy_hash) {
-            const Part *older = a->legacy_hash ? a : b, *newer = a->legacy_hash ? b : a;
-            return ptr_error_set(err, PTR_ERR_USAGE,
-                                 "%s: written by an older ptr than %s (its scene fingerprinted "
-                                 "as ptr:scene_hash, not ptr:scene_xxh3): render it again to "
-                                 "merge them", older->path, newer->path);
-        }
         const char *what = strcmp(a->hash, b->hash)    ? "scene"
                            : strcmp(a->seed, b->seed) ? "seed"
                            : a->max_depth != b->max_depth ? "depth limit"

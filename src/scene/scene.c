@@ -10,6 +10,9 @@
  * documentation offers: nothing to link, in libptr.a too. */
 #define XXH_INLINE_ALL
 #include <xxhash.h>
+#if XXH_VERSION_NUMBER < 800
+#error "ptr needs xxHash 0.8 or later: XXH3's values are fixed from 0.8 on"
+#endif
 
 #include "base/memory.h"
 
@@ -367,13 +370,14 @@ static void hash_vec(XXH3_state_t *h, PtrVec3 v)
     hash_bytes(h, f, sizeof f);
 }
 
-/* Entries gathered into the stream at a time: one update a block, not one
- * an entry. */
-enum { GATHER = 4096 };
+/* Entries gathered into the stream at a time, of at most GATHER_ENTRY
+ * bytes each (PTR_SPHERE_ATTRIBUTES' are checked below): one update a
+ * block, not one an entry, in 8 KB of the caller's stack. */
+enum { GATHER = 1024, GATHER_ENTRY = 8 };
 
-/* The entries (size bytes each, at most 8) of a per-sphere array in file
- * order: by_id[k] is the position of the sphere whose id is k (NULL: the
- * arrays are in file order). */
+/* The entries (size bytes each) of a per-sphere array in file order:
+ * by_id[k] is the position of the sphere whose id is k (NULL: the arrays
+ * are in file order). */
 static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
                                const uint32_t *by_id, size_t count)
 {
@@ -382,7 +386,7 @@ static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
         hash_bytes(h, a, count * size);
         return;
     }
-    unsigned char block[GATHER * 8];
+    unsigned char block[GATHER * GATHER_ENTRY];
     for (size_t k = 0; k < count; k += GATHER) {
         const size_t n = count - k < GATHER ? count - k : GATHER;
         for (size_t j = 0; j < n; j++)
@@ -432,6 +436,7 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     hash_in_file_order(&h, s->radius, sizeof *s->radius, by_id, s->count);
     hash_materials(&h, s, by_id);
 #define HASH_ATTRIBUTE(name, type, per_sphere, none)                                       \
+    _Static_assert((per_sphere) * sizeof(type) <= GATHER_ENTRY, #name " is gathered whole"); \
     if (s->name)                                                                           \
         hash_in_file_order(&h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
     PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)

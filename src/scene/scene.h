@@ -273,10 +273,11 @@ static inline PtrVec3 ptr_sphere_centre(const PtrSpheres *s, size_t i)
 /* In *hash, a 64-bit fingerprint of everything in the scene that shapes an
  * image (spheres, materials, camera, sky, origin), the spheres taken in the
  * file's order: parts of one render match, parts of different scenes almost
- * surely do not. XXH3 (64 bits) of those values' bytes, recorded in
- * images as ptr:scene_xxh3 (docs/distributed.md says what came before). Taken before the tree's build (as the renderer does), whose
- * order it does not know. PTR_ERR_NOMEM if the file's order, where the
- * arrays are not in it, cannot be held: never another fingerprint. */
+ * surely do not. XXH3 (64 bits) of those values' bytes, recorded in images
+ * as ptr:scene_xxh3 (docs/distributed.md says what came before). Taken
+ * before the tree's build (as the renderer does), whose order it does not
+ * know. PTR_ERR_NOMEM if the file's order, where the arrays are not in it,
+ * cannot be held: never another fingerprint. */
 PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err);
 
 /* The gradient sky's radiance along a unit direction. */

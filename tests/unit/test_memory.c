@@ -227,27 +227,48 @@ static size_t mapped_bytes(void)
 
 /* The hash takes the spheres in the file's order: a scene whose first
  * sphere the importer put last (its id saying so) hashes as the same scene
- * in order; and where that order cannot be allocated, the hash fails with
- * PTR_ERR_NOMEM instead of giving a fingerprint of the arrays' order. */
+ * in order, its materials (two bytes each: more than 256) and colours too,
+ * over a last block of the gather cut short; a sphere's other material or
+ * colour makes another fingerprint; and where that order cannot be
+ * allocated, the hash fails with PTR_ERR_NOMEM instead of giving a
+ * fingerprint of the arrays' order. */
 static void test_hash_in_file_order(void)
 {
-    enum { COUNT = 1 << 22 }; /* 16 MB of order: more than the limit leaves */
+    enum {
+        COUNT = (1 << 22) + 37, /* 16 MB of order: more than the limit leaves */
+        MATERIALS = 300,
+    };
     PtrScene in_order, reordered;
     ptr_scene_init(&in_order);
     ptr_scene_init(&reordered);
+    for (int m = 0; m < MATERIALS; m++) {
+        const PtrMaterial material = { .kind = PTR_MATERIAL_DIFFUSE,
+                                       .albedo = v3((float)m / MATERIALS, 0.5f, 0.5f) };
+        uint32_t index;
+        CHECK_INT(ptr_scene_add_material(&in_order, &material, &index, NULL), PTR_OK);
+        CHECK_INT(ptr_scene_add_material(&reordered, &material, &index, NULL), PTR_OK);
+    }
     CHECK_INT(ptr_spheres_resize(&in_order.spheres, COUNT, NULL), PTR_OK);
     CHECK_INT(ptr_spheres_resize(&reordered.spheres, COUNT, NULL), PTR_OK);
     CHECK_INT(ptr_spheres_make_ids(&reordered.spheres, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_make(&in_order.spheres, (void **)&in_order.spheres.color, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_make(&reordered.spheres, (void **)&reordered.spheres.color, NULL),
+              PTR_OK);
+    CHECK_INT((int)in_order.spheres.material_size, 2);
     for (size_t i = 0; i < COUNT; i++) {
         const size_t file = (i + 1) % COUNT; /* sphere 0 of the file last */
         PtrSpheres *a = &in_order.spheres, *b = &reordered.spheres;
         a->cx[i] = a->cy[i] = a->cz[i] = (float)i;
         a->radius[i] = i ? 1.0f : 1000.0f;
-        ptr_sphere_set_material(a, i, 0);
+        ptr_sphere_set_material(a, i, (uint32_t)(i % MATERIALS));
         b->cx[i] = b->cy[i] = b->cz[i] = (float)file;
         b->radius[i] = file ? 1.0f : 1000.0f;
-        ptr_sphere_set_material(b, i, 0);
+        ptr_sphere_set_material(b, i, (uint32_t)(file % MATERIALS));
         b->id[i] = (uint32_t)file;
+        for (int k = 0; k < 4; k++) {
+            a->color[4 * i + k] = (uint16_t)(i * 4 + (size_t)k);
+            b->color[4 * i + k] = (uint16_t)(file * 4 + (size_t)k);
+        }
     }
     uint64_t expected = 0, hash = 1;
     CHECK_INT(ptr_scene_hash(&in_order, &expected, NULL), PTR_OK);
@@ -266,6 +287,16 @@ static void test_hash_in_file_order(void)
         CHECK_INT(r, PTR_ERR_NOMEM);
         CHECK(hash == 1 && err.code == PTR_ERR_NOMEM && err.message[0]);
     }
+    /* After the limit's case, whose order is the first allocated: glibc
+     * keeps a freed order in its heap for the next. */
+    ptr_sphere_set_material(&reordered.spheres, COUNT - 1, 1); /* the file's first */
+    CHECK_INT(ptr_scene_hash(&reordered, &hash, NULL), PTR_OK);
+    CHECK(hash != expected);
+    ptr_sphere_set_material(&reordered.spheres, COUNT - 1, 0);
+    reordered.spheres.color[4 * (COUNT - 1) + 3] ^= 1;
+    CHECK_INT(ptr_scene_hash(&reordered, &hash, NULL), PTR_OK);
+    CHECK(hash != expected);
+    reordered.spheres.color[4 * (COUNT - 1) + 3] ^= 1;
     ptr_scene_free(&in_order);
     ptr_scene_free(&reordered);
 }
