@@ -56,6 +56,17 @@ static void store3(float out[3], __m128 v)
     memcpy(out, lanes, 3 * sizeof *out);
 }
 
+/* bvh_half_area of the box in the x, y and z lanes of lo and hi: its
+ * arithmetic in its order, (dx dy + dy dz) + dz dx, without storing the
+ * lanes (the sweep over a candidate's bins asks it twice a bin). */
+static inline float half_area4(__m128 lo, __m128 hi)
+{
+    const __m128 d = _mm_sub_ps(hi, lo);
+    const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));
+    return _mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1))) +
+           _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
+}
+
 static int bin_of(const BvhCandidate *c, const BvhPrim *p, int axis)
 {
     float centre = 2.0f * p->centre[axis]; /* the box's lower + upper */
@@ -74,21 +85,34 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
     }
 }
 
+/* A prim's bins on the three axes at once, in k[0 .. 2]: bin_of's
+ * arithmetic lane by lane (the radius lane, scaled by 0, gives bin 0). */
+static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre, int k[4])
+{
+    const __m128 at = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(centre, centre), base), scale);
+    const __m128i bins = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(at, _mm_setzero_ps()), last));
+    _mm_storeu_si128((__m128i *)k, bins);
+}
+
 /* Every stride-th prim of the run. */
 static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stride,
                     const BvhCandidate *c, Bins *b)
 {
+    const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
+    const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
+    const __m128 last = _mm_set1_ps((float)(c->bins - 1));
     for (size_t i = begin; i < end; i += stride) {
         const BvhPrim *p = &set->prims[i];
         /* bvh_prim_box's arithmetic, the radius in the unused lane */
         const __m128 centre = _mm_loadu_ps(p->centre),
                      extent = _mm_set1_ps(bvh_prim_extent(p, set->magnitude));
         const __m128 lower = _mm_sub_ps(centre, extent), upper = _mm_add_ps(centre, extent);
+        int k[4];
+        bins_of(base, scale, last, centre, k);
         for (int a = 0; a < 3; a++) {
-            int k = bin_of(c, p, a);
-            b->lower[a][k] = _mm_min_ps(b->lower[a][k], lower);
-            b->upper[a][k] = _mm_max_ps(b->upper[a][k], upper);
-            b->count[a][k]++;
+            b->lower[a][k[a]] = _mm_min_ps(b->lower[a][k[a]], lower);
+            b->upper[a][k[a]] = _mm_max_ps(b->upper[a][k[a]], upper);
+            b->count[a][k[a]]++;
         }
     }
 }
@@ -228,7 +252,7 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
     }
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
-        float right_lo[BINS][3], right_hi[BINS][3];
+        __m128 right_lo[BINS], right_hi[BINS];
         size_t right_count[BINS];
         __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
         size_t n = 0;
@@ -236,32 +260,29 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
             lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
             hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
             n += bins.count[a][k];
-            store3(right_lo[k], lo4);
-            store3(right_hi[k], hi4);
+            right_lo[k] = lo4;
+            right_hi[k] = hi4;
             right_count[k] = n;
         }
         lo4 = _mm_set1_ps(INFINITY);
         hi4 = _mm_set1_ps(-INFINITY);
         n = 0;
         for (int k = 0; k < c->bins - 1; k++) {
-            float lo[3], hi[3];
             lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
             hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
-            store3(lo, lo4);
-            store3(hi, hi4);
             n += bins.count[a][k];
             if (n == 0 || right_count[k + 1] == 0)
                 continue;
-            float cost = bvh_half_area(lo, hi) * (float)n +
-                         bvh_half_area(right_lo[k + 1], right_hi[k + 1]) * (float)right_count[k + 1];
+            float cost = half_area4(lo4, hi4) * (float)n +
+                         half_area4(right_lo[k + 1], right_hi[k + 1]) * (float)right_count[k + 1];
             if (cost < best) {
                 best = cost;
                 c->axis = a;
                 c->split_bin = k;
-                memcpy(c->left_lower, lo, sizeof lo);
-                memcpy(c->left_upper, hi, sizeof hi);
-                memcpy(c->right_lower, right_lo[k + 1], sizeof lo);
-                memcpy(c->right_upper, right_hi[k + 1], sizeof hi);
+                store3(c->left_lower, lo4);
+                store3(c->left_upper, hi4);
+                store3(c->right_lower, right_lo[k + 1]);
+                store3(c->right_upper, right_hi[k + 1]);
             }
         }
     }
@@ -272,13 +293,15 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
  * split chosen from samples learns its halves' boxes in the pass that moves
  * them, not in one more over all of them. */
 typedef struct SideBoxes {
-    float lower[2][3], upper[2][3];
+    __m128 lower[2], upper[2]; /* x, y, z and an unused lane, as a bin's */
 } SideBoxes;
 
 static void sides_empty(SideBoxes *b)
 {
-    for (int side = 0; side < 2; side++)
-        bounds_empty(b->lower[side], b->upper[side]);
+    for (int side = 0; side < 2; side++) {
+        b->lower[side] = _mm_set1_ps(INFINITY);
+        b->upper[side] = _mm_set1_ps(-INFINITY);
+    }
 }
 
 static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim *p,
@@ -286,9 +309,11 @@ static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim 
 {
     if (!b)
         return;
-    float lower[3], upper[3];
-    bvh_prim_box(p, set->magnitude, lower, upper);
-    bounds_grow(b->lower[side], b->upper[side], lower, upper);
+    /* bvh_prim_box's arithmetic, the radius in the unused lane */
+    const __m128 centre = _mm_loadu_ps(p->centre),
+                 extent = _mm_set1_ps(bvh_prim_extent(p, set->magnitude));
+    b->lower[side] = _mm_min_ps(b->lower[side], _mm_sub_ps(centre, extent));
+    b->upper[side] = _mm_max_ps(b->upper[side], _mm_add_ps(centre, extent));
 }
 
 /* Moves the prims begin .. end - 1 that go left by c's split before those
@@ -450,9 +475,10 @@ static size_t partition(const BvhPrimSet *set, int threads, const BvhCandidate *
     else
         partition_half(&half[1]);
     for (int h = 0; sides && h < 2; h++)
-        for (int side = 0; side < 2; side++)
-            bounds_grow(sides->lower[side], sides->upper[side], half[h].sides.lower[side],
-                        half[h].sides.upper[side]);
+        for (int side = 0; side < 2; side++) {
+            sides->lower[side] = _mm_min_ps(sides->lower[side], half[h].sides.lower[side]);
+            sides->upper[side] = _mm_max_ps(sides->upper[side], half[h].sides.upper[side]);
+        }
     /* [left A | right A | left B | right B]: swap right A with the end of
      * left B, or left B with the start of right A. */
     size_t right_a = mid - half[0].first_right, left_b = half[1].first_right - mid;
@@ -472,13 +498,18 @@ PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, i
      * the bins of one from every prim know them already. */
     const float *box[2][2] = { { NULL, NULL }, { NULL, NULL } };
     SideBoxes sides;
+    float side_box[2][2][3];
     const BvhCandidate whole = *c;
     if (!middle && whole.axis >= 0) {
         mid = partition(set, threads, &whole, scratch, whole.sampled ? &sides : NULL);
         for (int side = 0; side < 2; side++) {
-            box[side][0] = whole.sampled ? sides.lower[side]
+            if (whole.sampled) {
+                store3(side_box[side][0], sides.lower[side]);
+                store3(side_box[side][1], sides.upper[side]);
+            }
+            box[side][0] = whole.sampled ? side_box[side][0]
                                          : side ? whole.right_lower : whole.left_lower;
-            box[side][1] = whole.sampled ? sides.upper[side]
+            box[side][1] = whole.sampled ? side_box[side][1]
                                          : side ? whole.right_upper : whole.left_upper;
         }
     }
