@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <xmmintrin.h> /* SSE, which every x86-64 CPU has */
+#include <emmintrin.h> /* SSE2, which every x86-64 CPU has */
 
 #include "base/threads.h"
 

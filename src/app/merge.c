@@ -127,7 +127,7 @@ static PtrResult check_fingerprints(const Part *parts, int count, PtrError *err)
         return PTR_OK;
     return ptr_error_set(err, PTR_ERR_USAGE,
                          "%s: written by an older ptr than %s (its scene fingerprinted as "
-                         "ptr:scene_hash, not ptr:scene_xxh3), as are %d of the %d parts: "
+                         "ptr:scene_hash, not ptr:scene_xxh3); parts so written: %d of %d: "
                          "render those again to merge them",
                          older->path, newer->path, older_count, count);
 }

@@ -381,6 +381,7 @@ enum { GATHER = 1024, GATHER_ENTRY = 8 };
 static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
                                const uint32_t *by_id, size_t count)
 {
+    assert(size <= GATHER_ENTRY);
     const unsigned char *a = array;
     if (!by_id) {
         hash_bytes(h, a, count * size);

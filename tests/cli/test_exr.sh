@@ -87,9 +87,9 @@ mixed() {
         fail "merge of old and new parts ($*): not one line saying '$expected': $(cat "$dir/err")"
     [ ! -e "$dir/mixed.exr" ] || fail "merge of old and new parts ($*) wrote an output"
 }
-mixed "$fixtures/part1.exr: written by an older ptr than $dir/part0.exr .*, as are 1 of the 2 parts" \
+mixed "$fixtures/part1.exr: written by an older ptr than $dir/part0.exr .*; parts so written: 1 of 2" \
     "$dir/part0.exr" "$fixtures/part1.exr"
-mixed "$fixtures/part0.exr: written by an older ptr than $dir/part1.exr .*, as are 2 of the 3 parts" \
+mixed "$fixtures/part0.exr: written by an older ptr than $dir/part1.exr .*; parts so written: 2 of 3" \
     "$fixtures/part0.exr" "$fixtures/part1.exr" "$dir/part1.exr"
 
 # Broken parts: exit 2 and one line naming the file, the output untouched.
