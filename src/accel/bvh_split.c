@@ -67,6 +67,16 @@ static inline float half_area4(__m128 lo, __m128 hi)
            _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
 }
 
+/* bvh_prim_box in registers: x, y, z and, in the unused lane, the radius
+ * less and plus the extent. */
+static inline void prim_box4(const BvhPrim *p, float magnitude, __m128 *lower, __m128 *upper)
+{
+    const __m128 centre = _mm_loadu_ps(p->centre),
+                 extent = _mm_set1_ps(bvh_prim_extent(p, magnitude));
+    *lower = _mm_sub_ps(centre, extent);
+    *upper = _mm_add_ps(centre, extent);
+}
+
 static int bin_of(const BvhCandidate *c, const BvhPrim *p, int axis)
 {
     float centre = 2.0f * p->centre[axis]; /* the box's lower + upper */
@@ -103,12 +113,10 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stri
     const __m128 last = _mm_set1_ps((float)(c->bins - 1));
     for (size_t i = begin; i < end; i += stride) {
         const BvhPrim *p = &set->prims[i];
-        /* bvh_prim_box's arithmetic, the radius in the unused lane */
-        const __m128 centre = _mm_loadu_ps(p->centre),
-                     extent = _mm_set1_ps(bvh_prim_extent(p, set->magnitude));
-        const __m128 lower = _mm_sub_ps(centre, extent), upper = _mm_add_ps(centre, extent);
+        __m128 lower, upper;
+        prim_box4(p, set->magnitude, &lower, &upper);
         int k[4];
-        bins_of(base, scale, last, centre, k);
+        bins_of(base, scale, last, _mm_loadu_ps(p->centre), k);
         for (int a = 0; a < 3; a++) {
             b->lower[a][k[a]] = _mm_min_ps(b->lower[a][k[a]], lower);
             b->upper[a][k[a]] = _mm_max_ps(b->upper[a][k[a]], upper);
@@ -309,11 +317,10 @@ static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim 
 {
     if (!b)
         return;
-    /* bvh_prim_box's arithmetic, the radius in the unused lane */
-    const __m128 centre = _mm_loadu_ps(p->centre),
-                 extent = _mm_set1_ps(bvh_prim_extent(p, set->magnitude));
-    b->lower[side] = _mm_min_ps(b->lower[side], _mm_sub_ps(centre, extent));
-    b->upper[side] = _mm_max_ps(b->upper[side], _mm_add_ps(centre, extent));
+    __m128 lower, upper;
+    prim_box4(p, set->magnitude, &lower, &upper);
+    b->lower[side] = _mm_min_ps(b->lower[side], lower);
+    b->upper[side] = _mm_max_ps(b->upper[side], upper);
 }
 
 /* Moves the prims begin .. end - 1 that go left by c's split before those
