@@ -198,33 +198,37 @@ static void keep_output_rows(void *arg, size_t from, size_t to)
     }
 }
 
-/* Runs the network on one tile into job->result. */
-static PtrResult filter_tile(const PtrUnet *unet, TileJob *job, int threads, PtrError *err)
+/* Runs the network on one tile into job->result, its maps from maps. */
+static PtrResult filter_tile(const PtrUnet *unet, PtrUnetMaps *maps, TileJob *job, int threads,
+                             PtrError *err)
 {
     size_t w = round_up16(job->x.size), h = round_up16(job->y.size);
-    float *input = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
-    float *output = ptr_unet_map_new(w, h, PTR_CONV_BLOCK);
+    float *input = ptr_unet_map_take(maps, w, h, PTR_CONV_BLOCK);
+    float *output = ptr_unet_map_take(maps, w, h, PTR_CONV_BLOCK);
     PtrResult res = PTR_ERR_NOMEM;
     if (input && output) {
+        /* The pixels past the image, up to a multiple of 16, are zeros. */
+        memset(input, 0, (w + 2) * (h + 2) * PTR_CONV_BLOCK * sizeof *input);
         job->map_width = w;
         job->map = input;
         ptr_parallel_ranges(threads, 0, job->y.size, fill_input_rows, job);
-        res = ptr_unet_run(unet, input, w, h, threads, output, err);
+        res = ptr_unet_run(unet, maps, input, w, h, threads, output, err);
         job->map = output;
         if (res == PTR_OK)
             ptr_parallel_ranges(threads, job->y.out_begin, job->y.out_end, keep_output_rows, job);
     } else {
         ptr_error_set(err, res, "out of memory for the denoiser's tile of %zux%zu pixels", w, h);
     }
-    free(input);
-    free(output);
+    ptr_unet_map_give(maps, input);
+    ptr_unet_map_give(maps, output);
     return res;
 }
 
 /* Runs the network over the image, tile by tile, into result (RGB, the
- * image's size). */
-static PtrResult filter_image(const PtrUnet *unet, Mode mode, const PtrDenoiseInput *input,
-                              size_t tile, int threads, float *result, PtrError *err)
+ * image's size), its maps from maps. */
+static PtrResult filter_image(const PtrUnet *unet, PtrUnetMaps *maps, Mode mode,
+                              const PtrDenoiseInput *input, size_t tile, int threads,
+                              float *result, PtrError *err)
 {
     size_t width = input->width, height = input->height;
     TileJob job = { .input = input, .mode = mode, .result = result };
@@ -237,7 +241,7 @@ static PtrResult filter_image(const PtrUnet *unet, Mode mode, const PtrDenoiseIn
         for (size_t i = 0; res == PTR_OK && i < columns; i++) {
             job.y = tile_span(height, tile, rows, j);
             job.x = tile_span(width, tile, columns, i);
-            res = filter_tile(unet, &job, threads, err);
+            res = filter_tile(unet, maps, &job, threads, err);
         }
     return res;
 }
@@ -262,25 +266,33 @@ PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *
         return ptr_error_set(err, PTR_ERR_NOMEM, "an image of %zux%zu pixels is too large",
                              input->width, input->height);
     float *result = malloc(pixels * (guides ? 9 : 3) * sizeof(float));
-    if (!result)
+    /* The feature maps of every tile and network: each tile's are the
+     * memory of the tile before (ptr_unet_maps_new says why). */
+    PtrUnetMaps *maps = ptr_unet_maps_new();
+    if (!result || !maps) {
+        free(result);
+        ptr_unet_maps_free(maps);
         return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the denoised image");
+    }
     PtrDenoiseInput clean = *input;
     PtrResult res = PTR_OK;
     if (guides) {
         clean.albedo = result + pixels * 3;
         clean.normal = result + pixels * 6;
         clean.albedo_stride = clean.normal_stride = 3;
-        res = filter_image(denoiser->albedo, MODE_ALBEDO, input, tile, threads,
+        res = filter_image(denoiser->albedo, maps, MODE_ALBEDO, input, tile, threads,
                            (float *)clean.albedo, err);
         if (res == PTR_OK)
-            res = filter_image(denoiser->normal, MODE_NORMAL, input, tile, threads,
+            res = filter_image(denoiser->normal, maps, MODE_NORMAL, input, tile, threads,
                                (float *)clean.normal, err);
     }
     if (res == PTR_OK)
-        res = filter_image(denoiser->color, MODE_COLOR, &clean, tile, threads, result, err);
+        res = filter_image(denoiser->color, maps, MODE_COLOR, &clean, tile, threads, result,
+                           err);
     if (res == PTR_OK)
         for (size_t p = 0; p < pixels; p++)
             memcpy(out + p * out_stride, result + p * 3, 3 * sizeof(float));
+    ptr_unet_maps_free(maps);
     free(result);
     return res;
 }

@@ -55,8 +55,9 @@ PtrResult ptr_denoise(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
  * which overlap by PTR_DENOISE_OVERLAP pixels, more than half the receptive
  * field of the larger networks (202 pixels), and start at multiples of 16:
  * each output pixel is computed from the same values in the same order as
- * in one tile of the whole image, so the tiles bound memory (about 420 MB
- * for the default network, 500 MB for the large) without changing a bit of
+ * in one tile of the whole image, so the tiles bound memory (the maps of a
+ * tile: at most about 450 MB alive at once for the default network, 550 MB
+ * for the large, 500 and 870 MB kept for reuse) without changing a bit of
  * the result. The tiling depends only on the image's size. */
 enum { PTR_DENOISE_TILE = 768, PTR_DENOISE_OVERLAP = 112 };
 

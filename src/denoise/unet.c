@@ -45,9 +45,90 @@ static float *zeroed_floats(size_t count)
     return p;
 }
 
-float *ptr_unet_map_new(size_t width, size_t height, size_t channels)
+/* A map of the set: its floats, their count, and whether it is taken. */
+typedef struct Map {
+    float *floats;
+    size_t count;
+    int taken;
+} Map;
+
+struct PtrUnetMaps {
+    Map *map;
+    size_t count, room;
+};
+
+PtrUnetMaps *ptr_unet_maps_new(void)
 {
-    return zeroed_floats((width + 2) * (height + 2) * channels);
+    return calloc(1, sizeof(PtrUnetMaps));
+}
+
+void ptr_unet_maps_free(PtrUnetMaps *maps)
+{
+    if (!maps)
+        return;
+    for (size_t i = 0; i < maps->count; i++)
+        free(maps->map[i].floats);
+    free(maps->map);
+    free(maps);
+}
+
+/* Zeroes the border of a map of width x height pixels of channels. */
+static void zero_border(float *map, size_t width, size_t height, size_t channels)
+{
+    const size_t row = (width + 2) * channels;
+    memset(map, 0, row * sizeof *map);
+    memset(map + (height + 1) * row, 0, row * sizeof *map);
+    for (size_t y = 1; y <= height; y++) {
+        memset(map + y * row, 0, channels * sizeof *map);
+        memset(map + y * row + (width + 1) * channels, 0, channels * sizeof *map);
+    }
+}
+
+float *ptr_unet_map_take(PtrUnetMaps *maps, size_t width, size_t height, size_t channels)
+{
+    const size_t count = (width + 2) * (height + 2) * channels;
+    Map *best = NULL, *largest = NULL; /* of the free maps: the least that fits, the largest */
+    for (size_t i = 0; i < maps->count; i++) {
+        Map *m = &maps->map[i];
+        if (m->taken)
+            continue;
+        if (m->count >= count && (!best || m->count < best->count))
+            best = m;
+        if (!largest || m->count > largest->count)
+            largest = m;
+    }
+    if (!best) {
+        /* None fits: the largest free map gives way to a larger one, so that
+         * the set holds no more maps than a tile has at once. */
+        if (largest) {
+            free(largest->floats);
+            *largest = maps->map[--maps->count];
+        }
+        if (maps->count == maps->room) {
+            const size_t room = maps->room ? 2 * maps->room : 16;
+            Map *grown = realloc(maps->map, room * sizeof *grown);
+            if (!grown)
+                return NULL;
+            maps->map = grown;
+            maps->room = room;
+        }
+        const size_t bytes = (count * sizeof(float) + 63) / 64 * 64;
+        float *floats = aligned_alloc(64, bytes ? bytes : 64);
+        if (!floats)
+            return NULL;
+        best = &maps->map[maps->count++];
+        *best = (Map){ floats, count, 0 };
+    }
+    best->taken = 1;
+    zero_border(best->floats, width, height, channels);
+    return best->floats;
+}
+
+void ptr_unet_map_give(PtrUnetMaps *maps, float *map)
+{
+    for (size_t i = 0; map && i < maps->count; i++)
+        if (maps->map[i].floats == map)
+            maps->map[i].taken = 0;
 }
 
 /* The archive and where the build has come to: the channels of the map the
@@ -256,15 +337,16 @@ static void run_upsample_rows(void *arg, size_t y0, size_t y1)
 /* What the steps of one tile's run share. */
 typedef struct Run {
     const PtrUnet *unet;
+    PtrUnetMaps *maps;
     int threads;
     PtrError *err;
 } Run;
 
-/* A new zeroed map of width x height x channels, or NULL (with the error
- * set) when memory runs out. */
+/* A map of width x height x channels, its border zero, or NULL (with the
+ * error set) when memory runs out. */
 static float *new_map(Run *run, size_t width, size_t height, size_t channels)
 {
-    float *map = ptr_unet_map_new(width, height, channels);
+    float *map = ptr_unet_map_take(run->maps, width, height, channels);
     if (!map)
         ptr_error_set(run->err, PTR_ERR_NOMEM,
                       "out of memory for the denoiser's feature maps (%zux%zu pixels)", width,
@@ -309,10 +391,10 @@ static float *upsample_concat(Run *run, const float *src, size_t channels, const
     return out;
 }
 
-PtrResult ptr_unet_run(const PtrUnet *unet, const float *input, size_t width, size_t height,
-                       int threads, float *output, PtrError *err)
+PtrResult ptr_unet_run(const PtrUnet *unet, PtrUnetMaps *maps, const float *input, size_t width,
+                       size_t height, int threads, float *output, PtrError *err)
 {
-    Run run = { unet, threads, err };
+    Run run = { unet, maps, threads, err };
     /* pools[k], k = 1 to 4: the map pooled to level k, kept for the decoder;
      * src: the map the next step reads, which owned holds when it is not
      * the input, a pooled map or the output. */
@@ -326,26 +408,26 @@ PtrResult ptr_unet_run(const PtrUnet *unet, const float *input, size_t width, si
             float *joined = upsample_concat(&run, src, unet->conv[l - 1].out,
                                             c->concat ? pools[c->concat] : input,
                                             c->concat_channels, w, h);
-            free(owned);
+            ptr_unet_map_give(maps, owned);
             src = owned = joined;
             if (!joined)
                 break;
         }
         float *out = conv(&run, l, src, w, h, last ? output : NULL);
-        free(owned);
+        ptr_unet_map_give(maps, owned);
         owned = last ? NULL : out;
         if (!(src = out))
             break;
         if (c->pool) {
             pools[c->pool] = pool(&run, src, c->out, w, h);
-            free(owned);
+            ptr_unet_map_give(maps, owned);
             owned = NULL;
             if (!(src = pools[c->pool]))
                 break;
         }
     }
-    free(owned);
+    ptr_unet_map_give(maps, owned);
     for (int k = 1; k <= 4; k++)
-        free(pools[k]);
+        ptr_unet_map_give(maps, pools[k]);
     return src == output ? PTR_OK : PTR_ERR_NOMEM;
 }
