@@ -207,7 +207,10 @@ static PtrResult filter_tile(const PtrUnet *unet, PtrUnetMaps *maps, TileJob *jo
     float *output = ptr_unet_map_take(maps, w, h, PTR_CONV_BLOCK);
     PtrResult res = PTR_ERR_NOMEM;
     if (input && output) {
-        /* The pixels past the image, up to a multiple of 16, are zeros. */
+        /* The pixels past the image, up to a multiple of 16, and the
+         * channels past the 3 or 9 the transfer writes, are zeros: the
+         * convolution reads them with weights of zero, and NaN times zero
+         * is NaN. */
         memset(input, 0, (w + 2) * (h + 2) * PTR_CONV_BLOCK * sizeof *input);
         job->map_width = w;
         job->map = input;
@@ -267,7 +270,7 @@ PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *
                              input->width, input->height);
     float *result = malloc(pixels * (guides ? 9 : 3) * sizeof(float));
     /* The feature maps of every tile and network: each tile's are the
-     * memory of the tile before (ptr_unet_maps_new says why). */
+     * memory of the tile before (PtrUnetMaps, unet.h, says why). */
     PtrUnetMaps *maps = ptr_unet_maps_new();
     if (!result || !maps) {
         free(result);

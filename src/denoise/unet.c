@@ -344,7 +344,7 @@ typedef struct Run {
 
 /* A map of width x height x channels, its border zero, or NULL (with the
  * error set) when memory runs out. */
-static float *new_map(Run *run, size_t width, size_t height, size_t channels)
+static float *take_map(Run *run, size_t width, size_t height, size_t channels)
 {
     float *map = ptr_unet_map_take(run->maps, width, height, channels);
     if (!map)
@@ -359,7 +359,7 @@ static float *new_map(Run *run, size_t width, size_t height, size_t channels)
 static float *conv(Run *run, int l, const float *src, size_t width, size_t height, float *dst)
 {
     const PtrUnetConv *c = &run->unet->conv[l];
-    float *out = dst ? dst : new_map(run, width, height, c->out);
+    float *out = dst ? dst : take_map(run, width, height, c->out);
     if (!out)
         return NULL;
     Step s = { run->unet, c, out, src, NULL, width, 0, 0, l != run->unet->count - 1 };
@@ -370,7 +370,7 @@ static float *conv(Run *run, int l, const float *src, size_t width, size_t heigh
 /* 2x2 max-pooling of src (width x height, channels channels). */
 static float *pool(Run *run, const float *src, size_t channels, size_t width, size_t height)
 {
-    float *out = new_map(run, width / 2, height / 2, channels);
+    float *out = take_map(run, width / 2, height / 2, channels);
     if (!out)
         return NULL;
     Step s = { run->unet, NULL, out, src, NULL, width / 2, channels, 0, 0 };
@@ -383,7 +383,7 @@ static float *pool(Run *run, const float *src, size_t channels, size_t width, si
 static float *upsample_concat(Run *run, const float *src, size_t channels, const float *skip,
                               size_t skip_channels, size_t width, size_t height)
 {
-    float *out = new_map(run, width, height, channels + skip_channels);
+    float *out = take_map(run, width, height, channels + skip_channels);
     if (!out)
         return NULL;
     Step s = { run->unet, NULL, out, src, skip, width, channels, skip_channels, 0 };

@@ -54,9 +54,9 @@ void ptr_unet_free(PtrUnet *unet);
 /* Feature maps kept for reuse. A tile's run takes its maps from here and
  * gives them back, so that the next tile's maps are the same memory: each
  * new page costs a fault and the kernel's zeroing (at 1920x1080, maps new
- * to every step cost 1.2 million faults, 4 s of system time against 15 s
- * of convolutions), and a map's interior need not be zeroed at all, since
- * the step that makes it writes it whole. */
+ * to every step cost 1.2 million faults, about 3.5 s of system time
+ * against 16 s of user time), and a map's interior need not be zeroed at
+ * all, since the step that makes it writes it whole. */
 typedef struct PtrUnetMaps PtrUnetMaps;
 
 /* An empty set of maps, or NULL when memory runs out. */
