@@ -121,19 +121,19 @@ static size_t round_up16(size_t n)
     return (n + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
 }
 
-static size_t tile_count(size_t n, size_t tile)
+static size_t tile_count(size_t n, size_t tile, size_t overlap)
 {
-    size_t stride = tile - 2 * PTR_DENOISE_OVERLAP;
+    size_t stride = tile - 2 * overlap;
     return round_up16(n) <= tile ? 1 : 1 + (n - tile + stride - 1) / stride;
 }
 
-static Span tile_span(size_t n, size_t tile, size_t count, size_t j)
+static Span tile_span(size_t n, size_t tile, size_t overlap, size_t count, size_t j)
 {
     if (count == 1)
         return (Span){ 0, n, 0, n };
-    size_t begin = j * (tile - 2 * PTR_DENOISE_OVERLAP);
-    Span s = { begin, n - begin < tile ? n - begin : tile, begin + PTR_DENOISE_OVERLAP,
-               begin + tile - PTR_DENOISE_OVERLAP };
+    size_t begin = j * (tile - 2 * overlap);
+    Span s = { begin, n - begin < tile ? n - begin : tile, begin + overlap,
+               begin + tile - overlap };
     if (j == 0)
         s.out_begin = 0;
     if (j == count - 1)
@@ -228,22 +228,29 @@ static PtrResult filter_tile(const PtrUnet *unet, PtrUnetMaps *maps, TileJob *jo
 }
 
 /* Runs the network over the image, tile by tile, into result (RGB, the
- * image's size), its maps from maps. */
+ * image's size), its maps from maps. The tiles overlap by as much as the
+ * network needs to keep every bit of the result, and no more, which would
+ * be work for nothing. */
 static PtrResult filter_image(const PtrUnet *unet, PtrUnetMaps *maps, Mode mode,
                               const PtrDenoiseInput *input, size_t tile, int threads,
                               float *result, PtrError *err)
 {
+    const size_t overlap = ptr_unet_overlap(unet);
+    if (tile <= 2 * overlap)
+        return ptr_error_set(err, PTR_ERR_INTERNAL,
+                             "denoiser tiles of %zu pixels: not above twice the overlap of %zu",
+                             tile, overlap);
     size_t width = input->width, height = input->height;
     TileJob job = { .input = input, .mode = mode, .result = result };
     if (mode == MODE_COLOR)
         ptr_transfer_init(&job.transfer,
                           ptr_autoexposure(input->color, input->color_stride, width, height));
-    size_t columns = tile_count(width, tile), rows = tile_count(height, tile);
+    size_t columns = tile_count(width, tile, overlap), rows = tile_count(height, tile, overlap);
     PtrResult res = PTR_OK;
     for (size_t j = 0; res == PTR_OK && j < rows; j++)
         for (size_t i = 0; res == PTR_OK && i < columns; i++) {
-            job.y = tile_span(height, tile, rows, j);
-            job.x = tile_span(width, tile, columns, i);
+            job.y = tile_span(height, tile, overlap, rows, j);
+            job.x = tile_span(width, tile, overlap, columns, i);
             res = filter_tile(unet, maps, &job, threads, err);
         }
     return res;
@@ -253,10 +260,9 @@ PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *
                             size_t tile, int threads, float *out, size_t out_stride,
                             PtrError *err)
 {
-    if (tile % PTR_UNET_ALIGNMENT || tile <= 2 * PTR_DENOISE_OVERLAP)
+    if (tile % PTR_UNET_ALIGNMENT)
         return ptr_error_set(err, PTR_ERR_INTERNAL,
-                             "denoiser tiles of %zu pixels: not a multiple of 16 above %d", tile,
-                             2 * PTR_DENOISE_OVERLAP);
+                             "denoiser tiles of %zu pixels: not a multiple of 16", tile);
     size_t pixels = input->width * input->height;
     if (!pixels)
         return PTR_OK;

@@ -52,17 +52,18 @@ PtrResult ptr_denoise(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
                       int threads, float *out, size_t out_stride, PtrError *err);
 
 /* The network runs on tiles of at most PTR_DENOISE_TILE pixels a side,
- * which overlap by PTR_DENOISE_OVERLAP pixels, more than half the receptive
- * field of the larger networks (202 pixels), and start at multiples of 16:
+ * which overlap by what the network needs (ptr_unet_overlap: 80 pixels for
+ * UNet, 96 for UNetLarge) and start at multiples of 16:
  * each output pixel is computed from the same values in the same order as
  * in one tile of the whole image, so the tiles bound memory (the maps of a
  * tile: at most about 450 MB alive at once for the default network, 550 MB
  * for the large, 500 and 870 MB kept for reuse) without changing a bit of
- * the result. The tiling depends only on the image's size. */
-enum { PTR_DENOISE_TILE = 768, PTR_DENOISE_OVERLAP = 112 };
+ * the result. The tiling depends only on the image's size and the
+ * network. */
+enum { PTR_DENOISE_TILE = 768 };
 
 /* ptr_denoise with tiles of at most tile pixels a side (a multiple of 16
- * above 2 * PTR_DENOISE_OVERLAP), for the tests of the tiling. */
+ * above twice the overlap), for the tests of the tiling. */
 PtrResult ptr_denoise_tiled(const PtrDenoiser *denoiser, const PtrDenoiseInput *input,
                             size_t tile, int threads, float *out, size_t out_stride,
                             PtrError *err);

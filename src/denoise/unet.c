@@ -1,5 +1,6 @@
 #include "denoise/unet.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -251,6 +252,52 @@ PtrResult ptr_unet_load(const char *path, size_t input_channels, PtrCpuLevel lev
     ptr_conv_init_level(&unet->table, level);
     *out = unet;
     return PTR_OK;
+}
+
+/* A range of pixels of one row of a map, lo .. hi (empty: lo > hi). */
+typedef struct Range {
+    long lo, hi;
+} Range;
+
+static void widen(Range *s, Range by)
+{
+    s->lo = by.lo < s->lo ? by.lo : s->lo;
+    s->hi = by.hi > s->hi ? by.hi : s->hi;
+}
+
+/* The input pixels of a row that output pixel p depends on: the network
+ * walked from its last convolution back, each step's needs in the map it
+ * reads (p large enough that no range goes below 0). */
+static Range input_range(const PtrUnet *unet, long p)
+{
+    Range need = { p, p }, pooled[5]; /* pooled[k]: of the map pooled to level k; 0: the input */
+    for (int k = 0; k < 5; k++)
+        pooled[k] = (Range){ LONG_MAX, LONG_MIN };
+    for (int l = unet->count - 1; l >= 0; l--) {
+        const PtrUnetConv *c = &unet->conv[l];
+        need.lo--, need.hi++; /* a 3x3 convolution, in its level's pixels */
+        if (c->concat >= 0) { /* reads the map before it, upsampled, and a pooled one */
+            widen(&pooled[c->concat], need);
+            need = (Range){ need.lo / 2, need.hi / 2 };
+        } else if (l > 0 && unet->conv[l - 1].pool) { /* reads the map before it pooled */
+            Range *in = &pooled[unet->conv[l - 1].pool];
+            widen(in, need);
+            need = (Range){ 2 * in->lo, 2 * in->hi + 1 };
+        }
+    }
+    widen(&pooled[0], need);
+    return pooled[0];
+}
+
+size_t ptr_unet_overlap(const PtrUnet *unet)
+{
+    /* Both sides of an edge at 1024, on the grid: the first pixel kept
+     * after it and the last before it. */
+    const long edge = 1024;
+    const long before = edge - input_range(unet, edge).lo,
+               after = input_range(unet, edge - 1).hi - (edge - 1);
+    const size_t reach = (size_t)(before > after ? before : after);
+    return (reach + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
 }
 
 void ptr_unet_free(PtrUnet *unet)

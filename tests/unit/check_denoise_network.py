@@ -88,14 +88,16 @@ check_same("levels and threads",
            [(f"{level} with {threads} thread(s)", run_ptr("balanced", images, threads, 0, level))
             for level in levels for threads in (1, 2)])
 
-# Tiles of 240 pixels (the smallest: 16 beyond twice the overlap) across a
-# 256-pixel side make two; each pixel is the untiled image's, bit for bit.
-for width, height in ((256, 24), (24, 256)):
-    images = denoise_reference.test_images(width, height, 4)
-    check_same(f"tiles of {width}x{height}",
-               [("one tile", run_ptr("fast", images)),
-                ("tiles of 240", run_ptr("fast", images, 1, 240)),
-                ("tiles of 240, 2 threads", run_ptr("fast", images, 2, 240))])
+# Tiles of 240 pixels (16 beyond twice UNetLarge's overlap of 112) across a
+# 256-pixel side make two for either network: UNet's (fast) overlap by 96,
+# UNetLarge's (high) by 112. Each pixel is the untiled image's, bit for bit.
+for quality in ("fast", "high"):
+    for width, height in ((256, 24), (24, 256)):
+        images = denoise_reference.test_images(width, height, 4)
+        check_same(f"{quality}, tiles of {width}x{height}",
+                   [("one tile", run_ptr(quality, images)),
+                    ("tiles of 240", run_ptr(quality, images, 1, 240)),
+                    ("tiles of 240, 2 threads", run_ptr(quality, images, 2, 240))])
 
 shutil.rmtree(work)
 for failure in failures:

@@ -1,7 +1,8 @@
 /* The denoiser's parts that have closed forms (denoise/transfer.h,
  * denoise/unet.h): the PU transfer function and its inverse, the guides'
  * mappings for their own networks (sRGB, [-1, 1] to [0, 1]), the exposure
- * of constant images, pooling and upsampling; its errors: a quality that
+ * of constant images, pooling and upsampling, the tiles' overlap for each
+ * architecture; its errors: a quality that
  * does not exist, a missing weight file (for each quality), one that
  * cannot be read, an archive whose tensors are not the U-Net's. The networks themselves are checked
  * against NumPy by check_denoise_network. */
@@ -248,6 +249,49 @@ static void weights_unreadable(void)
     rmdir(dir);
 }
 
+/* A network's layout as ptr_unet_load builds it, without weights: each
+ * convolution's level, the pooled map it joins (-1: none) and the map its
+ * output is pooled into (0: none), from OIDN's training/model.py. */
+static void layout(PtrUnet *unet, const int (*convs)[3], int count)
+{
+    unet->count = count;
+    for (int l = 0; l < count; l++) {
+        unet->conv[l].level = convs[l][0];
+        unet->conv[l].concat = convs[l][1];
+        unet->conv[l].pool = convs[l][2];
+    }
+}
+
+/* The overlap is the reach past a 16-pixel edge of the pixels beside it,
+ * counted by hand: from dec_conv0 back, UNet's convolutions reach
+ * 3 + 2 * 2 + 2 * 4 + 2 * 8 + 2 * 16 + 8 + 4 + 2 + 2 * 1 = 79 pixels, and
+ * the first upsampling (3 convolutions at full size: an odd reach) cuts
+ * one pixel more into the grid: 80. UNetLarge's reach 93, so 94, and 96 on
+ * the grid. */
+static void tile_overlaps(void)
+{
+    static const int unet[][3] = {
+        { 0, -1, 0 }, { 0, -1, 1 }, { 1, -1, 2 }, { 2, -1, 3 }, { 3, -1, 4 }, { 4, -1, 0 },
+        { 4, -1, 0 }, { 3, 3, 0 },  { 3, -1, 0 }, { 2, 2, 0 },  { 2, -1, 0 }, { 1, 1, 0 },
+        { 1, -1, 0 }, { 0, 0, 0 },  { 0, -1, 0 }, { 0, -1, 0 },
+    };
+    static const int large[][3] = {
+        { 0, -1, 0 }, { 0, -1, 1 }, { 1, -1, 0 }, { 1, -1, 2 }, { 2, -1, 0 },
+        { 2, -1, 3 }, { 3, -1, 0 }, { 3, -1, 4 }, { 4, -1, 0 }, { 4, -1, 0 },
+        { 3, 3, 0 },  { 3, -1, 0 }, { 2, 2, 0 },  { 2, -1, 0 }, { 1, 1, 0 },
+        { 1, -1, 0 }, { 0, 0, 0 },  { 0, -1, 0 }, { 0, -1, 0 },
+    };
+    PtrUnet net = { 0 };
+    layout(&net, unet, (int)(sizeof unet / sizeof unet[0]));
+    CHECK_INT(ptr_unet_overlap(&net), 80);
+    layout(&net, large, (int)(sizeof large / sizeof large[0]));
+    CHECK_INT(ptr_unet_overlap(&net), 96);
+    /* One 3x3 convolution, at full size: one pixel, 16 on the grid. */
+    static const int one[][3] = { { 0, -1, 0 } };
+    layout(&net, one, 1);
+    CHECK_INT(ptr_unet_overlap(&net), 16);
+}
+
 int main(void)
 {
     static const TestCase cases[] = {
@@ -255,7 +299,7 @@ int main(void)
         TEST_CASE(autoexposure_of_constant_images),
         TEST_CASE(pooling_and_upsampling), TEST_CASE(qualities),
         TEST_CASE(missing_weights), TEST_CASE(archives_not_a_unet),
-        TEST_CASE(weights_unreadable),
+        TEST_CASE(weights_unreadable), TEST_CASE(tile_overlaps),
     };
     TEST_RUN(cases);
     return test_report();
