@@ -88,9 +88,9 @@ check_same("levels and threads",
            [(f"{level} with {threads} thread(s)", run_ptr("balanced", images, threads, 0, level))
             for level in levels for threads in (1, 2)])
 
-# Tiles of 240 pixels (16 beyond twice UNetLarge's overlap of 112) across a
-# 256-pixel side make two for either network: UNet's (fast) overlap by 96,
-# UNetLarge's (high) by 112. Each pixel is the untiled image's, bit for bit.
+# Tiles of 240 pixels across a 256-pixel side make two for either network:
+# UNet's (fast) overlap by 80, UNetLarge's (high) by 96. Each pixel is the
+# untiled image's, bit for bit.
 for quality in ("fast", "high"):
     for width, height in ((256, 24), (24, 256)):
         images = denoise_reference.test_images(width, height, 4)
