@@ -267,7 +267,9 @@ static void widen(Range *s, Range by)
 
 /* The input pixels of a row that output pixel p depends on: the network
  * walked from its last convolution back, each step's needs in the map it
- * reads (p large enough that no range goes below 0). */
+ * reads. p must be large enough that no range goes below 0: halving with
+ * `/` rounds towards zero, which is the floor only for what is not
+ * negative. */
 static Range input_range(const PtrUnet *unet, long p)
 {
     Range need = { p, p }, pooled[5]; /* pooled[k]: of the map pooled to level k; 0: the input */

@@ -54,9 +54,9 @@ void ptr_unet_free(PtrUnet *unet);
 /* The overlap tiles on the pooling grid need, so that each pixel a tile
  * keeps is the whole image's to the bit: how far past an edge on the grid
  * the pixels beside it reach into the input, rounded up to the grid. A 3x3
- * convolution at level k reaches 2^k pixels further, and a step between
- * levels that cuts the grid a little more (UNet: 80 pixels, UNetLarge: 94,
- * so 96; from a pixel off the grid, up to 94 and 108). */
+ * convolution at level k reaches 2^k pixels further, plus one pixel where
+ * an odd reach at one level meets the coarser level (UNet: 80 pixels,
+ * UNetLarge: 94, so 96; from a pixel off the grid, up to 94 and 108). */
 size_t ptr_unet_overlap(const PtrUnet *unet);
 
 /* Feature maps kept for reuse. A tile's run takes its maps from here and

@@ -89,10 +89,11 @@ check_same("levels and threads",
             for level in levels for threads in (1, 2)])
 
 # Tiles of 240 pixels across a 256-pixel side make two for either network:
-# UNet's (fast) overlap by 80, UNetLarge's (high) by 96. Each pixel is the
-# untiled image's, bit for bit.
+# UNet's (fast) overlap by 80, UNetLarge's (high) by 96; across 250 pixels,
+# the last is padded to a multiple of 16 as the whole image is. Each pixel is
+# the untiled image's, bit for bit.
 for quality in ("fast", "high"):
-    for width, height in ((256, 24), (24, 256)):
+    for width, height in ((256, 24), (24, 256), (250, 24)):
         images = denoise_reference.test_images(width, height, 4)
         check_same(f"{quality}, tiles of {width}x{height}",
                    [("one tile", run_ptr(quality, images)),
