@@ -11,6 +11,8 @@ CONV_PIXELS equ 6
 
 ; ymm(2k), ymm(2k + 1): pixel k's output channels 0-7 and 8-15.
 ; ymm12, ymm13: the step's weights; ymm14: an input value; ymm15: zero.
+; Groups are of one block (no CONV_PAIR_PIXELS: two blocks' accumulators
+; would not fit in 16 registers), so each macro's block count is 1.
 
 ; lo, hi = the numbers of pixel %1's two registers.
 %macro ACC_PAIR 1
@@ -18,7 +20,7 @@ CONV_PIXELS equ 6
 %assign hi 2 * %1 + 1
 %endmacro
 
-%macro ACC_BIAS 0
+%macro ACC_BIAS 1
     vmovups     ymm0, [rcx]
     vmovups     ymm1, [rcx + 32]
 %endmacro
@@ -29,19 +31,19 @@ CONV_PIXELS equ 6
     vmovaps     ymm%[hi], ymm1
 %endmacro
 
-%macro ACC_WEIGHTS 1
+%macro ACC_WEIGHTS 2
     vmovups     ymm12, [r12 + 64 * %1]
     vmovups     ymm13, [r12 + 64 * %1 + 32]
 %endmacro
 
-%macro ACC_FMA 2
+%macro ACC_FMA 3
     ACC_PAIR    %1
     vbroadcastss ymm14, [INPUT(%1) + 4 * %2]
     vfmadd231ps ymm%[lo], ymm14, ymm12
     vfmadd231ps ymm%[hi], ymm14, ymm13
 %endmacro
 
-%macro ACC_ZERO 0
+%macro ACC_ZERO 1
     vxorps      ymm15, ymm15, ymm15
 %endmacro
 
