@@ -104,14 +104,21 @@ static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre
     _mm_storeu_si128((__m128i *)k, bins);
 }
 
-/* Every stride-th prim of the run. */
+/* Every stride-th prim of the run. Samples far apart are each a cache
+ * miss the hardware's prefetchers do not foresee: fetched PREFETCH_SAMPLES
+ * samples ahead, they overlap. */
+enum { PREFETCH_SAMPLES = 16 };
+
 static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stride,
                     const BvhCandidate *c, Bins *b)
 {
     const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
     const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
     const __m128 last = _mm_set1_ps((float)(c->bins - 1));
+    const size_t ahead = stride > 1 ? PREFETCH_SAMPLES * stride : 0;
     for (size_t i = begin; i < end; i += stride) {
+        if (ahead && end - i > ahead)
+            _mm_prefetch((const char *)&set->prims[i + ahead], _MM_HINT_T0);
         const BvhPrim *p = &set->prims[i];
         __m128 lower, upper;
         prim_box4(p, set->magnitude, &lower, &upper);
@@ -149,7 +156,7 @@ enum { PARALLEL_PRIMS = 1 << 14, SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
 
 typedef struct ParallelRun {
     const BvhPrimSet *set;
-    size_t begin, end;
+    size_t begin, end, stride;     /* every stride-th prim (binning only) */
     const BvhCandidate *candidate; /* NULL: bounds only */
     Bins *bins;                 /* one per thread */
     int thread, threads;
@@ -158,30 +165,32 @@ typedef struct ParallelRun {
 static void *parallel_bin_worker(void *arg)
 {
     ParallelRun *r = arg;
-    size_t n = r->end - r->begin;
-    size_t lo = r->begin + n * (size_t)r->thread / (size_t)r->threads;
-    size_t hi = r->begin + n * (size_t)(r->thread + 1) / (size_t)r->threads;
+    size_t n = (r->end - r->begin + r->stride - 1) / r->stride; /* prims taken */
+    size_t lo = r->begin + n * (size_t)r->thread / (size_t)r->threads * r->stride;
+    size_t hi = r->begin + n * (size_t)(r->thread + 1) / (size_t)r->threads * r->stride;
+    if (hi > r->end)
+        hi = r->end;
     bins_clear(r->bins, r->candidate ? r->candidate->bins : 0);
     if (r->candidate)
-        bin_run(r->set, lo, hi, 1, r->candidate, r->bins);
+        bin_run(r->set, lo, hi, r->stride, r->candidate, r->bins);
     else
         bound_run(r->set, lo, hi, r->bins);
     return NULL;
 }
 
-/* Bins (or, with c NULL, only bounds) prims begin .. end - 1 into *out, on
- * up to max_threads threads if the run is large. Counts add and boxes take
- * minima and maxima, so the result does not depend on how the run is shared
- * between threads. */
+/* Bins every stride-th prim of begin .. end - 1 (or, with c NULL, bounds
+ * every prim: stride 1) into *out, on up to max_threads threads if they
+ * are many. Counts add and boxes take minima and maxima, so the result does
+ * not depend on how the run is shared between threads. */
 static PtrResult bin_range(const BvhPrimSet *set, int max_threads, size_t begin, size_t end,
-                           const BvhCandidate *c, Bins *out, PtrError *err)
+                           size_t stride, const BvhCandidate *c, Bins *out, PtrError *err)
 {
-    int threads = end - begin >= PARALLEL_PRIMS ? max_threads : 1;
+    int threads = (end - begin) / stride >= PARALLEL_PRIMS ? max_threads : 1;
     int bins = c ? c->bins : 0;
     if (threads == 1) {
         bins_clear(out, bins);
         if (c)
-            bin_run(set, begin, end, 1, c, out);
+            bin_run(set, begin, end, stride, c, out);
         else
             bound_run(set, begin, end, out);
         return PTR_OK;
@@ -197,7 +206,7 @@ static PtrResult bin_range(const BvhPrimSet *set, int max_threads, size_t begin,
     }
     int started = 1; /* threads 1 .. started - 1 run; the rest are done here */
     for (int t = 0; t < threads; t++)
-        runs[t] = (ParallelRun){ set, begin, end, c, &per_thread[t], t, threads };
+        runs[t] = (ParallelRun){ set, begin, end, stride, c, &per_thread[t], t, threads };
     while (started < threads && (ids[started] = ptr_thread_start(parallel_bin_worker, &runs[started])))
         started++;
     parallel_bin_worker(&runs[0]);
@@ -224,7 +233,7 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
     c->axis = -1;
     c->sampled = 0;
     if (!lower) {
-        PtrResult r = bin_range(set, threads, begin, end, NULL, &bins, err);
+        PtrResult r = bin_range(set, threads, begin, end, 1, NULL, &bins, err);
         if (r != PTR_OK)
             return r;
         lower = bins.box_lo;
@@ -250,14 +259,10 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
     if (!spread)
         return PTR_OK;
     c->sampled = end - begin > SAMPLED_ABOVE;
-    if (c->sampled) {
-        bins_clear(&bins, c->bins);
-        bin_run(set, begin, end, (end - begin) / SAMPLES, c, &bins);
-    } else {
-        PtrResult r = bin_range(set, threads, begin, end, c, &bins, err);
-        if (r != PTR_OK)
-            return r;
-    }
+    PtrResult r = bin_range(set, threads, begin, end, c->sampled ? (end - begin) / SAMPLES : 1,
+                            c, &bins, err);
+    if (r != PTR_OK)
+        return r;
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
         __m128 right_lo[BINS], right_hi[BINS];
