@@ -116,15 +116,10 @@ typedef struct Span {
     size_t begin, size, out_begin, out_end;
 } Span;
 
-static size_t round_up16(size_t n)
-{
-    return (n + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
-}
-
 static size_t tile_count(size_t n, size_t tile, size_t overlap)
 {
     size_t stride = tile - 2 * overlap;
-    return round_up16(n) <= tile ? 1 : 1 + (n - tile + stride - 1) / stride;
+    return ptr_unet_align(n) <= tile ? 1 : 1 + (n - tile + stride - 1) / stride;
 }
 
 static Span tile_span(size_t n, size_t tile, size_t overlap, size_t count, size_t j)
@@ -202,7 +197,7 @@ static void keep_output_rows(void *arg, size_t from, size_t to)
 static PtrResult filter_tile(const PtrUnet *unet, PtrUnetMaps *maps, TileJob *job, int threads,
                              PtrError *err)
 {
-    size_t w = round_up16(job->x.size), h = round_up16(job->y.size);
+    size_t w = ptr_unet_align(job->x.size), h = ptr_unet_align(job->y.size);
     float *input = ptr_unet_map_take(maps, w, h, PTR_CONV_BLOCK);
     float *output = ptr_unet_map_take(maps, w, h, PTR_CONV_BLOCK);
     PtrResult res = PTR_ERR_NOMEM;

@@ -299,7 +299,7 @@ size_t ptr_unet_overlap(const PtrUnet *unet)
     const long before = edge - input_range(unet, edge).lo,
                after = input_range(unet, edge - 1).hi - (edge - 1);
     const size_t reach = (size_t)(before > after ? before : after);
-    return (reach + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
+    return ptr_unet_align(reach);
 }
 
 void ptr_unet_free(PtrUnet *unet)

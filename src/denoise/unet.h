@@ -18,6 +18,12 @@ enum { PTR_UNET_OUTPUT_CHANNELS = 3 };
 /* Four poolings: a tile's sides are multiples of 16. */
 enum { PTR_UNET_ALIGNMENT = 16 };
 
+/* n rounded up to a multiple of PTR_UNET_ALIGNMENT. */
+static inline size_t ptr_unet_align(size_t n)
+{
+    return (n + PTR_UNET_ALIGNMENT - 1) / PTR_UNET_ALIGNMENT * PTR_UNET_ALIGNMENT;
+}
+
 /* The most convolutions a network has (OIDN's UNetLarge). */
 enum { PTR_UNET_MAX_CONVS = 19 };
 
