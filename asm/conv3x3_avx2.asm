@@ -21,6 +21,9 @@ CONV_PIXELS equ 6
 %endmacro
 
 %macro ACC_BIAS 1
+%if %1 != 1
+%error "the AVX2 kernel's groups are of one block"
+%endif
     vmovups     ymm0, [rcx]
     vmovups     ymm1, [rcx + 32]
 %endmacro

@@ -5,13 +5,13 @@
 ; 8 loads, in 12 independent chains. Where one block is left (the last of
 ; 16, 48, 80 or 112 channels): groups of 8 pixels x 16 channels, 8 FMAs to 9
 ; loads in 8 chains, as many as two FMA units of latency 4 keep busy. With
-; groups of 8 x 16 alone the convolutions went at 47-53% of the FMA peak on
-; one thread, with these at 68-72% (bench/denoise); groups of 8 x 32, with
-; zmm16-19 for the weights, went no faster. Each lane's chain is ptr_conv3x3_c's, so the
-; output is the same bit for bit. The input stays the multiplication's first
-; operand (not a broadcast from memory, which can only be the second), so
-; that where several operands are NaN the CPU picks the same one at every
-; level.
+; groups of 8 x 16 alone the convolutions went at 48-51% of the FMA peak on
+; one thread, with these at 70% (bench/denoise, docs/convolutions.md);
+; groups of 8 x 32, with zmm16-19 for the weights, went no faster. Each
+; lane's chain is ptr_conv3x3_c's, so the output is the same bit for bit.
+; The input stays the multiplication's first operand (not a broadcast from
+; memory, which can only be the second), so that where several operands are
+; NaN the CPU picks the same one at every level.
 
 %include "ptr.inc"
 

@@ -104,11 +104,11 @@ static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre
     _mm_storeu_si128((__m128i *)k, bins);
 }
 
-/* Every stride-th prim of the run. Samples far apart are each a cache
- * miss the hardware's prefetchers do not foresee: fetched PREFETCH_SAMPLES
- * samples ahead, they overlap. */
+/* Samples far apart are each a cache miss the hardware's prefetchers do
+ * not foresee: fetched this many samples ahead, they overlap. */
 enum { PREFETCH_SAMPLES = 16 };
 
+/* Every stride-th prim of the run. */
 static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stride,
                     const BvhCandidate *c, Bins *b)
 {
@@ -143,8 +143,9 @@ static void bins_merge(Bins *into, const Bins *b, int bins)
     bounds_grow(into->box_lo, into->box_hi, b->box_lo, b->box_hi);
 }
 
-/* Runs of this many prims are bounded, binned and partitioned by all threads
- * together; smaller ones by the calling thread (a run of 16,384 prims takes
+/* Runs of this many prims (or samples, of a sampled run: so every sampled
+ * run) are bounded, binned and partitioned by all threads together; smaller
+ * ones by the calling thread (a run of 16,384 prims takes
  * some hundred microseconds; handing a piece to a kept thread and back,
  * about 20 while that thread still watches for work, 100 to 200 where it
  * has gone to sleep on an idle virtual machine: docs/intersectors.md,
