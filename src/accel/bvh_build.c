@@ -18,12 +18,18 @@
  * leaves of 16 and this rule, 5.4, at the same rays per second
  * (docs/intersectors.md, "Full nodes at the bottom").
  *
- * Threads: the top of the tree is built on the calling thread, with the
- * binning of large ranges spread over all threads; every subtree of at most
- * task_spheres spheres (1/64 of all, at least TASK_SPHERES_MIN: a rule of
- * the sphere count alone) is a task built by one thread into its own node
- * array. The arrays are then laid out in task order, so the tree's bytes
- * never depend on the number of threads. */
+ * Threads: the root is built on the calling thread, with the binning and
+ * partitions of its ranges spread over all threads. Each of its children
+ * of more than task_spheres spheres (1/64 of all, at least
+ * TASK_SPHERES_MIN: a rule of the sphere count alone) is a part: the rest
+ * of the top level below it, built by one thread into its own node and task
+ * arrays, while the other threads build other parts (splitting each range
+ * on all threads handed work to the others and back a few hundred times,
+ * and a 10^6 build's top level gained 1.1x from a second thread). Every
+ * subtree of at most task_spheres spheres is a task built by one thread
+ * into its own node array. The arrays are laid out in the order a
+ * depth-first build on one thread would have made them, so the tree's
+ * bytes never depend on the number of threads. */
 #include "accel/bvh.h"
 
 #include <malloc.h>
@@ -44,6 +50,7 @@ enum {
     TASK_SPHERES_MIN = 4096, /* smaller subtrees are never split among tasks */
     TASKS_PER_TREE = 64,     /* about this many tasks, for an even load */
     TASK_FLAG = 1u << 31,    /* a top-level child that is a task, not yet laid out */
+    PART_FLAG = 1u << 30,    /* a child of the root that is a part, not yet laid out */
     /* See the head: 6 leaves' worth (7 or 5 gave 0.2 and 0.05 bytes a sphere
      * more on a uniform 10^6 cloud). */
     BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
@@ -63,17 +70,40 @@ typedef struct Task {
     int failed;
 } Task;
 
+typedef struct TaskList {
+    Task *tasks;
+    size_t count, capacity;
+} TaskList;
+
+/* A part of the top level: a child of the root and the top level below it,
+ * whose tasks are its own until the parts are laid out. */
+typedef struct Part {
+    BvhCandidate range;
+    int level; /* of its root node */
+    NodeArray nodes;
+    TaskList tasks;
+    int failed;
+} Part;
+
+/* How build_node treats a node: the root, on all threads, makes parts of
+ * its large children; a node of a part makes tasks of its small children
+ * (both: its children of at most task_spheres); a node of a task splits on. */
+typedef enum NodeKind { NODE_ROOT, NODE_PART, NODE_TASK } NodeKind;
+
 typedef struct Build {
     BvhPrimSet set;
-    /* The build's threads: all of them split the top level's large ranges;
-     * a task, run on one of them while the others run theirs, splits on
-     * its thread alone. */
+    /* The build's threads: all of them split the root's ranges; a part or
+     * a task, run on one of them while the others run theirs, splits on its
+     * thread alone. */
     int threads;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
     size_t task_spheres;
-    Task *tasks;
-    size_t task_count, task_capacity;
-    atomic_size_t next_task;
+    TaskList root_tasks; /* the root's small children */
+    Part parts[PTR_BVH_WIDTH]; /* its large ones */
+    size_t part_count;
+    const size_t *part_order; /* largest first, for an even load */
+    TaskList tasks;           /* all, in the order of a depth-first build */
+    atomic_size_t next;       /* the next part or task to take */
 } Build;
 
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
@@ -93,30 +123,30 @@ static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
     return PTR_OK;
 }
 
-static PtrResult add_task(Build *build, size_t begin, size_t end, int level, uint32_t *task,
+static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, uint32_t *task,
                           PtrError *err)
 {
-    if (build->task_count == build->task_capacity) {
-        size_t capacity = build->task_capacity ? build->task_capacity * 2 : 64;
-        Task *grown = realloc(build->tasks, capacity * sizeof *grown);
+    if (list->count == list->capacity) {
+        size_t capacity = list->capacity ? list->capacity * 2 : 64;
+        Task *grown = realloc(list->tasks, capacity * sizeof *grown);
         if (!grown)
             return bvh_out_of_memory(err);
-        build->tasks = grown;
-        build->task_capacity = capacity;
+        list->tasks = grown;
+        list->capacity = capacity;
     }
-    *task = (uint32_t)build->task_count;
-    build->tasks[build->task_count++] = (Task){ .begin = begin, .end = end, .level = level };
+    *task = (uint32_t)list->count;
+    list->tasks[list->count++] = (Task){ .begin = begin, .end = end, .level = level };
     return PTR_OK;
 }
 
-/* Builds the node at this level over c's range into nodes (its index in
- * *index), and its inner children below it; depth: levels below the node. In
- * the top level (top set), split on all threads, inner children of at most
- * task_spheres spheres become tasks. scratch: see bvh_split (tasks have it,
- * the top level not). */
-static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
-                            const BvhCandidate *range, int top, int level, size_t *index,
-                            int *depth, PtrError *err)
+/* Builds the node of this kind at this level over c's range into nodes
+ * (its index in *index), and its inner children below it that are neither
+ * parts nor tasks; depth: levels below the node, not counting those. tasks:
+ * where a node of the top level puts its tasks. scratch: see bvh_split
+ * (tasks have it, the top level not). */
+static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+                            const BvhCandidate *range, NodeKind kind, int level,
+                            size_t *index, int *depth, PtrError *err)
 {
     PtrResult r;
     BvhCandidate child[PTR_BVH_WIDTH];
@@ -138,7 +168,7 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
         }
         if (pick < 0)
             break;
-        r = bvh_split(&build->set, top ? build->threads : 1, &child[pick],
+        r = bvh_split(&build->set, kind == NODE_ROOT ? build->threads : 1, &child[pick],
                       level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick], &child[n], err);
         if (r != PTR_OK)
             return r;
@@ -172,16 +202,22 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
             continue;
         }
         node.leaf_count[k] = 0;
-        if (top && count <= build->task_spheres) {
+        if (kind != NODE_TASK && count <= build->task_spheres) {
             uint32_t task;
-            if ((r = add_task(build, c->begin, c->end, level + 1, &task, err)) != PTR_OK)
+            if ((r = add_task(tasks, c->begin, c->end, level + 1, &task, err)) != PTR_OK)
                 return r;
             node.child[k] = TASK_FLAG | task;
             continue;
         }
+        if (kind == NODE_ROOT) {
+            node.child[k] = PART_FLAG | (uint32_t)build->part_count;
+            build->parts[build->part_count++] = (Part){ .range = *c, .level = level + 1 };
+            continue;
+        }
         size_t below;
         int below_depth;
-        r = build_node(build, nodes, scratch, c, top, level + 1, &below, &below_depth, err);
+        r = build_node(build, nodes, tasks, scratch, c, kind, level + 1, &below, &below_depth,
+                       err);
         if (r != PTR_OK)
             return r;
         node.child[k] = (uint32_t)below;
@@ -192,6 +228,21 @@ static PtrResult build_node(Build *build, NodeArray *nodes, BvhPrim *scratch,
     return PTR_OK;
 }
 
+static void *part_worker(void *arg)
+{
+    Build *build = arg;
+    for (;;) {
+        size_t i = atomic_fetch_add(&build->next, 1);
+        if (i >= build->part_count)
+            break;
+        Part *p = &build->parts[build->part_order[i]];
+        size_t root;
+        p->failed = build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART,
+                               p->level, &root, &p->nodes.depth, NULL) != PTR_OK;
+    }
+    return NULL;
+}
+
 static void *task_worker(void *arg)
 {
     Build *build = arg;
@@ -199,10 +250,10 @@ static void *task_worker(void *arg)
      * task_spheres): fresh memory for each would be cleared page by page. */
     BvhPrim *scratch = NULL;
     for (;;) {
-        size_t i = atomic_fetch_add(&build->next_task, 1);
-        if (i >= build->task_count)
+        size_t i = atomic_fetch_add(&build->next, 1);
+        if (i >= build->tasks.count)
             break;
-        Task *t = &build->tasks[i];
+        Task *t = &build->tasks.tasks[i];
         BvhCandidate range;
         size_t root;
         if (!scratch)
@@ -210,30 +261,127 @@ static void *task_worker(void *arg)
         t->failed = !scratch ||
                     bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL,
                                        NULL) != PTR_OK ||
-                    build_node(build, &t->nodes, scratch, &range, 0, t->level, &root,
-                               &t->nodes.depth, NULL) != PTR_OK;
+                    build_node(build, &t->nodes, NULL, scratch, &range, NODE_TASK, t->level,
+                               &root, &t->nodes.depth, NULL) != PTR_OK;
     }
     free(scratch);
     return NULL;
 }
 
-static PtrResult run_tasks(Build *build, PtrError *err)
+/* Runs worker on the calling thread and the others until it has taken
+ * every part or task. */
+static PtrResult run_workers(Build *build, void *(*worker)(void *), PtrError *err)
 {
     int threads = build->threads;
     PtrThread **ids = malloc((size_t)threads * sizeof *ids);
     if (!ids)
         return bvh_out_of_memory(err);
-    atomic_init(&build->next_task, 0);
+    atomic_init(&build->next, 0);
     int started = 0;
-    while (started < threads - 1 && (ids[started] = ptr_thread_start(task_worker, build)))
+    while (started < threads - 1 && (ids[started] = ptr_thread_start(worker, build)))
         started++;
-    task_worker(build);
+    worker(build);
     for (int i = 0; i < started; i++)
         ptr_thread_join(ids[i]);
     free(ids);
-    for (size_t i = 0; i < build->task_count; i++)
-        if (build->tasks[i].failed)
-            return bvh_out_of_memory(err);
+    return PTR_OK;
+}
+
+static size_t part_size(const Part *p)
+{
+    return p->range.end - p->range.begin;
+}
+
+/* Builds the parts, the largest first, so that no thread is left with a
+ * large one at the end. */
+static PtrResult run_parts(Build *build, PtrError *err)
+{
+    size_t order[PTR_BVH_WIDTH];
+    for (size_t i = 0; i < build->part_count; i++) {
+        size_t j = i;
+        for (; j > 0 && part_size(&build->parts[order[j - 1]]) < part_size(&build->parts[i]); j--)
+            order[j] = order[j - 1];
+        order[j] = i;
+    }
+    build->part_order = order;
+    PtrResult r = run_workers(build, part_worker, err);
+    build->part_order = NULL;
+    for (size_t i = 0; r == PTR_OK && i < build->part_count; i++)
+        if (build->parts[i].failed)
+            r = bvh_out_of_memory(err);
+    return r;
+}
+
+static PtrResult run_tasks(Build *build, PtrError *err)
+{
+    PtrResult r = run_workers(build, task_worker, err);
+    for (size_t i = 0; r == PTR_OK && i < build->tasks.count; i++)
+        if (build->tasks.tasks[i].failed)
+            r = bvh_out_of_memory(err);
+    return r;
+}
+
+/* True for a lane of an inner node that holds a child node (or a part or a
+ * task not yet laid out): not a leaf, not empty. */
+static int inner_child(const PtrBvhNode *node, int k)
+{
+    return node->leaf_count[k] == 0 && node->lower_x[k] <= node->upper_x[k];
+}
+
+/* Makes top the root and its parts' nodes in one array, and build->tasks
+ * the root's and the parts' tasks, in the order a depth-first build on one
+ * thread makes them: the root, then each part's nodes in the order of the
+ * root's lanes; each task where the root or its part refers to it. Frees
+ * the parts' arrays. */
+static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
+{
+    size_t node_total = top->count, task_total = build->root_tasks.count;
+    for (size_t i = 0; i < build->part_count; i++) {
+        node_total += build->parts[i].nodes.count;
+        task_total += build->parts[i].tasks.count;
+    }
+    PtrBvhNode *nodes = aligned_alloc(64, node_total * sizeof *nodes);
+    Task *tasks = malloc((task_total ? task_total : 1) * sizeof *tasks);
+    if (!nodes || !tasks) {
+        free(nodes);
+        free(tasks);
+        return bvh_out_of_memory(err);
+    }
+    memcpy(nodes, top->nodes, top->count * sizeof *nodes);
+    size_t node_count = top->count, task_count = 0;
+    PtrBvhNode *root = &nodes[0];
+    for (int k = 0; k < PTR_BVH_WIDTH; k++) {
+        if (!inner_child(root, k))
+            continue;
+        if (root->child[k] & TASK_FLAG) {
+            tasks[task_count] = build->root_tasks.tasks[root->child[k] & ~TASK_FLAG];
+            root->child[k] = TASK_FLAG | (uint32_t)task_count++;
+            continue;
+        }
+        Part *p = &build->parts[root->child[k] & ~PART_FLAG];
+        PtrBvhNode *part_nodes = nodes + node_count;
+        memcpy(part_nodes, p->nodes.nodes, p->nodes.count * sizeof *nodes);
+        memcpy(tasks + task_count, p->tasks.tasks, p->tasks.count * sizeof *tasks);
+        for (size_t j = 0; j < p->nodes.count; j++)
+            for (int lane = 0; lane < PTR_BVH_WIDTH; lane++)
+                if (inner_child(&part_nodes[j], lane))
+                    part_nodes[j].child[lane] += (part_nodes[j].child[lane] & TASK_FLAG)
+                                                     ? (uint32_t)task_count
+                                                     : (uint32_t)node_count;
+        root->child[k] = (uint32_t)node_count;
+        node_count += p->nodes.count;
+        task_count += p->tasks.count;
+        if (p->nodes.depth + 1 > top->depth)
+            top->depth = p->nodes.depth + 1;
+        free(p->nodes.nodes);
+        free(p->tasks.tasks);
+        p->nodes.nodes = NULL;
+        p->tasks.tasks = NULL;
+    }
+    free(top->nodes);
+    top->nodes = nodes;
+    top->count = top->capacity = node_total;
+    build->tasks = (TaskList){ tasks, task_count, task_total };
     return PTR_OK;
 }
 
@@ -256,14 +404,14 @@ static void lay_out_tasks(void *arg, size_t begin, size_t end)
 {
     const LayOut *l = arg;
     for (size_t i = begin; i < end; i++) {
-        NodeArray *a = &l->build->tasks[i].nodes;
+        NodeArray *a = &l->build->tasks.tasks[i].nodes;
         PtrBvhNode *nodes = l->nodes + l->start[i];
         memcpy(nodes, a->nodes, a->count * sizeof *nodes);
         free(a->nodes);
         a->nodes = NULL;
         for (size_t j = 0; j < a->count; j++)
             for (int k = 0; k < PTR_BVH_WIDTH; k++)
-                if (nodes[j].leaf_count[k] == 0 && nodes[j].lower_x[k] <= nodes[j].upper_x[k])
+                if (inner_child(&nodes[j], k))
                     nodes[j].child[k] += (uint32_t)l->start[i];
     }
 }
@@ -272,13 +420,13 @@ static void lay_out_tasks(void *arg, size_t begin, size_t end)
  * reference and every inner child index moved to its final place. */
 static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *err)
 {
-    size_t *start = malloc((build->task_count + 1) * sizeof *start);
+    size_t *start = malloc((build->tasks.count + 1) * sizeof *start);
     if (!start)
         return bvh_out_of_memory(err);
     size_t total = top->count;
-    for (size_t i = 0; i < build->task_count; i++) {
+    for (size_t i = 0; i < build->tasks.count; i++) {
         start[i] = total;
-        total += build->tasks[i].nodes.count;
+        total += build->tasks.tasks[i].nodes.count;
     }
     PtrBvhNode *nodes = aligned_alloc(64, total * sizeof *nodes);
     if (!nodes) {
@@ -287,10 +435,10 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
     }
     memcpy(nodes, top->nodes, top->count * sizeof *nodes);
     LayOut l = { build, nodes, start };
-    for (size_t first = 0; first < build->task_count;) {
+    for (size_t first = 0; first < build->tasks.count;) {
         size_t last = first, bytes = 0;
-        while (last < build->task_count && bytes < TRIM_BYTES)
-            bytes += build->tasks[last++].nodes.count * sizeof *nodes;
+        while (last < build->tasks.count && bytes < TRIM_BYTES)
+            bytes += build->tasks.tasks[last++].nodes.count * sizeof *nodes;
         ptr_parallel_ranges(build->threads, first, last, lay_out_tasks, &l);
         malloc_trim(0);
         first = last;
@@ -299,10 +447,9 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
     int depth = 0;
     for (size_t j = 0; j < top->count; j++)
         for (int k = 0; k < PTR_BVH_WIDTH; k++)
-            if (nodes[j].leaf_count[k] == 0 && (nodes[j].child[k] & TASK_FLAG) &&
-                nodes[j].lower_x[k] <= nodes[j].upper_x[k]) {
-                const Task *t = &build->tasks[nodes[j].child[k] & ~TASK_FLAG];
-                nodes[j].child[k] = (uint32_t)start[t - build->tasks];
+            if (inner_child(&nodes[j], k) && (nodes[j].child[k] & TASK_FLAG)) {
+                const Task *t = &build->tasks.tasks[nodes[j].child[k] & ~TASK_FLAG];
+                nodes[j].child[k] = (uint32_t)start[t - build->tasks.tasks];
                 if (t->nodes.depth > depth)
                     depth = t->nodes.depth;
             }
@@ -380,7 +527,12 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         r = bvh_candidate_init(&build.set, build.threads, &root, 0, prim_count, NULL, NULL,
                                err);
         if (r == PTR_OK)
-            r = build_node(&build, &top, NULL, &root, 1, 0, &index, &top.depth, err);
+            r = build_node(&build, &top, &build.root_tasks, NULL, &root, NODE_ROOT, 0, &index,
+                           &top.depth, err);
+        if (r == PTR_OK && build.part_count)
+            r = run_parts(&build, err);
+        if (r == PTR_OK)
+            r = join_parts(&build, &top, err);
         if (r == PTR_OK)
             r = run_tasks(&build, err);
     }
@@ -399,9 +551,14 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
      * once the prims are gone. */
     if (r == PTR_OK && prim_count > 0)
         r = lay_out(&build, &top, bvh, err);
-    for (size_t i = 0; i < build.task_count; i++)
-        free(build.tasks[i].nodes.nodes);
-    free(build.tasks);
+    for (size_t i = 0; i < build.tasks.count; i++)
+        free(build.tasks.tasks[i].nodes.nodes);
+    free(build.tasks.tasks);
+    for (size_t i = 0; i < build.part_count; i++) {
+        free(build.parts[i].nodes.nodes);
+        free(build.parts[i].tasks.tasks);
+    }
+    free(build.root_tasks.tasks);
     free(top.nodes);
     if (r != PTR_OK)
         ptr_bvh_free(bvh);
