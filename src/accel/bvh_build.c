@@ -23,9 +23,9 @@
  * of more than task_spheres spheres (1/64 of all, at least
  * TASK_SPHERES_MIN: a rule of the sphere count alone) is a part: the rest
  * of the top level below it, built by one thread into its own node and task
- * arrays, while the other threads build other parts (splitting each range
- * on all threads handed work to the others and back a few hundred times,
- * and a 10^6 build's top level gained 1.1x from a second thread). Every
+ * arrays, while the other threads build other parts. (When every split of
+ * the top level was shared, each of some 300 at 10^6 handing work to the
+ * others and back, the top level gained 1.2x from a second thread.) Every
  * subtree of at most task_spheres spheres is a task built by one thread
  * into its own node array. The arrays are laid out in the order a
  * depth-first build on one thread would have made them, so the tree's
@@ -56,7 +56,7 @@ enum {
     BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
 };
 
-/* Node arrays: the top level's, and one per task. */
+/* Node arrays: the root's, one per part and one per task. */
 typedef struct NodeArray {
     PtrBvhNode *nodes;
     size_t count, capacity;
@@ -76,7 +76,7 @@ typedef struct TaskList {
 } TaskList;
 
 /* A part of the top level: a child of the root and the top level below it,
- * whose tasks are its own until the parts are laid out. */
+ * whose tasks are its own until join_parts numbers them all. */
 typedef struct Part {
     BvhCandidate range;
     int level; /* of its root node */
@@ -139,9 +139,9 @@ static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, u
     return PTR_OK;
 }
 
-/* Builds the node of this kind at this level over c's range into nodes
- * (its index in *index), and its inner children below it that are neither
- * parts nor tasks; depth: levels below the node, not counting those. tasks:
+/* Builds the node of this kind at this level over range into nodes (its
+ * index in *index), and its inner children below it that are neither parts
+ * nor tasks; depth: levels below the node, not counting parts and tasks. tasks:
  * where a node of the top level puts its tasks. scratch: see bvh_split
  * (tasks have it, the top level not). */
 static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
@@ -237,6 +237,9 @@ static void *part_worker(void *arg)
             break;
         Part *p = &build->parts[build->part_order[i]];
         size_t root;
+        /* No scratch: the in-place partition makes the moves the root's
+         * shared splits make, where the stable one would order the prims,
+         * and so the tree, otherwise. */
         p->failed = build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART,
                                p->level, &root, &p->nodes.depth, NULL) != PTR_OK;
     }

@@ -283,9 +283,10 @@ static void test_tree_bytes(void)
         BvhSceneKind kind;
         int count;
         uint64_t hash;
+        int depth; /* the traversal's stack is sized by it */
     } sets[] = {
-        { BVH_SCENE_CLUSTERS, 300000, UINT64_C(0xd780aba4d7f7764e) },
-        { BVH_SCENE_RANDOM, 5000, UINT64_C(0xdf3f94129d98524b) },
+        { BVH_SCENE_CLUSTERS, 300000, UINT64_C(0xd780aba4d7f7764e), 7 },
+        { BVH_SCENE_RANDOM, 5000, UINT64_C(0xdf3f94129d98524b), 3 },
     };
     for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
         PtrScene s;
@@ -307,6 +308,7 @@ static void test_tree_bytes(void)
                     bvh_scene_names[sets[k].kind], sets[k].count, (unsigned long long)h,
                     (unsigned long long)sets[k].hash);
         CHECK(h == sets[k].hash);
+        CHECK_INT(bvh.depth, sets[k].depth);
         ptr_bvh_free(&bvh);
         ptr_scene_free(&s);
     }
