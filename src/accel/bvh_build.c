@@ -331,6 +331,21 @@ static int inner_child(const PtrBvhNode *node, int k)
     return node->leaf_count[k] == 0 && node->lower_x[k] <= node->upper_x[k];
 }
 
+/* Moves the array from to joined[start ..], each inner child's index moved
+ * by start and each task's number (a part's) by first_task; frees it. */
+static void place_nodes(PtrBvhNode *joined, size_t start, NodeArray *from, size_t first_task)
+{
+    PtrBvhNode *nodes = joined + start;
+    memcpy(nodes, from->nodes, from->count * sizeof *nodes);
+    for (size_t j = 0; j < from->count; j++)
+        for (int k = 0; k < PTR_BVH_WIDTH; k++)
+            if (inner_child(&nodes[j], k))
+                nodes[j].child[k] += (uint32_t)((nodes[j].child[k] & TASK_FLAG) ? first_task
+                                                                                 : start);
+    free(from->nodes);
+    from->nodes = NULL;
+}
+
 /* Makes top the root and its parts' nodes in one array, and build->tasks
  * the root's and the parts' tasks, in the order a depth-first build on one
  * thread makes them: the root, then each part's nodes in the order of the
@@ -362,23 +377,14 @@ static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
             continue;
         }
         Part *p = &build->parts[root->child[k] & ~PART_FLAG];
-        PtrBvhNode *part_nodes = nodes + node_count;
-        memcpy(part_nodes, p->nodes.nodes, p->nodes.count * sizeof *nodes);
         memcpy(tasks + task_count, p->tasks.tasks, p->tasks.count * sizeof *tasks);
-        for (size_t j = 0; j < p->nodes.count; j++)
-            for (int lane = 0; lane < PTR_BVH_WIDTH; lane++)
-                if (inner_child(&part_nodes[j], lane))
-                    part_nodes[j].child[lane] += (part_nodes[j].child[lane] & TASK_FLAG)
-                                                     ? (uint32_t)task_count
-                                                     : (uint32_t)node_count;
+        place_nodes(nodes, node_count, &p->nodes, task_count);
         root->child[k] = (uint32_t)node_count;
         node_count += p->nodes.count;
         task_count += p->tasks.count;
         if (p->nodes.depth + 1 > top->depth)
             top->depth = p->nodes.depth + 1;
-        free(p->nodes.nodes);
         free(p->tasks.tasks);
-        p->nodes.nodes = NULL;
         p->tasks.tasks = NULL;
     }
     free(top->nodes);
@@ -406,17 +412,8 @@ typedef struct LayOut {
 static void lay_out_tasks(void *arg, size_t begin, size_t end)
 {
     const LayOut *l = arg;
-    for (size_t i = begin; i < end; i++) {
-        NodeArray *a = &l->build->tasks.tasks[i].nodes;
-        PtrBvhNode *nodes = l->nodes + l->start[i];
-        memcpy(nodes, a->nodes, a->count * sizeof *nodes);
-        free(a->nodes);
-        a->nodes = NULL;
-        for (size_t j = 0; j < a->count; j++)
-            for (int k = 0; k < PTR_BVH_WIDTH; k++)
-                if (inner_child(&nodes[j], k))
-                    nodes[j].child[k] += (uint32_t)l->start[i];
-    }
+    for (size_t i = begin; i < end; i++)
+        place_nodes(l->nodes, l->start[i], &l->build->tasks.tasks[i].nodes, 0);
 }
 
 /* One node array: the top level's first, then each task's, with every task
