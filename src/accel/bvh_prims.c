@@ -16,50 +16,100 @@
  * reach the tree.) */
 enum { HUGE_RATIO = 100 };
 
-/* The k-th smallest of values[0 .. n - 1] (reorders values). */
-static float select_kth(float *values, size_t n, size_t k)
+/* Pieces the radii are counted and offered in: one a thread, at most this
+ * many (each piece's counts take 256 KB). */
+enum { RADIUS_PIECES_MAX = 16 };
+
+/* The median radius is found exactly, on all threads, without a copy of
+ * the radii: radii are positive floats (the importers' rule), which order
+ * as their bits do, so counting the radii by their high 16 bits finds the
+ * median's, and counting those radii by their low 16 bits the rest. */
+enum { HALF_BITS = 16, HALF_VALUES = 1 << HALF_BITS };
+
+typedef struct RadiusCount {
+    const float *radius;
+    size_t count;
+    size_t pieces;
+    int low;       /* 0: count by high bits; 1: by low bits, radii with these high bits */
+    uint32_t high;
+    uint32_t *bins; /* HALF_VALUES counts a piece */
+} RadiusCount;
+
+static size_t piece_start(size_t count, size_t pieces, size_t k)
 {
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        float a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi];
-        float pivot = a < b ? (b < c ? b : a < c ? c : a) : (a < c ? a : b < c ? c : b);
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (values[i] < pivot)
-                i++;
-            while (values[j] > pivot)
-                j--;
-            if (i <= j) {
-                float t = values[i];
-                values[i] = values[j];
-                values[j] = t;
-                i++;
-                if (j == 0)
-                    break;
-                j--;
-            }
+    return count * k / pieces;
+}
+
+static void count_radii(void *arg, size_t first_piece, size_t end_piece)
+{
+    const RadiusCount *c = arg;
+    for (size_t k = first_piece; k < end_piece; k++) {
+        uint32_t *bins = c->bins + k * HALF_VALUES;
+        memset(bins, 0, HALF_VALUES * sizeof *bins);
+        const size_t end = piece_start(c->count, c->pieces, k + 1);
+        for (size_t i = piece_start(c->count, c->pieces, k); i < end; i++) {
+            uint32_t bits;
+            memcpy(&bits, &c->radius[i], sizeof bits);
+            if (!c->low)
+                bins[bits >> HALF_BITS]++;
+            else if (bits >> HALF_BITS == c->high)
+                bins[bits & (HALF_VALUES - 1)]++;
         }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return values[k];
     }
-    return values[k];
+}
+
+/* The half-value whose radii hold the rank-th (from 0) of those counted,
+ * all pieces together; *rank becomes its rank among them. */
+static uint32_t half_of_rank(const RadiusCount *c, size_t *rank)
+{
+    for (uint32_t v = 0;; v++) {
+        size_t with_v = 0;
+        for (size_t k = 0; k < c->pieces; k++)
+            with_v += c->bins[k * HALF_VALUES + v];
+        if (*rank < with_v)
+            return v;
+        *rank -= with_v;
+    }
 }
 
 /* The limit above which a radius is huge for the tree; NaN if out of
  * memory. */
-static float huge_radius(const PtrSpheres *s)
+static float huge_radius(const PtrSpheres *s, size_t pieces, int threads)
 {
-    float *radii = malloc(s->count * sizeof *radii);
-    if (!radii)
+    RadiusCount c = { .radius = s->radius, .count = s->count, .pieces = pieces };
+    c.bins = malloc(pieces * HALF_VALUES * sizeof *c.bins);
+    if (!c.bins)
         return NAN;
-    memcpy(radii, s->radius, s->count * sizeof *radii);
-    float median = select_kth(radii, s->count, s->count / 2);
-    free(radii);
+    size_t rank = s->count / 2;
+    ptr_parallel_ranges(threads, 0, pieces, count_radii, &c);
+    c.high = half_of_rank(&c, &rank);
+    c.low = 1;
+    ptr_parallel_ranges(threads, 0, pieces, count_radii, &c);
+    const uint32_t bits = c.high << HALF_BITS | half_of_rank(&c, &rank);
+    free(c.bins);
+    float median;
+    memcpy(&median, &bits, sizeof median);
     return median * HUGE_RATIO;
+}
+
+/* The huge spheres' choice, a piece at a time: the choice keeps the largest
+ * by one order (PtrHugeChoice), so the pieces' choices offered again give
+ * the choice of all. */
+typedef struct HugeOffer {
+    const PtrSpheres *spheres;
+    size_t pieces;
+    PtrHugeChoice *choice; /* a piece's, the limit set */
+} HugeOffer;
+
+static void offer_huge(void *arg, size_t first_piece, size_t end_piece)
+{
+    const HugeOffer *o = arg;
+    const PtrSpheres *s = o->spheres;
+    for (size_t k = first_piece; k < end_piece; k++) {
+        const size_t end = piece_start(s->count, o->pieces, k + 1);
+        for (size_t i = piece_start(s->count, o->pieces, k); i < end; i++)
+            ptr_huge_offer(&o->choice[k], i, ptr_sphere_id(s, i), s->radius[i]);
+    }
 }
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
@@ -136,11 +186,20 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     *magnitude_out = 0.0f;
     if (s->count == 0)
         return PTR_OK;
-    PtrHugeChoice choice = { .limit = huge_radius(s) };
+    const size_t pieces = threads < RADIUS_PIECES_MAX ? (size_t)threads : RADIUS_PIECES_MAX;
+    PtrHugeChoice choice = { .limit = huge_radius(s, pieces, threads) };
     if (isnan(choice.limit))
         return bvh_out_of_memory(err);
-    for (size_t i = 0; i < s->count; i++)
-        ptr_huge_offer(&choice, i, ptr_sphere_id(s, i), s->radius[i]);
+    PtrHugeChoice piece_choice[RADIUS_PIECES_MAX];
+    for (size_t k = 0; k < pieces; k++)
+        piece_choice[k] = (PtrHugeChoice){ .limit = choice.limit };
+    HugeOffer offer = { s, pieces, piece_choice };
+    ptr_parallel_ranges(threads, 0, pieces, offer_huge, &offer);
+    for (size_t k = 0; k < pieces; k++)
+        for (size_t j = 0; j < piece_choice[k].count; j++) {
+            const PtrHugeCandidate *h = &piece_choice[k].sphere[j];
+            ptr_huge_offer(&choice, h->index, h->file_position, h->radius);
+        }
     ptr_huge_file_order(&choice);
     /* By index, to skip them below. */
     size_t out[PTR_HUGE_MAX + 1];

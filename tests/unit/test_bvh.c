@@ -224,6 +224,49 @@ static void test_huge(void)
     }
 }
 
+/* The tree's limit and its choice of huge spheres, on any thread count as
+ * the rule gives them: 3,001 spheres whose median radius is 1 (1,500 of 0.5
+ * and 1,500 of 2 alternating, one of 1), so the limit is 100 to the bit.
+ * Every 98th is made radius 100, not huge, or 150, 200 or 250 (huge: 22
+ * of them, more than PTR_HUGE_MAX, with equal radii), spread over every
+ * thread's share of the arrays. A median one place off would make the limit
+ * 50 or 200 and move the choice. */
+static void test_huge_threads(void)
+{
+    enum { COUNT = 3001 };
+    float radius[COUNT];
+    for (int i = 0; i < COUNT; i++)
+        radius[i] = i == COUNT / 2 ? 1.0f : i % 2 ? 0.5f : 2.0f;
+    for (int i = 98, k = 0; i < COUNT; i += 98, k++) /* a 2: the median stays 1 */
+        radius[i] = k % 4 == 0 ? 100.0f : 100.0f + 50.0f * (float)(k % 4);
+    PtrHugeChoice rule = { .limit = 100.0 };
+    for (int i = 0; i < COUNT; i++)
+        ptr_huge_offer(&rule, (size_t)i, (size_t)i, radius[i]);
+    ptr_huge_file_order(&rule);
+    CHECK_INT(rule.count, PTR_HUGE_MAX);
+    for (int t = 0; t < 3; t++) {
+        const int threads[] = { 1, 2, 7 };
+        PtrScene s;
+        ptr_scene_init(&s);
+        for (int i = 0; i < COUNT; i++)
+            CHECK_INT(ptr_scene_add_sphere(&s, v3((float)(i % 60) * 5.0f, (float)(i / 60) * 5.0f,
+                                                  -10.0f),
+                                           radius[i], 0, NULL),
+                      PTR_OK);
+        tag_file_order(&s);
+        PtrBvh bvh;
+        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t], NULL), PTR_OK);
+        CHECK_INT(bvh.huge_count, PTR_HUGE_MAX);
+        size_t wrong = 0;
+        for (size_t k = 0; k < bvh.huge_count; k++)
+            wrong += file_position(&s.spheres, k, (FileOrder){ 0 }) !=
+                     rule.sphere[k].file_position;
+        CHECK_INT(wrong, 0);
+        ptr_bvh_free(&bvh);
+        ptr_scene_free(&s);
+    }
+}
+
 /* The same tree bytes and sphere order with 1, 2 and 7 threads, on a set
  * large enough for parallel binning and many tasks. */
 static void test_threads(void)
@@ -504,6 +547,7 @@ int main(void)
         TEST_CASE(test_coincident),
         TEST_CASE(test_huge_rule),
         TEST_CASE(test_huge),
+        TEST_CASE(test_huge_threads),
         TEST_CASE(test_scenes),
         TEST_CASE(test_threads),
         TEST_CASE(test_tree_bytes),
