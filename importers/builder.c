@@ -269,31 +269,87 @@ static void use_override(PtrSceneBuilder *b)
 static inline double least(double a, double b) { return b < a ? b : a; }
 static inline double most(double a, double b) { return b > a ? b : a; }
 
+/* The passes below over every sphere run on all cores, a result a piece
+ * (ptr_parallel_pieces), taken in the pieces' order: minima and maxima,
+ * which do not depend on how the spheres are grouped. */
+enum { PIECES_MAX = 64 };
+
+static size_t piece_count(void)
+{
+    const int threads = ptr_online_cpus();
+    return threads < PIECES_MAX ? (size_t)threads : PIECES_MAX;
+}
+
+typedef struct SmallestPass {
+    const double *spheres;
+    double smallest[PIECES_MAX];
+} SmallestPass;
+
+static void smallest_in(void *arg, size_t piece, size_t from, size_t to)
+{
+    SmallestPass *p = arg;
+    double smallest = INFINITY;
+    for (size_t i = from; i < to; i++)
+        smallest = least(smallest, p->spheres[4 * i + 3]);
+    p->smallest[piece] = smallest;
+}
+
 static double smallest_radius(const PtrSceneBuilder *b)
 {
+    SmallestPass p = { .spheres = b->spheres };
+    const size_t pieces = piece_count();
+    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, smallest_in, &p);
     double smallest = INFINITY;
-    for (size_t i = 0; i < b->count; i++)
-        smallest = least(smallest, b->spheres[4 * i + 3]);
+    for (size_t k = 0; k < pieces; k++)
+        smallest = least(smallest, p.smallest[k]);
     return smallest;
 }
 
-static int is_framed(const PtrSceneBuilder *b, size_t i, double smallest)
+static int is_framed(const double *sphere, double smallest)
 {
-    return !(b->spheres[4 * i + 3] > SMALL_RATIO * smallest);
+    return !(sphere[3] > SMALL_RATIO * smallest);
+}
+
+typedef struct BoxPass {
+    const double *spheres;
+    double smallest;
+    double lo[PIECES_MAX][3], hi[PIECES_MAX][3];
+    int any[PIECES_MAX];
+} BoxPass;
+
+static void box_in(void *arg, size_t piece, size_t from, size_t to)
+{
+    BoxPass *p = arg;
+    double lo[3] = { 0 }, hi[3] = { 0 }; /* here, not in p's lines, which other pieces write */
+    int any = 0;
+    for (size_t i = from; i < to; i++) {
+        const double *s = &p->spheres[4 * i];
+        if (!is_framed(s, p->smallest))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = any ? least(lo[k], s[k] - s[3]) : s[k] - s[3];
+            hi[k] = any ? most(hi[k], s[k] + s[3]) : s[k] + s[3];
+        }
+        any = 1;
+    }
+    memcpy(p->lo[piece], lo, sizeof lo);
+    memcpy(p->hi[piece], hi, sizeof hi);
+    p->any[piece] = any;
 }
 
 /* The box around the spheres the framing considers; 0 if there are none. */
 static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
 {
-    double smallest = smallest_radius(b);
+    BoxPass p = { .spheres = b->spheres, .smallest = smallest_radius(b) };
+    const size_t pieces = piece_count();
+    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, box_in, &p);
     int any = 0;
-    for (size_t i = 0; i < b->count; i++) {
-        const double *s = &b->spheres[4 * i];
-        if (!is_framed(b, i, smallest))
+    for (size_t piece = 0; piece < pieces; piece++) {
+        if (!p.any[piece])
             continue;
         for (int k = 0; k < 3; k++) {
-            lo[k] = any ? least(lo[k], s[k] - s[3]) : s[k] - s[3];
-            hi[k] = any ? most(hi[k], s[k] + s[3]) : s[k] + s[3];
+            lo[k] = any ? least(lo[k], p.lo[piece][k]) : p.lo[piece][k];
+            hi[k] = any ? most(hi[k], p.hi[piece][k]) : p.hi[piece][k];
         }
         any = 1;
     }
@@ -308,20 +364,43 @@ static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
  * (c_axis - E_axis) cos a + (c_z - E_z) sin a + r <= 0; the two planes give
  * E_z sin a >= hi - E_axis cos a and E_z sin a >= lo + E_axis cos a, least
  * when both hold with equality. */
+typedef struct AxisPass {
+    const double *spheres;
+    double smallest, ca, sa;
+    int axis;
+    double hi[PIECES_MAX], lo[PIECES_MAX];
+} AxisPass;
+
+static void axis_in(void *arg, size_t piece, size_t from, size_t to)
+{
+    AxisPass *p = arg;
+    const int axis = p->axis;
+    double hi = -INFINITY, lo = -INFINITY;
+    for (size_t i = from; i < to; i++) {
+        const double *s = &p->spheres[4 * i];
+        if (!is_framed(s, p->smallest))
+            continue;
+        hi = most(hi, s[axis] * p->ca + s[2] * p->sa + s[3]);
+        lo = most(lo, -s[axis] * p->ca + s[2] * p->sa + s[3]);
+    }
+    p->hi[piece] = hi;
+    p->lo[piece] = lo;
+}
+
 static void fit_axis(const PtrSceneBuilder *b, int axis, double half_angle, double *eye_axis,
                      double *eye_z)
 {
-    double smallest = smallest_radius(b), hi = -INFINITY, lo = -INFINITY;
-    double ca = cos(half_angle), sa = sin(half_angle);
-    for (size_t i = 0; i < b->count; i++) {
-        const double *s = &b->spheres[4 * i];
-        if (!is_framed(b, i, smallest))
-            continue;
-        hi = most(hi, s[axis] * ca + s[2] * sa + s[3]);
-        lo = most(lo, -s[axis] * ca + s[2] * sa + s[3]);
+    AxisPass p = { .spheres = b->spheres, .smallest = smallest_radius(b),
+                   .ca = cos(half_angle), .sa = sin(half_angle), .axis = axis };
+    const size_t pieces = piece_count();
+    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, axis_in, &p);
+    double hi = -INFINITY, lo = -INFINITY;
+    for (size_t k = 0; k < pieces; k++) {
+        hi = most(hi, p.hi[k]);
+        lo = most(lo, p.lo[k]);
     }
-    *eye_axis = 0.5 * (hi - lo) / ca;
-    *eye_z = 0.5 * (hi + lo) / sa;
+    *eye_axis = 0.5 * (hi - lo) / p.ca;
+    *eye_z = 0.5 * (hi + lo) / p.sa;
 }
 
 /* The automatic camera: looking down -Z, +Y up, placed so that the spheres'
@@ -411,6 +490,18 @@ static PtrVec3 relative(const double p[3], const double origin[3])
  * how many. */
 #define HUGE_RATIO 256.0
 
+typedef struct HugePass {
+    const double *spheres;
+    PtrHugeChoice choice[PIECES_MAX];
+} HugePass;
+
+static void huge_in(void *arg, size_t piece, size_t from, size_t to)
+{
+    HugePass *p = arg;
+    for (size_t i = from; i < to; i++)
+        ptr_huge_offer(&p->choice[piece], i, i, p->spheres[4 * i + 3]);
+}
+
 static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
                           size_t huge[PTR_HUGE_MAX])
 {
@@ -426,9 +517,19 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
     double extent = 0;
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
+    HugePass p = { .spheres = b->spheres };
+    const size_t pieces = piece_count();
+    for (size_t k = 0; k < pieces; k++)
+        p.choice[k] = (PtrHugeChoice){ .limit = HUGE_RATIO * extent };
+    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, huge_in, &p);
+    /* The choice keeps the largest by one order, so the pieces' choices
+     * offered again give the choice of all. */
     PtrHugeChoice choice = { .limit = HUGE_RATIO * extent };
-    for (size_t i = 0; i < b->count; i++)
-        ptr_huge_offer(&choice, i, i, b->spheres[4 * i + 3]);
+    for (size_t k = 0; k < pieces; k++)
+        for (size_t j = 0; j < p.choice[k].count; j++) {
+            const PtrHugeCandidate *h = &p.choice[k].sphere[j];
+            ptr_huge_offer(&choice, h->index, h->file_position, h->radius);
+        }
     ptr_huge_file_order(&choice);
     for (size_t k = 0; k < choice.count; k++)
         huge[k] = choice.sphere[k].index;
@@ -495,6 +596,19 @@ static void move_spheres(void *arg, size_t begin, size_t end)
         atomic_store(&m->invalid, 1);
 }
 
+typedef struct Recentre {
+    double *spheres;
+    const double *origin;
+} Recentre;
+
+static void recentre_spheres(void *arg, size_t begin, size_t end)
+{
+    const Recentre *r = arg;
+    for (size_t i = begin; i < end; i++)
+        for (int k = 0; k < 3; k++)
+            r->spheres[4 * i + k] -= r->origin[k];
+}
+
 /* The spheres in file order, the huge ones last (then ids keep the file's
  * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
  * all cores from the last back, the builder's arrays shrinking behind, so
@@ -505,9 +619,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
     PtrScene *scene = b->scene;
     const size_t count = b->count;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
-    for (size_t i = 0; i < count; i++)
-        for (int k = 0; k < 3; k++)
-            b->spheres[4 * i + k] -= origin[k];
+    Recentre recentre = { b->spheres, origin };
+    ptr_parallel_ranges(ptr_online_cpus(), 0, count, recentre_spheres, &recentre);
     size_t huge[PTR_HUGE_MAX];
     const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);

@@ -28,33 +28,24 @@ enum { HALF_BITS = 16, HALF_VALUES = 1 << HALF_BITS };
 
 typedef struct RadiusCount {
     const float *radius;
-    size_t count;
     size_t pieces;
     int low;       /* 0: count by high bits; 1: by low bits, radii with these high bits */
     uint32_t high;
     uint32_t *bins; /* HALF_VALUES counts a piece */
 } RadiusCount;
 
-static size_t piece_start(size_t count, size_t pieces, size_t k)
-{
-    return count * k / pieces;
-}
-
-static void count_radii(void *arg, size_t first_piece, size_t end_piece)
+static void count_radii(void *arg, size_t piece, size_t from, size_t to)
 {
     const RadiusCount *c = arg;
-    for (size_t k = first_piece; k < end_piece; k++) {
-        uint32_t *bins = c->bins + k * HALF_VALUES;
-        memset(bins, 0, HALF_VALUES * sizeof *bins);
-        const size_t end = piece_start(c->count, c->pieces, k + 1);
-        for (size_t i = piece_start(c->count, c->pieces, k); i < end; i++) {
-            uint32_t bits;
-            memcpy(&bits, &c->radius[i], sizeof bits);
-            if (!c->low)
-                bins[bits >> HALF_BITS]++;
-            else if (bits >> HALF_BITS == c->high)
-                bins[bits & (HALF_VALUES - 1)]++;
-        }
+    uint32_t *bins = c->bins + piece * HALF_VALUES;
+    memset(bins, 0, HALF_VALUES * sizeof *bins);
+    for (size_t i = from; i < to; i++) {
+        uint32_t bits;
+        memcpy(&bits, &c->radius[i], sizeof bits);
+        if (!c->low)
+            bins[bits >> HALF_BITS]++;
+        else if (bits >> HALF_BITS == c->high)
+            bins[bits & (HALF_VALUES - 1)]++;
     }
 }
 
@@ -76,15 +67,15 @@ static uint32_t half_of_rank(const RadiusCount *c, size_t *rank)
  * memory. */
 static float huge_radius(const PtrSpheres *s, size_t pieces, int threads)
 {
-    RadiusCount c = { .radius = s->radius, .count = s->count, .pieces = pieces };
+    RadiusCount c = { .radius = s->radius, .pieces = pieces };
     c.bins = malloc(pieces * HALF_VALUES * sizeof *c.bins);
     if (!c.bins)
         return NAN;
     size_t rank = s->count / 2;
-    ptr_parallel_ranges(threads, 0, pieces, count_radii, &c);
+    ptr_parallel_pieces(threads, s->count, pieces, count_radii, &c);
     c.high = half_of_rank(&c, &rank);
     c.low = 1;
-    ptr_parallel_ranges(threads, 0, pieces, count_radii, &c);
+    ptr_parallel_pieces(threads, s->count, pieces, count_radii, &c);
     const uint32_t bits = c.high << HALF_BITS | half_of_rank(&c, &rank);
     free(c.bins);
     float median;
@@ -97,19 +88,14 @@ static float huge_radius(const PtrSpheres *s, size_t pieces, int threads)
  * the choice of all. */
 typedef struct HugeOffer {
     const PtrSpheres *spheres;
-    size_t pieces;
     PtrHugeChoice *choice; /* a piece's, the limit set */
 } HugeOffer;
 
-static void offer_huge(void *arg, size_t first_piece, size_t end_piece)
+static void offer_huge(void *arg, size_t piece, size_t from, size_t to)
 {
     const HugeOffer *o = arg;
-    const PtrSpheres *s = o->spheres;
-    for (size_t k = first_piece; k < end_piece; k++) {
-        const size_t end = piece_start(s->count, o->pieces, k + 1);
-        for (size_t i = piece_start(s->count, o->pieces, k); i < end; i++)
-            ptr_huge_offer(&o->choice[k], i, ptr_sphere_id(s, i), s->radius[i]);
-    }
+    for (size_t i = from; i < to; i++)
+        ptr_huge_offer(&o->choice[piece], i, ptr_sphere_id(o->spheres, i), o->spheres->radius[i]);
 }
 
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
@@ -193,8 +179,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     PtrHugeChoice piece_choice[RADIUS_PIECES_MAX];
     for (size_t k = 0; k < pieces; k++)
         piece_choice[k] = (PtrHugeChoice){ .limit = choice.limit };
-    HugeOffer offer = { s, pieces, piece_choice };
-    ptr_parallel_ranges(threads, 0, pieces, offer_huge, &offer);
+    HugeOffer offer = { s, piece_choice };
+    ptr_parallel_pieces(threads, s->count, pieces, offer_huge, &offer);
     for (size_t k = 0; k < pieces; k++)
         for (size_t j = 0; j < piece_choice[k].count; j++) {
             const PtrHugeCandidate *h = &piece_choice[k].sphere[j];

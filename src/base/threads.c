@@ -180,3 +180,23 @@ void ptr_parallel_ranges(int threads, size_t begin, size_t end,
         if (ids[i])
             ptr_thread_join(ids[i]);
 }
+
+typedef struct Pieces {
+    void (*fn)(void *arg, size_t piece, size_t from, size_t to);
+    void *arg;
+    size_t count, pieces;
+} Pieces;
+
+static void run_pieces(void *arg, size_t first, size_t end)
+{
+    const Pieces *p = arg;
+    for (size_t k = first; k < end; k++)
+        p->fn(p->arg, k, p->count * k / p->pieces, p->count * (k + 1) / p->pieces);
+}
+
+void ptr_parallel_pieces(int threads, size_t count, size_t pieces,
+                         void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg)
+{
+    Pieces p = { fn, arg, count, pieces };
+    ptr_parallel_ranges(threads, 0, pieces, run_pieces, &p);
+}

@@ -31,4 +31,12 @@ void ptr_thread_join(PtrThread *thread);
 void ptr_parallel_ranges(int threads, size_t begin, size_t end,
                          void (*fn)(void *arg, size_t from, size_t to), void *arg);
 
+/* Runs fn(arg, k, from, to) for each piece k < pieces of 0 .. count - 1,
+ * piece k being count * k / pieces .. count * (k + 1) / pieces - 1, the
+ * pieces shared out as ptr_parallel_ranges shares its range: for work that
+ * keeps a result a piece, which the caller then takes in the pieces' order,
+ * so that the result does not depend on the thread count. */
+void ptr_parallel_pieces(int threads, size_t count, size_t pieces,
+                         void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg);
+
 #endif /* PTR_THREADS_H */

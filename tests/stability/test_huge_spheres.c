@@ -101,6 +101,46 @@ static void test_walls_are_huge(void)
     ptr_scene_free(&probe);
 }
 
+/* The builder's choice of huge spheres when more than PTR_HUGE_MAX are
+ * (scene.h's rule), made on all cores: 3,000 radius-1 spheres in a
+ * 60 x 50 grid with 40 huge ones among them, radii 1e6 to 4e6 with ties,
+ * spread through the file. The scene keeps the 16 largest, on equal radii
+ * the first in the file, in the file's order, each in double. */
+static void test_many_huge(void)
+{
+    enum { SMALL = 3000, HUGE = 40, STEP = (SMALL + HUGE) / HUGE };
+    const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = v3_splat(0.5f) };
+    PtrScene s;
+    uint32_t m;
+    ptr_scene_init(&s);
+    CHECK_INT(ptr_scene_add_material(&s, &grey, &m, NULL), PTR_OK);
+    PtrSceneBuilder b;
+    ptr_builder_init(&b, &s, NULL);
+    PtrHugeChoice rule = { .limit = 1e5 };
+    for (int i = 0, small = 0, huge = 0; i < SMALL + HUGE; i++) {
+        const int is_huge = i % STEP == STEP - 1 && huge < HUGE;
+        /* A huge sphere's x is its place in the file, to find it by. */
+        const double centre[3] = { is_huge ? i : small % 60 * 2.0, small / 60 * 2.0, -100.0 };
+        const double radius = is_huge ? 1e6 * (1 + huge % 4) : 1.0;
+        CHECK_INT(ptr_builder_add_sphere(&b, centre, radius, m, NULL), PTR_OK);
+        ptr_huge_offer(&rule, (size_t)i, (size_t)i, radius);
+        huge += is_huge;
+        small += !is_huge;
+    }
+    ptr_huge_file_order(&rule);
+    const double eye[3] = { 60, 50, 200 }, at[3] = { 60, 50, 0 }, up[3] = { 0, 1, 0 };
+    const PtrCamera lens = { .vfov_deg = 50.0f, .focus_distance = 1.0f };
+    ptr_builder_set_camera(&b, eye, at, up, &lens);
+    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
+    CHECK_INT((int)s.huge.count, PTR_HUGE_MAX);
+    int wrong = 0;
+    for (size_t k = 0; k < s.huge.count; k++)
+        wrong += s.huge.centre_radius[4 * k] + s.origin[0] != (double)rule.sphere[k].file_position ||
+                 s.huge.centre_radius[4 * k + 3] != rule.sphere[k].radius;
+    CHECK_INT(wrong, 0);
+    ptr_scene_free(&s);
+}
+
 static void test_closed_room(void)
 {
     const PtrSky black = { .kind = PTR_SKY_BLACK };
@@ -147,6 +187,7 @@ int main(void)
     CHECK_INT(stability_ptr_methods(methods, method_count), stability_ptr_levels());
     const TestCase cases[] = {
         TEST_CASE(test_walls_are_huge),
+        TEST_CASE(test_many_huge),
         TEST_CASE(test_closed_room),
         TEST_CASE(test_lit_ground),
     };
