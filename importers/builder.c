@@ -271,13 +271,20 @@ static inline double most(double a, double b) { return b > a ? b : a; }
 
 /* The passes below over every sphere run on all cores, a result a piece
  * (ptr_parallel_pieces), taken in the pieces' order: minima and maxima,
- * which do not depend on how the spheres are grouped. */
+ * and the huge choice (choose_huge), which do not depend on how the spheres
+ * are grouped. (NaN aside, where the framed box may differ: add_sphere
+ * refuses such a scene either way.) */
 enum { PIECES_MAX = 64 };
 
-static size_t piece_count(void)
+/* Runs fn over the builder's spheres in pieces, one a thread; returns how
+ * many pieces. */
+static size_t over_pieces(const PtrSceneBuilder *b,
+                          void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg)
 {
     const int threads = ptr_online_cpus();
-    return threads < PIECES_MAX ? (size_t)threads : PIECES_MAX;
+    const size_t pieces = threads < PIECES_MAX ? (size_t)threads : PIECES_MAX;
+    ptr_parallel_pieces(threads, b->count, pieces, fn, arg);
+    return pieces;
 }
 
 typedef struct SmallestPass {
@@ -285,7 +292,7 @@ typedef struct SmallestPass {
     double smallest[PIECES_MAX];
 } SmallestPass;
 
-static void smallest_in(void *arg, size_t piece, size_t from, size_t to)
+static void smallest_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     SmallestPass *p = arg;
     double smallest = INFINITY;
@@ -297,8 +304,7 @@ static void smallest_in(void *arg, size_t piece, size_t from, size_t to)
 static double smallest_radius(const PtrSceneBuilder *b)
 {
     SmallestPass p = { .spheres = b->spheres };
-    const size_t pieces = piece_count();
-    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, smallest_in, &p);
+    const size_t pieces = over_pieces(b, smallest_of_piece, &p);
     double smallest = INFINITY;
     for (size_t k = 0; k < pieces; k++)
         smallest = least(smallest, p.smallest[k]);
@@ -317,7 +323,7 @@ typedef struct BoxPass {
     int any[PIECES_MAX];
 } BoxPass;
 
-static void box_in(void *arg, size_t piece, size_t from, size_t to)
+static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     BoxPass *p = arg;
     double lo[3] = { 0 }, hi[3] = { 0 }; /* here, not in p's lines, which other pieces write */
@@ -337,12 +343,12 @@ static void box_in(void *arg, size_t piece, size_t from, size_t to)
     p->any[piece] = any;
 }
 
-/* The box around the spheres the framing considers; 0 if there are none. */
-static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
+/* The box around the spheres the framing considers (smallest: the smallest
+ * radius); 0 if there are none. */
+static int framed_box(const PtrSceneBuilder *b, double smallest, double lo[3], double hi[3])
 {
-    BoxPass p = { .spheres = b->spheres, .smallest = smallest_radius(b) };
-    const size_t pieces = piece_count();
-    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, box_in, &p);
+    BoxPass p = { .spheres = b->spheres, .smallest = smallest };
+    const size_t pieces = over_pieces(b, box_of_piece, &p);
     int any = 0;
     for (size_t piece = 0; piece < pieces; piece++) {
         if (!p.any[piece])
@@ -356,24 +362,16 @@ static int framed_box(const PtrSceneBuilder *b, double lo[3], double hi[3])
     return any;
 }
 
-/* How a perspective camera looking down -Z with half-angle half_angle (in
- * the plane of axis and Z) sees the spheres: the least eye z at which all of
- * them lie inside the two planes bounding the view along that axis, and the
- * eye's coordinate on the axis that centres them. A sphere (c, r) is inside
- * the plane through the eye E with outward normal (cos a, sin a) iff
- * (c_axis - E_axis) cos a + (c_z - E_z) sin a + r <= 0; the two planes give
- * E_z sin a >= hi - E_axis cos a and E_z sin a >= lo + E_axis cos a, least
- * when both hold with equality. */
-typedef struct AxisPass {
+typedef struct PlanesPass {
     const double *spheres;
     double smallest, ca, sa;
     int axis;
     double hi[PIECES_MAX], lo[PIECES_MAX];
-} AxisPass;
+} PlanesPass;
 
-static void axis_in(void *arg, size_t piece, size_t from, size_t to)
+static void planes_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
-    AxisPass *p = arg;
+    PlanesPass *p = arg;
     const int axis = p->axis;
     double hi = -INFINITY, lo = -INFINITY;
     for (size_t i = from; i < to; i++) {
@@ -387,13 +385,20 @@ static void axis_in(void *arg, size_t piece, size_t from, size_t to)
     p->lo[piece] = lo;
 }
 
-static void fit_axis(const PtrSceneBuilder *b, int axis, double half_angle, double *eye_axis,
-                     double *eye_z)
+/* How a perspective camera looking down -Z with half-angle half_angle (in
+ * the plane of axis and Z) sees the spheres: the least eye z at which all of
+ * them lie inside the two planes bounding the view along that axis, and the
+ * eye's coordinate on the axis that centres them. A sphere (c, r) is inside
+ * the plane through the eye E with outward normal (cos a, sin a) iff
+ * (c_axis - E_axis) cos a + (c_z - E_z) sin a + r <= 0; the two planes give
+ * E_z sin a >= hi - E_axis cos a and E_z sin a >= lo + E_axis cos a, least
+ * when both hold with equality. */
+static void fit_axis(const PtrSceneBuilder *b, double smallest, int axis, double half_angle,
+                     double *eye_axis, double *eye_z)
 {
-    AxisPass p = { .spheres = b->spheres, .smallest = smallest_radius(b),
-                   .ca = cos(half_angle), .sa = sin(half_angle), .axis = axis };
-    const size_t pieces = piece_count();
-    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, axis_in, &p);
+    PlanesPass p = { .spheres = b->spheres, .smallest = smallest, .ca = cos(half_angle),
+                     .sa = sin(half_angle), .axis = axis };
+    const size_t pieces = over_pieces(b, planes_of_piece, &p);
     double hi = -INFINITY, lo = -INFINITY;
     for (size_t k = 0; k < pieces; k++) {
         hi = most(hi, p.hi[k]);
@@ -409,14 +414,14 @@ static void fit_axis(const PtrSceneBuilder *b, int axis, double half_angle, doub
  * orthographic views parallel rays from in front of every sphere. The
  * image's aspect is the command line's, else the scene's resolution's,
  * else 16:9, and the camera keeps it, so the image size follows. */
-static void frame_spheres(PtrSceneBuilder *b)
+static void frame_spheres(PtrSceneBuilder *b, double smallest)
 {
     const PtrScene *scene = b->scene;
     double aspect = b->auto_aspect > 0   ? b->auto_aspect
                     : scene->width > 0 ? (double)scene->width / scene->height
                                        : 16.0 / 9.0;
     double lo[3] = { -1, -1, -1 }, hi[3] = { 1, 1, 1 };
-    framed_box(b, lo, hi);
+    framed_box(b, smallest, lo, hi);
     double centre[3];
     for (int k = 0; k < 3; k++)
         centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -433,8 +438,8 @@ static void frame_spheres(PtrSceneBuilder *b)
         const double vfov_deg = 40.0, tan_v = tan(0.5 * vfov_deg * DEG_TO_RAD);
         if (b->count) {
             double z_v, z_h;
-            fit_axis(b, 1, atan(FRAME_FILL * tan_v), &eye[1], &z_v);
-            fit_axis(b, 0, atan(FRAME_FILL * tan_v * aspect), &eye[0], &z_h);
+            fit_axis(b, smallest, 1, atan(FRAME_FILL * tan_v), &eye[1], &z_v);
+            fit_axis(b, smallest, 0, atan(FRAME_FILL * tan_v * aspect), &eye[0], &z_h);
             eye[2] = fmax(z_v, z_h);
         } else { /* nothing to frame: the unit sphere at the origin */
             eye[0] = eye[1] = 0;
@@ -457,12 +462,12 @@ static void orbit_point(double p[3], double cos_t, double sin_t, const double ax
 
 /* Turns the camera about the vertical axis (+Y) through the centre of the
  * framed spheres' box, counter-clockwise seen from above. */
-static void orbit_camera(PtrSceneBuilder *b)
+static void orbit_camera(PtrSceneBuilder *b, double smallest)
 {
     if (b->orbit_degrees == 0)
         return;
     double lo[3] = { 0, 0, 0 }, hi[3] = { 0, 0, 0 };
-    framed_box(b, lo, hi);
+    framed_box(b, smallest, lo, hi);
     const double axis[2] = { 0.5 * (lo[0] + hi[0]), 0.5 * (lo[2] + hi[2]) };
     double t = b->orbit_degrees * DEG_TO_RAD, c = cos(t), s = sin(t);
     const double through_origin[2] = { 0, 0 };
@@ -474,6 +479,18 @@ static void orbit_camera(PtrSceneBuilder *b)
 static PtrVec3 relative(const double p[3], const double origin[3])
 {
     return v3((float)(p[0] - origin[0]), (float)(p[1] - origin[1]), (float)(p[2] - origin[2]));
+}
+
+typedef struct HugePass {
+    const double *spheres;
+    PtrHugeChoice choice[PIECES_MAX];
+} HugePass;
+
+static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
+{
+    HugePass *p = arg;
+    for (size_t i = from; i < to; i++)
+        ptr_huge_offer(&p->choice[piece], i, i, p->spheres[4 * i + 3]);
 }
 
 /* The huge spheres (scene.h's rule) kept in double (accel/huge.h says why):
@@ -490,26 +507,14 @@ static PtrVec3 relative(const double p[3], const double origin[3])
  * how many. */
 #define HUGE_RATIO 256.0
 
-typedef struct HugePass {
-    const double *spheres;
-    PtrHugeChoice choice[PIECES_MAX];
-} HugePass;
-
-static void huge_in(void *arg, size_t piece, size_t from, size_t to)
-{
-    HugePass *p = arg;
-    for (size_t i = from; i < to; i++)
-        ptr_huge_offer(&p->choice[piece], i, i, p->spheres[4 * i + 3]);
-}
-
-static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
+static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const double eye[3],
                           size_t huge[PTR_HUGE_MAX])
 {
     double lo[3], hi[3];
     memcpy(lo, eye, sizeof lo);
     memcpy(hi, eye, sizeof hi);
     double around[2][3];
-    if (framed_box(b, around[0], around[1]))
+    if (framed_box(b, smallest, around[0], around[1]))
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], around[0][k]);
             hi[k] = fmax(hi[k], around[1][k]);
@@ -517,19 +522,13 @@ static size_t choose_huge(const PtrSceneBuilder *b, const double eye[3],
     double extent = 0;
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
+    const PtrHugeChoice choice_of_none = { .limit = HUGE_RATIO * extent };
     HugePass p = { .spheres = b->spheres };
-    const size_t pieces = piece_count();
-    for (size_t k = 0; k < pieces; k++)
-        p.choice[k] = (PtrHugeChoice){ .limit = HUGE_RATIO * extent };
-    ptr_parallel_pieces(ptr_online_cpus(), b->count, pieces, huge_in, &p);
-    /* The choice keeps the largest by one order, so the pieces' choices
-     * offered again give the choice of all. */
-    PtrHugeChoice choice = { .limit = HUGE_RATIO * extent };
-    for (size_t k = 0; k < pieces; k++)
-        for (size_t j = 0; j < p.choice[k].count; j++) {
-            const PtrHugeCandidate *h = &p.choice[k].sphere[j];
-            ptr_huge_offer(&choice, h->index, h->file_position, h->radius);
-        }
+    for (size_t k = 0; k < PIECES_MAX; k++)
+        p.choice[k] = choice_of_none;
+    const size_t pieces = over_pieces(b, huge_of_piece, &p);
+    PtrHugeChoice choice = choice_of_none;
+    ptr_huge_merge(&choice, p.choice, pieces);
     ptr_huge_file_order(&choice);
     for (size_t k = 0; k < choice.count; k++)
         huge[k] = choice.sphere[k].index;
@@ -613,8 +612,8 @@ static void recentre_spheres(void *arg, size_t begin, size_t end)
  * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
  * all cores from the last back, the builder's arrays shrinking behind, so
  * that 10^8 spheres are never in memory twice. */
-static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int huge_in_double,
-                             PtrError *err)
+static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double origin[3],
+                             int huge_in_double, PtrError *err)
 {
     PtrScene *scene = b->scene;
     const size_t count = b->count;
@@ -622,7 +621,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, const double origin[3], int hug
     Recentre recentre = { b->spheres, origin };
     ptr_parallel_ranges(ptr_online_cpus(), 0, count, recentre_spheres, &recentre);
     size_t huge[PTR_HUGE_MAX];
-    const size_t huge_count = huge_in_double ? choose_huge(b, eye, huge) : 0;
+    const size_t huge_count = huge_in_double ? choose_huge(b, smallest, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
 #define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
@@ -664,16 +663,19 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
 {
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
+    /* The framing, the orbit and the huge choice look at the spheres whose
+     * radius is within SMALL_RATIO of this. */
+    const double smallest = smallest_radius(b);
     if (b->override)
         use_override(b);
     else if (!b->has_camera)
-        frame_spheres(b);
-    orbit_camera(b);
+        frame_spheres(b, smallest);
+    orbit_camera(b, smallest);
     const double zero[3] = { 0, 0, 0 };
     const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : zero;
     memcpy(scene->origin, origin, sizeof scene->origin);
 
-    res = add_spheres(b, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
+    res = add_spheres(b, smallest, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
     scene->camera = b->lens;
     scene->camera.lookfrom = relative(b->eye, origin);
     scene->camera.lookat = relative(b->target, origin);

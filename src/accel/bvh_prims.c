@@ -21,9 +21,11 @@ enum { HUGE_RATIO = 100 };
 enum { RADIUS_PIECES_MAX = 16 };
 
 /* The median radius is found exactly, on all threads, without a copy of
- * the radii: radii are positive floats (the importers' rule), which order
- * as their bits do, so counting the radii by their high 16 bits finds the
- * median's, and counting those radii by their low 16 bits the rest. */
+ * the radii: radii are positive finite floats (the importers' rule, and the
+ * API's), which order as their bits do, so counting the radii by their high
+ * 16 bits finds the median's, and counting those radii by their low 16 bits
+ * the rest. A piece's counts fit 32 bits: the build takes fewer than 2^31
+ * spheres (TASK_FLAG). */
 enum { HALF_BITS = 16, HALF_VALUES = 1 << HALF_BITS };
 
 typedef struct RadiusCount {
@@ -83,9 +85,7 @@ static float huge_radius(const PtrSpheres *s, size_t pieces, int threads)
     return median * HUGE_RATIO;
 }
 
-/* The huge spheres' choice, a piece at a time: the choice keeps the largest
- * by one order (PtrHugeChoice), so the pieces' choices offered again give
- * the choice of all. */
+/* The huge spheres' choice, a piece at a time (ptr_huge_merge joins them). */
 typedef struct HugeOffer {
     const PtrSpheres *spheres;
     PtrHugeChoice *choice; /* a piece's, the limit set */
@@ -181,11 +181,7 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
         piece_choice[k] = (PtrHugeChoice){ .limit = choice.limit };
     HugeOffer offer = { s, piece_choice };
     ptr_parallel_pieces(threads, s->count, pieces, offer_huge, &offer);
-    for (size_t k = 0; k < pieces; k++)
-        for (size_t j = 0; j < piece_choice[k].count; j++) {
-            const PtrHugeCandidate *h = &piece_choice[k].sphere[j];
-            ptr_huge_offer(&choice, h->index, h->file_position, h->radius);
-        }
+    ptr_huge_merge(&choice, piece_choice, pieces);
     ptr_huge_file_order(&choice);
     /* By index, to skip them below. */
     size_t out[PTR_HUGE_MAX + 1];

@@ -52,8 +52,8 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
  * sits at 0, other rays start on spheres) and so scales the boxes' padding.
  * Gives back the spheres' memory as it goes (ptr_spheres_release): on
  * success the prims and huge hold the only copy of spheres 0 .. count - 1
- * but their values. Copies on this many threads (ptr_thread_count's
- * count). Fails only for memory (the spheres untouched). */
+ * but their values. Counts, chooses and copies on this many threads
+ * (ptr_thread_count's count). Fails only for memory (the spheres untouched). */
 PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, BvhPrim *huge, size_t *huge_count,
                         BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
 

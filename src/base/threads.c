@@ -181,15 +181,15 @@ void ptr_parallel_ranges(int threads, size_t begin, size_t end,
             ptr_thread_join(ids[i]);
 }
 
-typedef struct Pieces {
+typedef struct Split {
     void (*fn)(void *arg, size_t piece, size_t from, size_t to);
     void *arg;
     size_t count, pieces;
-} Pieces;
+} Split;
 
-static void run_pieces(void *arg, size_t first, size_t end)
+static void run_split(void *arg, size_t first, size_t end)
 {
-    const Pieces *p = arg;
+    const Split *p = arg;
     for (size_t k = first; k < end; k++)
         p->fn(p->arg, k, p->count * k / p->pieces, p->count * (k + 1) / p->pieces);
 }
@@ -197,6 +197,10 @@ static void run_pieces(void *arg, size_t first, size_t end)
 void ptr_parallel_pieces(int threads, size_t count, size_t pieces,
                          void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg)
 {
-    Pieces p = { fn, arg, count, pieces };
-    ptr_parallel_ranges(threads, 0, pieces, run_pieces, &p);
+    Split p = { fn, arg, count, pieces };
+    /* No more threads than pieces: the others would start for nothing. */
+    const int busy = threads < 1 || pieces == 0      ? 1
+                     : (size_t)threads < pieces ? threads
+                                                : (int)pieces;
+    ptr_parallel_ranges(busy, 0, pieces, run_split, &p);
 }

@@ -35,7 +35,9 @@ void ptr_parallel_ranges(int threads, size_t begin, size_t end,
  * piece k being count * k / pieces .. count * (k + 1) / pieces - 1, the
  * pieces shared out as ptr_parallel_ranges shares its range: for work that
  * keeps a result a piece, which the caller then takes in the pieces' order,
- * so that the result does not depend on the thread count. */
+ * so that the result does not depend on which thread ran which piece. (A
+ * caller whose piece count follows the thread count also needs results that
+ * do not depend on how the items are grouped: minima, maxima, PtrHugeChoice.) */
 void ptr_parallel_pieces(int threads, size_t count, size_t pieces,
                          void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg);
 

@@ -345,6 +345,15 @@ void ptr_huge_insert(PtrHugeChoice *c, size_t index, size_t file_position, doubl
         c->sphere[at] = (PtrHugeCandidate){ radius, index, file_position };
 }
 
+void ptr_huge_merge(PtrHugeChoice *c, const PtrHugeChoice *pieces, size_t count)
+{
+    for (size_t k = 0; k < count; k++)
+        for (size_t j = 0; j < pieces[k].count; j++) {
+            const PtrHugeCandidate *h = &pieces[k].sphere[j];
+            ptr_huge_offer(c, h->index, h->file_position, h->radius);
+        }
+}
+
 void ptr_huge_file_order(PtrHugeChoice *c)
 {
     for (size_t k = 1; k < c->count; k++) {

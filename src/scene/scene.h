@@ -155,6 +155,12 @@ static inline void ptr_huge_offer(PtrHugeChoice *choice, size_t index, size_t fi
         ptr_huge_insert(choice, index, file_position, radius);
 }
 
+/* Offers choice the spheres of count choices, each made over a piece of
+ * the spheres with choice's limit: the choice keeps the largest by one
+ * order, so this gives the choice of all the pieces' spheres together, for
+ * choices made on several threads. */
+void ptr_huge_merge(PtrHugeChoice *choice, const PtrHugeChoice *pieces, size_t count);
+
 /* Sorts the choice by file position. */
 void ptr_huge_file_order(PtrHugeChoice *choice);
 

@@ -105,7 +105,8 @@ static void test_walls_are_huge(void)
  * (scene.h's rule), made on all cores: 3,000 radius-1 spheres in a
  * 60 x 50 grid with 40 huge ones among them, radii 1e6 to 4e6 with ties,
  * spread through the file. The scene keeps the 16 largest, on equal radii
- * the first in the file, in the file's order, each in double. */
+ * the first in the file, in the file's order, each in double. (The builder
+ * makes a piece a CPU: on one CPU this checks the serial choice alone.) */
 static void test_many_huge(void)
 {
     enum { SMALL = 3000, HUGE = 40, STEP = (SMALL + HUGE) / HUGE };
