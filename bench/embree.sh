@@ -14,7 +14,11 @@ src=$(cd "$(dirname "$0")/.." && pwd)
 peer=${EMBREE_PT_SOURCE:-$src/../shared/peers/embree_pt.c}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-gcc -O3 -march=native "$peer" -o "$dir/embree_pt" -lembree3 -lcjson -lpthread -lm
+gcc -O3 -march=native "$peer" -o "$dir/embree_pt" -lembree3 -lcjson -lpthread -lm || {
+    echo "bench/embree.sh: the peer did not build: it needs Embree 3 and cJSON" \
+        "(apt-get install libembree-dev libcjson-dev)" >&2
+    exit 2
+}
 python3 "$src/scripts/make_scenes.py" --instanced "$json" "$dir/scene.glb"
 # Each run: ptr, then each Embree mode, with their build + render seconds and
 # the whole process's wall time (/usr/bin/time: loading, import, writing).

@@ -13,6 +13,11 @@ build=$1 scene=$2 spp=$3 query_spp=${4:-2}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 hz=$(awk '/^cpu MHz/ { print $4 * 1e6; exit }' /proc/cpuinfo)
+if [ ! -x "$build/bench/query" ]; then
+    echo "bench/stages.sh: $build/bench/query is not built: it needs Embree 3" \
+        "(apt-get install libembree-dev), then cmake -S . -B $build again" >&2
+    exit 2
+fi
 
 perf record -q -o "$dir/render.perf" "$build/src/ptr" "$scene" -o "$dir/out.exr" \
     --samples "$spp" --quiet --json >"$dir/render.json" 2>/dev/null
