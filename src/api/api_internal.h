@@ -16,7 +16,7 @@
 #include "ptr/ptr.h"
 
 struct PtrContext {
-    int threads;           /* 0: one per online CPU */
+    int threads;           /* 0: one per CPU it may run on */
     PtrCpuLevel cpu_level; /* the CPU's, capped by $PTR_CPUMASK, then by the options */
     char *weights_dir;     /* NULL: the denoiser's default */
     PtrImageLoader *images;
@@ -67,7 +67,7 @@ typedef struct PtrRenderRequest {
     double time_budget;    /* seconds; 0: none */
     uint64_t seed;
     int max_depth;
-    int threads;           /* 0: one per online CPU */
+    int threads;           /* 0: one per CPU it may run on */
     PtrKernel kernel;
     PtrCpuLevel level;
     PtrIntegrator integrator;

@@ -31,7 +31,7 @@ typedef enum PtrRenderNumber {
     PTR_NUMBER_SAMPLES,     /* samples per pixel, and the end of a sample range */
     PTR_NUMBER_MIN_SAMPLES,
     PTR_NUMBER_MAX_DEPTH,
-    PTR_NUMBER_THREADS,     /* 0: one per online CPU */
+    PTR_NUMBER_THREADS,     /* 0: one per CPU it may run on */
 } PtrRenderNumber;
 
 /* Whether value is in number's range. */

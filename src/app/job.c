@@ -128,6 +128,7 @@ PtrResult ptr_job_render(const PtrOptions *o, const char *scene_path, const char
 {
     *report = (PtrJobReport){
         .scene = scene_path, .output = output, .seed = o->seed, .sample_first = o->sample_first,
+        .threads = ptr_thread_count(o->threads),
         .samples_requested = o->preview && o->samples > PREVIEW_SAMPLES ? PREVIEW_SAMPLES : o->samples,
     };
     PtrError err = { 0 };

@@ -99,6 +99,7 @@ void ptr_report_json(FILE *out, const PtrJobReport *r)
     ptr_json_string(out, r->accel);
     fputs(", \"integrator\": ", out);
     ptr_json_string(out, r->integrator);
+    fprintf(out, ", \"threads\": %d", r->threads);
     fprintf(out,
             ", \"spheres\": %zu, \"import_seconds\": %.6f, \"build_seconds\": %.6f, "
             "\"render_seconds\": %.6f",

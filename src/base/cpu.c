@@ -1,5 +1,7 @@
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "base/cpu.h"
 
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -81,7 +83,13 @@ PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *er
 
 int ptr_online_cpus(void)
 {
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    /* The CPUs this process may run on, which taskset, a container's or a
+     * batch system's cpuset can make fewer than the machine's: a thread
+     * more than them only waits. sched_getaffinity fails past CPU_SETSIZE
+     * (1024) CPUs; then the machine's count. */
+    cpu_set_t allowed;
+    long n = sched_getaffinity(0, sizeof allowed, &allowed) == 0 ? CPU_COUNT(&allowed)
+                                                                  : sysconf(_SC_NPROCESSORS_ONLN);
     return n > 0 ? (int)(n < 1024 ? n : 1024) : 1;
 }
 

@@ -31,12 +31,12 @@ const char *ptr_cpu_level_name(PtrCpuLevel level);
 /* Parses a level name; PTR_ERR_USAGE if it is not one. */
 PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *err);
 
-/* The number of online CPUs (at least 1, at most 1024): the default thread
- * count. */
+/* The number of CPUs this process may run on (its affinity: taskset,
+ * cpusets; at least 1, at most 1024): the default thread count. */
 int ptr_online_cpus(void);
 
-/* The threads a run asked for (--threads), or every online CPU where it
- * asked for none (0 or less). */
+/* The threads a run asked for (--threads), or one per CPU it may run on
+ * (ptr_online_cpus) where it asked for none (0 or less). */
 int ptr_thread_count(int requested);
 
 /* Seconds on a monotonic clock, for timing. */

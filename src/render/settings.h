@@ -33,7 +33,7 @@ typedef struct PtrRenderSettings {
     int max_depth;     /* rays per path at most, from the camera or a scattering
                         * (shadow rays do not count); a path cut there adds
                         * nothing */
-    int threads;       /* 0: one per online CPU */
+    int threads;       /* 0: one per CPU it may run on */
     /* 0: rays leave a surface by ptr's scaled offset (ptr_spawn_ray). When
      * positive, they leave it the seed renderer's way instead, from the hit
      * point with this fixed t_min (0.001 there): the counter-example the

@@ -75,5 +75,17 @@ wait $pid
 code=$?
 check "SIGINT while watching exits 0 (got $code)" '[ $code -eq 0 ]'
 
+# The render's threads, which --json reports: --threads N as asked; by
+# default one per CPU the process may run on, which taskset (like a
+# container's or a batch system's cpuset) can make fewer than the machine's.
+threads_of() {
+    "$@" "$src/scenes/seed.gltf" -o "$dir/threads.exr" --samples 1 --width 16 --quiet --json |
+        sed -E 's/.*"threads": ([0-9]+).*/\1/'
+}
+check "--threads 3 renders on 3 threads" '[ "$(threads_of "$ptr" --threads 3)" = 3 ]'
+check "under taskset -c 0, one thread" '[ "$(threads_of taskset -c 0 "$ptr")" = 1 ]'
+check "by default, one per CPU the process may run on" \
+    '[ "$(threads_of "$ptr")" = "$(nproc)" ]'
+
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]
