@@ -243,7 +243,7 @@ static int denoise_curves(FILE *csv, const Bench *bench, const PtrScene *scene,
                 };
                 PtrError err = { 0 };
                 double start = now();
-                ok = ptr_denoise(denoisers[q], &input, ptr_online_cpus(), out, 3, &err) == PTR_OK;
+                ok = ptr_denoise(denoisers[q], &input, ptr_usable_cpus(), out, 3, &err) == PTR_OK;
                 denoise_seconds = now() - start;
                 if (!ok)
                     fprintf(stderr, "accuracy: %s\n", err.message);

@@ -111,7 +111,7 @@ int main(int argc, char **argv)
     ptr_isect_init_level(&c, PTR_CPU_NONE);
     ptr_isect_init(&fastest, PTR_KERNEL_AUTO, ptr_cpu_level(), SIZE_MAX, NULL);
     printf("cloud scenes, %dx%d, %" PRIu32 " spp, %d threads; Mrays/s (camera and scattered rays)\n",
-           setup.width, setup.height, setup.spp, ptr_online_cpus());
+           setup.width, setup.height, setup.spp, ptr_usable_cpus());
     printf("%9s %9s %8s %5s %11s %11s %11s %11s %11s\n", "spheres", "build s", "bytes/sp", "depth",
            "brute c", "brute asm", "bvh c", "bvh asm", "bvh asm s");
     if (csv)

@@ -302,7 +302,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: denoise [TILE] (a multiple of 16, default 512)\n");
         return 2;
     }
-    int threads = ptr_online_cpus();
+    int threads = ptr_usable_cpus();
     ptr_threads_keep(threads);
     PtrCpuLevel top = ptr_cpu_level();
     /* Other work on the machine shares the cores' caches and memory with

@@ -281,7 +281,7 @@ enum { PIECES_MAX = 64 };
 static size_t over_pieces(const PtrSceneBuilder *b,
                           void (*fn)(void *arg, size_t piece, size_t from, size_t to), void *arg)
 {
-    const int threads = ptr_online_cpus();
+    const int threads = ptr_usable_cpus();
     const size_t pieces = threads < PIECES_MAX ? (size_t)threads : PIECES_MAX;
     ptr_parallel_pieces(threads, b->count, pieces, fn, arg);
     return pieces;
@@ -619,7 +619,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
     const size_t count = b->count;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
     Recentre recentre = { b->spheres, origin };
-    ptr_parallel_ranges(ptr_online_cpus(), 0, count, recentre_spheres, &recentre);
+    ptr_parallel_ranges(ptr_usable_cpus(), 0, count, recentre_spheres, &recentre);
     size_t huge[PTR_HUGE_MAX];
     const size_t huge_count = huge_in_double ? choose_huge(b, smallest, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
@@ -644,7 +644,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
     }
     SphereMove move = { .builder = b, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
-    const int threads = ptr_online_cpus();
+    const int threads = ptr_usable_cpus();
     for (size_t end = count; end > 0 && res == PTR_OK;) {
         const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
         ptr_parallel_ranges(threads, begin, end, move_spheres, &move);

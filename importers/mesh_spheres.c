@@ -73,7 +73,7 @@ static int unite(Link *parent, uint32_t a, uint32_t b)
 
 static int threads_for(const PtrMeshSource *mesh)
 {
-    return mesh->vertex_count + mesh->triangle_count >= PARALLEL_SIZE ? ptr_online_cpus() : 1;
+    return mesh->vertex_count + mesh->triangle_count >= PARALLEL_SIZE ? ptr_usable_cpus() : 1;
 }
 
 /* A hash of a position's bits: each coordinate multiplied apart, then
@@ -319,8 +319,8 @@ static void match_partitions(void *arg, size_t from, size_t to)
 
 /* The slices and partitions of a mesh's vertices, on threads: decided once,
  * so that the scratch keyed_room sizes and the pools unite_positions files
- * into are cut alike (the number of online CPUs can change between two
- * questions). */
+ * into are cut alike (the CPUs the process may run on can change between
+ * two questions). */
 static void plan_partitions(PositionMatch *pm, const PtrMeshSource *mesh, int threads)
 {
     *pm = (PositionMatch){ .mesh = mesh, .threads = threads, .bucket = MIN_BUCKET,

@@ -185,7 +185,7 @@ static PtrResult add_part_colors(Importer *im, const Origin *o, size_t mesh_inde
                                        sizeof *b.values) };
     if (!b.values)
         return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-    const int threads = count >= PARALLEL_COLORS ? ptr_online_cpus() : 1;
+    const int threads = count >= PARALLEL_COLORS ? ptr_usable_cpus() : 1;
     for (; v < count && res == PTR_OK; v = b.first + COLOR_BLOCK) {
         b.first = v;
         const size_t end = count - v > COLOR_BLOCK ? v + COLOR_BLOCK : count;

@@ -504,7 +504,7 @@ static PtrResult start_run(Importer *im, NodeRun *run)
 static void convert_run(const Importer *im, NodeRun *run)
 {
     const size_t slots = run->instances * run->slots;
-    const int threads = slots >= PARALLEL_PARTS ? ptr_online_cpus() : 1;
+    const int threads = slots >= PARALLEL_PARTS ? ptr_usable_cpus() : 1;
     for (size_t begin = 0; begin < slots && atomic_load(&run->failed) == SIZE_MAX;
          begin += PARALLEL_BLOCK) {
         const size_t end = slots - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : slots;

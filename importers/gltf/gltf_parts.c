@@ -190,7 +190,7 @@ PtrResult gltf_surface_part(Importer *im, const Origin *o, size_t mesh, size_t p
         n = a->count;
         IndexCheck check = { .indices = a, .vertices = vertices };
         atomic_init(&check.first_past, SIZE_MAX);
-        ptr_parallel_ranges(n >= PARALLEL_INDICES ? ptr_online_cpus() : 1, 0, n, check_indices,
+        ptr_parallel_ranges(n >= PARALLEL_INDICES ? ptr_usable_cpus() : 1, 0, n, check_indices,
                             &check);
         const size_t past = atomic_load(&check.first_past);
         if (past != SIZE_MAX)

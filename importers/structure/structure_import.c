@@ -256,7 +256,7 @@ static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const Str
           ptr_builder_add_spheres(builder, spheres, 1, &e.first, NULL) != PTR_OK)))
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     if (res == PTR_OK)
-        ptr_parallel_ranges(spheres >= PARALLEL_SPHERES ? ptr_online_cpus() : 1, 0, spheres,
+        ptr_parallel_ranges(spheres >= PARALLEL_SPHERES ? ptr_usable_cpus() : 1, 0, spheres,
                             fill_slots, &e);
     free(looks);
     free(e.slot_start);

@@ -87,7 +87,7 @@ PTR_PUBLIC const char *ptr_version(void);
 typedef struct PtrContext PtrContext;
 
 typedef struct PtrContextOptions {
-    int threads;             /* render threads, at most 1024; 0: one per online CPU */
+    int threads;             /* render threads, at most 1024; 0: one per CPU the process may run on */
     /* The highest CPU level used ("none", "sse41", "avx2", "avx512"), as
      * --cpumask takes it; NULL: the CPU's, capped by $PTR_CPUMASK. */
     const char *cpu_cap;

@@ -131,7 +131,7 @@ class Material:
 
 
 class Context:
-    """What renders share: threads (0: one per CPU; at most 1024), the
+    """What renders share: threads (0: one per CPU the process may run on; at most 1024), the
     highest CPU level used (cpu_cap: "none", "sse41", "avx2", "avx512";
     None: the CPU's, capped by $PTR_CPUMASK), the denoiser's weights folder
     and an OpenColorIO config (None: ptr's). Its calls run one at a time."""

@@ -50,7 +50,7 @@ typedef struct PtrAccel {
  * kernels of isect; the tree's build reorders the spheres (all arrays
  * together; see bvh.h), for brute force too, which then searches them in
  * that order; packets as for ptr_accel_crossover. threads: for the build, 0 for
- * one per CPU. Fails only with PTR_ERR_NOMEM, said in err (which may be NULL). */
+ * one per CPU the process may run on. Fails only with PTR_ERR_NOMEM, said in err (which may be NULL). */
 PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectTable *isect,
                          int packets, PtrScene *scene, int threads, PtrError *err);
 

@@ -61,7 +61,7 @@ typedef struct PtrOutputInfo {
      * given is denoised already, for an EXR's layer (NULL: not denoised). */
     const float *noisy;
     const char *denoise_quality; /* the denoiser's name, for the metadata */
-    int threads;           /* the denoiser's; 0: one per CPU */
+    int threads;           /* the denoiser's; 0: one per CPU it may run on */
     /* Per pixel, the share of its samples that were covered (may be NULL):
      * the image's alpha, the RGB given then premultiplied by it. */
     const float *alpha;

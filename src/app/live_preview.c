@@ -19,7 +19,7 @@
  * their antialiasing, at a few percent of a render of hundreds. The
  * niceness is the live encoder's: a frame waits rather than the render. */
 enum { GUIDE_SAMPLES = 4, PREVIEW_NICE = 10 };
-/* The share of the machine's cores the preview takes at most, over time:
+/* The share of the cores ptr may run on that the preview takes at most, over time:
  * a niceness alone bounds it only against the render's threads, not when
  * they wait (between passes, for the last tiles) or compete with other
  * processes, where the preview took a quarter of ptr's CPU time. After a
@@ -176,7 +176,7 @@ static void *preview_loop(void *arg)
     PtrLivePreview *p = arg;
     pthread_setname_np(pthread_self(), "ptr-live-oidn");
     setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), PREVIEW_NICE);
-    const double cores = ptr_online_cpus();
+    const double cores = ptr_usable_cpus();
     Work w = { 0 };
     pthread_mutex_lock(&p->lock);
     /* Stopping, a frame still waiting is denoised (the render's last),

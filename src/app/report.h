@@ -21,7 +21,7 @@ typedef struct PtrJobReport {
     char kernel[16];
     char accel[8];              /* "brute" or "bvh" */
     char integrator[8];         /* "paths" or "bundles" */
-    int threads;                /* the render's */
+    int threads;                /* asked for, or the default (ptr_thread_count) */
     size_t spheres;
     double import_seconds, build_seconds;
     double seconds;             /* rendering */

@@ -81,12 +81,13 @@ PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *er
     return ptr_error_set(err, PTR_ERR_USAGE, "'%s' is not none, sse41, avx2 or avx512", name);
 }
 
-int ptr_online_cpus(void)
+int ptr_usable_cpus(void)
 {
     /* The CPUs this process may run on, which taskset, a container's or a
      * batch system's cpuset can make fewer than the machine's: a thread
-     * more than them only waits. sched_getaffinity fails past CPU_SETSIZE
-     * (1024) CPUs; then the machine's count. */
+     * more than them only waits. sched_getaffinity fails where the kernel
+     * allows for more than CPU_SETSIZE (1024) CPUs; then the machine's
+     * online count. */
     cpu_set_t allowed;
     long n = sched_getaffinity(0, sizeof allowed, &allowed) == 0 ? CPU_COUNT(&allowed)
                                                                   : sysconf(_SC_NPROCESSORS_ONLN);
@@ -95,7 +96,7 @@ int ptr_online_cpus(void)
 
 int ptr_thread_count(int requested)
 {
-    return requested > 0 ? requested : ptr_online_cpus();
+    return requested > 0 ? requested : ptr_usable_cpus();
 }
 
 double ptr_now_seconds(void)

@@ -33,10 +33,10 @@ PtrResult ptr_cpu_parse_level(const char *name, PtrCpuLevel *level, PtrError *er
 
 /* The number of CPUs this process may run on (its affinity: taskset,
  * cpusets; at least 1, at most 1024): the default thread count. */
-int ptr_online_cpus(void);
+int ptr_usable_cpus(void);
 
 /* The threads a run asked for (--threads), or one per CPU it may run on
- * (ptr_online_cpus) where it asked for none (0 or less). */
+ * (ptr_usable_cpus) where it asked for none (0 or less). */
 int ptr_thread_count(int requested);
 
 /* Seconds on a monotonic clock, for timing. */

@@ -101,7 +101,7 @@ static PtrThread *spawn_locked(void)
     }
     pthread_detach(id);
     kept++;
-    atomic_store_explicit(&spin_fits, kept <= ptr_online_cpus(), memory_order_relaxed);
+    atomic_store_explicit(&spin_fits, kept <= ptr_usable_cpus(), memory_order_relaxed);
     return t;
 }
 

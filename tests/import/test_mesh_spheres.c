@@ -1,6 +1,6 @@
 /* The components of a mesh large enough to be found on all cores are the
- * same whatever the number of CPUs online, even where it changes while they
- * are found (CPUs taken on or off line): ptr_online_cpus is replaced here
+ * same whatever the number of CPUs usable, even where it changes while they
+ * are found (CPUs taken on or off line, an affinity changed): ptr_usable_cpus is replaced here
  * (the test links with --wrap) by a script of answers. */
 #include <math.h>
 #include <stdlib.h>
@@ -10,12 +10,12 @@
 #include "mesh_spheres.h"
 #include "test.h"
 
-/* The answers ptr_online_cpus gives, one a call, the last repeated. */
+/* The answers ptr_usable_cpus gives, one a call, the last repeated. */
 static const int *script;
 static size_t script_length, asked;
 
-int __wrap_ptr_online_cpus(void);
-int __wrap_ptr_online_cpus(void)
+int __wrap_ptr_usable_cpus(void);
+int __wrap_ptr_usable_cpus(void)
 {
     const size_t at = asked < script_length ? asked : script_length - 1;
     asked++;
