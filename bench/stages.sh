@@ -45,12 +45,16 @@ def periods(path):
             out[key] = out.get(key, 0) + int(m.group(1))
     return out
 
+# A leaf's test: the kernels' test_leaf and the test_eight it calls for each
+# eight spheres (asm/bvh.inc), the C traversal's test_leaf.
+LEAF_SYMBOLS = ("test_leaf", "test_eight")
+
 # First match wins: a leaf's symbols before the traversal's, a path's steps
 # before "trace".
 RENDER_STAGES = [
     ("sampling", ("bounce_numbers", "sobol", "owen", "ptr_sampler", "ptr_rng")),
     ("camera rays", ("camera_rays", "make_camera_batch", "ptr_path_camera_ray", "ptr_camera")),
-    ("leaves", ("test_leaf",)),
+    ("leaves", LEAF_SYMBOLS),
     ("shading", ("find_surfaces", "scatter", "continue_or_end", "add_sky_and_emission",
                  "emission_weights", "refill", "ptr_path_", "sample_emitters", "render_round",
                  "ptr_render_tile", "trace_path", "lights", "ptr_sky")),
@@ -75,12 +79,19 @@ def table(title, ns_by_stage, rays, names):
 
 render = json.load(open(dir + "/render.json"))
 by = {}
+other = {}
 for (dso, sym), ns in periods(dir + "/render.txt").items():
     s = stage_of(dso, sym, RENDER_STAGES)
     by[s] = by.get(s, 0) + ns
+    if s == "other":
+        other[sym] = other.get(sym, 0) + ns
 table("ptr render: %s, %d spp, %s, %s, %d rays" % (render["scene"], render["samples"],
       render["kernel"], render["integrator"], render["rays"]), by, render["rays"],
       ["sampling", "camera rays", "traversal", "leaves", "shading", "other"])
+# What "other" holds, so that a symbol renamed out of its stage shows here.
+largest = sorted(other.items(), key=lambda kv: -kv[1])[:4]
+print("  other's largest: " + ", ".join("%s %.1f%%" % (sym, 100.0 * ns / sum(by.values()))
+                                       for sym, ns in largest))
 
 # The query: the method's measured ns/ray split by its symbols' shares.
 for m in methods:
@@ -94,7 +105,7 @@ for m in methods:
                 leaf += ns
             elif "libembree" in dso:
                 trav += ns
-        elif "test_leaf" in sym:
+        elif any(k in sym for k in LEAF_SYMBOLS):
             leaf += ns
         elif "bvh_closest_hit" in sym:
             trav += ns
