@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "api/output.h"
+#include "base/threads.h"
 #include "image/image.h"
 
 typedef struct Part {
@@ -259,6 +260,7 @@ static PtrResult combine(const Part *parts, int count, const char *output, const
     report->sample_first = (uint32_t)first;
     report->samples = report->samples_requested = (uint32_t)fewest;
     report->seed = strtoull(parts[0].seed, NULL, 10);
+    report->threads = ptr_thread_count(o->threads); /* the denoiser's, if it runs */
     const PtrImageLayout full = { w, h, 0, 0, w, h };
     PtrOutputInfo info = {
         .scene_path = parts[0].scene, .scene_hash = strtoull(parts[0].hash, NULL, 16),

@@ -92,6 +92,17 @@ check "under taskset -c $first_cpu, one thread by default (got $pinned)" '[ "$pi
 default=$(threads_of "$ptr")
 check "by default, one per CPU the process may run on: $usable (got $default)" \
     '[ "$default" = "$usable" ]'
+# ptr merge reports the threads its denoiser would take, by the same rule.
+"$ptr" "$src/scenes/seed.gltf" -o "$dir/part0.exr" --width 16 --sample-range 0:1 --quiet
+"$ptr" "$src/scenes/seed.gltf" -o "$dir/part1.exr" --width 16 --sample-range 1:2 --quiet
+merge_threads() {
+    "$ptr" merge "$dir/part0.exr" "$dir/part1.exr" -o "$dir/merged.exr" --quiet --json "$@" |
+        sed -E 's/.*"threads": ([0-9]+).*/\1/'
+}
+merged=$(merge_threads)
+check "ptr merge reports $usable threads by default (got $merged)" '[ "$merged" = "$usable" ]'
+merged=$(merge_threads --threads 3)
+check "ptr merge --threads 3 reports 3 (got $merged)" '[ "$merged" = 3 ]'
 
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]
