@@ -100,11 +100,50 @@ static void set_lane_ray(Lanes *lanes, int l, PtrRay ray)
     r->tmax[l] = ray.tmax;
 }
 
+/* ptr_sampler_pair_bits of every lane's pixel key, sample index and pair
+ * dim, into bits[0][l] and bits[1][l]. In steps, each a loop over the lanes
+ * that the compiler turns into a few vector instructions: as one loop, the
+ * 64-bit keys beside the 32-bit scrambles, it was left half scalar. */
+static inline void lanes_pair_bits(PtrSamplerKind kind, const uint64_t key[LANES],
+                                   const uint32_t index[LANES], const uint32_t dim[LANES],
+                                   uint32_t bits[restrict 2][LANES])
+{
+    uint64_t pair_key[LANES], scramble[LANES];
+    for (int l = 0; l < LANES; l++)
+        pair_key[l] = ptr_sampler_pair_key(key[l], dim[l]);
+    if (kind == PTR_SAMPLER_INDEPENDENT) {
+        for (int l = 0; l < LANES; l++) {
+            uint32_t pair[2];
+            ptr_independent_pair_bits(pair_key[l], index[l], pair);
+            bits[0][l] = pair[0];
+            bits[1][l] = pair[1];
+        }
+        return;
+    }
+    for (int l = 0; l < LANES; l++)
+        scramble[l] = ptr_mix64(pair_key[l]);
+    for (int l = 0; l < LANES; l++) {
+        uint32_t pair[2];
+        ptr_sobol_pair_bits((uint32_t)pair_key[l], scramble[l], index[l], pair);
+        bits[0][l] = pair[0];
+        bits[1][l] = pair[1];
+    }
+}
+
 STAGE void camera_rays(const PtrPathJob *job, CameraBatch *batch)
 {
+    uint32_t pixel_dim[LANES], lens_dim[LANES], pixel[2][LANES], lens[2][LANES];
+    for (int l = 0; l < LANES; l++) {
+        pixel_dim[l] = PTR_DIM_PIXEL;
+        lens_dim[l] = PTR_DIM_LENS;
+    }
+    lanes_pair_bits(job->settings->sampler, batch->key, batch->index, pixel_dim, pixel);
+    lanes_pair_bits(job->settings->sampler, batch->key, batch->index, lens_dim, lens);
     for (int l = 0; l < LANES; l++) {
         PtrVec3 o, d;
-        ptr_path_camera_ray(job, batch->key[l], batch->index[l], batch->x[l], batch->y[l], &o, &d);
+        const uint32_t pixel_bits[2] = { pixel[0][l], pixel[1][l] },
+                       lens_bits[2] = { lens[0][l], lens[1][l] };
+        ptr_path_camera_ray_of(job, pixel_bits, lens_bits, batch->x[l], batch->y[l], &o, &d);
         set_lane_v3(batch->ray.org, l, o);
         set_lane_v3(batch->ray.dir, l, d);
         batch->ray.tmin[l] = 0.0f;
@@ -363,15 +402,15 @@ STAGE void sample_emitters(const PtrPathJob *job, Lanes *restrict lanes, const V
 
 /* The lanes' numbers of pair slot of their bounce, as floats. */
 STAGE void bounce_numbers(const PtrPathJob *job, const Lanes *restrict lanes, int slot,
-                           float u0[LANES], float u1[LANES])
+                           float u0[restrict LANES], float u1[restrict LANES])
 {
-    PtrSamplerKind kind = job->settings->sampler;
+    uint32_t dim[LANES], bits[2][LANES];
+    for (int l = 0; l < LANES; l++)
+        dim[l] = ptr_bounce_dim(lanes->depth[l], slot);
+    lanes_pair_bits(job->settings->sampler, lanes->key, lanes->index, dim, bits);
     for (int l = 0; l < LANES; l++) {
-        uint32_t bits[2];
-        ptr_sampler_pair_bits(kind, lanes->key[l], lanes->index[l],
-                              ptr_bounce_dim(lanes->depth[l], slot), bits);
-        u0[l] = ptr_sample_float(bits[0]);
-        u1[l] = ptr_sample_float(bits[1]);
+        u0[l] = ptr_sample_float(bits[0][l]);
+        u1[l] = ptr_sample_float(bits[1][l]);
     }
 }
 

@@ -122,6 +122,19 @@ static inline uint64_t ptr_path_pixel_key(const PtrPathJob *job, int x, int y)
     return ptr_sampler_for_sample(s->sampler, s->seed, pixel, 0).pixel_key;
 }
 
+/* The camera ray through pixel (x, y) of the sample whose pairs
+ * PTR_DIM_PIXEL and PTR_DIM_LENS are pixel_bits and lens_bits. */
+static inline void ptr_path_camera_ray_of(const PtrPathJob *job, const uint32_t pixel_bits[2],
+                                          const uint32_t lens_bits[2], int x, int y,
+                                          PtrVec3 *origin, PtrVec3 *dir)
+{
+    float lens_r = sqrtf(ptr_sample_float(lens_bits[0])), sin_phi, cos_phi;
+    ptr_sincos_turns(ptr_sample_float(lens_bits[1]), &sin_phi, &cos_phi);
+    ptr_view_ray(&job->view, x, y, ptr_sample_float(pixel_bits[0]),
+                 ptr_sample_float(pixel_bits[1]), lens_r * cos_phi, lens_r * sin_phi, origin,
+                 dir);
+}
+
 /* The camera ray of sample index of pixel (x, y). */
 static inline void ptr_path_camera_ray(const PtrPathJob *job, uint64_t pixel_key, uint32_t index,
                                        int x, int y, PtrVec3 *origin, PtrVec3 *dir)
@@ -130,11 +143,7 @@ static inline void ptr_path_camera_ray(const PtrPathJob *job, uint64_t pixel_key
     uint32_t pixel_bits[2], lens_bits[2];
     ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_PIXEL, pixel_bits);
     ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_LENS, lens_bits);
-    float lens_r = sqrtf(ptr_sample_float(lens_bits[0])), sin_phi, cos_phi;
-    ptr_sincos_turns(ptr_sample_float(lens_bits[1]), &sin_phi, &cos_phi);
-    ptr_view_ray(&job->view, x, y, ptr_sample_float(pixel_bits[0]),
-                 ptr_sample_float(pixel_bits[1]), lens_r * cos_phi, lens_r * sin_phi, origin,
-                 dir);
+    ptr_path_camera_ray_of(job, pixel_bits, lens_bits, x, y, origin, dir);
 }
 
 /* Where ray met the sphere hit names: the point on its surface and the

@@ -93,28 +93,49 @@ static inline uint32_t ptr_sobol_second_reversed(uint32_t index)
     return index;
 }
 
-/* The pair of numbers for pair dim of sample index of the pixel keyed
- * pixel_key, as 32-bit fractions; inline and branch-free for one kind, so
- * that bundles of paths compute it lane by lane in vector registers. */
-static inline void ptr_sampler_pair_bits(PtrSamplerKind kind, uint64_t pixel_key, uint32_t index,
-                                         uint32_t dim, uint32_t out[2])
+/* The key of pair dim of the pixel keyed pixel_key, from which its
+ * numbers are drawn. */
+static inline uint64_t ptr_sampler_pair_key(uint64_t pixel_key, uint32_t dim)
 {
-    uint64_t pair_key = ptr_mix64(pixel_key ^ ((uint64_t)(dim + 1) * UINT64_C(0xd1b54a32d192ed03)));
-    if (kind == PTR_SAMPLER_INDEPENDENT) {
-        uint64_t h = ptr_mix64(pair_key ^ ((uint64_t)index * UINT64_C(0x9e3779b97f4a7c15)));
-        out[0] = (uint32_t)(h >> 32);
-        out[1] = (uint32_t)h;
-        return;
-    }
+    return ptr_mix64(pixel_key ^ ((uint64_t)(dim + 1) * UINT64_C(0xd1b54a32d192ed03)));
+}
+
+/* PTR_SAMPLER_INDEPENDENT's pair for sample index, from its pair's key. */
+static inline void ptr_independent_pair_bits(uint64_t pair_key, uint32_t index, uint32_t out[2])
+{
+    uint64_t h = ptr_mix64(pair_key ^ ((uint64_t)index * UINT64_C(0x9e3779b97f4a7c15)));
+    out[0] = (uint32_t)(h >> 32);
+    out[1] = (uint32_t)h;
+}
+
+/* PTR_SAMPLER_SOBOL's pair for sample index, as 32-bit fractions: from the
+ * low half of its pair's key (the index's shuffle) and ptr_mix64 of the
+ * whole key (the two scrambles). 32-bit arithmetic only, so that bundles of
+ * paths compute it for eight lanes in one vector register, having made the
+ * 64-bit keys before it in two. */
+static inline void ptr_sobol_pair_bits(uint32_t pair_key, uint64_t scramble, uint32_t index,
+                                       uint32_t out[2])
+{
     /* The shuffle, an Owen scramble of the index, maps every aligned block
      * of 2^k indices onto another aligned block (bits flip as the bits above
      * them decide), and any such block of a (0,2)-sequence is a (0,k,2)-net;
      * it decorrelates this pair from the others (padding). */
-    uint64_t scramble = ptr_mix64(pair_key);
-    uint32_t i = ptr_reverse_bits(ptr_laine_karras(ptr_reverse_bits(index), (uint32_t)pair_key));
+    uint32_t i = ptr_reverse_bits(ptr_laine_karras(ptr_reverse_bits(index), pair_key));
     out[0] = ptr_reverse_bits(ptr_laine_karras(i, (uint32_t)scramble));
     out[1] = ptr_reverse_bits(
         ptr_laine_karras(ptr_sobol_second_reversed(i), (uint32_t)(scramble >> 32)));
+}
+
+/* The pair of numbers for pair dim of sample index of the pixel keyed
+ * pixel_key, as 32-bit fractions. */
+static inline void ptr_sampler_pair_bits(PtrSamplerKind kind, uint64_t pixel_key, uint32_t index,
+                                         uint32_t dim, uint32_t out[2])
+{
+    const uint64_t pair_key = ptr_sampler_pair_key(pixel_key, dim);
+    if (kind == PTR_SAMPLER_INDEPENDENT)
+        ptr_independent_pair_bits(pair_key, index, out);
+    else
+        ptr_sobol_pair_bits((uint32_t)pair_key, ptr_mix64(pair_key), index, out);
 }
 
 /* A 32-bit fraction as a float in [0, 1) with 24 bits, exact. */
