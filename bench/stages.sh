@@ -45,14 +45,15 @@ def periods(path):
             out[key] = out.get(key, 0) + int(m.group(1))
     return out
 
-# A leaf's test: the kernels' test_leaf and the test_eight it calls for each
-# eight spheres (asm/bvh.inc), the C traversal's test_leaf.
+# A leaf's test: the one-ray kernels' test_leaf and the test_eight it calls
+# for each eight spheres (asm/bvh.inc), the packet kernels' test_leaf. (The C
+# traversal tests its leaves inline: its time is the traversal's.)
 LEAF_SYMBOLS = ("test_leaf", "test_eight")
 
 # First match wins: a leaf's symbols before the traversal's, a path's steps
 # before "trace".
 RENDER_STAGES = [
-    ("sampling", ("bounce_numbers", "sobol", "owen", "ptr_sampler", "ptr_rng")),
+    ("sampling", ("bounce_numbers", "pair_bits", "sobol", "owen", "ptr_sampler", "ptr_rng")),
     ("camera rays", ("camera_rays", "make_camera_batch", "ptr_path_camera_ray", "ptr_camera")),
     ("leaves", LEAF_SYMBOLS),
     ("shading", ("find_surfaces", "scatter", "continue_or_end", "add_sky_and_emission",
@@ -90,8 +91,10 @@ table("ptr render: %s, %d spp, %s, %s, %d rays" % (render["scene"], render["samp
       ["sampling", "camera rays", "traversal", "leaves", "shading", "other"])
 # What "other" holds, so that a symbol renamed out of its stage shows here.
 largest = sorted(other.items(), key=lambda kv: -kv[1])[:4]
-print("  other's largest: " + ", ".join("%s %.1f%%" % (sym, 100.0 * ns / sum(by.values()))
-                                       for sym, ns in largest))
+total = sum(by.values())
+if largest:
+    print("  other's largest: " + ", ".join("%s %.1f%%" % (sym, 100.0 * ns / total)
+                                           for sym, ns in largest))
 
 # The query: the method's measured ns/ray split by its symbols' shares.
 for m in methods:

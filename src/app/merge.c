@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "api/output.h"
-#include "base/threads.h"
+#include "base/cpu.h"
 #include "image/image.h"
 
 typedef struct Part {

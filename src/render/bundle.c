@@ -102,8 +102,9 @@ static void set_lane_ray(Lanes *lanes, int l, PtrRay ray)
 
 /* ptr_sampler_pair_bits of every lane's pixel key, sample index and pair
  * dim, into bits[0][l] and bits[1][l]. In steps, each a loop over the lanes
- * that the compiler turns into a few vector instructions: as one loop, the
- * 64-bit keys beside the 32-bit scrambles, it was left half scalar. */
+ * that the compiler turns into vector instructions: one loop mixing the
+ * 64-bit key hashes with the 32-bit Owen scrambling is only partly
+ * vectorised by gcc. */
 static inline void lanes_pair_bits(PtrSamplerKind kind, const uint64_t key[LANES],
                                    const uint32_t index[LANES], const uint32_t dim[LANES],
                                    uint32_t bits[restrict 2][LANES])
@@ -143,7 +144,7 @@ STAGE void camera_rays(const PtrPathJob *job, CameraBatch *batch)
         PtrVec3 o, d;
         const uint32_t pixel_bits[2] = { pixel[0][l], pixel[1][l] },
                        lens_bits[2] = { lens[0][l], lens[1][l] };
-        ptr_path_camera_ray_of(job, pixel_bits, lens_bits, batch->x[l], batch->y[l], &o, &d);
+        ptr_path_camera_ray_from_bits(job, pixel_bits, lens_bits, batch->x[l], batch->y[l], &o, &d);
         set_lane_v3(batch->ray.org, l, o);
         set_lane_v3(batch->ray.dir, l, d);
         batch->ray.tmin[l] = 0.0f;

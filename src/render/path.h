@@ -124,9 +124,10 @@ static inline uint64_t ptr_path_pixel_key(const PtrPathJob *job, int x, int y)
 
 /* The camera ray through pixel (x, y) of the sample whose pairs
  * PTR_DIM_PIXEL and PTR_DIM_LENS are pixel_bits and lens_bits. */
-static inline void ptr_path_camera_ray_of(const PtrPathJob *job, const uint32_t pixel_bits[2],
-                                          const uint32_t lens_bits[2], int x, int y,
-                                          PtrVec3 *origin, PtrVec3 *dir)
+static inline void ptr_path_camera_ray_from_bits(const PtrPathJob *job,
+                                                 const uint32_t pixel_bits[2],
+                                                 const uint32_t lens_bits[2], int x, int y,
+                                                 PtrVec3 *origin, PtrVec3 *dir)
 {
     float lens_r = sqrtf(ptr_sample_float(lens_bits[0])), sin_phi, cos_phi;
     ptr_sincos_turns(ptr_sample_float(lens_bits[1]), &sin_phi, &cos_phi);
@@ -143,7 +144,7 @@ static inline void ptr_path_camera_ray(const PtrPathJob *job, uint64_t pixel_key
     uint32_t pixel_bits[2], lens_bits[2];
     ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_PIXEL, pixel_bits);
     ptr_sampler_pair_bits(kind, pixel_key, index, PTR_DIM_LENS, lens_bits);
-    ptr_path_camera_ray_of(job, pixel_bits, lens_bits, x, y, origin, dir);
+    ptr_path_camera_ray_from_bits(job, pixel_bits, lens_bits, x, y, origin, dir);
 }
 
 /* Where ray met the sphere hit names: the point on its surface and the

@@ -108,19 +108,19 @@ static inline void ptr_independent_pair_bits(uint64_t pair_key, uint32_t index, 
     out[1] = (uint32_t)h;
 }
 
-/* PTR_SAMPLER_SOBOL's pair for sample index, as 32-bit fractions: from the
- * low half of its pair's key (the index's shuffle) and ptr_mix64 of the
- * whole key (the two scrambles). 32-bit arithmetic only, so that bundles of
- * paths compute it for eight lanes in one vector register, having made the
- * 64-bit keys before it in two. */
-static inline void ptr_sobol_pair_bits(uint32_t pair_key, uint64_t scramble, uint32_t index,
+/* PTR_SAMPLER_SOBOL's pair for sample index, as 32-bit fractions, from the
+ * seed of the index's shuffle (the low half of the pair's key) and the two
+ * scrambles (ptr_mix64 of the whole key). 32-bit arithmetic only, so that
+ * bundles of paths compute it for eight lanes in one vector register, having
+ * made the 64-bit keys before it in wider ones. */
+static inline void ptr_sobol_pair_bits(uint32_t shuffle_seed, uint64_t scramble, uint32_t index,
                                        uint32_t out[2])
 {
     /* The shuffle, an Owen scramble of the index, maps every aligned block
      * of 2^k indices onto another aligned block (bits flip as the bits above
      * them decide), and any such block of a (0,2)-sequence is a (0,k,2)-net;
      * it decorrelates this pair from the others (padding). */
-    uint32_t i = ptr_reverse_bits(ptr_laine_karras(ptr_reverse_bits(index), pair_key));
+    uint32_t i = ptr_reverse_bits(ptr_laine_karras(ptr_reverse_bits(index), shuffle_seed));
     out[0] = ptr_reverse_bits(ptr_laine_karras(i, (uint32_t)scramble));
     out[1] = ptr_reverse_bits(
         ptr_laine_karras(ptr_sobol_second_reversed(i), (uint32_t)(scramble >> 32)));

@@ -93,8 +93,9 @@ default=$(threads_of "$ptr")
 check "by default, one per CPU the process may run on: $usable (got $default)" \
     '[ "$default" = "$usable" ]'
 # ptr merge reports the threads its denoiser would take, by the same rule.
-"$ptr" "$src/scenes/seed.gltf" -o "$dir/part0.exr" --width 16 --sample-range 0:1 --quiet
-"$ptr" "$src/scenes/seed.gltf" -o "$dir/part1.exr" --width 16 --sample-range 1:2 --quiet
+check "two parts to merge render" \
+    '"$ptr" "$src/scenes/seed.gltf" -o "$dir/part0.exr" --width 16 --sample-range 0:1 --quiet &&
+     "$ptr" "$src/scenes/seed.gltf" -o "$dir/part1.exr" --width 16 --sample-range 1:2 --quiet'
 merge_threads() {
     "$ptr" merge "$dir/part0.exr" "$dir/part1.exr" -o "$dir/merged.exr" --quiet --json "$@" |
         sed -E 's/.*"threads": ([0-9]+).*/\1/'
