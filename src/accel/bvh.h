@@ -65,9 +65,9 @@ typedef struct PtrBvh {
 
 /* Builds the tree over the first count spheres, reordering them (see
  * bvh.h's head) and leaving the rest in place after them (the scene's
- * huge spheres, which accel/huge.h tests); threads 0 means one per online
- * CPU. The tree's bytes depend only on
- * the spheres, never on the thread count. On failure (out of memory) *bvh
+ * huge spheres, which accel/huge.h tests); threads 0 means one per CPU the
+ * process may run on. The tree's bytes depend only on the spheres, never
+ * on the thread count. On failure (out of memory) *bvh
  * is empty and the spheres may be part reordered: the scene can only be
  * freed; err (which may be NULL) says so. */
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,

@@ -90,7 +90,7 @@ static int same_sphere(const PtrMeshSphere *a, const PtrMeshSphere *b)
            a->first_triangle == b->first_triangle && a->is_sphere == b->is_sphere;
 }
 
-static void test_online_cpus(void)
+static void test_cpus_changing(void)
 {
     Mesh m;
     const PtrMeshSource mesh = make_mesh(&m);
@@ -405,7 +405,7 @@ static void test_runs_match_union(void)
  * ptr_mesh_spheres finds what the union finds: a last triangle reaching
  * back into the first sphere (on one thread, and where the slices put it
  * apart from that sphere), a first triangle of one vertex (a run of one),
- * the octahedra of test_online_cpus (half of them open), and a run larger
+ * the octahedra of test_cpus_changing (half of them open), and a run larger
  * than a run may be. */
 static void test_runs_give_way(void)
 {
@@ -465,7 +465,7 @@ static void test_runs_give_way(void)
 int main(void)
 {
     const TestCase cases[] = {
-        TEST_CASE(test_online_cpus),
+        TEST_CASE(test_cpus_changing),
         TEST_CASE(test_least_closed),
         TEST_CASE(test_runs_match_union),
         TEST_CASE(test_runs_give_way),
