@@ -41,28 +41,13 @@ PtrResult gltf_attribute_accessor(Importer *im, const Origin *o, const char *wha
     return PTR_OK;
 }
 
-void gltf_element(const GltfAccessor *a, size_t i, double out[4])
+void gltf_element_integers(const GltfAccessor *a, size_t i, double out[4])
 {
     const unsigned char *p = a->data + i * a->stride;
-    if (a->component_type == GLTF_FLOAT) { /* the common case, without a switch a component */
-        /* Copies of a size the compiler knows are moves of registers; one
-         * of a size it does not is a call to memcpy an element. */
-        float f[4] = { 0, 0, 0, 0 };
-        switch (a->components) {
-        case 1: memcpy(f, p, 1 * sizeof *f); break;
-        case 2: memcpy(f, p, 2 * sizeof *f); break;
-        case 3: memcpy(f, p, 3 * sizeof *f); break;
-        case 4: memcpy(f, p, 4 * sizeof *f); break;
-        }
-        for (int c = 0; c < 4; c++)
-            out[c] = f[c];
-        return;
-    }
     for (int c = 0; c < 4; c++) {
         double raw = 0;
         if (c < a->components) {
             switch (a->component_type) {
-            case GLTF_FLOAT: { float f; memcpy(&f, p + 4 * c, 4); raw = f; break; }
             case GLTF_UNSIGNED_BYTE: raw = p[c]; break;
             case GLTF_BYTE: raw = (signed char)p[c]; break;
             case GLTF_UNSIGNED_SHORT: { uint16_t u; memcpy(&u, p + 2 * c, 2); raw = u; break; }

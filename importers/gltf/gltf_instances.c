@@ -168,13 +168,14 @@ typedef enum Fault { NO_FAULT, TRANSFORM_FAULT, VALUE_FAULT, SPHERE_FAULT } Faul
 /* Instance i of the run, or why it gives no spheres. */
 static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
 {
-    out->world = *run->world;
     if (run->instanced) {
         Mat4 local;
         if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
                             run->has_s ? &run->s : NULL, i, &local))
             return TRANSFORM_FAULT;
         out->world = gltf_mat4_mul(run->world, &local);
+    } else {
+        out->world = *run->world;
     }
     out->has_color = run->has_c;
     if (run->has_c)
