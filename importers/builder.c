@@ -311,6 +311,8 @@ static double smallest_radius(const PtrSceneBuilder *b)
     return smallest;
 }
 
+static const double world_origin[3] = { 0, 0, 0 };
+
 static int is_framed(const double *sphere, double smallest)
 {
     return !(sphere[3] > SMALL_RATIO * smallest);
@@ -318,6 +320,7 @@ static int is_framed(const double *sphere, double smallest)
 
 typedef struct BoxPass {
     const double *spheres;
+    const double *origin; /* the box is of the spheres less this */
     double smallest;
     double lo[PIECES_MAX][3], hi[PIECES_MAX][3];
     int any[PIECES_MAX];
@@ -333,8 +336,9 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
         if (!is_framed(s, p->smallest))
             continue;
         for (int k = 0; k < 3; k++) {
-            lo[k] = any ? least(lo[k], s[k] - s[3]) : s[k] - s[3];
-            hi[k] = any ? most(hi[k], s[k] + s[3]) : s[k] + s[3];
+            const double c = s[k] - p->origin[k];
+            lo[k] = any ? least(lo[k], c - s[3]) : c - s[3];
+            hi[k] = any ? most(hi[k], c + s[3]) : c + s[3];
         }
         any = 1;
     }
@@ -344,10 +348,13 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 }
 
 /* The box around the spheres the framing considers (smallest: the smallest
- * radius); 0 if there are none. */
-static int framed_box(const PtrSceneBuilder *b, double smallest, double lo[3], double hi[3])
+ * radius), their centres taken relative to origin (as add_sphere takes
+ * them: each centre less origin, in double, then the radius); 0 if there
+ * are none. */
+static int framed_box(const PtrSceneBuilder *b, double smallest, const double origin[3],
+                      double lo[3], double hi[3])
 {
-    BoxPass p = { .spheres = b->spheres, .smallest = smallest };
+    BoxPass p = { .spheres = b->spheres, .origin = origin, .smallest = smallest };
     const size_t pieces = over_pieces(b, box_of_piece, &p);
     int any = 0;
     for (size_t piece = 0; piece < pieces; piece++) {
@@ -421,7 +428,7 @@ static void frame_spheres(PtrSceneBuilder *b, double smallest)
                     : scene->width > 0 ? (double)scene->width / scene->height
                                        : 16.0 / 9.0;
     double lo[3] = { -1, -1, -1 }, hi[3] = { 1, 1, 1 };
-    framed_box(b, smallest, lo, hi);
+    framed_box(b, smallest, world_origin, lo, hi);
     double centre[3];
     for (int k = 0; k < 3; k++)
         centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -467,7 +474,7 @@ static void orbit_camera(PtrSceneBuilder *b, double smallest)
     if (b->orbit_degrees == 0)
         return;
     double lo[3] = { 0, 0, 0 }, hi[3] = { 0, 0, 0 };
-    framed_box(b, smallest, lo, hi);
+    framed_box(b, smallest, world_origin, lo, hi);
     const double axis[2] = { 0.5 * (lo[0] + hi[0]), 0.5 * (lo[2] + hi[2]) };
     double t = b->orbit_degrees * DEG_TO_RAD, c = cos(t), s = sin(t);
     const double through_origin[2] = { 0, 0 };
@@ -503,18 +510,19 @@ static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
  * ground under a scene a few units (or a room 100) across is huge; the
  * radius-100 and radius-1000 grounds of seed.gltf and final.gltf are not;
  * a cloud of like spheres has none (the tree's limit takes those grounds
- * out of its boxes). Puts their indices in huge[], ascending, and returns
- * how many. */
+ * out of its boxes). The box is taken relative to origin, as the scene
+ * holds the spheres, and eye is too. Puts their indices in huge[],
+ * ascending, and returns how many. */
 #define HUGE_RATIO 256.0
 
-static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const double eye[3],
-                          size_t huge[PTR_HUGE_MAX])
+static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const double origin[3],
+                          const double eye[3], size_t huge[PTR_HUGE_MAX])
 {
     double lo[3], hi[3];
     memcpy(lo, eye, sizeof lo);
     memcpy(hi, eye, sizeof hi);
     double around[2][3];
-    if (framed_box(b, smallest, around[0], around[1]))
+    if (framed_box(b, smallest, origin, around[0], around[1]))
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], around[0][k]);
             hi[k] = fmax(hi[k], around[1][k]);
@@ -535,13 +543,15 @@ static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const doubl
     return choice.count;
 }
 
-/* Puts sphere i of the builder (already relative to the scene's origin) at
+/* Puts sphere i of the builder, its centre less origin (the scene's), at
  * entry at of the scene's arrays (its value at entry i: see PtrSpheres),
  * whose attributes and values exist if the builder's do. */
-static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, PtrError *err)
+static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const double origin[3],
+                            PtrError *err)
 {
     const double *d = &b->spheres[4 * i];
-    PtrVec3 c = v3((float)d[0], (float)d[1], (float)d[2]);
+    PtrVec3 c = v3((float)(d[0] - origin[0]), (float)(d[1] - origin[1]),
+                   (float)(d[2] - origin[2]));
     float r = (float)d[3];
     if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
         return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
@@ -571,6 +581,7 @@ enum { SHRINK_STEP = 1 << 20 };
 
 typedef struct SphereMove {
     PtrSceneBuilder *builder;
+    const double *origin;
     const size_t *huge; /* ascending */
     size_t huge_count;
     atomic_int invalid; /* a sphere the scene cannot hold */
@@ -589,39 +600,26 @@ static void move_spheres(void *arg, size_t begin, size_t end)
         if (huge_before < m->huge_count && m->huge[huge_before] == i)
             huge_before++;
         else
-            invalid |= add_sphere(m->builder, i, i - huge_before, NULL) != PTR_OK;
+            invalid |= add_sphere(m->builder, i, i - huge_before, m->origin, NULL) != PTR_OK;
     }
     if (invalid)
         atomic_store(&m->invalid, 1);
 }
 
-typedef struct Recentre {
-    double *spheres;
-    const double *origin;
-} Recentre;
-
-static void recentre_spheres(void *arg, size_t begin, size_t end)
-{
-    const Recentre *r = arg;
-    for (size_t i = begin; i < end; i++)
-        for (int k = 0; k < 3; k++)
-            r->spheres[4 * i + k] -= r->origin[k];
-}
-
 /* The spheres in file order, the huge ones last (then ids keep the file's
- * order; see PtrSpheres.id), with the huge ones in double as well. Moved on
- * all cores from the last back, the builder's arrays shrinking behind, so
- * that 10^8 spheres are never in memory twice. */
+ * order; see PtrSpheres.id), with the huge ones in double as well, all
+ * relative to origin: each centre less origin as it is moved (a pass of its
+ * own over the builder's 32 bytes a sphere cost more than the subtraction).
+ * Moved on all cores from the last back, the builder's arrays shrinking
+ * behind, so that 10^8 spheres are never in memory twice. */
 static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double origin[3],
                              int huge_in_double, PtrError *err)
 {
     PtrScene *scene = b->scene;
     const size_t count = b->count;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
-    Recentre recentre = { b->spheres, origin };
-    ptr_parallel_ranges(ptr_usable_cpus(), 0, count, recentre_spheres, &recentre);
     size_t huge[PTR_HUGE_MAX];
-    const size_t huge_count = huge_in_double ? choose_huge(b, smallest, eye, huge) : 0;
+    const size_t huge_count = huge_in_double ? choose_huge(b, smallest, origin, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
 #define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
@@ -639,10 +637,13 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
             res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the huge spheres");
     }
     for (size_t k = 0; k < huge_count && res == PTR_OK; k++) {
-        memcpy(&scene->huge.centre_radius[4 * k], &b->spheres[4 * huge[k]], 4 * sizeof(double));
-        res = add_sphere(b, huge[k], count - huge_count + k, err);
+        double *centre_radius = &scene->huge.centre_radius[4 * k];
+        for (int a = 0; a < 3; a++)
+            centre_radius[a] = b->spheres[4 * huge[k] + a] - origin[a];
+        centre_radius[3] = b->spheres[4 * huge[k] + 3];
+        res = add_sphere(b, huge[k], count - huge_count + k, origin, err);
     }
-    SphereMove move = { .builder = b, .huge = huge, .huge_count = huge_count };
+    SphereMove move = { .builder = b, .origin = origin, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
     const int threads = ptr_usable_cpus();
     for (size_t end = count; end > 0 && res == PTR_OK;) {
