@@ -1,7 +1,6 @@
 /* 4x4 transforms (gltf_transforms.h). */
 #include "gltf_transforms.h"
 
-#include <math.h>
 #include <string.h>
 
 Mat4 gltf_node_local(const GltfNode *n)

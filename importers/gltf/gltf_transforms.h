@@ -8,8 +8,7 @@
 
 /* 4x4 affine transforms, column-major like glTF: m[column * 4 + row]. The
  * arithmetic is inline, for it runs once an instance: called, each result
- * went through memory, and its reader stalled on the stores (instanced
- * imports took 1.4 times as long). */
+ * went through memory, and its reader stalled on the stores. */
 typedef struct Mat4 {
     double m[16];
 } Mat4;
