@@ -142,6 +142,7 @@ typedef struct NodeRun {
     size_t surface_count;        /* surface spheres an instance */
     uint32_t *surface_materials; /* theirs */
     const Mat4 *world;
+    int world_identity; /* world is the identity (gltf_mat4_mul_identity) */
     int instanced;
     GltfAccessor t, r, s, c, v; /* the instances' attributes, read where has_ says */
     int has_t, has_r, has_s, has_c, has_v;
@@ -173,7 +174,8 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
         if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
                             run->has_s ? &run->s : NULL, i, &local))
             return TRANSFORM_FAULT;
-        out->world = gltf_mat4_mul(run->world, &local);
+        out->world = run->world_identity ? gltf_mat4_mul_identity(&local)
+                                         : gltf_mat4_mul(run->world, &local);
     } else {
         out->world = *run->world;
     }
@@ -522,6 +524,7 @@ PtrResult gltf_add_node_spheres(Importer *im, size_t node_index, const GltfNode 
     const Origin o = { node_index, label(node->name, "unnamed"), NULL, 0 };
     const Origin instance = { node_index, o.node_name, node->instanced ? "instance" : NULL, 0 };
     NodeRun run = { .builder = &im->builder, .node = node, .mesh = &mesh, .world = world,
+                    .world_identity = gltf_mat4_is_identity(world),
                     .instanced = node->instanced, .instances = 1, .slots = 1 };
     atomic_init(&run.failed, SIZE_MAX);
     atomic_init(&run.nonuniform, 0);

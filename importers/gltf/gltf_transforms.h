@@ -27,6 +27,28 @@ static inline Mat4 gltf_mat4_mul(const Mat4 *a, const Mat4 *b)
     return r;
 }
 
+/* Whether a is the identity. */
+static inline int gltf_mat4_is_identity(const Mat4 *a)
+{
+    for (int k = 0; k < 16; k++)
+        if (a->m[k] != (k % 5 == 0 ? 1.0 : 0.0))
+            return 0;
+    return 1;
+}
+
+/* gltf_mat4_mul(a, b) for an identity a, without its 64 products: each
+ * entry of b plus 0.0. gltf_mat4_mul's sum for an entry is, in order, zeros
+ * (a's zeros times b's finite entries, +0 or -0, summed from +0.0: +0),
+ * b's entry, then more zeros, which change no sum but a zero's sign: so b's
+ * entry with a -0 made +0, which is what adding 0.0 does. b finite. */
+static inline Mat4 gltf_mat4_mul_identity(const Mat4 *b)
+{
+    Mat4 r;
+    for (int k = 0; k < 16; k++)
+        r.m[k] = b->m[k] + 0.0;
+    return r;
+}
+
 /* T * R * S, as glTF composes a node's TRS properties (rotation a unit
  * quaternion x, y, z, w). */
 static inline Mat4 gltf_trs_matrix(const double translation[3], const double rotation[4],
