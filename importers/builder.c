@@ -311,6 +311,8 @@ static double smallest_radius(const PtrSceneBuilder *b)
     return smallest;
 }
 
+/* The origin of the file's coordinates, for the passes that run before the
+ * scene's origin is known (and for the scene's, when not recentred). */
 static const double world_origin[3] = { 0, 0, 0 };
 
 static int is_framed(const double *sphere, double smallest)
@@ -550,8 +552,7 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const doubl
                             PtrError *err)
 {
     const double *d = &b->spheres[4 * i];
-    PtrVec3 c = v3((float)(d[0] - origin[0]), (float)(d[1] - origin[1]),
-                   (float)(d[2] - origin[2]));
+    PtrVec3 c = relative(d, origin);
     float r = (float)d[3];
     if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
         return ptr_error_set(err, PTR_ERR_SCENE_INVALID,
@@ -672,15 +673,14 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
     else if (!b->has_camera)
         frame_spheres(b, smallest);
     orbit_camera(b, smallest);
-    const double zero[3] = { 0, 0, 0 };
-    const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : zero;
+    const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : world_origin;
     memcpy(scene->origin, origin, sizeof scene->origin);
 
     res = add_spheres(b, smallest, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
     scene->camera = b->lens;
     scene->camera.lookfrom = relative(b->eye, origin);
     scene->camera.lookat = relative(b->target, origin);
-    scene->camera.up = relative(b->up, zero);
+    scene->camera.up = relative(b->up, world_origin);
     ptr_builder_free(b);
     return res;
 }

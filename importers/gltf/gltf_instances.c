@@ -142,7 +142,7 @@ typedef struct NodeRun {
     size_t surface_count;        /* surface spheres an instance */
     uint32_t *surface_materials; /* theirs */
     const Mat4 *world;
-    int world_identity; /* world is the identity (gltf_mat4_mul_identity) */
+    int world_identity; /* world is the identity (see gltf_mat4_identity_mul) */
     int instanced;
     GltfAccessor t, r, s, c, v; /* the instances' attributes, read where has_ says */
     int has_t, has_r, has_s, has_c, has_v;
@@ -174,7 +174,9 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
         if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
                             run->has_s ? &run->s : NULL, i, &local))
             return TRANSFORM_FAULT;
-        out->world = run->world_identity ? gltf_mat4_mul_identity(&local)
+        /* local is finite (instance_local checks it), as the identity's
+         * product without its products needs. */
+        out->world = run->world_identity ? gltf_mat4_identity_mul(&local)
                                          : gltf_mat4_mul(run->world, &local);
     } else {
         out->world = *run->world;

@@ -27,21 +27,25 @@ static inline Mat4 gltf_mat4_mul(const Mat4 *a, const Mat4 *b)
     return r;
 }
 
-/* Whether a is the identity. */
+/* Whether a is the identity (a zero of either sign counting as 0). */
 static inline int gltf_mat4_is_identity(const Mat4 *a)
 {
     for (int k = 0; k < 16; k++)
-        if (a->m[k] != (k % 5 == 0 ? 1.0 : 0.0))
+        if (a->m[k] != (k % 5 == 0 ? 1.0 : 0.0)) /* entries 0, 5, 10, 15: the diagonal */
             return 0;
     return 1;
 }
 
-/* gltf_mat4_mul(a, b) for an identity a, without its 64 products: each
- * entry of b plus 0.0. gltf_mat4_mul's sum for an entry is, in order, zeros
- * (a's zeros times b's finite entries, +0 or -0, summed from +0.0: +0),
- * b's entry, then more zeros, which change no sum but a zero's sign: so b's
- * entry with a -0 made +0, which is what adding 0.0 does. b finite. */
-static inline Mat4 gltf_mat4_mul_identity(const Mat4 *b)
+/* gltf_mat4_mul(a, b) for an identity a and a finite b, without its 64
+ * products: each entry of b plus 0.0, the same bits. gltf_mat4_mul sums an
+ * entry from +0.0 in k's order. Its terms before b's entry are zeros (a zero
+ * of a times a finite entry of b: +0 or -0), and +0.0 plus a zero of either
+ * sign is +0. Then 1 times b's entry, exact, is added: b's entry, or +0 for
+ * a -0. The terms after are zeros again, which change neither a nonzero sum
+ * nor a +0. So the sum is b's entry with -0 made +0, as adding 0.0 makes it.
+ * (IEEE arithmetic rounding to nearest, subnormals kept: ptr never changes
+ * either.) */
+static inline Mat4 gltf_mat4_identity_mul(const Mat4 *b)
 {
     Mat4 r;
     for (int k = 0; k < 16; k++)

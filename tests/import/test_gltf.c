@@ -1,5 +1,6 @@
 /* The glTF importer against fixtures whose spheres, materials and camera are
- * worked out by hand from docs/scenes.md. */
+ * worked out by hand from docs/scenes.md, and its transforms' shortcut held
+ * to the arithmetic it skips. */
 #include <float.h>
 
 #include "gltf/gltf_transforms.h"
@@ -292,16 +293,20 @@ static void test_orthographic_camera(void)
 
 /* The product with an identity, without its products, is the product's
  * bits: on matrices of zeros of both signs, subnormals, the largest finite
- * numbers and random ones. A version that returned b itself would keep the
- * -0 entries the product makes +0: counted, so that the case cannot pass
- * without any. */
+ * numbers and random ones, after an identity with +0 and with -0 off its
+ * diagonal (both count as the identity). A version that returned b itself
+ * would keep the -0 entries the product makes +0: counted, so that the case
+ * cannot pass without any. */
 static void test_identity_product(void)
 {
     static const double special[] = { 0.0, -0.0, 1.0, -1.0, 5e-324, -5e-324, DBL_MAX,
                                       -DBL_MAX, 1e-300, -1e300, 0.1, -3.5 };
     enum { N = sizeof special / sizeof special[0] };
     const Mat4 identity = { { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    const Mat4 signed_identity = { { 1, -0.0, 0, -0.0, 0, 1, -0.0, 0, -0.0, 0, 1, -0.0, 0, -0.0,
+                                     -0.0, 1 } };
     CHECK(gltf_mat4_is_identity(&identity));
+    CHECK(gltf_mat4_is_identity(&signed_identity));
     PtrRng rng = ptr_rng_for_sample(36, 0, 0);
     int negative_zeros = 0;
     for (int trial = 0; trial < 10000; trial++) {
@@ -311,8 +316,11 @@ static void test_identity_product(void)
             b.m[k] = r % 2 ? special[(r >> 1) % N] : ((double)(r >> 11) * 0x1p-53 - 0.5) * 1e3;
             negative_zeros += b.m[k] == 0.0 && signbit(b.m[k]);
         }
-        const Mat4 product = gltf_mat4_mul(&identity, &b), fast = gltf_mat4_mul_identity(&b);
+        const Mat4 fast = gltf_mat4_identity_mul(&b);
+        const Mat4 product = gltf_mat4_mul(&identity, &b),
+                   signed_product = gltf_mat4_mul(&signed_identity, &b);
         CHECK(memcmp(&product, &fast, sizeof product) == 0);
+        CHECK(memcmp(&signed_product, &fast, sizeof product) == 0);
         Mat4 not_identity = identity;
         not_identity.m[trial % 16] = b.m[0] == not_identity.m[trial % 16] ? 2.0 : b.m[0];
         CHECK(!gltf_mat4_is_identity(&not_identity));
