@@ -90,8 +90,7 @@ static PtrResult start_optional(PtrSceneBuilder *b, size_t k, size_t filled, Ptr
     return PTR_OK;
 }
 
-/* Resizes every array to capacity spheres (while they fill, count stays
- * below it; add_spheres shrinks them below count as it empties them). */
+/* Resizes every array to capacity spheres (count stays below it). */
 static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
 {
     if (capacity > SIZE_MAX / (4 * sizeof *b->spheres))
@@ -576,9 +575,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const doubl
     return PTR_OK;
 }
 
-/* The builder's arrays give back this many spheres' memory at a time as
- * add_spheres empties them: 32 MB of centres. */
-enum { SHRINK_STEP = 1 << 20 };
+/* add_spheres moves this many spheres at a time: 32 MB of centres. */
+enum { MOVE_STEP = 1 << 20 };
 
 typedef struct SphereMove {
     PtrSceneBuilder *builder;
@@ -588,31 +586,52 @@ typedef struct SphereMove {
     atomic_int invalid; /* a sphere the scene cannot hold */
 } SphereMove;
 
+/* How many of the huge spheres (ascending) come before sphere i. */
+static size_t huge_before(const size_t *huge, size_t huge_count, size_t i)
+{
+    size_t k = 0;
+    while (k < huge_count && huge[k] < i)
+        k++;
+    return k;
+}
+
 /* Puts spheres begin .. end - 1 but the huge ones at their entries, each
  * moved forward by the huge spheres before it. */
 static void move_spheres(void *arg, size_t begin, size_t end)
 {
     SphereMove *m = arg;
-    size_t huge_before = 0;
-    while (huge_before < m->huge_count && m->huge[huge_before] < begin)
-        huge_before++;
+    size_t before = huge_before(m->huge, m->huge_count, begin);
     int invalid = 0;
     for (size_t i = begin; i < end; i++) {
-        if (huge_before < m->huge_count && m->huge[huge_before] == i)
-            huge_before++;
+        if (before < m->huge_count && m->huge[before] == i)
+            before++;
         else
-            invalid |= add_sphere(m->builder, i, i - huge_before, m->origin, NULL) != PTR_OK;
+            invalid |= add_sphere(m->builder, i, i - before, m->origin, NULL) != PTR_OK;
     }
     if (invalid)
         atomic_store(&m->invalid, 1);
+}
+
+/* Gives the pages of spheres begin .. end - 1 in the builder's arrays to
+ * bank (see ptr_pages_put), for add_spheres, which has moved them. */
+static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_t end)
+{
+    ptr_pages_put(bank, b->spheres, begin * 4 * sizeof *b->spheres, end * 4 * sizeof *b->spheres);
+    ptr_pages_put(bank, b->materials, begin * sizeof *b->materials, end * sizeof *b->materials);
+    for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
+        if (*optional_array(b, k)) {
+            const size_t entry = optional_arrays[k].words * sizeof **optional_array(b, k);
+            ptr_pages_put(bank, *optional_array(b, k), begin * entry, end * entry);
+        }
 }
 
 /* The spheres in file order, the huge ones last (then ids keep the file's
  * order; see PtrSpheres.id), with the huge ones in double as well, all
  * relative to origin: each centre less origin as it is moved (a pass of its
  * own over the builder's 32 bytes a sphere cost more than the subtraction).
- * Moved on all cores from the last back, the builder's arrays shrinking
- * behind, so that 10^8 spheres are never in memory twice. */
+ * Moved on all cores a step at a time, the builder's pages going to the
+ * scene's arrays as they empty, so that 10^8 spheres are never in memory
+ * twice. */
 static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double origin[3],
                              int huge_in_double, PtrError *err)
 {
@@ -647,15 +666,19 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
     SphereMove move = { .builder = b, .origin = origin, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
     const int threads = ptr_usable_cpus();
-    for (size_t end = count; end > 0 && res == PTR_OK;) {
-        const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
+    PtrPageBank bank = { 0 };
+    for (size_t begin = 0; begin < count && res == PTR_OK; begin += MOVE_STEP) {
+        const size_t end = count - begin > MOVE_STEP ? begin + MOVE_STEP : count;
+        /* Each step's spheres on the pages of those the step before moved. */
+        ptr_spheres_take_pages(&scene->spheres, &bank, begin - huge_before(huge, huge_count, begin),
+                               end - huge_before(huge, huge_count, end));
         ptr_parallel_ranges(threads, begin, end, move_spheres, &move);
         if (atomic_load(&move.invalid))
             res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                                 "a sphere lies too far from the camera for single precision");
-        (void)resize(b, begin, NULL); /* spheres begin and on are moved; failing keeps more */
-        end = begin;
+        put_pages(b, &bank, begin, end);
     }
+    ptr_pages_free(&bank);
     if (res == PTR_OK)
         scene->huge.count = huge_count;
     return res;

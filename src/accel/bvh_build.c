@@ -473,28 +473,26 @@ static void write_spheres(void *arg, size_t begin, size_t end)
         bvh_prim_store(&w->prims[i], w->spheres, w->first + i);
 }
 
-/* The prims give back this many spheres' memory at a time as they are
- * written back: 32 MB. */
-enum { SHRINK_STEP = 1 << 20 };
+/* The prims are written back this many at a time: 32 MB. */
+enum { WRITE_STEP = 1 << 20 };
 
 /* Writes the tree's spheres back to the scene's arrays from the prims, in
  * the tree's order: a sequential write where a gather would read 10^8
- * scattered entries. From the last prim back, the prims shrinking behind,
- * so that the two copies are never both whole. Frees the prims. */
+ * scattered entries. Each step's spheres go on the pages of the prims the
+ * step before wrote, so that the two copies are never both whole, and the
+ * arrays' pages are not faulted in afresh. Frees the prims. */
 static void write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
                        int threads)
 {
     SphereWrite w = { s, prims, first };
-    for (size_t end = prim_count; end > 0;) {
-        const size_t begin = end > SHRINK_STEP ? end - SHRINK_STEP : 0;
-        w.prims = prims + begin;
-        w.first = first + begin;
-        ptr_parallel_ranges(threads, 0, end - begin, write_spheres, &w);
-        BvhPrim *shrunk = begin ? realloc(prims, begin * sizeof *prims) : NULL;
-        if (shrunk) /* failing to shrink keeps them whole */
-            prims = shrunk;
-        end = begin;
+    PtrPageBank bank = { 0 };
+    for (size_t begin = 0; begin < prim_count; begin += WRITE_STEP) {
+        const size_t end = prim_count - begin > WRITE_STEP ? begin + WRITE_STEP : prim_count;
+        ptr_spheres_take_pages(s, &bank, first + begin, first + end);
+        ptr_parallel_ranges(threads, begin, end, write_spheres, &w);
+        ptr_pages_put(&bank, prims, begin * sizeof *prims, end * sizeof *prims);
     }
+    ptr_pages_free(&bank);
     free(prims);
 }
 

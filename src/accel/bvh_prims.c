@@ -195,11 +195,22 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     out[choice.count] = SIZE_MAX;
     PrimCopy copy = { .spheres = s, .prims = prims, .huge_index = out };
     atomic_init(&copy.magnitude, 0);
+    /* Each step's prims on the pages of the spheres the step before
+     * copied. */
+    PtrPageBank bank = { 0 };
+    size_t first_prim = 0;
     for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
         const size_t end = s->count - begin > RELEASE_STEP ? begin + RELEASE_STEP : s->count;
+        size_t huge_before_end = 0;
+        while (out[huge_before_end] < end)
+            huge_before_end++;
+        const size_t end_prim = end - huge_before_end;
+        ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims);
         ptr_parallel_ranges(threads, begin, end, copy_prims, &copy);
-        ptr_spheres_release(s, begin, end);
+        ptr_spheres_release(s, &bank, begin, end);
+        first_prim = end_prim;
     }
+    ptr_pages_free(&bank);
     const uint32_t bits = (uint32_t)atomic_load(&copy.magnitude);
     memcpy(magnitude_out, &bits, sizeof bits);
     *huge_count = choice.count;

@@ -1,6 +1,7 @@
-#define _DEFAULT_SOURCE /* madvise */
+#define _GNU_SOURCE /* mremap */
 #include "base/memory.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -62,14 +63,102 @@ uint64_t ptr_memory_available(void)
     return room;
 }
 
-void ptr_memory_release(void *base, size_t from, size_t to)
+/* The pages that lie wholly inside base[from .. to - 1]: [*lo, *hi). With
+ * finished set, those wholly inside base[0 .. to - 1] but not inside
+ * base[0 .. from - 1]: the page that holds base[from] too, where a call
+ * before, to from, left it. */
+static void pages_in(void *base, size_t from, size_t to, int finished, uintptr_t *lo,
+                     uintptr_t *hi)
 {
     const uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE), start = (uintptr_t)base;
     const uintptr_t first = (start + page - 1) & ~(page - 1); /* base's page may hold more */
-    uintptr_t lo = (start + from) & ~(page - 1);
-    const uintptr_t hi = (start + to) & ~(page - 1);
-    if (lo < first)
-        lo = first;
-    if (hi > lo) /* a hint: where refused, the memory is only given back later */
-        (void)madvise((void *)lo, hi - lo, MADV_DONTNEED);
+    *lo = finished ? (start + from) & ~(page - 1) : (start + from + page - 1) & ~(page - 1);
+    *hi = (start + to) & ~(page - 1);
+    if (*lo < first)
+        *lo = first;
+    if (*hi < *lo)
+        *hi = *lo;
+}
+
+/* Moves the pages of [lo, hi) into bank, the range left mapped and empty;
+ * false where the bank is full (errno ENOSPC) or the kernel refuses. */
+static int bank_run(PtrPageBank *bank, uintptr_t lo, uintptr_t hi)
+{
+    if (bank->runs == PTR_PAGE_BANK_RUNS || bank->bytes + (hi - lo) > PTR_PAGE_BANK_BYTES) {
+        errno = ENOSPC;
+        return 0;
+    }
+    /* The new address too (NULL: the kernel's choice): the kernel reads
+     * it with MREMAP_DONTUNMAP, and a stray value fails the call. */
+    void *at = mremap((void *)lo, hi - lo, hi - lo, MREMAP_MAYMOVE | MREMAP_DONTUNMAP, NULL);
+    if (at == MAP_FAILED)
+        return 0;
+    bank->run[bank->runs++] = (struct PtrPageRun){ at, hi - lo };
+    bank->bytes += hi - lo;
+    return 1;
+}
+
+/* Banks [lo, hi), or gives it back to the machine. */
+static void put_range(PtrPageBank *bank, uintptr_t lo, uintptr_t hi, uintptr_t page)
+{
+    if (bank && !bank->refused) {
+        if (bank_run(bank, lo, hi))
+            return;
+        /* An array filled from the bank is a mapping for each run it took,
+         * and the kernel moves one mapping at a time: a range that spans
+         * several is halved until each piece is one. A page it will not
+         * move (Linux before 5.7) stops the bank. */
+        if (errno == EINVAL || errno == EFAULT) {
+            if (hi - lo > page) {
+                const uintptr_t mid = lo + (hi - lo) / page / 2 * page;
+                put_range(bank, lo, mid, page);
+                put_range(bank, mid, hi, page);
+                return;
+            }
+            bank->refused = 1;
+        }
+    }
+    /* A hint: where refused, the memory is only given back later. */
+    (void)madvise((void *)lo, hi - lo, MADV_DONTNEED);
+}
+
+void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to)
+{
+    uintptr_t lo, hi;
+    pages_in(base, from, to, 1, &lo, &hi);
+    if (hi > lo)
+        put_range(bank, lo, hi, (uintptr_t)sysconf(_SC_PAGESIZE));
+}
+
+void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
+{
+    uintptr_t lo, hi;
+    pages_in(base, from, to, 0, &lo, &hi);
+    while (lo < hi && bank->runs > 0) {
+        struct PtrPageRun *run = &bank->run[bank->runs - 1];
+        const size_t n = run->bytes < hi - lo ? run->bytes : hi - lo;
+        /* The run's last n bytes, so that the rest stays one mapping. */
+        if (mremap(run->at + run->bytes - n, n, n, MREMAP_MAYMOVE | MREMAP_FIXED,
+                   (void *)lo) == MAP_FAILED) {
+            /* The kernel unmaps the destination before it moves the pages,
+             * and may fail after (out of memory): map it again, empty, where
+             * it is gone. */
+            (void)mmap((void *)lo, n, PROT_READ | PROT_WRITE,
+                       MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED_NOREPLACE, -1, 0);
+            ptr_pages_free(bank);
+            bank->refused = 1;
+            return;
+        }
+        run->bytes -= n;
+        bank->bytes -= n;
+        bank->runs -= run->bytes == 0;
+        lo += n;
+    }
+}
+
+void ptr_pages_free(PtrPageBank *bank)
+{
+    for (size_t k = 0; k < bank->runs; k++)
+        munmap(bank->run[k].at, bank->run[k].bytes);
+    bank->runs = bank->bytes = 0;
 }

@@ -35,6 +35,7 @@ typedef struct SphereArray {
     uint32_t padding; /* bits of a padding entry */
     int optional;     /* may be NULL: then it stays so */
     int moves;        /* with the spheres when reordered: all but value */
+    int stored;       /* written for each sphere moved in: all but id and value */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -52,17 +53,17 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
     /* Entries are whole 4-byte words, or smaller ones padded with 0 (see
      * pad_array). */
     SphereArray list[] = {
-        { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1 },
-        { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1 },
-        { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1 },
-        { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1 }, /* never hit */
-        { (void **)&s->material, s->material_size, 0, 0, 1 },
-        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1 },
+        { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1, 1 },
+        { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1, 1 },
+        { (void **)&s->cz, sizeof *s->cz, zero.u, 0, 1, 1 },
+        { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1, 1 }, /* never hit */
+        { (void **)&s->material, s->material_size, 0, 0, 1, 1 },
+        { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1, 0 },
 #define ATTRIBUTE_ARRAY(name, type, per_sphere, none)                                      \
-    { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1 },
+    { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1, 1 },
         PTR_SPHERE_ATTRIBUTES(ATTRIBUTE_ARRAY)
 #undef ATTRIBUTE_ARRAY
-        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0 }, /* none */
+        { (void **)&s->value, sizeof *s->value, nan_bits.u, 1, 0, 0 }, /* none */
     };
     static_assert(sizeof list / sizeof list[0] <= SPHERE_ARRAYS_MAX, "room for the list");
     memcpy(a, list, sizeof list);
@@ -182,13 +183,22 @@ PtrResult ptr_spheres_resize(PtrSpheres *s, size_t count, PtrError *err)
     return PTR_OK;
 }
 
-void ptr_spheres_release(PtrSpheres *s, size_t begin, size_t end)
+void ptr_spheres_release(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t end)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
     const int arrays = sphere_arrays(s, a);
     for (int k = 0; k < arrays; k++)
         if (a[k].moves && *a[k].data)
-            ptr_memory_release(*a[k].data, begin * a[k].size, end * a[k].size);
+            ptr_pages_put(bank, *a[k].data, begin * a[k].size, end * a[k].size);
+}
+
+void ptr_spheres_take_pages(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t end)
+{
+    SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
+    const int arrays = sphere_arrays(s, a);
+    for (int k = 0; k < arrays; k++)
+        if (a[k].stored && *a[k].data)
+            ptr_pages_take(bank, *a[k].data, begin * a[k].size, end * a[k].size);
 }
 
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,

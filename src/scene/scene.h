@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/memory.h"
 #include "base/result.h"
 #include "base/vec.h"
 
@@ -195,13 +196,18 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
  * unchanged) if they cannot grow. */
 PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count, PtrError *err);
 
-/* Gives back the memory of the entries of spheres begin .. end - 1 in every
- * array but value, page by page, for a caller that has copied them and
- * writes them back in a new order (the tree's build: at 10^8 spheres, 3 GB
- * it then has for itself). Called as the copy grows, each begin the last
- * call's end (see ptr_memory_release); the entries given back read as zero
- * until written again. */
-void ptr_spheres_release(PtrSpheres *spheres, size_t begin, size_t end);
+/* Gives up the memory of the entries of spheres begin .. end - 1 in every
+ * array but value, page by page, to bank (NULL: to the machine; see
+ * ptr_pages_put), for a caller that has copied them and writes them back in
+ * a new order (the tree's build: at 10^8 spheres, 3 GB it then has for
+ * itself). Called as the copy grows, each begin the last call's end; the
+ * entries read as zero until written again. */
+void ptr_spheres_release(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
+
+/* Puts pages from bank under the entries of spheres begin .. end - 1 in the
+ * arrays a sphere's store writes (all but id and value; see
+ * ptr_pages_take), for a caller that then writes each of those spheres. */
+void ptr_spheres_take_pages(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */

@@ -1,15 +1,19 @@
-/* Giving memory back (ptr_memory_release, and ptr_spheres_release over a
+/* Giving memory back (ptr_pages_put, and ptr_spheres_release over a
  * scene's arrays): exactly the pages the contract names leave the process
  * (mincore says which pages are resident), every byte the caller has not
  * finished with keeps its value, and releasing a range in steps, each from
- * where the last ended, leaves no page of it behind; the material array's
- * entries, 1 byte a sphere until the materials need more; and the hash,
- * which needs memory for the file's order, failing without it. */
+ * where the last ended, leaves no page of it behind; a page bank moving
+ * those pages under another array's (ptr_pages_take), their bytes with
+ * them, across the mappings that leaves, and holding no more than its
+ * limit; the material array's entries, 1 byte a sphere until the materials
+ * need more; and the hash, which needs memory for the file's order, failing
+ * without it. */
 #define _DEFAULT_SOURCE /* mincore */
 #include "test.h"
 
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -89,19 +93,19 @@ static void test_release_whole_pages_only(void)
      * below from, released by an earlier call if any; 3 .. 8 are released,
      * 9 holds bytes past to. */
     const size_t from = 3 * page, to = 9 * page;
-    ptr_memory_release(b.data, from, to);
+    ptr_pages_put(NULL, b.data, from, to);
     check_released(&b, to, 3, 9, "one range");
     munmap(b.map, (PAGES + 2) * page);
 
     /* From 0: data's own first page is shared with what comes before. */
     b = buffer_make();
-    ptr_memory_release(b.data, 0, b.bytes);
+    ptr_pages_put(NULL, b.data, 0, b.bytes);
     check_released(&b, b.bytes, 1, PAGES, "the whole buffer");
     munmap(b.map, (PAGES + 2) * page);
 
     /* Nothing whole inside: nothing released. */
     b = buffer_make();
-    ptr_memory_release(b.data, page / 4, page / 4 + page / 2);
+    ptr_pages_put(NULL, b.data, page / 4, page / 4 + page / 2);
     check_released(&b, page / 4 + page / 2, 0, 0, "less than a page");
     munmap(b.map, (PAGES + 2) * page);
 }
@@ -117,11 +121,142 @@ static void test_release_in_steps(void)
     for (size_t to = step; from < b.bytes; to += step) {
         if (to > b.bytes)
             to = b.bytes;
-        ptr_memory_release(b.data, from, to);
+        ptr_pages_put(NULL, b.data, from, to);
         from = to;
     }
     check_released(&b, b.bytes, 1, PAGES, "in steps");
     munmap(b.map, (PAGES + 2) * page);
+}
+
+/* Whether page p of b->map holds the bytes buffer_make wrote to page
+ * source of a buffer's map. */
+static int holds_page_of(const Buffer *b, size_t p, size_t source)
+{
+    const size_t page = page_size();
+    size_t differ = 0;
+    for (size_t i = 0; i < page; i++)
+        differ += b->map[p * page + i] != (unsigned char)(1 + (source * page + i) % 251);
+    return differ == 0;
+}
+
+/* An untouched buffer like buffer_make's: nothing resident. */
+static Buffer buffer_fresh(void)
+{
+    const size_t page = page_size();
+    Buffer b = { mmap(NULL, (PAGES + 2) * page, PROT_READ | PROT_WRITE,
+                      MAP_PRIVATE | MAP_ANONYMOUS, -1, 0), NULL, PAGES * page };
+    if (b.map == MAP_FAILED)
+        abort();
+    b.data = b.map + page / 2;
+    return b;
+}
+
+/* Pages put in a bank leave their array as ptr_pages_put says, and a take
+ * puts them, bytes and all, under another array's whole pages, the last
+ * put first; a take larger than the bank leaves the rest of its range as
+ * it was. */
+static void test_bank_moves_pages(void)
+{
+    const size_t page = page_size();
+    PtrPageBank bank = { 0 };
+    Buffer from = buffer_make(), to = buffer_fresh();
+    ptr_pages_put(&bank, from.data, 0, 10 * page);           /* map pages 1 .. 9 */
+    ptr_pages_put(&bank, from.data, 10 * page, 20 * page);   /* 10 .. 19 */
+    check_released(&from, 20 * page, 1, 20, "put in a bank");
+    CHECK_INT(bank.refused, 0);
+    CHECK_INT(bank.runs, 2);
+    CHECK(bank.bytes == 19 * page);
+    /* to's whole pages from data[page]: map pages 2 .. 29, of which the
+     * bank fills 2 .. 20 with from's 10 .. 19, then 1 .. 9. */
+    ptr_pages_take(&bank, to.data, page, 30 * page);
+    CHECK_INT(bank.runs, 0);
+    CHECK(bank.bytes == 0);
+    size_t wrong = 0;
+    for (size_t p = 0; p < 10; p++)
+        wrong += !holds_page_of(&to, 2 + p, 10 + p);
+    for (size_t p = 0; p < 9; p++)
+        wrong += !holds_page_of(&to, 12 + p, 1 + p);
+    CHECK_INT(wrong, 0);
+    size_t resident_after = 0;
+    for (size_t p = 21; p < PAGES + 2; p++)
+        resident_after += resident(&to, p);
+    CHECK_INT(resident_after, 0);
+    CHECK_INT(resident(&to, 1), 0);
+    ptr_pages_free(&bank);
+    munmap(from.map, (PAGES + 2) * page);
+    munmap(to.map, (PAGES + 2) * page);
+}
+
+/* An array filled from a bank is one mapping for each run it took: putting
+ * a range across them banks every page still, and the pages travel on. */
+static void test_bank_across_mappings(void)
+{
+    const size_t page = page_size();
+    PtrPageBank bank = { 0 }, again = { 0 };
+    Buffer a = buffer_make(), b = buffer_make(), to = buffer_fresh(), last = buffer_fresh();
+    ptr_pages_put(&bank, a.data, 0, 8 * page);   /* a's map pages 1 .. 7 */
+    ptr_pages_put(&bank, b.data, 0, 12 * page);  /* b's 1 .. 11 */
+    ptr_pages_take(&bank, to.data, page, 30 * page); /* to's 2 .. 12 from b, 13 .. 19 from a */
+    CHECK(bank.bytes == 0);
+    /* From the middle of b's run to the middle of a's: map pages 5 .. 16. */
+    ptr_pages_put(&again, to.data, 4 * page + page / 2, 17 * page);
+    CHECK_INT(again.refused, 0);
+    CHECK(again.bytes == 12 * page);
+    CHECK(again.runs >= 2);
+    size_t resident_left = 0;
+    for (size_t p = 5; p < 17; p++)
+        resident_left += resident(&to, p);
+    CHECK_INT(resident_left, 0);
+    ptr_pages_take(&again, last.data, page, 20 * page); /* last's 2 .. 13 */
+    CHECK(again.bytes == 0);
+    /* Whatever the runs' order, each of to's pages 5 .. 16 arrives once:
+     * b's pages 4 .. 11 and a's 1 .. 4 (a and b were written alike, so
+     * page 4's bytes arrive twice). */
+    size_t found[12] = { 0 }, stray = 0;
+    for (size_t p = 2; p < 14; p++) {
+        size_t q = 1;
+        while (q < 12 && !holds_page_of(&last, p, q))
+            q++;
+        if (q < 12)
+            found[q]++;
+        else
+            stray++;
+    }
+    CHECK_INT(stray, 0);
+    size_t wrong = 0;
+    for (size_t q = 1; q < 12; q++)
+        wrong += found[q] != (size_t)(q >= 4) + (size_t)(q <= 4);
+    CHECK_INT(wrong, 0);
+    munmap(a.map, (PAGES + 2) * page);
+    munmap(b.map, (PAGES + 2) * page);
+    munmap(to.map, (PAGES + 2) * page);
+    munmap(last.map, (PAGES + 2) * page);
+}
+
+/* A bank holds at most PTR_PAGE_BANK_BYTES: the rest of a put goes back to
+ * the machine, and freeing the bank gives back what it holds. */
+static void test_bank_limit(void)
+{
+    const size_t page = page_size(), bytes = (size_t)PTR_PAGE_BANK_BYTES + 64 * page;
+    unsigned char *array = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
+                                MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (array == MAP_FAILED)
+        abort();
+    memset(array, 7, bytes);
+    PtrPageBank bank = { 0 };
+    ptr_pages_put(&bank, array, 0, PTR_PAGE_BANK_BYTES - 16 * page);
+    ptr_pages_put(&bank, array, PTR_PAGE_BANK_BYTES - 16 * page, bytes);
+    CHECK(bank.bytes == PTR_PAGE_BANK_BYTES - 16 * page); /* the second did not fit */
+    unsigned char in_core[64];
+    CHECK_INT(mincore(array + bytes - 64 * page, 64 * page, in_core), 0);
+    size_t kept = 0;
+    for (size_t p = 0; p < 64; p++)
+        kept += in_core[p] & 1;
+    CHECK_INT(kept, 0);
+    CHECK_INT(array[bytes - 1], 0);
+    ptr_pages_free(&bank);
+    CHECK(bank.bytes == 0 && bank.runs == 0);
+    munmap(array, bytes);
 }
 
 /* The tree's use: a scene's arrays, released up to a count, keep the rest
@@ -143,8 +278,8 @@ static void test_spheres_release(void)
         failed_values += ptr_scene_set_sphere_value(&scene, i, 2.0f, NULL) != PTR_OK;
     }
     CHECK_INT(failed_values, 0);
-    ptr_spheres_release(s, 0, count / 2);
-    ptr_spheres_release(s, count / 2, count);
+    ptr_spheres_release(s, NULL, 0, count / 2);
+    ptr_spheres_release(s, NULL, count / 2, count);
     size_t zeroed = 0, changed_after = 0, values_changed = 0;
     for (size_t i = 0; i < count; i++)
         zeroed += s->cx[i] == 0.0f && s->radius[i] == 0.0f && s->id[i] == 0;
@@ -160,6 +295,50 @@ static void test_spheres_release(void)
     CHECK_INT(values_changed, 0);
     CHECK(isnan(s->radius[count + kept])); /* padding */
     ptr_scene_free(&scene);
+}
+
+/* The arrays a sphere's store writes take pages from a bank; id and value,
+ * which it does not write, take none. */
+static void test_spheres_take_pages(void)
+{
+    const size_t count = 1 << 20;
+    PtrScene from, to;
+    ptr_scene_init(&from);
+    ptr_scene_init(&to);
+    CHECK_INT(ptr_spheres_resize(&from.spheres, count, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_resize(&to.spheres, count, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_make_ids(&to.spheres, NULL), PTR_OK);
+    CHECK_INT(ptr_spheres_make(&to.spheres, (void **)&to.spheres.value, NULL), PTR_OK);
+    for (size_t i = 0; i < count; i++)
+        from.spheres.cx[i] = from.spheres.cy[i] = from.spheres.cz[i] = from.spheres.radius[i] = 1.0f;
+    PtrPageBank bank = { 0 };
+    ptr_spheres_release(&from.spheres, &bank, 0, count);
+    const size_t banked = bank.bytes;
+    ptr_spheres_take_pages(&to.spheres, &bank, 0, count / 4);
+    CHECK(banked > 0 && bank.bytes < banked);
+    /* Each float array's whole pages below count / 4 hold the ones put:
+     * resident without a write. */
+    const size_t page = page_size();
+    size_t taken = 0, pages = 0;
+    unsigned char in_core;
+    for (size_t at = page; at + page < count / 4 * sizeof(float); at += page) {
+        const uintptr_t p = ((uintptr_t)to.spheres.cz + at) & ~(uintptr_t)(page - 1);
+        CHECK_INT(mincore((void *)p, page, &in_core), 0);
+        taken += in_core & 1;
+        pages++;
+    }
+    CHECK_INT(taken, pages);
+    size_t untouched = 0;
+    const void *other[2] = { to.spheres.id, to.spheres.value };
+    for (int k = 0; k < 2; k++) {
+        const uintptr_t p = ((uintptr_t)other[k] + 2 * page) & ~(uintptr_t)(page - 1);
+        CHECK_INT(mincore((void *)p, page, &in_core), 0);
+        untouched += !(in_core & 1);
+    }
+    CHECK_INT(untouched, 2);
+    ptr_pages_free(&bank);
+    ptr_scene_free(&from);
+    ptr_scene_free(&to);
 }
 
 /* Adds materials until the scene has count. */
@@ -306,7 +485,11 @@ int main(void)
     const TestCase cases[] = {
         TEST_CASE(test_release_whole_pages_only),
         TEST_CASE(test_release_in_steps),
+        TEST_CASE(test_bank_moves_pages),
+        TEST_CASE(test_bank_across_mappings),
+        TEST_CASE(test_bank_limit),
         TEST_CASE(test_spheres_release),
+        TEST_CASE(test_spheres_take_pages),
         TEST_CASE(test_material_widths),
         TEST_CASE(test_hash_in_file_order),
     };
