@@ -35,7 +35,8 @@ typedef struct Buffer {
     size_t bytes;
 } Buffer;
 
-static Buffer buffer_make(void)
+/* Nothing resident yet. */
+static Buffer buffer_fresh(void)
 {
     const size_t page = page_size();
     Buffer b = { mmap(NULL, (PAGES + 2) * page, PROT_READ | PROT_WRITE,
@@ -43,7 +44,14 @@ static Buffer buffer_make(void)
     if (b.map == MAP_FAILED)
         abort();
     b.data = b.map + page / 2;
-    for (size_t i = 0; i < (PAGES + 2) * page; i++)
+    return b;
+}
+
+/* Every byte written: byte i of the map is 1 + i % 251. */
+static Buffer buffer_make(void)
+{
+    Buffer b = buffer_fresh();
+    for (size_t i = 0; i < (PAGES + 2) * page_size(); i++)
         b.map[i] = (unsigned char)(1 + i % 251);
     return b;
 }
@@ -137,18 +145,6 @@ static int holds_page_of(const Buffer *b, size_t p, size_t source)
     for (size_t i = 0; i < page; i++)
         differ += b->map[p * page + i] != (unsigned char)(1 + (source * page + i) % 251);
     return differ == 0;
-}
-
-/* An untouched buffer like buffer_make's: nothing resident. */
-static Buffer buffer_fresh(void)
-{
-    const size_t page = page_size();
-    Buffer b = { mmap(NULL, (PAGES + 2) * page, PROT_READ | PROT_WRITE,
-                      MAP_PRIVATE | MAP_ANONYMOUS, -1, 0), NULL, PAGES * page };
-    if (b.map == MAP_FAILED)
-        abort();
-    b.data = b.map + page / 2;
-    return b;
 }
 
 /* Pages put in a bank leave their array as ptr_pages_put says, and a take
