@@ -80,6 +80,44 @@ static void pages_in(void *base, size_t from, size_t to, int finished, uintptr_t
         *hi = *lo;
 }
 
+/* Lines of a text file (0 if it cannot be read). */
+static size_t count_lines(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    char chunk[65536];
+    size_t lines = 0, n;
+    while ((n = fread(chunk, 1, sizeof chunk, f)) > 0)
+        for (size_t i = 0; i < n; i++)
+            lines += chunk[i] == '\n';
+    fclose(f);
+    return lines;
+}
+
+/* The moves a bank starting now may make. Each page run it moves can split
+ * a mapping in two (the array's, or a run's), and a process holds at most
+ * vm.max_map_count mappings (65,530 by default), past which every mmap,
+ * and so every malloc of a large block, fails: a bank takes at most a
+ * quarter of the room left. At 10^8 spheres a stage makes about 8,500
+ * moves and the process holds about 10,000 mappings at most. */
+static size_t mapping_room(void)
+{
+    const uint64_t max = read_number("/proc/sys/vm/max_map_count");
+    const size_t held = count_lines("/proc/self/maps");
+    return max != UINT64_MAX && held > 0 && max > held ? (size_t)(max - held) / 4 : 0;
+}
+
+/* Whether bank may move pages now. */
+static int bank_open(PtrPageBank *bank)
+{
+    if (!bank->started) {
+        bank->moves_left = mapping_room();
+        bank->started = 1;
+    }
+    return !bank->refused && bank->moves_left > 0;
+}
+
 /* Moves the pages of [lo, hi) into bank, the range left mapped and empty;
  * false where the bank is full (errno ENOSPC) or the kernel refuses. */
 static int bank_run(PtrPageBank *bank, uintptr_t lo, uintptr_t hi)
@@ -95,13 +133,14 @@ static int bank_run(PtrPageBank *bank, uintptr_t lo, uintptr_t hi)
         return 0;
     bank->run[bank->runs++] = (struct PtrPageRun){ at, hi - lo };
     bank->bytes += hi - lo;
+    bank->moves_left--;
     return 1;
 }
 
 /* Banks [lo, hi), or gives it back to the machine. */
 static void put_range(PtrPageBank *bank, uintptr_t lo, uintptr_t hi, uintptr_t page)
 {
-    if (bank && !bank->refused) {
+    if (bank && bank_open(bank)) {
         if (bank_run(bank, lo, hi))
             return;
         /* An array filled from the bank is a mapping for each run it took,
@@ -134,7 +173,7 @@ void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
 {
     uintptr_t lo, hi;
     pages_in(base, from, to, 0, &lo, &hi);
-    while (lo < hi && bank->runs > 0) {
+    while (lo < hi && bank->runs > 0 && bank_open(bank)) {
         struct PtrPageRun *run = &bank->run[bank->runs - 1];
         const size_t n = run->bytes < hi - lo ? run->bytes : hi - lo;
         /* The run's last n bytes, so that the rest stays one mapping. */
@@ -149,6 +188,7 @@ void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
             bank->refused = 1;
             return;
         }
+        bank->moves_left--;
         run->bytes -= n;
         bank->bytes -= n;
         bank->runs -= run->bytes == 0;

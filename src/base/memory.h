@@ -34,6 +34,10 @@ typedef struct PtrPageBank {
         size_t bytes;
     } run[PTR_PAGE_BANK_RUNS]; /* each one mapping of its own */
     size_t runs, bytes;
+    /* Moves the bank may still make (each may split a mapping), set at its
+     * first put: see mapping_room in memory.c. */
+    size_t moves_left;
+    int started;
     int refused; /* the kernel would not move pages: the bank gives them back */
 } PtrPageBank;
 

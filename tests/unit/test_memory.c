@@ -5,9 +5,9 @@
  * where the last ended, leaves no page of it behind; a page bank moving
  * those pages under another array's (ptr_pages_take), their bytes with
  * them, across the mappings that leaves, and holding no more than its
- * limit; the material array's entries, 1 byte a sphere until the materials
- * need more; and the hash, which needs memory for the file's order, failing
- * without it. */
+ * limits of bytes and of moves; the material array's entries, 1 byte a
+ * sphere until the materials need more; and the hash, which needs memory
+ * for the file's order, failing without it. */
 #define _DEFAULT_SOURCE /* mincore */
 #include "test.h"
 
@@ -255,6 +255,32 @@ static void test_bank_limit(void)
     munmap(array, bytes);
 }
 
+/* A bank makes at most the moves it was given at its first put (a share of
+ * the mappings the process may still make): then it gives pages back. */
+static void test_bank_moves_limit(void)
+{
+    const size_t page = page_size();
+    PtrPageBank bank = { 0 };
+    Buffer b = buffer_make();
+    ptr_pages_put(&bank, b.data, 0, 4 * page);
+    CHECK(bank.started && bank.moves_left > 0 && bank.moves_left < 65530 / 4);
+    CHECK(bank.bytes == 3 * page);
+    bank.moves_left = 1;
+    ptr_pages_put(&bank, b.data, 4 * page, 8 * page);
+    CHECK(bank.bytes == 7 * page);
+    CHECK(bank.moves_left == 0);
+    ptr_pages_put(&bank, b.data, 8 * page, 12 * page); /* given back */
+    CHECK(bank.bytes == 7 * page);
+    check_released(&b, 12 * page, 1, 12, "a bank out of moves");
+    Buffer to = buffer_fresh();
+    ptr_pages_take(&bank, to.data, 0, 8 * page); /* nothing moves */
+    CHECK(bank.bytes == 7 * page);
+    CHECK_INT(resident(&to, 1), 0);
+    ptr_pages_free(&bank);
+    munmap(b.map, (PAGES + 2) * page);
+    munmap(to.map, (PAGES + 2) * page);
+}
+
 /* The tree's use: a scene's arrays, released up to a count, keep the rest
  * (the spheres after the tree and the padding) and value whole. */
 static void test_spheres_release(void)
@@ -484,6 +510,7 @@ int main(void)
         TEST_CASE(test_bank_moves_pages),
         TEST_CASE(test_bank_across_mappings),
         TEST_CASE(test_bank_limit),
+        TEST_CASE(test_bank_moves_limit),
         TEST_CASE(test_spheres_release),
         TEST_CASE(test_spheres_take_pages),
         TEST_CASE(test_material_widths),
