@@ -670,8 +670,12 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
     for (size_t begin = 0; begin < count && res == PTR_OK; begin += MOVE_STEP) {
         const size_t end = count - begin > MOVE_STEP ? begin + MOVE_STEP : count;
         /* Each step's spheres on the pages of those the step before moved. */
-        ptr_spheres_take_pages(&scene->spheres, &bank, begin - huge_before(huge, huge_count, begin),
-                               end - huge_before(huge, huge_count, end));
+        if (!ptr_spheres_take_pages(&scene->spheres, &bank,
+                                    begin - huge_before(huge, huge_count, begin),
+                                    end - huge_before(huge, huge_count, end))) {
+            res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory moving the spheres");
+            break;
+        }
         ptr_parallel_ranges(threads, begin, end, move_spheres, &move);
         if (atomic_load(&move.invalid))
             res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,

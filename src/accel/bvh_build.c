@@ -479,21 +479,27 @@ enum { WRITE_STEP = 1 << 20 };
 /* Writes the tree's spheres back to the scene's arrays from the prims, in
  * the tree's order: a sequential write where a gather would read 10^8
  * scattered entries. Each step's spheres go on the pages of the prims the
- * step before wrote, so that the two copies are never both whole, and the
- * arrays' pages are not faulted in afresh. Frees the prims. */
-static void write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
-                       int threads)
+ * step before read, so that the two copies are never both whole, and the
+ * arrays' pages are not faulted in afresh. Frees the prims. Fails only for
+ * memory, where the kernel lost pages it moved (ptr_pages_take). */
+static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
+                            int threads, PtrError *err)
 {
     SphereWrite w = { s, prims, first };
     PtrPageBank bank = { 0 };
-    for (size_t begin = 0; begin < prim_count; begin += WRITE_STEP) {
+    PtrResult r = PTR_OK;
+    for (size_t begin = 0; begin < prim_count && r == PTR_OK; begin += WRITE_STEP) {
         const size_t end = prim_count - begin > WRITE_STEP ? begin + WRITE_STEP : prim_count;
-        ptr_spheres_take_pages(s, &bank, first + begin, first + end);
+        if (!ptr_spheres_take_pages(s, &bank, first + begin, first + end)) {
+            r = bvh_out_of_memory(err);
+            break;
+        }
         ptr_parallel_ranges(threads, begin, end, write_spheres, &w);
         ptr_pages_put(&bank, prims, begin * sizeof *prims, end * sizeof *prims);
     }
     ptr_pages_free(&bank);
     free(prims);
+    return r;
 }
 
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
@@ -503,8 +509,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
     Build build = { .threads = ptr_thread_count(threads) };
-    /* The prims and huge take the tree's spheres, whose memory the
-     * scene's arrays give back meanwhile; the spheres after them stay. */
+    /* The prims and huge take the tree's spheres, whose pages the scene's
+     * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
@@ -535,8 +541,11 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             r = run_tasks(&build, err);
     }
     if (r == PTR_OK) {
-        write_back(spheres, build.set.prims, prim_count, bvh->huge_count, build.threads);
+        r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, build.threads,
+                       err);
         build.set.prims = NULL;
+    }
+    if (r == PTR_OK) {
         SphereWrite first = { spheres, huge, 0 };
         write_spheres(&first, 0, bvh->huge_count);
         /* The ids have done their work (the leaves' order): from here on a

@@ -205,7 +205,10 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
         while (out[huge_before_end] < end)
             huge_before_end++;
         const size_t end_prim = end - huge_before_end;
-        ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims);
+        if (!ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims)) {
+            ptr_pages_free(&bank);
+            return bvh_out_of_memory(err);
+        }
         ptr_parallel_ranges(threads, begin, end, copy_prims, &copy);
         ptr_spheres_release(s, &bank, begin, end);
         first_prim = end_prim;

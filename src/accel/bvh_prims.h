@@ -11,8 +11,8 @@
 
 /* A sphere as the build moves it, whole: 32 bytes with its colour. At 10^8
  * spheres the prims are the build's largest array, and the scene's arrays
- * give their memory back as the prims are filled; the tree's leaves are
- * written back to them from the prims, in their final order. */
+ * give their pages up to them as they are filled; the tree's leaves are
+ * written back to the arrays from the prims, in their final order. */
 typedef struct BvhPrim {
     float centre[3], radius;
     uint32_t id; /* the sphere's in the file (ptr_sphere_id), which orders a leaf */
@@ -50,10 +50,13 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
  * arrays' order), and in *magnitude the largest coordinate magnitude in the
  * tree, which bounds both the spheres' and the rays' origins (the camera
  * sits at 0, other rays start on spheres) and so scales the boxes' padding.
- * Gives back the spheres' memory as it goes (ptr_spheres_release): on
- * success the prims and huge hold the only copy of spheres 0 .. count - 1
- * but their values. Counts, chooses and copies on this many threads
- * (ptr_thread_count's count). Fails only for memory (the spheres untouched). */
+ * Gives up the spheres' memory as it goes (ptr_spheres_release), its pages
+ * moved under the next prims: on success the prims and huge hold the only
+ * copy of spheres 0 .. count - 1 but their values. Counts, chooses and
+ * copies on this many threads (ptr_thread_count's count). Fails only for
+ * memory: the spheres untouched, but where the kernel ran out of memory
+ * moving pages (ptr_pages_take), when some are already given up, as they
+ * are where the build fails after this. */
 PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, BvhPrim *huge, size_t *huge_count,
                         BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
 

@@ -97,10 +97,10 @@ static size_t count_lines(const char *path)
 
 /* The moves a bank starting now may make. Each page run it moves can split
  * a mapping in two (the array's, or a run's), and a process holds at most
- * vm.max_map_count mappings (65,530 by default), past which every mmap,
- * and so every malloc of a large block, fails: a bank takes at most a
+ * vm.max_map_count mappings (65,530 by default), past which most new
+ * mappings (thread stacks, large blocks) fail: a bank takes at most a
  * quarter of the room left. At 10^8 spheres a stage makes about 8,500
- * moves and the process holds about 10,000 mappings at most. */
+ * moves and the process holds about 10,500 mappings at most. */
 static size_t mapping_room(void)
 {
     const uint64_t max = read_number("/proc/sys/vm/max_map_count");
@@ -169,7 +169,7 @@ void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to)
         put_range(bank, lo, hi, (uintptr_t)sysconf(_SC_PAGESIZE));
 }
 
-void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
+int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
 {
     uintptr_t lo, hi;
     pages_in(base, from, to, 0, &lo, &hi);
@@ -179,14 +179,18 @@ void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
         /* The run's last n bytes, so that the rest stays one mapping. */
         if (mremap(run->at + run->bytes - n, n, n, MREMAP_MAYMOVE | MREMAP_FIXED,
                    (void *)lo) == MAP_FAILED) {
-            /* The kernel unmaps the destination before it moves the pages,
-             * and may fail after (out of memory): map it again, empty, where
-             * it is gone. */
-            (void)mmap((void *)lo, n, PROT_READ | PROT_WRITE,
-                       MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED_NOREPLACE, -1, 0);
+            /* Some kernels unmap the destination before they move the
+             * pages, and may then fail (out of memory): map it again, empty,
+             * where it is gone. (A kernel before 4.17 takes the address as a
+             * hint, and maps elsewhere where the range is still there.) */
+            void *again = mmap((void *)lo, n, PROT_READ | PROT_WRITE,
+                               MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED_NOREPLACE, -1, 0);
+            const int kept = again != MAP_FAILED || errno == EEXIST;
+            if (again != MAP_FAILED && again != (void *)lo)
+                munmap(again, n);
             ptr_pages_free(bank);
             bank->refused = 1;
-            return;
+            return kept;
         }
         bank->moves_left--;
         run->bytes -= n;
@@ -194,6 +198,7 @@ void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
         bank->runs -= run->bytes == 0;
         lo += n;
     }
+    return 1;
 }
 
 void ptr_pages_free(PtrPageBank *bank)

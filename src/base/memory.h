@@ -1,6 +1,7 @@
 /* How much memory this process can still take without the machine
  * swapping or the process being refused: what a scene's import checks
- * before it allocates for millions of spheres. */
+ * before it allocates for millions of spheres. And pages moved from an
+ * array a stage has finished with to the one it fills next (a page bank). */
 #ifndef PTR_MEMORY_H
 #define PTR_MEMORY_H
 
@@ -35,7 +36,7 @@ typedef struct PtrPageBank {
     } run[PTR_PAGE_BANK_RUNS]; /* each one mapping of its own */
     size_t runs, bytes;
     /* Moves the bank may still make (each may split a mapping), set at its
-     * first put: see mapping_room in memory.c. */
+     * first put or take: see mapping_room in memory.c. */
     size_t moves_left;
     int started;
     int refused; /* the kernel would not move pages: the bank gives them back */
@@ -50,10 +51,14 @@ typedef struct PtrPageBank {
 void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to);
 
 /* Puts pages from bank in place of those that lie wholly inside
- * base[from .. to - 1], as many as it has, for a caller that writes every
- * byte of the range before reading any: a page taken from the bank holds
- * what its last array left there. The rest stay as they were. */
-void ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to);
+ * base[from .. to - 1], as many as it has and while it may still move them,
+ * for a caller that writes every byte of the range before reading any: a
+ * page taken from the bank holds what its last array left there. The rest
+ * stay as they were. A move the kernel refuses gives the bank's pages back
+ * and stops it. Returns 0 only where the kernel ran out of memory in the
+ * middle of a move and the range could not be mapped again: then the caller
+ * must not write it, and fails for memory. */
+int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to);
 
 /* Gives back the pages bank still holds; it is empty afterwards. */
 void ptr_pages_free(PtrPageBank *bank);

@@ -35,7 +35,7 @@ typedef struct SphereArray {
     uint32_t padding; /* bits of a padding entry */
     int optional;     /* may be NULL: then it stays so */
     int moves;        /* with the spheres when reordered: all but value */
-    int stored;       /* written for each sphere moved in: all but id and value */
+    int stored;       /* written by every store of a sphere: all but id and value */
 } SphereArray;
 
 enum { SPHERE_ARRAYS_MAX = 16 };
@@ -192,13 +192,15 @@ void ptr_spheres_release(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t 
             ptr_pages_put(bank, *a[k].data, begin * a[k].size, end * a[k].size);
 }
 
-void ptr_spheres_take_pages(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t end)
+int ptr_spheres_take_pages(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t end)
 {
     SphereArray a[SPHERE_ARRAYS_MAX] = { 0 }; /* all set; the compiler cannot tell */
     const int arrays = sphere_arrays(s, a);
     for (int k = 0; k < arrays; k++)
-        if (a[k].stored && *a[k].data)
-            ptr_pages_take(bank, *a[k].data, begin * a[k].size, end * a[k].size);
+        if (a[k].stored && *a[k].data &&
+            !ptr_pages_take(bank, *a[k].data, begin * a[k].size, end * a[k].size))
+            return 0;
+    return 1;
 }
 
 PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,

@@ -205,9 +205,11 @@ PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count, PtrError *err);
 void ptr_spheres_release(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
 
 /* Puts pages from bank under the entries of spheres begin .. end - 1 in the
- * arrays a sphere's store writes (all but id and value; see
- * ptr_pages_take), for a caller that then writes each of those spheres. */
-void ptr_spheres_take_pages(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
+ * arrays every store of a sphere writes (all but id and value; see
+ * ptr_pages_take), for a caller that then writes each of those spheres.
+ * Returns 0 where the kernel lost a range (see ptr_pages_take): then the
+ * caller fails for memory. */
+int ptr_spheres_take_pages(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
 
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
