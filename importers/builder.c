@@ -575,9 +575,6 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const doubl
     return PTR_OK;
 }
 
-/* add_spheres moves this many spheres at a time: 32 MB of centres. */
-enum { MOVE_STEP = 1 << 20 };
-
 typedef struct SphereMove {
     PtrSceneBuilder *builder;
     const double *origin;
@@ -667,8 +664,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
     atomic_init(&move.invalid, 0);
     const int threads = ptr_usable_cpus();
     PtrPageBank bank = { 0 };
-    for (size_t begin = 0; begin < count && res == PTR_OK; begin += MOVE_STEP) {
-        const size_t end = count - begin > MOVE_STEP ? begin + MOVE_STEP : count;
+    for (size_t begin = 0; begin < count && res == PTR_OK; begin += PTR_PAGE_STEP) {
+        const size_t end = count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : count;
         /* Each step's spheres on the pages of those the step before moved. */
         if (!ptr_spheres_take_pages(&scene->spheres, &bank,
                                     begin - huge_before(huge, huge_count, begin),
@@ -680,7 +677,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double o
         if (atomic_load(&move.invalid))
             res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                                 "a sphere lies too far from the camera for single precision");
-        put_pages(b, &bank, begin, end);
+        put_pages(b, end < count ? &bank : NULL, begin, end);
     }
     ptr_pages_free(&bank);
     if (res == PTR_OK)

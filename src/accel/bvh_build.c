@@ -473,9 +473,6 @@ static void write_spheres(void *arg, size_t begin, size_t end)
         bvh_prim_store(&w->prims[i], w->spheres, w->first + i);
 }
 
-/* The prims are written back this many at a time: 32 MB. */
-enum { WRITE_STEP = 1 << 20 };
-
 /* Writes the tree's spheres back to the scene's arrays from the prims, in
  * the tree's order: a sequential write where a gather would read 10^8
  * scattered entries. Each step's spheres go on the pages of the prims the
@@ -488,14 +485,16 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
     SphereWrite w = { s, prims, first };
     PtrPageBank bank = { 0 };
     PtrResult r = PTR_OK;
-    for (size_t begin = 0; begin < prim_count && r == PTR_OK; begin += WRITE_STEP) {
-        const size_t end = prim_count - begin > WRITE_STEP ? begin + WRITE_STEP : prim_count;
+    for (size_t begin = 0; begin < prim_count && r == PTR_OK; begin += PTR_PAGE_STEP) {
+        const size_t end = prim_count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP
+                                                              : prim_count;
         if (!ptr_spheres_take_pages(s, &bank, first + begin, first + end)) {
             r = bvh_out_of_memory(err);
             break;
         }
         ptr_parallel_ranges(threads, begin, end, write_spheres, &w);
-        ptr_pages_put(&bank, prims, begin * sizeof *prims, end * sizeof *prims);
+        ptr_pages_put(end < prim_count ? &bank : NULL, prims, begin * sizeof *prims,
+                      end * sizeof *prims);
     }
     ptr_pages_free(&bank);
     free(prims);

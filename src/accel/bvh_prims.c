@@ -124,9 +124,15 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
 #undef COPY_OUT
 }
 
-/* Spheres copied between two releases of the arrays' memory: 4 MB of each
- * float array. */
-enum { RELEASE_STEP = 1 << 20 };
+/* How many of the huge spheres (indices ascending, then SIZE_MAX) come
+ * before sphere i. */
+static size_t huge_before(const size_t *huge_index, size_t i)
+{
+    size_t k = 0;
+    while (huge_index[k] < i)
+        k++;
+    return k;
+}
 
 /* The copy of spheres into prims, in pieces on all threads: a piece's first
  * prim is its first sphere's index less the huge spheres before it, so the
@@ -143,9 +149,7 @@ typedef struct PrimCopy {
 static void copy_prims(void *arg, size_t begin, size_t end)
 {
     PrimCopy *c = arg;
-    size_t k = 0;
-    while (c->huge_index[k] < begin)
-        k++;
+    size_t k = huge_before(c->huge_index, begin);
     BvhPrim *out = c->prims + (begin - k);
     float magnitude = 0.0f;
     for (size_t i = begin; i < end; i++) {
@@ -199,18 +203,15 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
      * copied. */
     PtrPageBank bank = { 0 };
     size_t first_prim = 0;
-    for (size_t begin = 0; begin < s->count; begin += RELEASE_STEP) {
-        const size_t end = s->count - begin > RELEASE_STEP ? begin + RELEASE_STEP : s->count;
-        size_t huge_before_end = 0;
-        while (out[huge_before_end] < end)
-            huge_before_end++;
-        const size_t end_prim = end - huge_before_end;
+    for (size_t begin = 0; begin < s->count; begin += PTR_PAGE_STEP) {
+        const size_t end = s->count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : s->count;
+        const size_t end_prim = end - huge_before(out, end);
         if (!ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims)) {
             ptr_pages_free(&bank);
             return bvh_out_of_memory(err);
         }
         ptr_parallel_ranges(threads, begin, end, copy_prims, &copy);
-        ptr_spheres_release(s, &bank, begin, end);
+        ptr_spheres_release(s, end < s->count ? &bank : NULL, begin, end);
         first_prim = end_prim;
     }
     ptr_pages_free(&bank);

@@ -23,6 +23,10 @@ uint64_t ptr_memory_available(void);
  * in the tree's order) as they empty others. A bank is the caller's, on one
  * thread; zero-initialised it is empty. */
 enum {
+    /* Entries a stage writes between a take and a put (a million spheres:
+     * at most 44 MB of the import's arrays, well within the bank's bytes);
+     * the stages of one scene step alike. */
+    PTR_PAGE_STEP = 1 << 20,
     PTR_PAGE_BANK_RUNS = 512,
     /* Bytes a bank holds at most: pages beyond go back to the machine, so
      * that banking never keeps much more memory than giving back would. */
@@ -44,10 +48,11 @@ typedef struct PtrPageBank {
 
 /* Takes from base the pages that lie wholly inside base[0 .. to - 1] but
  * not wholly inside base[0 .. from - 1], keeping them mapped: they read as
- * zero afterwards. They go to bank while it has room (bank may be NULL),
- * else back to the machine. For a caller that has finished with
- * base[0 .. to - 1] and gives it up as it goes through it, each call's from
- * the last one's to, so that every whole page goes once. */
+ * zero afterwards. They go to bank while it has room, else back to the
+ * machine (bank NULL: for a stage's last step, whose pages no take
+ * follows). For a caller that has finished with base[0 .. to - 1] and
+ * gives it up as it goes through it, each call's from the last one's to,
+ * so that every whole page goes once. */
 void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to);
 
 /* Puts pages from bank in place of those that lie wholly inside
