@@ -17,7 +17,7 @@
 enum { HUGE_RATIO = 100 };
 
 /* Pieces the radii are counted and offered in: one a thread, at most this
- * many (each piece's counts take 256 KB). */
+ * many (each piece's counters take 1 MB: see COPIES). */
 enum { RADIUS_PIECES_MAX = 16 };
 
 /* The median radius is found exactly, on all threads, without a copy of
@@ -28,26 +28,48 @@ enum { RADIUS_PIECES_MAX = 16 };
  * spheres (TASK_FLAG). */
 enum { HALF_BITS = 16, HALF_VALUES = 1 << HALF_BITS };
 
+/* Each half-value is counted in COPIES counters, sphere i in copy i %
+ * COPIES, and they are summed after. Equal radii are the common case (a
+ * cloud of one size, a molecule's few elements): with one counter each
+ * increment waited on the last one's store to the same place. */
+enum { COPIES = 4 };
+
 typedef struct RadiusCount {
     const float *radius;
     size_t pieces;
     int low;       /* 0: count by high bits; 1: by low bits, radii with these high bits */
     uint32_t high;
-    uint32_t *bins; /* HALF_VALUES counts a piece */
+    uint32_t *bins; /* HALF_VALUES * COPIES counters a piece; summed, the first HALF_VALUES */
 } RadiusCount;
 
 static void count_radii(void *arg, size_t piece, size_t from, size_t to)
 {
     const RadiusCount *c = arg;
-    uint32_t *bins = c->bins + piece * HALF_VALUES;
-    memset(bins, 0, HALF_VALUES * sizeof *bins);
-    for (size_t i = from; i < to; i++) {
-        uint32_t bits;
-        memcpy(&bits, &c->radius[i], sizeof bits);
-        if (!c->low)
-            bins[bits >> HALF_BITS]++;
-        else if (bits >> HALF_BITS == c->high)
-            bins[bits & (HALF_VALUES - 1)]++;
+    uint32_t *bins = c->bins + piece * HALF_VALUES * COPIES;
+    memset(bins, 0, HALF_VALUES * COPIES * sizeof *bins);
+    /* In locals: the counters' stores could otherwise change them. */
+    const float *radius = c->radius;
+    const uint32_t high = c->high;
+    if (!c->low)
+        for (size_t i = from; i < to; i++) {
+            uint32_t bits;
+            memcpy(&bits, &radius[i], sizeof bits);
+            bins[(bits >> HALF_BITS) * COPIES + i % COPIES]++;
+        }
+    else
+        for (size_t i = from; i < to; i++) {
+            uint32_t bits;
+            memcpy(&bits, &radius[i], sizeof bits);
+            if (bits >> HALF_BITS == high)
+                bins[(bits & (HALF_VALUES - 1)) * COPIES + i % COPIES]++;
+        }
+    /* In place: counter v is written after copies 0 .. COPIES - 1 of
+     * half-value v / COPIES <= v are read. */
+    for (size_t v = 0; v < HALF_VALUES; v++) {
+        uint32_t sum = 0;
+        for (size_t k = 0; k < COPIES; k++)
+            sum += bins[v * COPIES + k];
+        bins[v] = sum;
     }
 }
 
@@ -58,7 +80,7 @@ static uint32_t half_of_rank(const RadiusCount *c, size_t *rank)
     for (uint32_t v = 0;; v++) {
         size_t with_v = 0;
         for (size_t k = 0; k < c->pieces; k++)
-            with_v += c->bins[k * HALF_VALUES + v];
+            with_v += c->bins[k * HALF_VALUES * COPIES + v];
         if (*rank < with_v)
             return v;
         *rank -= with_v;
@@ -70,7 +92,7 @@ static uint32_t half_of_rank(const RadiusCount *c, size_t *rank)
 static float huge_radius(const PtrSpheres *s, size_t pieces, int threads)
 {
     RadiusCount c = { .radius = s->radius, .pieces = pieces };
-    c.bins = malloc(pieces * HALF_VALUES * sizeof *c.bins);
+    c.bins = malloc(pieces * HALF_VALUES * COPIES * sizeof *c.bins);
     if (!c.bins)
         return NAN;
     size_t rank = s->count / 2;
