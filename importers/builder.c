@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <emmintrin.h> /* SSE2, which every x86-64 CPU has */
 
 #include "base/cpu.h"
 #include "base/threads.h"
@@ -286,28 +287,37 @@ static size_t over_pieces(const PtrSceneBuilder *b,
     return pieces;
 }
 
-typedef struct SmallestPass {
-    const double *spheres;
-    double smallest[PIECES_MAX];
-} SmallestPass;
+/* The smallest and the largest radius. */
+typedef struct Radii {
+    double smallest, largest;
+} Radii;
 
-static void smallest_of_piece(void *arg, size_t piece, size_t from, size_t to)
+typedef struct RadiiPass {
+    const double *spheres;
+    Radii radii[PIECES_MAX];
+} RadiiPass;
+
+static void radii_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
-    SmallestPass *p = arg;
-    double smallest = INFINITY;
-    for (size_t i = from; i < to; i++)
-        smallest = least(smallest, p->spheres[4 * i + 3]);
-    p->smallest[piece] = smallest;
+    RadiiPass *p = arg;
+    Radii r = { INFINITY, -INFINITY };
+    for (size_t i = from; i < to; i++) {
+        r.smallest = least(r.smallest, p->spheres[4 * i + 3]);
+        r.largest = most(r.largest, p->spheres[4 * i + 3]);
+    }
+    p->radii[piece] = r;
 }
 
-static double smallest_radius(const PtrSceneBuilder *b)
+static Radii radii_of(const PtrSceneBuilder *b)
 {
-    SmallestPass p = { .spheres = b->spheres };
-    const size_t pieces = over_pieces(b, smallest_of_piece, &p);
-    double smallest = INFINITY;
-    for (size_t k = 0; k < pieces; k++)
-        smallest = least(smallest, p.smallest[k]);
-    return smallest;
+    RadiiPass p = { .spheres = b->spheres };
+    const size_t pieces = over_pieces(b, radii_of_piece, &p);
+    Radii r = { INFINITY, -INFINITY };
+    for (size_t k = 0; k < pieces; k++) {
+        r.smallest = least(r.smallest, p.radii[k].smallest);
+        r.largest = most(r.largest, p.radii[k].largest);
+    }
+    return r;
 }
 
 /* The origin of the file's coordinates, for the passes that run before the
@@ -327,24 +337,38 @@ typedef struct BoxPass {
     int any[PIECES_MAX];
 } BoxPass;
 
+/* Two lanes at a time, in SSE2 registers: x and y, then z and the radius
+ * (that lane unused). _mm_min_pd(v, box) and _mm_max_pd(v, box) are
+ * least(box, v) and most(box, v) lane by lane, and the box starts from its
+ * first sphere, so it has the bits of the scalar fold, NaN included, which
+ * took 1.6 times as long: this pass compares and selects more than it reads
+ * (10^7 spheres, 320 MB: 60 ms on one thread in scalar code, 37 ms so, 27
+ * ms to read the radii alone). */
 static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     BoxPass *p = arg;
-    double lo[3] = { 0 }, hi[3] = { 0 }; /* here, not in p's lines, which other pieces write */
+    const __m128d origin_xy = _mm_loadu_pd(p->origin), origin_z = _mm_set_pd(0.0, p->origin[2]);
+    __m128d lo_xy = _mm_setzero_pd(), lo_z = lo_xy, hi_xy = lo_xy, hi_z = lo_xy;
     int any = 0;
     for (size_t i = from; i < to; i++) {
         const double *s = &p->spheres[4 * i];
         if (!is_framed(s, p->smallest))
             continue;
-        for (int k = 0; k < 3; k++) {
-            const double c = s[k] - p->origin[k];
-            lo[k] = any ? least(lo[k], c - s[3]) : c - s[3];
-            hi[k] = any ? most(hi[k], c + s[3]) : c + s[3];
-        }
+        const __m128d zr = _mm_loadu_pd(s + 2), r = _mm_unpackhi_pd(zr, zr);
+        const __m128d c_xy = _mm_sub_pd(_mm_loadu_pd(s), origin_xy);
+        const __m128d c_z = _mm_sub_pd(zr, origin_z);
+        const __m128d l_xy = _mm_sub_pd(c_xy, r), l_z = _mm_sub_pd(c_z, r);
+        const __m128d h_xy = _mm_add_pd(c_xy, r), h_z = _mm_add_pd(c_z, r);
+        lo_xy = any ? _mm_min_pd(l_xy, lo_xy) : l_xy;
+        lo_z = any ? _mm_min_pd(l_z, lo_z) : l_z;
+        hi_xy = any ? _mm_max_pd(h_xy, hi_xy) : h_xy;
+        hi_z = any ? _mm_max_pd(h_z, hi_z) : h_z;
         any = 1;
     }
-    memcpy(p->lo[piece], lo, sizeof lo);
-    memcpy(p->hi[piece], hi, sizeof hi);
+    _mm_storeu_pd(p->lo[piece], lo_xy);
+    _mm_storel_pd(&p->lo[piece][2], lo_z);
+    _mm_storeu_pd(p->hi[piece], hi_xy);
+    _mm_storel_pd(&p->hi[piece][2], hi_z);
     p->any[piece] = any;
 }
 
@@ -513,17 +537,19 @@ static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
  * a cloud of like spheres has none (the tree's limit takes those grounds
  * out of its boxes). The box is taken relative to origin, as the scene
  * holds the spheres, and eye is too. Puts their indices in huge[],
- * ascending, and returns how many. */
+ * ascending, and returns how many: none, without a pass of its own over
+ * the spheres (3.2 GB at 10^8), if the largest radius is within the limit,
+ * as in most scenes. */
 #define HUGE_RATIO 256.0
 
-static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const double origin[3],
+static size_t choose_huge(const PtrSceneBuilder *b, Radii radii, const double origin[3],
                           const double eye[3], size_t huge[PTR_HUGE_MAX])
 {
     double lo[3], hi[3];
     memcpy(lo, eye, sizeof lo);
     memcpy(hi, eye, sizeof hi);
     double around[2][3];
-    if (framed_box(b, smallest, origin, around[0], around[1]))
+    if (framed_box(b, radii.smallest, origin, around[0], around[1]))
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], around[0][k]);
             hi[k] = fmax(hi[k], around[1][k]);
@@ -532,6 +558,8 @@ static size_t choose_huge(const PtrSceneBuilder *b, double smallest, const doubl
     for (int k = 0; k < 3; k++)
         extent = fmax(extent, hi[k] - lo[k]);
     const PtrHugeChoice choice_of_none = { .limit = HUGE_RATIO * extent };
+    if (!(radii.largest > choice_of_none.limit)) /* ptr_huge_offer's test */
+        return 0;
     HugePass p = { .spheres = b->spheres };
     for (size_t k = 0; k < PIECES_MAX; k++)
         p.choice[k] = choice_of_none;
@@ -629,14 +657,14 @@ static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_
  * Moved on all cores a step at a time, the builder's pages going to the
  * scene's arrays as they empty, so that 10^8 spheres are never in memory
  * twice. */
-static PtrResult add_spheres(PtrSceneBuilder *b, double smallest, const double origin[3],
+static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origin[3],
                              int huge_in_double, PtrError *err)
 {
     PtrScene *scene = b->scene;
     const size_t count = b->count;
     const double eye[3] = { b->eye[0] - origin[0], b->eye[1] - origin[1], b->eye[2] - origin[2] };
     size_t huge[PTR_HUGE_MAX];
-    const size_t huge_count = huge_in_double ? choose_huge(b, smallest, origin, eye, huge) : 0;
+    const size_t huge_count = huge_in_double ? choose_huge(b, radii, origin, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
 #define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
@@ -690,17 +718,17 @@ PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
     /* The framing, the orbit and the huge choice look at the spheres whose
-     * radius is within SMALL_RATIO of this. */
-    const double smallest = smallest_radius(b);
+     * radius is within SMALL_RATIO of the smallest. */
+    const Radii radii = radii_of(b);
     if (b->override)
         use_override(b);
     else if (!b->has_camera)
-        frame_spheres(b, smallest);
-    orbit_camera(b, smallest);
+        frame_spheres(b, radii.smallest);
+    orbit_camera(b, radii.smallest);
     const double *origin = flags & PTR_BUILD_RECENTRE ? b->eye : world_origin;
     memcpy(scene->origin, origin, sizeof scene->origin);
 
-    res = add_spheres(b, smallest, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
+    res = add_spheres(b, radii, origin, flags & PTR_BUILD_HUGE_IN_DOUBLE, err);
     scene->camera = b->lens;
     scene->camera.lookfrom = relative(b->eye, origin);
     scene->camera.lookat = relative(b->target, origin);
