@@ -340,10 +340,10 @@ typedef struct BoxPass {
 /* Two lanes at a time, in SSE2 registers: x and y, then z and the radius
  * (that lane unused). _mm_min_pd(v, box) and _mm_max_pd(v, box) are
  * least(box, v) and most(box, v) lane by lane, and the box starts from its
- * first sphere, so it has the bits of the scalar fold, NaN included, which
- * took 1.6 times as long: this pass compares and selects more than it reads
- * (10^7 spheres, 320 MB: 60 ms on one thread in scalar code, 37 ms so, 27
- * ms to read the radii alone). */
+ * first sphere, so it has the scalar fold's bits, NaN included. The scalar
+ * fold took 1.6 times as long: the pass compares and selects more than it
+ * reads (10^7 spheres, 320 MB: 60 ms on one thread in scalar code, 37 ms
+ * so; reading the radii alone takes 27). */
 static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     BoxPass *p = arg;
