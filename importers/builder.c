@@ -15,6 +15,7 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
 {
     memset(builder, 0, sizeof *builder);
     builder->scene = scene;
+    builder->material_size = scene->spheres.material_size;
     if (options) {
         builder->override = options->camera;
         builder->auto_projection = options->auto_projection;
@@ -101,7 +102,7 @@ static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
     if (!spheres)
         return no_room(capacity, err);
     b->spheres = spheres;
-    uint32_t *materials = realloc(b->materials, entries * sizeof *materials);
+    void *materials = realloc(b->materials, entries * b->material_size);
     if (!materials)
         return no_room(capacity, err);
     b->materials = materials;
@@ -123,11 +124,42 @@ PtrResult ptr_builder_reserve(PtrSceneBuilder *b, size_t count, PtrError *err)
     return count > b->capacity ? resize(b, count, err) : PTR_OK;
 }
 
+/* The builder's materials, read and written as the scene's are. */
+static PtrSpheres material_column(const PtrSceneBuilder *b)
+{
+    return (PtrSpheres){ .material = b->materials, .material_size = b->material_size };
+}
+
+/* Makes the builder's material entries as wide as the scene's, which the
+ * materials it gained since the last spheres were added may have widened:
+ * at 10^8 spheres of at most 256 materials, 100 MB where 4-byte entries
+ * took 400. */
+static PtrResult widen_materials(PtrSceneBuilder *b, PtrError *err)
+{
+    const size_t size = b->scene->spheres.material_size;
+    if (size <= b->material_size)
+        return PTR_OK;
+    void *wide = malloc((b->capacity ? b->capacity : 1) * size);
+    if (!wide)
+        return no_room(b->capacity, err);
+    const PtrSpheres narrow = material_column(b);
+    b->materials = wide;
+    b->material_size = size;
+    PtrSpheres to = material_column(b);
+    for (size_t i = 0; i < b->count; i++)
+        ptr_sphere_set_material(&to, i, ptr_sphere_material(&narrow, i));
+    free(narrow.material);
+    return PTR_OK;
+}
+
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material, PtrError *err)
 {
+    PtrResult r = widen_materials(b, err);
+    if (r != PTR_OK)
+        return r;
     if (b->count == b->capacity) {
-        PtrResult r = resize(b, b->capacity ? 2 * b->capacity : 64, err);
+        r = resize(b, b->capacity ? 2 * b->capacity : 64, err);
         if (r != PTR_OK)
             return r;
     }
@@ -139,22 +171,26 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     s[1] = centre[1];
     s[2] = centre[2];
     s[3] = radius;
-    b->materials[b->count++] = material;
+    PtrSpheres column = material_column(b);
+    ptr_sphere_set_material(&column, b->count++, material);
     return PTR_OK;
 }
 
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_colors,
                                   size_t *first, PtrError *err)
 {
+    PtrResult r = widen_materials(b, err);
+    if (r != PTR_OK)
+        return r;
     if (b->count + count > b->capacity) {
-        PtrResult r = resize(b, b->count + count, err);
+        r = resize(b, b->count + count, err);
         if (r != PTR_OK)
             return r;
     }
     if (with_colors && !*optional_array(b, OPTIONAL_color)) {
         /* The earlier spheres only: the caller writes the new ones' (at
          * 10^8 spheres, 800 MB), and each later one fills its own. */
-        PtrResult r = start_optional(b, OPTIONAL_color, b->count, err);
+        r = start_optional(b, OPTIONAL_color, b->count, err);
         if (r != PTR_OK)
             return r;
     }
@@ -177,7 +213,8 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3
     double *out = &b->spheres[4 * n];
     memcpy(out, centre, 3 * sizeof *centre);
     out[3] = radius;
-    b->materials[n] = material;
+    PtrSpheres column = material_column(b);
+    ptr_sphere_set_material(&column, n, material);
     if (rgb)
         quantize_color(rgb, &b->color[4 * n]);
 }
@@ -589,7 +626,8 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const doubl
     s->cy[at] = c.y;
     s->cz[at] = c.z;
     s->radius[at] = r;
-    ptr_sphere_set_material(s, at, b->materials[i]);
+    const PtrSpheres column = material_column(b);
+    ptr_sphere_set_material(s, at, ptr_sphere_material(&column, i));
     if (s->id)
         s->id[at] = (uint32_t)i;
 #define COPY_ATTRIBUTE(name, type, per_sphere, none)                                       \
@@ -642,7 +680,7 @@ static void move_spheres(void *arg, size_t begin, size_t end)
 static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_t end)
 {
     ptr_pages_put(bank, b->spheres, begin * 4 * sizeof *b->spheres, end * 4 * sizeof *b->spheres);
-    ptr_pages_put(bank, b->materials, begin * sizeof *b->materials, end * sizeof *b->materials);
+    ptr_pages_put(bank, b->materials, begin * b->material_size, end * b->material_size);
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k)) {
             const size_t entry = optional_arrays[k].words * sizeof **optional_array(b, k);

@@ -22,7 +22,11 @@
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
-    uint32_t *materials;
+    /* Each sphere's material, in entries as wide as the scene's
+     * (PtrSpheres.material: 1 byte while it has at most 256 materials), and
+     * widened with them: material_size bytes an entry. */
+    void *materials;
+    size_t material_size;
     /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
      * each NULL while no sphere has one. */
 #define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
@@ -50,6 +54,9 @@ void ptr_builder_free(PtrSceneBuilder *builder);
  * (PTR_ERR_NOMEM, said in err, which may be NULL). */
 PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count, PtrError *err);
 
+/* material: an index the scene has when the sphere is added, here or by
+ * ptr_builder_add_spheres, since the builder's entries are then as wide as
+ * the scene's. */
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3],
                                  double radius, uint32_t material, PtrError *err);
 
