@@ -1,5 +1,6 @@
 #include "builder.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdatomic.h>
@@ -134,7 +135,7 @@ static PtrSpheres material_column(const PtrSceneBuilder *b)
  * materials it gained since the last spheres were added may have widened:
  * at 10^8 spheres of at most 256 materials, 100 MB where 4-byte entries
  * took 400. */
-static PtrResult widen_materials(PtrSceneBuilder *b, PtrError *err)
+static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
 {
     const size_t size = b->scene->spheres.material_size;
     if (size <= b->material_size)
@@ -155,7 +156,8 @@ static PtrResult widen_materials(PtrSceneBuilder *b, PtrError *err)
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material, PtrError *err)
 {
-    PtrResult r = widen_materials(b, err);
+    assert(material < b->scene->material_count);
+    PtrResult r = widen_to_scene(b, err);
     if (r != PTR_OK)
         return r;
     if (b->count == b->capacity) {
@@ -179,7 +181,7 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *b, size_t count, int with_colors,
                                   size_t *first, PtrError *err)
 {
-    PtrResult r = widen_materials(b, err);
+    PtrResult r = widen_to_scene(b, err);
     if (r != PTR_OK)
         return r;
     if (b->count + count > b->capacity) {
@@ -213,6 +215,8 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3
     double *out = &b->spheres[4 * n];
     memcpy(out, centre, 3 * sizeof *centre);
     out[3] = radius;
+    /* A material added since the spheres were would not fit their entries. */
+    assert(material < b->scene->material_count);
     PtrSpheres column = material_column(b);
     ptr_sphere_set_material(&column, n, material);
     if (rgb)
@@ -377,8 +381,9 @@ typedef struct BoxPass {
 /* Two lanes at a time, in SSE2 registers: x and y, then z and the radius
  * (that lane unused). _mm_min_pd(v, box) and _mm_max_pd(v, box) are
  * least(box, v) and most(box, v) lane by lane, and the box starts from its
- * first sphere, so it has the scalar fold's bits, NaN included. The scalar
- * fold took 1.6 times as long: the pass compares and selects more than it
+ * first sphere, so it has the scalar fold's bits for every value but NaN
+ * (whose sign and payload the compiler may choose either way; add_sphere
+ * refuses such a sphere). The scalar fold took 1.6 times as long: the pass compares and selects more than it
  * reads (10^7 spheres, 320 MB: 60 ms on one thread in scalar code, 37 ms
  * so; reading the radii alone takes 27). */
 static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)

@@ -22,9 +22,10 @@
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
     double *spheres;  /* x, y, z, radius of each sphere */
-    /* Each sphere's material, in entries as wide as the scene's
-     * (PtrSpheres.material: 1 byte while it has at most 256 materials), and
-     * widened with them: material_size bytes an entry. */
+    /* Each sphere's material, material_size bytes an entry: as wide as the
+     * scene's entries (PtrSpheres.material: 1 byte while it has at most 256
+     * materials) were when spheres were last added, so as wide as every
+     * material they may have needs. */
     void *materials;
     size_t material_size;
     /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
@@ -68,8 +69,9 @@ PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int wi
                                   size_t *first, PtrError *err);
 
 /* Fills sphere n of those ptr_builder_add_spheres added, from any thread:
- * centre, radius, material and, where rgb is not NULL (only if they were
- * added with_colors), its colour. */
+ * centre, radius, material (one the scene had when they were added) and,
+ * where rgb is not NULL (only if they were added with_colors), its
+ * colour. */
 void ptr_builder_fill_sphere(PtrSceneBuilder *builder, size_t n, const double centre[3],
                              double radius, uint32_t material, const double *rgb);
 

@@ -19,10 +19,10 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err);
 
 /* Bytes a sphere takes at the peak of its import and the tree's build
- * (bench/scale.sh measures 54 to 56 a sphere above an empty render from
- * 10^6 to 10^8 spheres with their own colours: the scene's 32, the tree's
- * nodes, and the order and spare array its reordering needs), with room for
- * a --color-by value. */
+ * (bench/scale.sh measures 41 to 44 a sphere above a one-sphere render from
+ * 10^6 to 10^8 spheres with their own colours: the import's builder, 32 of
+ * centre and radius in double, 8 of colour and the material's index, just
+ * before it is moved into the scene), with room for a --color-by value. */
 #define PTR_SPHERE_PEAK_BYTES 64
 
 /* Before a file's spheres are allocated: refuses (PTR_ERR_NOMEM, one line

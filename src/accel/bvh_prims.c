@@ -17,8 +17,10 @@
 enum { HUGE_RATIO = 100 };
 
 /* Pieces the radii are counted and offered in: one a thread, at most this
- * many (each piece's counters take 1 MB: see COPIES). */
-enum { RADIUS_PIECES_MAX = 16 };
+ * many, and at most one for each RADIUS_PIECE spheres: each piece's
+ * counters take 1 MB (see COPIES), which a scene of a few spheres need not
+ * clear 16 times. */
+enum { RADIUS_PIECES_MAX = 16, RADIUS_PIECE = 1024 };
 
 /* The median radius is found exactly, on all threads, without a copy of
  * the radii: radii are positive finite floats (the importers' rule, and the
@@ -198,7 +200,9 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     *magnitude_out = 0.0f;
     if (s->count == 0)
         return PTR_OK;
-    const size_t pieces = threads < RADIUS_PIECES_MAX ? (size_t)threads : RADIUS_PIECES_MAX;
+    size_t pieces = threads < RADIUS_PIECES_MAX ? (size_t)threads : RADIUS_PIECES_MAX;
+    if (pieces > 1 + s->count / RADIUS_PIECE)
+        pieces = 1 + s->count / RADIUS_PIECE;
     PtrHugeChoice choice = { .limit = huge_radius(s, pieces, threads) };
     if (isnan(choice.limit))
         return bvh_out_of_memory(err);
