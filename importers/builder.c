@@ -383,9 +383,9 @@ typedef struct BoxPass {
  * least(box, v) and most(box, v) lane by lane, and the box starts from its
  * first sphere, so it has the scalar fold's bits for every value but NaN
  * (whose sign and payload the compiler may choose either way; add_sphere
- * refuses such a sphere). The scalar fold took 1.6 times as long: the pass compares and selects more than it
- * reads (10^7 spheres, 320 MB: 60 ms on one thread in scalar code, 37 ms
- * so; reading the radii alone takes 27). */
+ * refuses such a sphere). The scalar fold took 1.6 times as long: the pass
+ * compares and selects more than it reads (10^7 spheres, 320 MB: 60 ms on
+ * one thread in scalar code, 37 ms so; reading the radii alone takes 27). */
 static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     BoxPass *p = arg;
