@@ -147,8 +147,7 @@ static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
     b->materials = wide;
     b->material_size = size;
     PtrSpheres to = material_column(b);
-    for (size_t i = 0; i < b->count; i++)
-        ptr_sphere_set_material(&to, i, ptr_sphere_material(&narrow, i));
+    ptr_spheres_copy_materials(&to, &narrow, b->count);
     free(narrow.material);
     return PTR_OK;
 }
@@ -654,21 +653,12 @@ typedef struct SphereMove {
     atomic_int invalid; /* a sphere the scene cannot hold */
 } SphereMove;
 
-/* How many of the huge spheres (ascending) come before sphere i. */
-static size_t huge_before(const size_t *huge, size_t huge_count, size_t i)
-{
-    size_t k = 0;
-    while (k < huge_count && huge[k] < i)
-        k++;
-    return k;
-}
-
 /* Puts spheres begin .. end - 1 but the huge ones at their entries, each
  * moved forward by the huge spheres before it. */
 static void move_spheres(void *arg, size_t begin, size_t end)
 {
     SphereMove *m = arg;
-    size_t before = huge_before(m->huge, m->huge_count, begin);
+    size_t before = ptr_huge_before(m->huge, m->huge_count, begin);
     int invalid = 0;
     for (size_t i = begin; i < end; i++) {
         if (before < m->huge_count && m->huge[before] == i)
@@ -739,8 +729,8 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
         const size_t end = count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : count;
         /* Each step's spheres on the pages of those the step before moved. */
         if (!ptr_spheres_take_pages(&scene->spheres, &bank,
-                                    begin - huge_before(huge, huge_count, begin),
-                                    end - huge_before(huge, huge_count, end))) {
+                                    begin - ptr_huge_before(huge, huge_count, begin),
+                                    end - ptr_huge_before(huge, huge_count, end))) {
             res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory moving the spheres");
             break;
         }

@@ -485,7 +485,7 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
     SphereWrite w = { s, prims, first };
     PtrPageBank bank = { 0 };
     PtrResult r = PTR_OK;
-    for (size_t begin = 0; begin < prim_count && r == PTR_OK; begin += PTR_PAGE_STEP) {
+    for (size_t begin = 0; begin < prim_count; begin += PTR_PAGE_STEP) {
         const size_t end = prim_count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP
                                                               : prim_count;
         if (!ptr_spheres_take_pages(s, &bank, first + begin, first + end)) {

@@ -148,23 +148,14 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
 #undef COPY_OUT
 }
 
-/* How many of the huge spheres (indices ascending, then SIZE_MAX) come
- * before sphere i. */
-static size_t huge_before(const size_t *huge_index, size_t i)
-{
-    size_t k = 0;
-    while (huge_index[k] < i)
-        k++;
-    return k;
-}
-
 /* The copy of spheres into prims, in pieces on all threads: a piece's first
  * prim is its first sphere's index less the huge spheres before it, so the
  * pieces need nothing of each other. */
 typedef struct PrimCopy {
     const PtrSpheres *spheres;
     BvhPrim *prims;
-    const size_t *huge_index; /* ascending, then SIZE_MAX */
+    const size_t *huge_index; /* ascending */
+    size_t huge_count;
     /* The largest magnitude so far, as the bits of a float that is never
      * negative: such floats order as their bits do. */
     atomic_uint_least32_t magnitude;
@@ -173,11 +164,11 @@ typedef struct PrimCopy {
 static void copy_prims(void *arg, size_t begin, size_t end)
 {
     PrimCopy *c = arg;
-    size_t k = huge_before(c->huge_index, begin);
+    size_t k = ptr_huge_before(c->huge_index, c->huge_count, begin);
     BvhPrim *out = c->prims + (begin - k);
     float magnitude = 0.0f;
     for (size_t i = begin; i < end; i++) {
-        if (c->huge_index[k] == i) {
+        if (k < c->huge_count && c->huge_index[k] == i) {
             k++;
             continue;
         }
@@ -214,7 +205,7 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     ptr_huge_merge(&choice, piece_choice, pieces);
     ptr_huge_file_order(&choice);
     /* By index, to skip them below. */
-    size_t out[PTR_HUGE_MAX + 1];
+    size_t out[PTR_HUGE_MAX];
     for (size_t k = 0; k < choice.count; k++) {
         huge[k] = bvh_prim_of(s, choice.sphere[k].index);
         size_t at = k;
@@ -222,8 +213,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
             out[at] = out[at - 1];
         out[at] = choice.sphere[k].index;
     }
-    out[choice.count] = SIZE_MAX;
-    PrimCopy copy = { .spheres = s, .prims = prims, .huge_index = out };
+    PrimCopy copy = { .spheres = s, .prims = prims, .huge_index = out,
+                      .huge_count = choice.count };
     atomic_init(&copy.magnitude, 0);
     /* Each step's prims on the pages of the spheres the step before
      * copied. */
@@ -231,7 +222,7 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     size_t first_prim = 0;
     for (size_t begin = 0; begin < s->count; begin += PTR_PAGE_STEP) {
         const size_t end = s->count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : s->count;
-        const size_t end_prim = end - huge_before(out, end);
+        const size_t end_prim = end - ptr_huge_before(out, choice.count, end);
         if (!ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims)) {
             ptr_pages_free(&bank);
             return bvh_out_of_memory(err);

@@ -285,6 +285,12 @@ PtrResult ptr_scene_set_sphere_value(PtrScene *scene, size_t i, float value, Ptr
     return res;
 }
 
+void ptr_spheres_copy_materials(PtrSpheres *to, const PtrSpheres *from, size_t count)
+{
+    for (size_t i = 0; i < count; i++)
+        ptr_sphere_set_material(to, i, ptr_sphere_material(from, i));
+}
+
 /* Gives the spheres' material array entries of size bytes, the indices
  * kept. */
 static PtrResult widen_materials(PtrSpheres *s, size_t size, PtrError *err)
@@ -295,8 +301,7 @@ static PtrResult widen_materials(PtrSpheres *s, size_t size, PtrError *err)
         if (!wide)
             return no_room(s->capacity, err);
         PtrSpheres to = { .material = wide, .material_size = size };
-        for (size_t i = 0; i < s->capacity; i++)
-            ptr_sphere_set_material(&to, i, ptr_sphere_material(s, i));
+        ptr_spheres_copy_materials(&to, s, s->capacity);
         free(s->material);
     }
     s->material = wide;

@@ -146,6 +146,17 @@ typedef struct PtrHugeChoice {
     PtrHugeCandidate sphere[PTR_HUGE_MAX];
 } PtrHugeChoice;
 
+/* How many of indices[0 .. count - 1] (ascending: a choice's, in the
+ * file's order) lie below i: the huge spheres before sphere i, which a stage
+ * that moves the others forward past them skips. */
+static inline size_t ptr_huge_before(const size_t *indices, size_t count, size_t i)
+{
+    size_t k = 0;
+    while (k < count && indices[k] < i)
+        k++;
+    return k;
+}
+
 /* Adds a sphere above the limit to the choice if among the largest. */
 void ptr_huge_insert(PtrHugeChoice *choice, size_t index, size_t file_position, double radius);
 
@@ -245,6 +256,10 @@ static inline uint32_t ptr_sphere_material(const PtrSpheres *s, size_t i)
     default: return ((const uint32_t *)s->material)[i];
     }
 }
+
+/* Copies the material indices of spheres 0 .. count - 1 from one array to
+ * another, each of its own width (material_size): for an array widening. */
+void ptr_spheres_copy_materials(PtrSpheres *to, const PtrSpheres *from, size_t count);
 
 /* Gives sphere i material m, an index the scene has (so one that fits). */
 static inline void ptr_sphere_set_material(PtrSpheres *s, size_t i, uint32_t m)
