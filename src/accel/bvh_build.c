@@ -27,14 +27,15 @@
  * the top level was shared, each of some 300 at 10^6 handing work to the
  * others and back, the top level gained 1.2x from a second thread.) Every
  * subtree of at most task_spheres spheres is a task built by one thread
- * into its own node array. The arrays are laid out in the order a
+ * into its own node array. The threads take the parts, then the tasks,
+ * from one pool (see Pool). The arrays are laid out in the order a
  * depth-first build on one thread would have made them, so the tree's
  * bytes never depend on the number of threads. */
 #include "accel/bvh.h"
 
 #include <malloc.h>
 #include <math.h>
-#include <stdatomic.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -90,6 +91,22 @@ typedef struct Part {
  * (both: its children of at most task_spheres); a node of a task splits on. */
 typedef enum NodeKind { NODE_ROOT, NODE_PART, NODE_TASK } NodeKind;
 
+/* The parts and tasks the threads share once the root is built: the parts
+ * first, largest first, then the tasks, the largest ready one first. A
+ * part's tasks are ready once the part is built, so that no thread waits
+ * for the last parts with nothing to do (with one phase for the parts and
+ * one for the tasks, a thread of two sat idle for a tenth of the parts'
+ * time at 10^7 spheres), and the largest tasks do not come last. */
+typedef struct Pool {
+    pthread_mutex_t lock;
+    pthread_cond_t wake;  /* a part is built: its tasks are ready */
+    size_t next_part;     /* in part_order */
+    size_t parts_running; /* taken and not yet built */
+    Task **ready;         /* a heap, the largest task first */
+    size_t ready_count, ready_capacity;
+    int failed;           /* out of memory for the heap: take no more */
+} Pool;
+
 typedef struct Build {
     BvhPrimSet set;
     /* The build's threads: all of them split the root's ranges; a part or
@@ -101,9 +118,9 @@ typedef struct Build {
     TaskList root_tasks; /* the root's small children */
     Part parts[PTR_BVH_WIDTH]; /* its large ones */
     size_t part_count;
-    const size_t *part_order; /* largest first, for an even load */
+    size_t part_order[PTR_BVH_WIDTH]; /* largest first, for an even load */
     TaskList tasks;           /* all, in the order of a depth-first build */
-    atomic_size_t next;       /* the next part or task to take */
+    Pool pool;
 } Build;
 
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
@@ -228,100 +245,165 @@ static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, Bvh
     return PTR_OK;
 }
 
-static void *part_worker(void *arg)
-{
-    Build *build = arg;
-    for (;;) {
-        size_t i = atomic_fetch_add(&build->next, 1);
-        if (i >= build->part_count)
-            break;
-        Part *p = &build->parts[build->part_order[i]];
-        size_t root;
-        /* No scratch: the in-place partition makes the moves the root's
-         * shared splits make, where the stable one would order the prims,
-         * and so the tree, otherwise. */
-        p->failed = build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART,
-                               p->level, &root, &p->nodes.depth, NULL) != PTR_OK;
-    }
-    return NULL;
-}
-
-static void *task_worker(void *arg)
-{
-    Build *build = arg;
-    /* One scratch for all of a thread's tasks (none is larger than
-     * task_spheres): fresh memory for each would be cleared page by page. */
-    BvhPrim *scratch = NULL;
-    for (;;) {
-        size_t i = atomic_fetch_add(&build->next, 1);
-        if (i >= build->tasks.count)
-            break;
-        Task *t = &build->tasks.tasks[i];
-        BvhCandidate range;
-        size_t root;
-        if (!scratch)
-            scratch = malloc(build->task_spheres * sizeof *scratch);
-        t->failed = !scratch ||
-                    bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL,
-                                       NULL) != PTR_OK ||
-                    build_node(build, &t->nodes, NULL, scratch, &range, NODE_TASK, t->level,
-                               &root, &t->nodes.depth, NULL) != PTR_OK;
-    }
-    free(scratch);
-    return NULL;
-}
-
-/* Runs worker on the calling thread and the others until it has taken
- * every part or task. */
-static PtrResult run_workers(Build *build, void *(*worker)(void *), PtrError *err)
-{
-    int threads = build->threads;
-    PtrThread **ids = malloc((size_t)threads * sizeof *ids);
-    if (!ids)
-        return bvh_out_of_memory(err);
-    atomic_init(&build->next, 0);
-    int started = 0;
-    while (started < threads - 1 && (ids[started] = ptr_thread_start(worker, build)))
-        started++;
-    worker(build);
-    for (int i = 0; i < started; i++)
-        ptr_thread_join(ids[i]);
-    free(ids);
-    return PTR_OK;
-}
-
 static size_t part_size(const Part *p)
 {
     return p->range.end - p->range.begin;
 }
 
-/* Builds the parts, the largest first, so that no thread is left with a
- * large one at the end. */
-static PtrResult run_parts(Build *build, PtrError *err)
+static size_t task_size(const Task *t)
 {
-    size_t order[PTR_BVH_WIDTH];
-    for (size_t i = 0; i < build->part_count; i++) {
-        size_t j = i;
-        for (; j > 0 && part_size(&build->parts[order[j - 1]]) < part_size(&build->parts[i]); j--)
-            order[j] = order[j - 1];
-        order[j] = i;
-    }
-    build->part_order = order;
-    PtrResult r = run_workers(build, part_worker, err);
-    build->part_order = NULL;
-    for (size_t i = 0; r == PTR_OK && i < build->part_count; i++)
-        if (build->parts[i].failed)
-            r = bvh_out_of_memory(err);
-    return r;
+    return t->end - t->begin;
 }
 
-static PtrResult run_tasks(Build *build, PtrError *err)
+/* Makes tasks ready to take, kept as a heap with the largest first; under
+ * the pool's lock. Fails only for memory. */
+static int pool_add_ready(Pool *pool, TaskList *tasks)
 {
-    PtrResult r = run_workers(build, task_worker, err);
-    for (size_t i = 0; r == PTR_OK && i < build->tasks.count; i++)
-        if (build->tasks.tasks[i].failed)
-            r = bvh_out_of_memory(err);
-    return r;
+    if (pool->ready_count + tasks->count > pool->ready_capacity) {
+        size_t capacity = 2 * (pool->ready_count + tasks->count);
+        Task **grown = realloc(pool->ready, capacity * sizeof *grown);
+        if (!grown)
+            return 0;
+        pool->ready = grown;
+        pool->ready_capacity = capacity;
+    }
+    for (size_t i = 0; i < tasks->count; i++) {
+        size_t at = pool->ready_count++;
+        for (; at > 0 && task_size(pool->ready[(at - 1) / 2]) < task_size(&tasks->tasks[i]);
+             at = (at - 1) / 2)
+            pool->ready[at] = pool->ready[(at - 1) / 2];
+        pool->ready[at] = &tasks->tasks[i];
+    }
+    return 1;
+}
+
+/* The largest ready task, taken from the pool (NULL if none is ready);
+ * under the pool's lock. */
+static Task *pool_take_task(Pool *pool)
+{
+    if (pool->ready_count == 0)
+        return NULL;
+    Task *largest = pool->ready[0], *last = pool->ready[--pool->ready_count];
+    size_t at = 0;
+    for (;;) {
+        size_t child = 2 * at + 1;
+        if (child >= pool->ready_count)
+            break;
+        if (child + 1 < pool->ready_count &&
+            task_size(pool->ready[child + 1]) > task_size(pool->ready[child]))
+            child++;
+        if (task_size(pool->ready[child]) <= task_size(last))
+            break;
+        pool->ready[at] = pool->ready[child];
+        at = child;
+    }
+    pool->ready[at] = last;
+    return largest;
+}
+
+static void build_part(Build *build, Part *p)
+{
+    size_t root;
+    /* No scratch: the in-place partition makes the moves the root's shared
+     * splits make, where the stable one would order the prims, and so the
+     * tree, otherwise. */
+    p->failed = build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART, p->level,
+                           &root, &p->nodes.depth, NULL) != PTR_OK;
+}
+
+static void build_task(Build *build, Task *t, BvhPrim **scratch)
+{
+    /* One scratch for all of a thread's tasks (none is larger than
+     * task_spheres): fresh memory for each would be cleared page by page. */
+    if (!*scratch)
+        *scratch = malloc(build->task_spheres * sizeof **scratch);
+    BvhCandidate range;
+    size_t root;
+    t->failed = !*scratch ||
+                bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL,
+                                   NULL) != PTR_OK ||
+                build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level,
+                           &root, &t->nodes.depth, NULL) != PTR_OK;
+}
+
+/* Takes parts, then tasks, until none is left or will be. */
+static void *pool_worker(void *arg)
+{
+    Build *build = arg;
+    Pool *pool = &build->pool;
+    BvhPrim *scratch = NULL;
+    pthread_mutex_lock(&pool->lock);
+    for (;;) {
+        if (!pool->failed && pool->next_part < build->part_count) {
+            Part *p = &build->parts[build->part_order[pool->next_part++]];
+            pool->parts_running++;
+            pthread_mutex_unlock(&pool->lock);
+            build_part(build, p);
+            pthread_mutex_lock(&pool->lock);
+            pool->parts_running--;
+            if (!p->failed && !pool_add_ready(pool, &p->tasks))
+                pool->failed = 1;
+            pthread_cond_broadcast(&pool->wake);
+            continue;
+        }
+        Task *t = pool->failed ? NULL : pool_take_task(pool);
+        if (t) {
+            pthread_mutex_unlock(&pool->lock);
+            build_task(build, t, &scratch);
+            pthread_mutex_lock(&pool->lock);
+            continue;
+        }
+        if (pool->parts_running == 0)
+            break;
+        pthread_cond_wait(&pool->wake, &pool->lock);
+    }
+    pthread_mutex_unlock(&pool->lock);
+    free(scratch);
+    return NULL;
+}
+
+/* Builds the parts and then the tasks on all threads (see Pool). */
+static PtrResult run_pool(Build *build, PtrError *err)
+{
+    Pool *pool = &build->pool;
+    for (size_t i = 0; i < build->part_count; i++) {
+        size_t j = i;
+        for (; j > 0 && part_size(&build->parts[build->part_order[j - 1]]) <
+                            part_size(&build->parts[i]);
+             j--)
+            build->part_order[j] = build->part_order[j - 1];
+        build->part_order[j] = i;
+    }
+    PtrThread **ids = malloc((size_t)build->threads * sizeof *ids);
+    if (!ids || !pool_add_ready(pool, &build->root_tasks)) {
+        free(ids);
+        return bvh_out_of_memory(err);
+    }
+    int started = 0;
+    while (started < build->threads - 1 && (ids[started] = ptr_thread_start(pool_worker, build)))
+        started++;
+    pool_worker(build);
+    for (int i = 0; i < started; i++)
+        ptr_thread_join(ids[i]);
+    free(ids);
+    int failed = pool->failed;
+    for (size_t i = 0; i < build->root_tasks.count; i++)
+        failed |= build->root_tasks.tasks[i].failed;
+    for (size_t i = 0; i < build->part_count; i++) {
+        failed |= build->parts[i].failed;
+        for (size_t j = 0; j < build->parts[i].tasks.count; j++)
+            failed |= build->parts[i].tasks.tasks[j].failed;
+    }
+    return failed ? bvh_out_of_memory(err) : PTR_OK;
+}
+
+/* Frees the tasks' node arrays and the list. */
+static void free_tasks(TaskList *list)
+{
+    for (size_t i = 0; i < list->count; i++)
+        free(list->tasks[i].nodes.nodes);
+    free(list->tasks);
+    *list = (TaskList){ 0 };
 }
 
 /* True for a lane of an inner node that holds a child node (or a part or a
@@ -385,8 +467,10 @@ static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
         if (p->nodes.depth + 1 > top->depth)
             top->depth = p->nodes.depth + 1;
         free(p->tasks.tasks);
-        p->tasks.tasks = NULL;
+        p->tasks = (TaskList){ 0 };
     }
+    free(build->root_tasks.tasks);
+    build->root_tasks = (TaskList){ 0 };
     free(top->nodes);
     top->nodes = nodes;
     top->count = top->capacity = node_total;
@@ -507,7 +591,9 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
-    Build build = { .threads = ptr_thread_count(threads) };
+    Build build = { .threads = ptr_thread_count(threads),
+                    .pool = { .lock = PTHREAD_MUTEX_INITIALIZER,
+                              .wake = PTHREAD_COND_INITIALIZER } };
     /* The prims and huge take the tree's spheres, whose pages the scene's
      * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
@@ -532,12 +618,10 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         if (r == PTR_OK)
             r = build_node(&build, &top, &build.root_tasks, NULL, &root, NODE_ROOT, 0, &index,
                            &top.depth, err);
-        if (r == PTR_OK && build.part_count)
-            r = run_parts(&build, err);
+        if (r == PTR_OK)
+            r = run_pool(&build, err);
         if (r == PTR_OK)
             r = join_parts(&build, &top, err);
-        if (r == PTR_OK)
-            r = run_tasks(&build, err);
     }
     if (r == PTR_OK) {
         r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, build.threads,
@@ -557,14 +641,15 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
      * once the prims are gone. */
     if (r == PTR_OK && prim_count > 0)
         r = lay_out(&build, &top, bvh, err);
-    for (size_t i = 0; i < build.tasks.count; i++)
-        free(build.tasks.tasks[i].nodes.nodes);
-    free(build.tasks.tasks);
+    free_tasks(&build.tasks);
     for (size_t i = 0; i < build.part_count; i++) {
         free(build.parts[i].nodes.nodes);
-        free(build.parts[i].tasks.tasks);
+        free_tasks(&build.parts[i].tasks);
     }
-    free(build.root_tasks.tasks);
+    free_tasks(&build.root_tasks);
+    free(build.pool.ready);
+    pthread_mutex_destroy(&build.pool.lock);
+    pthread_cond_destroy(&build.pool.wake);
     free(top.nodes);
     if (r != PTR_OK)
         ptr_bvh_free(bvh);
