@@ -68,7 +68,6 @@ typedef struct Task {
     size_t begin, end;
     int level; /* of its root node */
     NodeArray nodes;
-    int failed;
 } Task;
 
 typedef struct TaskList {
@@ -83,7 +82,6 @@ typedef struct Part {
     int level; /* of its root node */
     NodeArray nodes;
     TaskList tasks;
-    int failed;
 } Part;
 
 /* How build_node treats a node: the root, on all threads, makes parts of
@@ -93,18 +91,21 @@ typedef enum NodeKind { NODE_ROOT, NODE_PART, NODE_TASK } NodeKind;
 
 /* The parts and tasks the threads share once the root is built: the parts
  * first, largest first, then the tasks, the largest ready one first. A
- * part's tasks are ready once the part is built, so that no thread waits
- * for the last parts with nothing to do (with one phase for the parts and
- * one for the tasks, a thread of two sat idle for a tenth of the parts'
+ * part's tasks are ready once the part is built, so that a thread waits for
+ * the last parts only when no task is ready (with one phase for the parts
+ * and one for the tasks, a thread of two sat idle for a tenth of the parts'
  * time at 10^7 spheres), and the largest tasks do not come last. */
 typedef struct Pool {
+    struct Build *build;
     pthread_mutex_t lock;
-    pthread_cond_t wake;  /* a part is built: its tasks are ready */
+    /* A part is built or has failed: its tasks are ready, one part fewer
+     * is running. */
+    pthread_cond_t wake;
     size_t next_part;     /* in part_order */
     size_t parts_running; /* taken and not yet built */
     Task **ready;         /* a heap, the largest task first */
     size_t ready_count, ready_capacity;
-    int failed;           /* out of memory for the heap: take no more */
+    int failed;           /* out of memory: take no more */
 } Pool;
 
 typedef struct Build {
@@ -120,7 +121,6 @@ typedef struct Build {
     size_t part_count;
     size_t part_order[PTR_BVH_WIDTH]; /* largest first, for an even load */
     TaskList tasks;           /* all, in the order of a depth-first build */
-    Pool pool;
 } Build;
 
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
@@ -301,17 +301,19 @@ static Task *pool_take_task(Pool *pool)
     return largest;
 }
 
-static void build_part(Build *build, Part *p)
+/* Whether part p was built (else it ran out of memory). */
+static int build_part(Build *build, Part *p)
 {
     size_t root;
     /* No scratch: the in-place partition makes the moves the root's shared
      * splits make, where the stable one would order the prims, and so the
      * tree, otherwise. */
-    p->failed = build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART, p->level,
-                           &root, &p->nodes.depth, NULL) != PTR_OK;
+    return build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART, p->level, &root,
+                      &p->nodes.depth, NULL) == PTR_OK;
 }
 
-static void build_task(Build *build, Task *t, BvhPrim **scratch)
+/* Whether task t was built (else it ran out of memory). */
+static int build_task(Build *build, Task *t, BvhPrim **scratch)
 {
     /* One scratch for all of a thread's tasks (none is larger than
      * task_spheres): fresh memory for each would be cleared page by page. */
@@ -319,18 +321,19 @@ static void build_task(Build *build, Task *t, BvhPrim **scratch)
         *scratch = malloc(build->task_spheres * sizeof **scratch);
     BvhCandidate range;
     size_t root;
-    t->failed = !*scratch ||
-                bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL,
-                                   NULL) != PTR_OK ||
-                build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level,
-                           &root, &t->nodes.depth, NULL) != PTR_OK;
+    return *scratch &&
+           bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL, NULL) ==
+               PTR_OK &&
+           build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level, &root,
+                      &t->nodes.depth, NULL) == PTR_OK;
 }
 
-/* Takes parts, then tasks, until none is left or will be. */
+/* Takes parts, then tasks, until none is left or will be, or the pool
+ * has failed. */
 static void *pool_worker(void *arg)
 {
-    Build *build = arg;
-    Pool *pool = &build->pool;
+    Pool *pool = arg;
+    Build *build = pool->build;
     BvhPrim *scratch = NULL;
     pthread_mutex_lock(&pool->lock);
     for (;;) {
@@ -338,10 +341,10 @@ static void *pool_worker(void *arg)
             Part *p = &build->parts[build->part_order[pool->next_part++]];
             pool->parts_running++;
             pthread_mutex_unlock(&pool->lock);
-            build_part(build, p);
+            const int built = build_part(build, p);
             pthread_mutex_lock(&pool->lock);
             pool->parts_running--;
-            if (!p->failed && !pool_add_ready(pool, &p->tasks))
+            if (!built || !pool_add_ready(pool, &p->tasks))
                 pool->failed = 1;
             pthread_cond_broadcast(&pool->wake);
             continue;
@@ -349,8 +352,9 @@ static void *pool_worker(void *arg)
         Task *t = pool->failed ? NULL : pool_take_task(pool);
         if (t) {
             pthread_mutex_unlock(&pool->lock);
-            build_task(build, t, &scratch);
+            const int built = build_task(build, t, &scratch);
             pthread_mutex_lock(&pool->lock);
+            pool->failed |= !built;
             continue;
         }
         if (pool->parts_running == 0)
@@ -362,10 +366,10 @@ static void *pool_worker(void *arg)
     return NULL;
 }
 
-/* Builds the parts and then the tasks on all threads (see Pool). */
+/* Builds the parts and every task, the root's and the parts', on all
+ * threads from one pool (see Pool). */
 static PtrResult run_pool(Build *build, PtrError *err)
 {
-    Pool *pool = &build->pool;
     for (size_t i = 0; i < build->part_count; i++) {
         size_t j = i;
         for (; j > 0 && part_size(&build->parts[build->part_order[j - 1]]) <
@@ -374,27 +378,26 @@ static PtrResult run_pool(Build *build, PtrError *err)
             build->part_order[j] = build->part_order[j - 1];
         build->part_order[j] = i;
     }
+    Pool pool = { .build = build };
     PtrThread **ids = malloc((size_t)build->threads * sizeof *ids);
-    if (!ids || !pool_add_ready(pool, &build->root_tasks)) {
+    if (!ids || !pool_add_ready(&pool, &build->root_tasks)) {
         free(ids);
+        free(pool.ready);
         return bvh_out_of_memory(err);
     }
+    pthread_mutex_init(&pool.lock, NULL);
+    pthread_cond_init(&pool.wake, NULL);
     int started = 0;
-    while (started < build->threads - 1 && (ids[started] = ptr_thread_start(pool_worker, build)))
+    while (started < build->threads - 1 && (ids[started] = ptr_thread_start(pool_worker, &pool)))
         started++;
-    pool_worker(build);
+    pool_worker(&pool);
     for (int i = 0; i < started; i++)
         ptr_thread_join(ids[i]);
     free(ids);
-    int failed = pool->failed;
-    for (size_t i = 0; i < build->root_tasks.count; i++)
-        failed |= build->root_tasks.tasks[i].failed;
-    for (size_t i = 0; i < build->part_count; i++) {
-        failed |= build->parts[i].failed;
-        for (size_t j = 0; j < build->parts[i].tasks.count; j++)
-            failed |= build->parts[i].tasks.tasks[j].failed;
-    }
-    return failed ? bvh_out_of_memory(err) : PTR_OK;
+    free(pool.ready);
+    pthread_mutex_destroy(&pool.lock);
+    pthread_cond_destroy(&pool.wake);
+    return pool.failed ? bvh_out_of_memory(err) : PTR_OK;
 }
 
 /* Frees the tasks' node arrays and the list. */
@@ -432,7 +435,8 @@ static void place_nodes(PtrBvhNode *joined, size_t start, NodeArray *from, size_
  * the root's and the parts' tasks, in the order a depth-first build on one
  * thread makes them: the root, then each part's nodes in the order of the
  * root's lanes; each task where the root or its part refers to it. Frees
- * the parts' arrays. */
+ * the parts' node arrays, and their task lists and the root's, whose tasks
+ * (built, their nodes with them) move to build->tasks. */
 static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
 {
     size_t node_total = top->count, task_total = build->root_tasks.count;
@@ -591,9 +595,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
-    Build build = { .threads = ptr_thread_count(threads),
-                    .pool = { .lock = PTHREAD_MUTEX_INITIALIZER,
-                              .wake = PTHREAD_COND_INITIALIZER } };
+    Build build = { .threads = ptr_thread_count(threads) };
     /* The prims and huge take the tree's spheres, whose pages the scene's
      * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
@@ -647,9 +649,6 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         free_tasks(&build.parts[i].tasks);
     }
     free_tasks(&build.root_tasks);
-    free(build.pool.ready);
-    pthread_mutex_destroy(&build.pool.lock);
-    pthread_cond_destroy(&build.pool.wake);
     free(top.nodes);
     if (r != PTR_OK)
         ptr_bvh_free(bvh);

@@ -99,7 +99,10 @@ static PtrThread *spawn_locked(void)
     if (!t)
         return NULL;
     memset(t, 0, sizeof *t);
-    pthread_cond_init(&t->changed, NULL);
+    if (pthread_cond_init(&t->changed, NULL)) {
+        free(t);
+        return NULL;
+    }
     if (pthread_create(&id, NULL, run, t)) {
         pthread_cond_destroy(&t->changed);
         free(t);
