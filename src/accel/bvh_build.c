@@ -256,7 +256,7 @@ static size_t task_size(const Task *t)
 }
 
 /* Makes tasks ready to take, kept as a heap with the largest first; under
- * the pool's lock. Fails only for memory. */
+ * the pool's lock, or before its threads start. Fails only for memory. */
 static int pool_add_ready(Pool *pool, TaskList *tasks)
 {
     if (pool->ready_count + tasks->count > pool->ready_capacity) {

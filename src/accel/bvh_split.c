@@ -145,12 +145,11 @@ static void bins_merge(Bins *into, const Bins *b, int bins)
 
 /* Runs of this many prims (or samples, of a sampled run: so every sampled
  * run) are bounded, binned and partitioned by all threads together; smaller
- * ones by the calling thread (a run of 16,384 prims takes
- * some hundred microseconds; handing a piece to a kept thread and back,
- * about 5 while that thread still watches for work, 50 to 150 where it has
- * gone to sleep on an idle virtual machine: docs/intersectors.md, "From
- * one thread to two" and "One pool for the parts and the tasks"). Runs of
- * more than
+ * ones by the calling thread (a run of 16,384 prims takes some hundred
+ * microseconds; handing a piece to a kept thread and back, about 5 while
+ * that thread still watches for work, 50 to 150 where it has gone to sleep
+ * on an idle virtual machine: docs/intersectors.md, "From one thread to
+ * two" and "One pool for the parts and the tasks"). Runs of more than
  * SAMPLED_ABOVE prims choose their split from about SAMPLES of them, evenly
  * spaced: at the top of a tree of 10^7 spheres, binning every prim took a
  * third of the build and chose much the same splits. */
