@@ -101,6 +101,7 @@ typedef struct Pool {
     /* A part is built or has failed: its tasks are ready, one part fewer
      * is running. */
     pthread_cond_t wake;
+    size_t part_order[PTR_BVH_WIDTH]; /* the parts, largest first, for an even load */
     size_t next_part;     /* in part_order */
     size_t parts_running; /* taken and not yet built */
     Task **ready;         /* a heap, the largest task first */
@@ -119,7 +120,6 @@ typedef struct Build {
     TaskList root_tasks; /* the root's small children */
     Part parts[PTR_BVH_WIDTH]; /* its large ones */
     size_t part_count;
-    size_t part_order[PTR_BVH_WIDTH]; /* largest first, for an even load */
     TaskList tasks;           /* all, in the order of a depth-first build */
 } Build;
 
@@ -338,7 +338,7 @@ static void *pool_worker(void *arg)
     pthread_mutex_lock(&pool->lock);
     for (;;) {
         if (!pool->failed && pool->next_part < build->part_count) {
-            Part *p = &build->parts[build->part_order[pool->next_part++]];
+            Part *p = &build->parts[pool->part_order[pool->next_part++]];
             pool->parts_running++;
             pthread_mutex_unlock(&pool->lock);
             const int built = build_part(build, p);
@@ -370,15 +370,15 @@ static void *pool_worker(void *arg)
  * threads from one pool (see Pool). */
 static PtrResult run_pool(Build *build, PtrError *err)
 {
+    Pool pool = { .build = build };
     for (size_t i = 0; i < build->part_count; i++) {
         size_t j = i;
-        for (; j > 0 && part_size(&build->parts[build->part_order[j - 1]]) <
+        for (; j > 0 && part_size(&build->parts[pool.part_order[j - 1]]) <
                             part_size(&build->parts[i]);
              j--)
-            build->part_order[j] = build->part_order[j - 1];
-        build->part_order[j] = i;
+            pool.part_order[j] = pool.part_order[j - 1];
+        pool.part_order[j] = i;
     }
-    Pool pool = { .build = build };
     PtrThread **ids = malloc((size_t)build->threads * sizeof *ids);
     if (!ids || !pool_add_ready(&pool, &build->root_tasks)) {
         free(ids);
