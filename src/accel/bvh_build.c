@@ -18,9 +18,15 @@
  * leaves of 16 and this rule, 5.4, at the same rays per second
  * (docs/intersectors.md, "Full nodes at the bottom").
  *
- * Threads: the root is built on the calling thread, with the binning and
- * partitions of its ranges spread over all threads. Each of its children
- * of more than task_spheres spheres (1/64 of all, at least
+ * The root is grown so too, but from samples of the spheres before the
+ * prims exist (plan_root): the copy that makes the prims then sorts them
+ * into the root's children (ptr_bvh_prims), on all threads, in the pass
+ * it makes anyway. Split in place, the root's ranges took a pass over every
+ * prim for their box and one for each level of its splits, about three,
+ * which streamed memory at 1.8x on two threads (docs/intersectors.md, "The
+ * root chosen before the copy").
+ *
+ * Threads: each of the root's children of more than task_spheres spheres (1/64 of all, at least
  * TASK_SPHERES_MIN: a rule of the sphere count alone) is a part: the rest
  * of the top level below it, built by one thread into its own node and task
  * arrays, while the other threads build other parts. (When every split of
@@ -55,6 +61,7 @@ enum {
     /* See the head: 6 leaves' worth (7 or 5 gave 0.2 and 0.05 bytes a sphere
      * more on a uniform 10^6 cloud). */
     BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
+    ROOT_SAMPLES = 1 << 15, /* see plan_root */
 };
 
 /* Node arrays: the root's, one per part and one per task. */
@@ -156,41 +163,59 @@ static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, u
     return PTR_OK;
 }
 
-/* Builds the node of this kind at this level over range into nodes (its
- * index in *index), and its inner children below it that are neither parts
- * nor tasks; depth: levels below the node, not counting parts and tasks. tasks:
- * where a node of the top level puts its tasks. scratch: see bvh_split
- * (tasks have it, the top level not). */
-static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
-                            const BvhCandidate *range, NodeKind kind, int level,
-                            size_t *index, int *depth, PtrError *err)
+/* Splits range, at this level, into a node's children, child[0 .. *count -
+ * 1], Embree's way (see the head). Each prim of range stands for per_prim
+ * of the tree's (1 but for the root's samples, see plan_root), in the
+ * counts that decide which children are split. With plan, each split is
+ * recorded in it, and a child is split only by its best split, against
+ * which a prim can be tested (bvh_split_test), never in the middle.
+ * scratch: see bvh_split. */
+static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidate *range,
+                      int level, double per_prim, BvhCandidate child[PTR_BVH_WIDTH],
+                      int *count, BvhRootChildren *plan)
 {
-    PtrResult r;
-    BvhCandidate child[PTR_BVH_WIDTH];
     int n = 1;
     child[0] = *range;
-    const int over_bottom = range->end - range->begin > BOTTOM_SPHERES;
+    const int over_bottom = (double)(range->end - range->begin) * per_prim > BOTTOM_SPHERES;
     for (; n < PTR_BVH_WIDTH; n++) {
         int pick = -1;
         float pick_area = -1.0f;
         for (int k = 0; k < n; k++) {
             float area = bvh_half_area(child[k].lower, child[k].upper);
-            size_t count = child[k].end - child[k].begin;
-            if (over_bottom && count <= BOTTOM_SPHERES)
+            double prims = (double)(child[k].end - child[k].begin) * per_prim;
+            if ((over_bottom && prims <= BOTTOM_SPHERES) || (plan && child[k].axis < 0))
                 continue;
-            if (count > PTR_BVH_LEAF_MAX && area > pick_area) {
+            if (prims > PTR_BVH_LEAF_MAX && area > pick_area) {
                 pick = k;
                 pick_area = area;
             }
         }
         if (pick < 0)
             break;
-        r = bvh_split(&build->set, kind == NODE_ROOT ? build->threads : 1, &child[pick],
-                      level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick], &child[n], err);
-        if (r != PTR_OK)
-            return r;
+        if (plan) {
+            plan->source[n] = pick;
+            plan->test[n] = bvh_split_test(&child[pick]);
+        }
+        bvh_split(set, &child[pick], level >= MIDDLE_SPLIT_LEVEL, scratch, &child[pick],
+                  &child[n]);
     }
+    *count = n;
+}
 
+static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+                            const BvhCandidate *range, NodeKind kind, int level,
+                            size_t *index, int *depth, PtrError *err);
+
+/* Makes the node of this kind at this level over the children child[0 .. n
+ * - 1] in nodes (its index in *index), and its inner children below it that
+ * are neither parts nor tasks; depth: levels below the node, not counting
+ * parts and tasks. tasks: where a node of the top level puts its tasks.
+ * scratch: see bvh_split (tasks have it, the top level not). */
+static PtrResult make_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+                           const BvhCandidate child[PTR_BVH_WIDTH], int n, NodeKind kind,
+                           int level, size_t *index, int *depth, PtrError *err)
+{
+    PtrResult r;
     if ((r = node_array_add(nodes, index, err)) != PTR_OK)
         return r;
     size_t self = *index;
@@ -243,6 +268,18 @@ static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, Bvh
     }
     nodes->nodes[self] = node; /* after the children: the array may have moved */
     return PTR_OK;
+}
+
+/* Builds the node of this kind at this level over range (its split found)
+ * into nodes: see make_node. */
+static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+                            const BvhCandidate *range, NodeKind kind, int level,
+                            size_t *index, int *depth, PtrError *err)
+{
+    BvhCandidate child[PTR_BVH_WIDTH];
+    int n;
+    grow_node(&build->set, scratch, range, level, 1.0, child, &n, NULL);
+    return make_node(build, nodes, tasks, scratch, child, n, kind, level, index, depth, err);
 }
 
 static size_t part_size(const Part *p)
@@ -304,11 +341,13 @@ static Task *pool_take_task(Pool *pool)
 /* Whether part p was built (else it ran out of memory). */
 static int build_part(Build *build, Part *p)
 {
+    BvhCandidate range;
     size_t root;
-    /* No scratch: the in-place partition makes the moves the root's shared
-     * splits make, where the stable one would order the prims, and so the
-     * tree, otherwise. */
-    return build_node(build, &p->nodes, &p->tasks, NULL, &p->range, NODE_PART, p->level, &root,
+    bvh_candidate_init(&build->set, &range, p->range.begin, p->range.end, p->range.lower,
+                       p->range.upper);
+    /* No scratch: a part is as large as 1/8 of the tree, the scratch of
+     * the tasks 1/64. */
+    return build_node(build, &p->nodes, &p->tasks, NULL, &range, NODE_PART, p->level, &root,
                       &p->nodes.depth, NULL) == PTR_OK;
 }
 
@@ -319,12 +358,12 @@ static int build_task(Build *build, Task *t, BvhPrim **scratch)
      * task_spheres): fresh memory for each would be cleared page by page. */
     if (!*scratch)
         *scratch = malloc(build->task_spheres * sizeof **scratch);
+    if (!*scratch)
+        return 0;
     BvhCandidate range;
     size_t root;
-    return *scratch &&
-           bvh_candidate_init(&build->set, 1, &range, t->begin, t->end, NULL, NULL, NULL) ==
-               PTR_OK &&
-           build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level, &root,
+    bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL);
+    return build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level, &root,
                       &t->nodes.depth, NULL) == PTR_OK;
 }
 
@@ -589,6 +628,29 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
     return r;
 }
 
+/* The root's children (see the head): its splits chosen from ROOT_SAMPLES
+ * of the tree's spheres, evenly spaced, or all of them where they are no
+ * more, each standing for as many of the tree's as there are to a sample.
+ * Fails only for memory. */
+static PtrResult plan_root(const PtrSpheres *spheres, const size_t *huge_index,
+                           size_t huge_count, BvhRootChildren *plan, PtrError *err)
+{
+    plan->count = 1;
+    BvhPrimSet samples = { .prims = malloc(ROOT_SAMPLES * sizeof *samples.prims) };
+    if (!samples.prims)
+        return bvh_out_of_memory(err);
+    const size_t n = ptr_bvh_samples(spheres, huge_index, huge_count, samples.prims,
+                                     ROOT_SAMPLES, &samples.magnitude);
+    if (n > 0) {
+        BvhCandidate range, child[PTR_BVH_WIDTH];
+        bvh_candidate_init(&samples, &range, 0, n, NULL, NULL);
+        grow_node(&samples, NULL, &range, 0, (double)(spheres->count - huge_count) / (double)n,
+                  child, &plan->count, plan);
+    }
+    free(samples.prims);
+    return PTR_OK;
+}
+
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
                         PtrError *err)
 {
@@ -599,27 +661,35 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     /* The prims and huge take the tree's spheres, whose pages the scene's
      * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
+    size_t huge_index[PTR_HUGE_MAX];
+    BvhRootChildren root;
+    PtrSpheres tree_part = *spheres;
+    tree_part.count = count;
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
     size_t prim_count = 0;
     PtrResult r = build.set.prims ? PTR_OK : bvh_out_of_memory(err);
-    if (r == PTR_OK) {
-        PtrSpheres tree_part = *spheres;
-        tree_part.count = count;
-        r = ptr_bvh_prims(&tree_part, build.threads, huge, &bvh->huge_count,
+    if (r == PTR_OK)
+        r = ptr_bvh_huge(&tree_part, build.threads, huge, huge_index, &bvh->huge_count, err);
+    if (r == PTR_OK)
+        r = plan_root(&tree_part, huge_index, bvh->huge_count, &root, err);
+    if (r == PTR_OK)
+        r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
                           build.set.prims, &prim_count, &build.set.magnitude, err);
-    }
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
     if (r == PTR_OK && prim_count > 0) {
-        BvhCandidate root;
+        /* Their ranges and boxes: the parts find their splits (build_part). */
+        BvhCandidate child[PTR_BVH_WIDTH];
+        for (int k = 0; k < root.count; k++) {
+            child[k] = (BvhCandidate){ .begin = root.begin[k], .end = root.end[k], .axis = -1 };
+            memcpy(child[k].lower, root.lower[k], sizeof child[k].lower);
+            memcpy(child[k].upper, root.upper[k], sizeof child[k].upper);
+        }
         size_t index;
-        r = bvh_candidate_init(&build.set, build.threads, &root, 0, prim_count, NULL, NULL,
-                               err);
-        if (r == PTR_OK)
-            r = build_node(&build, &top, &build.root_tasks, NULL, &root, NODE_ROOT, 0, &index,
-                           &top.depth, err);
+        r = make_node(&build, &top, &build.root_tasks, NULL, child, root.count, NODE_ROOT, 0,
+                      &index, &top.depth, err);
         if (r == PTR_OK)
             r = run_pool(&build, err);
         if (r == PTR_OK)

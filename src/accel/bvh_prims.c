@@ -1,7 +1,6 @@
 #include "accel/bvh_prims.h"
 
 #include <math.h>
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -148,47 +147,10 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
 #undef COPY_OUT
 }
 
-/* The copy of spheres into prims, in pieces on all threads: a piece's first
- * prim is its first sphere's index less the huge spheres before it, so the
- * pieces need nothing of each other. */
-typedef struct PrimCopy {
-    const PtrSpheres *spheres;
-    BvhPrim *prims;
-    const size_t *huge_index; /* ascending */
-    size_t huge_count;
-    /* The largest magnitude so far, as the bits of a float that is never
-     * negative: such floats order as their bits do. */
-    atomic_uint_least32_t magnitude;
-} PrimCopy;
-
-static void copy_prims(void *arg, size_t begin, size_t end)
+PtrResult ptr_bvh_huge(const PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_index,
+                       size_t *huge_count, PtrError *err)
 {
-    PrimCopy *c = arg;
-    size_t k = ptr_huge_before(c->huge_index, c->huge_count, begin);
-    BvhPrim *out = c->prims + (begin - k);
-    float magnitude = 0.0f;
-    for (size_t i = begin; i < end; i++) {
-        if (k < c->huge_count && c->huge_index[k] == i) {
-            k++;
-            continue;
-        }
-        const float m = v3_max_abs(ptr_sphere_centre(c->spheres, i)) + c->spheres->radius[i];
-        if (m > magnitude)
-            magnitude = m;
-        *out++ = bvh_prim_of(c->spheres, i);
-    }
-    uint32_t bits;
-    memcpy(&bits, &magnitude, sizeof bits);
-    uint_least32_t seen = atomic_load(&c->magnitude);
-    while (bits > seen && !atomic_compare_exchange_weak(&c->magnitude, &seen, bits))
-        ;
-}
-
-PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_count,
-                        BvhPrim *prims, size_t *prim_count, float *magnitude_out, PtrError *err)
-{
-    *huge_count = *prim_count = 0;
-    *magnitude_out = 0.0f;
+    *huge_count = 0;
     if (s->count == 0)
         return PTR_OK;
     size_t pieces = threads < RADIUS_PIECES_MAX ? (size_t)threads : RADIUS_PIECES_MAX;
@@ -204,39 +166,248 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_
     ptr_parallel_pieces(threads, s->count, pieces, offer_huge, &offer);
     ptr_huge_merge(&choice, piece_choice, pieces);
     ptr_huge_file_order(&choice);
-    /* By index, to skip them below. */
-    size_t out[PTR_HUGE_MAX];
     for (size_t k = 0; k < choice.count; k++) {
         huge[k] = bvh_prim_of(s, choice.sphere[k].index);
         size_t at = k;
-        for (; at > 0 && out[at - 1] > choice.sphere[k].index; at--)
-            out[at] = out[at - 1];
-        out[at] = choice.sphere[k].index;
+        for (; at > 0 && huge_index[at - 1] > choice.sphere[k].index; at--)
+            huge_index[at] = huge_index[at - 1];
+        huge_index[at] = choice.sphere[k].index;
     }
-    PrimCopy copy = { .spheres = s, .prims = prims, .huge_index = out,
-                      .huge_count = choice.count };
-    atomic_init(&copy.magnitude, 0);
-    /* Each step's prims on the pages of the spheres the step before
-     * copied. */
-    PtrPageBank bank = { 0 };
-    size_t first_prim = 0;
-    for (size_t begin = 0; begin < s->count; begin += PTR_PAGE_STEP) {
-        const size_t end = s->count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : s->count;
-        const size_t end_prim = end - ptr_huge_before(out, choice.count, end);
-        if (!ptr_pages_take(&bank, prims, first_prim * sizeof *prims, end_prim * sizeof *prims)) {
-            ptr_pages_free(&bank);
-            return bvh_out_of_memory(err);
-        }
-        ptr_parallel_ranges(threads, begin, end, copy_prims, &copy);
-        ptr_spheres_release(s, end < s->count ? &bank : NULL, begin, end);
-        first_prim = end_prim;
-    }
-    ptr_pages_free(&bank);
-    const uint32_t bits = (uint32_t)atomic_load(&copy.magnitude);
-    memcpy(magnitude_out, &bits, sizeof bits);
     *huge_count = choice.count;
-    *prim_count = s->count - choice.count;
     return PTR_OK;
+}
+
+/* What a sphere adds to the tree's magnitude. */
+static float sphere_magnitude(const PtrSpheres *s, size_t i)
+{
+    return v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
+}
+
+size_t ptr_bvh_samples(const PtrSpheres *s, const size_t *huge_index, size_t huge_count,
+                       BvhPrim *samples, size_t max, float *magnitude)
+{
+    const size_t taken = s->count < max ? s->count : max;
+    size_t count = 0, k = 0;
+    *magnitude = 0.0f;
+    for (size_t j = 0; j < taken; j++) {
+        const size_t i = j * s->count / taken; /* below 2^15 * 2^31 */
+        while (k < huge_count && huge_index[k] < i)
+            k++;
+        if (k < huge_count && huge_index[k] == i)
+            continue;
+        *magnitude = ptr_maxf(sphere_magnitude(s, i), *magnitude);
+        samples[count++] = bvh_prim_of(s, i);
+    }
+    return count;
+}
+
+/* The spheres are counted and copied in blocks of this many: a block's
+ * prims go to the places its counts, and those of the blocks before it,
+ * give them, so the blocks need nothing of each other and the prims' order
+ * nothing of the threads. A step of the page bank is whole blocks. */
+enum { BLOCK = 1 << 16 };
+_Static_assert(PTR_PAGE_STEP % BLOCK == 0, "a page step is whole blocks");
+
+typedef struct RootSort {
+    const PtrSpheres *spheres;
+    const size_t *huge_index; /* ascending */
+    size_t huge_count;
+    int children;
+    /* Each split's test (BvhRootChildren) in four lanes, and its axis's
+     * array of centres. */
+    const float *key[PTR_BVH_WIDTH];
+    __m128 base[PTR_BVH_WIDTH], scale[PTR_BVH_WIDTH], last[PTR_BVH_WIDTH];
+    __m128i split_bin[PTR_BVH_WIDTH], source[PTR_BVH_WIDTH];
+    /* Per block: its prims in each child, then, before the copy, the place
+     * of its first prim in each; a row more for the children's ends. */
+    size_t (*place)[PTR_BVH_WIDTH];
+    float *magnitude; /* per block, then the tree's in [0] */
+    BvhPrim *prims;
+    __m128 (*lower)[PTR_BVH_WIDTH], (*upper)[PTR_BVH_WIDTH]; /* per block */
+} RootSort;
+
+/* The block's spheres are sorted a chunk at a time: their children first,
+ * four at once, then each sphere. */
+enum { CHUNK = 1024, NOT_IN_TREE = PTR_BVH_WIDTH };
+
+/* The children of spheres from .. to - 1 (at most CHUNK) in child[i -
+ * from], NOT_IN_TREE for the huge ones: bvh_goes_right's arithmetic four
+ * lanes at a time (centre + centre is 2 centre), each split moving the
+ * lanes in its source that go right. Lanes past the last sphere read the
+ * arrays' padding (PTR_SPHERE_BLOCK entries) into child's last 3 entries. */
+static void children_of(const RootSort *r, size_t from, size_t to, uint8_t child[CHUNK + 3])
+{
+    for (size_t i = from; i < to; i += 4) {
+        __m128i in = _mm_setzero_si128();
+        for (int s = 1; s < r->children; s++) {
+            const __m128 centre = _mm_loadu_ps(&r->key[s][i]);
+            const __m128 at = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(centre, centre), r->base[s]),
+                                         r->scale[s]);
+            const __m128i bin =
+                _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(at, _mm_setzero_ps()), r->last[s]));
+            const __m128i moves = _mm_and_si128(_mm_cmpgt_epi32(bin, r->split_bin[s]),
+                                                _mm_cmpeq_epi32(in, r->source[s]));
+            in = _mm_or_si128(_mm_andnot_si128(moves, in),
+                              _mm_and_si128(moves, _mm_set1_epi32(s)));
+        }
+        /* The four children, each below 8, in the four low bytes. */
+        const __m128i words = _mm_packs_epi32(in, in);
+        const uint32_t four = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(words, words));
+        memcpy(&child[i - from], &four, sizeof four);
+    }
+    for (size_t k = ptr_huge_before(r->huge_index, r->huge_count, from);
+         k < r->huge_count && r->huge_index[k] < to; k++)
+        child[r->huge_index[k] - from] = NOT_IN_TREE;
+}
+
+/* Counts blocks begin .. end - 1's prims in each child, and their
+ * magnitude. */
+static void count_blocks(void *arg, size_t begin, size_t end)
+{
+    RootSort *r = arg;
+    const PtrSpheres *s = r->spheres;
+    uint8_t child[CHUNK + 3];
+    for (size_t b = begin; b < end; b++) {
+        size_t *count = r->place[b];
+        float magnitude = 0.0f;
+        memset(count, 0, PTR_BVH_WIDTH * sizeof *count);
+        const size_t block_end = s->count - b * BLOCK > BLOCK ? (b + 1) * BLOCK : s->count;
+        for (size_t from = b * BLOCK; from < block_end; from += CHUNK) {
+            const size_t to = block_end - from > CHUNK ? from + CHUNK : block_end;
+            children_of(r, from, to, child);
+            for (size_t i = from; i < to; i++)
+                if (child[i - from] != NOT_IN_TREE) {
+                    count[child[i - from]]++;
+                    magnitude = ptr_maxf(sphere_magnitude(s, i), magnitude);
+                }
+        }
+        r->magnitude[b] = magnitude;
+    }
+}
+
+/* Copies blocks begin .. end - 1's prims to their places, with each
+ * child's box of them. */
+static void copy_blocks(void *arg, size_t begin, size_t end)
+{
+    RootSort *r = arg;
+    const PtrSpheres *s = r->spheres;
+    const float magnitude = r->magnitude[0];
+    uint8_t child[CHUNK + 3];
+    for (size_t b = begin; b < end; b++) {
+        size_t at[PTR_BVH_WIDTH];
+        __m128 *lower = r->lower[b], *upper = r->upper[b];
+        memcpy(at, r->place[b], sizeof at);
+        for (int k = 0; k < r->children; k++) {
+            lower[k] = _mm_set1_ps(INFINITY);
+            upper[k] = _mm_set1_ps(-INFINITY);
+        }
+        const size_t block_end = s->count - b * BLOCK > BLOCK ? (b + 1) * BLOCK : s->count;
+        for (size_t from = b * BLOCK; from < block_end; from += CHUNK) {
+            const size_t to = block_end - from > CHUNK ? from + CHUNK : block_end;
+            children_of(r, from, to, child);
+            for (size_t i = from; i < to; i++) {
+                const int k = child[i - from];
+                if (k == NOT_IN_TREE)
+                    continue;
+                BvhPrim *p = &r->prims[at[k]++];
+                *p = bvh_prim_of(s, i);
+                __m128 lo, hi;
+                bvh_prim_box4(p, magnitude, &lo, &hi);
+                lower[k] = _mm_min_ps(lower[k], lo);
+                upper[k] = _mm_max_ps(upper[k], hi);
+            }
+        }
+    }
+}
+
+PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
+                        size_t huge_count, BvhRootChildren *children, BvhPrim *prims,
+                        size_t *prim_count, float *magnitude_out, PtrError *err)
+{
+    *prim_count = s->count - huge_count;
+    *magnitude_out = 0.0f;
+    const size_t blocks = (s->count + BLOCK - 1) / BLOCK;
+    RootSort r = { .spheres = s, .huge_index = huge_index, .huge_count = huge_count,
+                   .children = children->count, .prims = prims };
+    for (int k = 1; k < children->count; k++) {
+        const BvhSplitTest *t = &children->test[k];
+        r.key[k] = t->axis == 0 ? s->cx : t->axis == 1 ? s->cy : s->cz;
+        r.base[k] = _mm_set1_ps(t->base);
+        r.scale[k] = _mm_set1_ps(t->scale);
+        r.last[k] = _mm_set1_ps(t->last);
+        r.split_bin[k] = _mm_set1_epi32(t->split_bin);
+        r.source[k] = _mm_set1_epi32(children->source[k]);
+    }
+    r.place = malloc((blocks + 1) * sizeof *r.place);
+    r.magnitude = malloc((blocks ? blocks : 1) * sizeof *r.magnitude);
+    r.lower = malloc((blocks ? blocks : 1) * sizeof *r.lower);
+    r.upper = malloc((blocks ? blocks : 1) * sizeof *r.upper);
+    PtrResult res = r.place && r.magnitude && r.lower && r.upper ? PTR_OK
+                                                                 : bvh_out_of_memory(err);
+    if (res == PTR_OK && blocks) {
+        ptr_parallel_ranges(threads, 0, blocks, count_blocks, &r);
+        /* The children in the order a split in place leaves them: the prims
+         * a split sends right follow those it leaves in its source. */
+        int order[PTR_BVH_WIDTH] = { 0 };
+        for (int k = 1; k < children->count; k++) {
+            int at = k;
+            for (; order[at - 1] != children->source[k]; at--)
+                order[at] = order[at - 1];
+            order[at] = k;
+        }
+        /* Each child's prims follow those of the child before it in that
+         * order; within a child, each block's follow the block's before. */
+        size_t next = 0;
+        for (int j = 0; j < children->count; j++) {
+            const int k = order[j];
+            children->begin[k] = next;
+            for (size_t b = 0; b <= blocks; b++) {
+                const size_t count = b < blocks ? r.place[b][k] : 0;
+                r.place[b][k] = next;
+                next += count;
+            }
+            children->end[k] = next;
+        }
+        for (size_t b = 1; b < blocks; b++)
+            r.magnitude[0] = ptr_maxf(r.magnitude[b], r.magnitude[0]);
+        /* Each step's prims on the pages of the spheres the step before
+         * copied. */
+        PtrPageBank bank = { 0 };
+        const size_t step_blocks = PTR_PAGE_STEP / BLOCK;
+        for (size_t first = 0; first < blocks && res == PTR_OK; first += step_blocks) {
+            const size_t last = blocks - first > step_blocks ? first + step_blocks : blocks;
+            for (int k = 0; k < children->count && res == PTR_OK; k++)
+                if (!ptr_pages_take(&bank, prims, r.place[first][k] * sizeof *prims,
+                                    r.place[last][k] * sizeof *prims))
+                    res = bvh_out_of_memory(err);
+            if (res != PTR_OK)
+                break;
+            ptr_parallel_ranges(threads, first, last, copy_blocks, &r);
+            const size_t end = last * (size_t)BLOCK < s->count ? last * (size_t)BLOCK : s->count;
+            ptr_spheres_release(s, end < s->count ? &bank : NULL, first * (size_t)BLOCK, end);
+        }
+        ptr_pages_free(&bank);
+    }
+    if (res == PTR_OK) {
+        for (int k = 0; k < children->count; k++) {
+            __m128 lower = _mm_set1_ps(INFINITY), upper = _mm_set1_ps(-INFINITY);
+            for (size_t b = 0; b < blocks; b++) {
+                lower = _mm_min_ps(lower, r.lower[b][k]);
+                upper = _mm_max_ps(upper, r.upper[b][k]);
+            }
+            float lanes[4];
+            _mm_storeu_ps(lanes, lower);
+            memcpy(children->lower[k], lanes, sizeof children->lower[k]);
+            _mm_storeu_ps(lanes, upper);
+            memcpy(children->upper[k], lanes, sizeof children->upper[k]);
+        }
+        *magnitude_out = blocks ? r.magnitude[0] : 0.0f;
+    }
+    free(r.place);
+    free(r.magnitude);
+    free(r.lower);
+    free(r.upper);
+    return res;
 }
 
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)

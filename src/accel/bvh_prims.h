@@ -1,11 +1,14 @@
-/* What the tree is built from: a padded box per sphere, and the choice of
- * the huge spheres it keeps out of its boxes. */
+/* What the tree is built from: a padded box per sphere, the choice of the
+ * huge spheres it keeps out of its boxes, and the copy that sorts the
+ * others into the root's children. */
 #ifndef PTR_BVH_PRIMS_H
 #define PTR_BVH_PRIMS_H
 
 #include <stddef.h>
 #include <stdint.h>
+#include <emmintrin.h> /* SSE2, which every x86-64 CPU has */
 
+#include "accel/bvh.h"
 #include "base/result.h"
 #include "scene/scene.h"
 
@@ -44,21 +47,74 @@ static inline void bvh_prim_box(const BvhPrim *p, float magnitude, float lower[3
     }
 }
 
+/* bvh_prim_box in registers: x, y, z and, in the unused lane, the radius
+ * less and plus the extent. */
+static inline void bvh_prim_box4(const BvhPrim *p, float magnitude, __m128 *lower,
+                                 __m128 *upper)
+{
+    const __m128 centre = _mm_loadu_ps(p->centre),
+                 extent = _mm_set1_ps(bvh_prim_extent(p, magnitude));
+    *lower = _mm_sub_ps(centre, extent);
+    *upper = _mm_add_ps(centre, extent);
+}
+
+/* A binned split as a prim is tested against it: whether the prim's bin on
+ * the split's axis, (2 centre - base) scale clamped to the bins, is past
+ * split_bin (bvh_split.c's bins: 2 centre is the box's lower + upper). */
+typedef struct BvhSplitTest {
+    int axis, split_bin;
+    float base, scale, last; /* last: the bins less 1 */
+} BvhSplitTest;
+
+static inline int bvh_goes_right(const BvhSplitTest *t, const BvhPrim *p)
+{
+    /* Clamped as a float, then converted: no branch, and a NaN-free range. */
+    const float k = (2.0f * p->centre[t->axis] - t->base) * t->scale;
+    return (int)ptr_minf(ptr_maxf(k, 0.0f), t->last) > t->split_bin;
+}
+
+/* The root's children as its splits make them, chosen from samples before
+ * the prims exist (bvh_build.c): split s, for s from 1 to count - 1 in
+ * turn, sends the prims of child source[s] that go right by test[s] to
+ * child s; every prim starts in child 0. ptr_bvh_prims sorts the prims into
+ * the children as it copies them, and fills in each child's prims, begin
+ * .. end - 1, and padded box. */
+typedef struct BvhRootChildren {
+    int count;
+    int source[PTR_BVH_WIDTH];
+    BvhSplitTest test[PTR_BVH_WIDTH];
+    size_t begin[PTR_BVH_WIDTH], end[PTR_BVH_WIDTH];
+    float lower[PTR_BVH_WIDTH][3], upper[PTR_BVH_WIDTH][3];
+} BvhRootChildren;
+
 /* Puts the huge spheres (scene.h's rule, with the tree's limit) in
- * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX), a
- * prim for each of the others in prims (their count in *prim_count, in the
- * arrays' order), and in *magnitude the largest coordinate magnitude in the
- * tree, which bounds both the spheres' and the rays' origins (the camera
- * sits at 0, other rays start on spheres) and so scales the boxes' padding.
- * Gives up the spheres' memory as it goes (ptr_spheres_release), its pages
- * moved under the next prims: on success the prims and huge hold the only
- * copy of spheres 0 .. count - 1 but their values. Counts, chooses and
- * copies on this many threads (ptr_thread_count's count). Fails only for
- * memory: the spheres untouched, but where the kernel ran out of memory
- * moving pages (ptr_pages_take), when some are already given up, as they
- * are where the build fails after this. */
-PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, BvhPrim *huge, size_t *huge_count,
-                        BvhPrim *prims, size_t *prim_count, float *magnitude, PtrError *err);
+ * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX) and
+ * their indices, ascending, in huge_index, counting and choosing on this
+ * many threads (ptr_thread_count's count). Fails only for memory. */
+PtrResult ptr_bvh_huge(const PtrSpheres *spheres, int threads, BvhPrim *huge,
+                       size_t *huge_index, size_t *huge_count, PtrError *err);
+
+/* Puts in samples up to max of the spheres but the huge ones (huge_index,
+ * ascending), evenly spaced, or all of them if they are no more; returns
+ * their count, and their magnitude (see ptr_bvh_prims) in *magnitude. */
+size_t ptr_bvh_samples(const PtrSpheres *spheres, const size_t *huge_index, size_t huge_count,
+                       BvhPrim *samples, size_t max, float *magnitude);
+
+/* Puts a prim for each sphere but the huge ones (huge_index, ascending) in
+ * prims, sorted into the children (in the arrays' order within each), their
+ * count in *prim_count, and in *magnitude the largest coordinate magnitude
+ * in the tree, which bounds both the spheres' and the rays' origins (the
+ * camera sits at 0, other rays start on spheres) and so scales the boxes'
+ * padding. Gives up the spheres' memory as it goes (ptr_spheres_release),
+ * its pages moved under the next prims: on success the prims and the huge
+ * spheres hold the only copy of spheres 0 .. count - 1 but their values.
+ * Counts and copies on this many threads; the prims' order does not depend
+ * on their number. Fails only for memory: the spheres untouched, but where
+ * the kernel ran out of memory moving pages (ptr_pages_take), when some are
+ * already given up, as they are where the build fails after this. */
+PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, const size_t *huge_index,
+                        size_t huge_count, BvhRootChildren *children, BvhPrim *prims,
+                        size_t *prim_count, float *magnitude, PtrError *err);
 
 /* Fails for memory the tree's build cannot have: every failure of the
  * build's functions is this one. (The code returned as a constant, so the

@@ -3,9 +3,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <emmintrin.h> /* SSE2, which every x86-64 CPU has */
-
-#include "base/threads.h"
 
 enum { BINS = 32 };
 
@@ -67,24 +64,6 @@ static inline float half_area4(__m128 lo, __m128 hi)
            _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
 }
 
-/* bvh_prim_box in registers: x, y, z and, in the unused lane, the radius
- * less and plus the extent. */
-static inline void prim_box4(const BvhPrim *p, float magnitude, __m128 *lower, __m128 *upper)
-{
-    const __m128 centre = _mm_loadu_ps(p->centre),
-                 extent = _mm_set1_ps(bvh_prim_extent(p, magnitude));
-    *lower = _mm_sub_ps(centre, extent);
-    *upper = _mm_add_ps(centre, extent);
-}
-
-static int bin_of(const BvhCandidate *c, const BvhPrim *p, int axis)
-{
-    float centre = 2.0f * p->centre[axis]; /* the box's lower + upper */
-    /* Clamped as a float, then converted: no branch, and a NaN-free range. */
-    float k = (centre - c->bin_base[axis]) * c->bin_scale[axis];
-    return (int)ptr_minf(ptr_maxf(k, 0.0f), (float)(c->bins - 1));
-}
-
 /* The box only (of a range split in the middle, or of the root). */
 static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
 {
@@ -95,7 +74,7 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
     }
 }
 
-/* A prim's bins on the three axes at once, in k[0 .. 2]: bin_of's
+/* A prim's bins on the three axes at once, in k[0 .. 2]: bvh_goes_right's
  * arithmetic lane by lane (the radius lane, scaled by 0, gives bin 0). */
 static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre, int k[4])
 {
@@ -121,7 +100,7 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stri
             _mm_prefetch((const char *)&set->prims[i + ahead], _MM_HINT_T0);
         const BvhPrim *p = &set->prims[i];
         __m128 lower, upper;
-        prim_box4(p, set->magnitude, &lower, &upper);
+        bvh_prim_box4(p, set->magnitude, &lower, &upper);
         int k[4];
         bins_of(base, scale, last, _mm_loadu_ps(p->centre), k);
         for (int a = 0; a < 3; a++) {
@@ -132,101 +111,14 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stri
     }
 }
 
-static void bins_merge(Bins *into, const Bins *b, int bins)
-{
-    for (int a = 0; a < 3; a++)
-        for (int k = 0; k < bins; k++) {
-            into->lower[a][k] = _mm_min_ps(into->lower[a][k], b->lower[a][k]);
-            into->upper[a][k] = _mm_max_ps(into->upper[a][k], b->upper[a][k]);
-            into->count[a][k] += b->count[a][k];
-        }
-    bounds_grow(into->box_lo, into->box_hi, b->box_lo, b->box_hi);
-}
+/* Runs of more than SAMPLED_ABOVE prims choose their split from about
+ * SAMPLES of them, evenly spaced: at the top of a tree of 10^7 spheres,
+ * binning every prim took a third of the build and chose much the same
+ * splits. */
+enum { SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
 
-/* Runs of this many prims (or samples, of a sampled run: so every sampled
- * run) are bounded, binned and partitioned by all threads together; smaller
- * ones by the calling thread (a run of 16,384 prims takes some hundred
- * microseconds; handing a piece to a kept thread and back, about 5 while
- * that thread still watches for work, 50 to 150 where it has gone to sleep
- * on an idle virtual machine: docs/intersectors.md, "From one thread to
- * two" and "One pool for the parts and the tasks"). Runs of more than
- * SAMPLED_ABOVE prims choose their split from about SAMPLES of them, evenly
- * spaced: at the top of a tree of 10^7 spheres, binning every prim took a
- * third of the build and chose much the same splits. */
-enum { PARALLEL_PRIMS = 1 << 14, SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
-
-typedef struct ParallelRun {
-    const BvhPrimSet *set;
-    size_t begin, end, stride;     /* every stride-th prim (binning only) */
-    const BvhCandidate *candidate; /* NULL: bounds only */
-    Bins *bins;                 /* one per thread */
-    int thread, threads;
-} ParallelRun;
-
-static void *parallel_bin_worker(void *arg)
-{
-    ParallelRun *r = arg;
-    size_t n = (r->end - r->begin + r->stride - 1) / r->stride; /* prims taken */
-    size_t lo = r->begin + n * (size_t)r->thread / (size_t)r->threads * r->stride;
-    size_t hi = r->begin + n * (size_t)(r->thread + 1) / (size_t)r->threads * r->stride;
-    if (hi > r->end)
-        hi = r->end;
-    bins_clear(r->bins, r->candidate ? r->candidate->bins : 0);
-    if (r->candidate)
-        bin_run(r->set, lo, hi, r->stride, r->candidate, r->bins);
-    else
-        bound_run(r->set, lo, hi, r->bins);
-    return NULL;
-}
-
-/* Bins every stride-th prim of begin .. end - 1 (or, with c NULL, bounds
- * every prim: stride 1) into *out, on up to max_threads threads if they
- * are many. Counts add and boxes take minima and maxima, so the result does
- * not depend on how the run is shared between threads. */
-static PtrResult bin_range(const BvhPrimSet *set, int max_threads, size_t begin, size_t end,
-                           size_t stride, const BvhCandidate *c, Bins *out, PtrError *err)
-{
-    int threads = (end - begin) / stride >= PARALLEL_PRIMS ? max_threads : 1;
-    int bins = c ? c->bins : 0;
-    if (threads == 1) {
-        bins_clear(out, bins);
-        if (c)
-            bin_run(set, begin, end, stride, c, out);
-        else
-            bound_run(set, begin, end, out);
-        return PTR_OK;
-    }
-    Bins *per_thread = malloc((size_t)threads * sizeof *per_thread);
-    ParallelRun *runs = malloc((size_t)threads * sizeof *runs);
-    PtrThread **ids = malloc((size_t)threads * sizeof *ids);
-    if (!per_thread || !runs || !ids) {
-        free(per_thread);
-        free(runs);
-        free(ids);
-        return bvh_out_of_memory(err);
-    }
-    int started = 1; /* threads 1 .. started - 1 run; the rest are done here */
-    for (int t = 0; t < threads; t++)
-        runs[t] = (ParallelRun){ set, begin, end, stride, c, &per_thread[t], t, threads };
-    while (started < threads && (ids[started] = ptr_thread_start(parallel_bin_worker, &runs[started])))
-        started++;
-    parallel_bin_worker(&runs[0]);
-    for (int t = started; t < threads; t++)
-        parallel_bin_worker(&runs[t]);
-    for (int t = 1; t < started; t++)
-        ptr_thread_join(ids[t]);
-    bins_clear(out, bins);
-    for (int t = 0; t < threads; t++)
-        bins_merge(out, &per_thread[t], bins);
-    free(per_thread);
-    free(runs);
-    free(ids);
-    return PTR_OK;
-}
-
-PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c, size_t begin,
-                             size_t end, const float lower[3], const float upper[3],
-                             PtrError *err)
+void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
+                        const float lower[3], const float upper[3])
 {
     Bins bins;
     c->begin = begin;
@@ -234,16 +126,15 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
     c->axis = -1;
     c->sampled = 0;
     if (!lower) {
-        PtrResult r = bin_range(set, threads, begin, end, 1, NULL, &bins, err);
-        if (r != PTR_OK)
-            return r;
+        bins_clear(&bins, 0);
+        bound_run(set, begin, end, &bins);
         lower = bins.box_lo;
         upper = bins.box_hi;
     }
     memcpy(c->lower, lower, sizeof c->lower);
     memcpy(c->upper, upper, sizeof c->upper);
     if (end - begin <= PTR_BVH_LEAF_MAX)
-        return PTR_OK;
+        return;
     /* Embree's rule: few bins for few prims, where more would mostly be
      * empty and only cost time. */
     c->bins = 4 + (int)((end - begin) / 20);
@@ -258,12 +149,10 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
         spread |= extent > 0.0f;
     }
     if (!spread)
-        return PTR_OK;
+        return;
     c->sampled = end - begin > SAMPLED_ABOVE;
-    PtrResult r = bin_range(set, threads, begin, end, c->sampled ? (end - begin) / SAMPLES : 1,
-                            c, &bins, err);
-    if (r != PTR_OK)
-        return r;
+    bins_clear(&bins, c->bins);
+    bin_run(set, begin, end, c->sampled ? (end - begin) / SAMPLES : 1, c, &bins);
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
         __m128 right_lo[BINS], right_hi[BINS];
@@ -300,7 +189,12 @@ PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c
             }
         }
     }
-    return PTR_OK;
+}
+
+BvhSplitTest bvh_split_test(const BvhCandidate *c)
+{
+    return (BvhSplitTest){ c->axis, c->split_bin, c->bin_base[c->axis], c->bin_scale[c->axis],
+                           (float)(c->bins - 1) };
 }
 
 /* The boxes of the prims a partition sends left ([0]) and right ([1]): a
@@ -318,13 +212,12 @@ static void sides_empty(SideBoxes *b)
     }
 }
 
-static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim *p,
-                             size_t side)
+static inline void sides_add(SideBoxes *b, float magnitude, const BvhPrim *p, size_t side)
 {
     if (!b)
         return;
     __m128 lower, upper;
-    prim_box4(p, set->magnitude, &lower, &upper);
+    bvh_prim_box4(p, magnitude, &lower, &upper);
     b->lower[side] = _mm_min_ps(b->lower[side], lower);
     b->upper[side] = _mm_max_ps(b->upper[side], upper);
 }
@@ -332,23 +225,22 @@ static inline void sides_add(SideBoxes *b, const BvhPrimSet *set, const BvhPrim 
 /* Moves the prims begin .. end - 1 that go left by c's split before those
  * that go right, adding their boxes to *sides if given; returns the first
  * right one. Hoare's partition. */
-static size_t partition_run(const BvhPrimSet *set, size_t begin, size_t end,
-                            const BvhCandidate *c, SideBoxes *sides)
+static size_t partition_run(BvhPrim *p, float magnitude, size_t begin, size_t end,
+                            const BvhSplitTest *test, SideBoxes *sides)
 {
-    BvhPrim *p = set->prims;
     size_t i = begin, j = end;
     for (;;) {
-        while (i < j && bin_of(c, &p[i], c->axis) <= c->split_bin)
-            sides_add(sides, set, &p[i++], 0);
-        while (i < j && bin_of(c, &p[j - 1], c->axis) > c->split_bin)
-            sides_add(sides, set, &p[--j], 1);
+        while (i < j && !bvh_goes_right(test, &p[i]))
+            sides_add(sides, magnitude, &p[i++], 0);
+        while (i < j && bvh_goes_right(test, &p[j - 1]))
+            sides_add(sides, magnitude, &p[--j], 1);
         if (i >= j)
             return i;
         BvhPrim t = p[i];
         p[i] = p[j - 1];
         p[j - 1] = t;
-        sides_add(sides, set, &p[i++], 0);
-        sides_add(sides, set, &p[--j], 1);
+        sides_add(sides, magnitude, &p[i++], 0);
+        sides_add(sides, magnitude, &p[--j], 1);
     }
 }
 
@@ -358,30 +250,29 @@ static size_t partition_run(const BvhPrimSet *set, size_t begin, size_t end,
  * lists swapped pairwise; the few prims left in the middle go to
  * partition_run. Everything before the left block belongs left, everything
  * after the right block right. */
-static size_t partition_blocks(const BvhPrimSet *set, size_t begin, size_t end,
-                               const BvhCandidate *c, SideBoxes *sides)
+static size_t partition_blocks(BvhPrim *p, float magnitude, size_t begin, size_t end,
+                               const BvhSplitTest *test, SideBoxes *sides)
 {
     enum { BLOCK = 128 };
-    BvhPrim *p = set->prims;
     unsigned char wrong_left[BLOCK], wrong_right[BLOCK]; /* offsets in each block */
     size_t l = begin, r = end, left_count = 0, right_count = 0, left_at = 0, right_at = 0;
     while (r - l >= 2 * BLOCK) {
         if (left_count == 0) {
             left_at = 0;
             for (size_t i = 0; i < BLOCK; i++) {
-                const size_t goes_right = bin_of(c, &p[l + i], c->axis) > c->split_bin;
+                const size_t right = (size_t)bvh_goes_right(test, &p[l + i]);
                 wrong_left[left_count] = (unsigned char)i;
-                left_count += goes_right;
-                sides_add(sides, set, &p[l + i], goes_right);
+                left_count += right;
+                sides_add(sides, magnitude, &p[l + i], right);
             }
         }
         if (right_count == 0) {
             right_at = 0;
             for (size_t i = 0; i < BLOCK; i++) {
-                const size_t goes_right = bin_of(c, &p[r - 1 - i], c->axis) > c->split_bin;
+                const size_t right = (size_t)bvh_goes_right(test, &p[r - 1 - i]);
                 wrong_right[right_count] = (unsigned char)i;
-                right_count += 1 - goes_right;
-                sides_add(sides, set, &p[r - 1 - i], goes_right);
+                right_count += 1 - right;
+                sides_add(sides, magnitude, &p[r - 1 - i], right);
             }
         }
         const size_t swaps = left_count < right_count ? left_count : right_count;
@@ -402,107 +293,47 @@ static size_t partition_blocks(const BvhPrimSet *set, size_t begin, size_t end,
     }
     /* A block half done is classified again: its boxes are added again to
      * the same side, which changes no box. */
-    return partition_run(set, l, r, c, sides);
+    return partition_run(p, magnitude, l, r, test, sides);
 }
 
 /* The same split as partition_run, keeping each side's order, through
  * scratch (room for the run): no branch on the side a prim goes to, which
  * for a random cloud is a coin toss the processor mispredicts half the
  * time. */
-static size_t partition_stable(const BvhPrimSet *set, size_t begin, size_t end,
-                               const BvhCandidate *c, BvhPrim *scratch, SideBoxes *sides)
+static size_t partition_stable(BvhPrim *p, float magnitude, size_t begin, size_t end,
+                               const BvhSplitTest *test, BvhPrim *scratch, SideBoxes *sides)
 {
-    BvhPrim *p = set->prims;
     size_t left = begin, right = 0;
     for (size_t i = begin; i < end; i++) {
         const BvhPrim prim = p[i];
-        const size_t goes_right = bin_of(c, &prim, c->axis) > c->split_bin;
+        const size_t goes_right = (size_t)bvh_goes_right(test, &prim);
         p[left] = prim;
         scratch[right] = prim;
         left += 1 - goes_right;
         right += goes_right;
-        sides_add(sides, set, &prim, goes_right);
+        sides_add(sides, magnitude, &prim, goes_right);
     }
     memcpy(p + left, scratch, right * sizeof *p);
     return left;
 }
 
-typedef struct PartitionHalf {
-    const BvhPrimSet *set;
-    size_t begin, end, first_right;
-    const BvhCandidate *c;
-    SideBoxes sides, *want_sides;
-} PartitionHalf;
-
-static void *partition_half(void *arg)
-{
-    PartitionHalf *h = arg;
-    if (h->want_sides)
-        sides_empty(&h->sides);
-    h->first_right = partition_blocks(h->set, h->begin, h->end, h->c,
-                                      h->want_sides ? &h->sides : NULL);
-    return NULL;
-}
-
-/* Two runs of prims of the same length, swapped piece by piece: on all
- * threads, for at the top of a random cloud's tree a quarter of a range
- * moves so. */
-typedef struct SwapRuns {
-    BvhPrim *a, *b;
-} SwapRuns;
-
-static void swap_runs(void *arg, size_t begin, size_t end)
-{
-    const SwapRuns *s = arg;
-    for (size_t i = begin; i < end; i++) {
-        const BvhPrim t = s->a[i];
-        s->a[i] = s->b[i];
-        s->b[i] = t;
-    }
-}
-
 /* Moves the prims of c that go left before those that go right, adding
  * their boxes to *sides if given (emptied first); returns the first right
- * one. With scratch, partition_stable; without, a large run is cut in two
- * halves, partitioned on two threads when there are two, and the right part
- * of the first half swapped with the left part of the second (the smaller
- * of the two moves): the same moves whatever the thread count, so the tree
- * is too. */
-static size_t partition(const BvhPrimSet *set, int threads, const BvhCandidate *c,
-                        BvhPrim *scratch, SideBoxes *sides)
+ * one. With scratch, partition_stable, else partition_blocks. */
+static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch,
+                        SideBoxes *sides)
 {
-    size_t begin = c->begin, end = c->end;
+    const BvhSplitTest test = bvh_split_test(c);
     if (sides)
         sides_empty(sides);
     if (scratch)
-        return partition_stable(set, begin, end, c, scratch, sides);
-    if (end - begin < PARALLEL_PRIMS)
-        return partition_blocks(set, begin, end, c, sides);
-    size_t mid = begin + (end - begin) / 2;
-    PartitionHalf half[2] = { { .set = set, .begin = begin, .end = mid, .c = c, .want_sides = sides },
-                              { .set = set, .begin = mid, .end = end, .c = c, .want_sides = sides } };
-    PtrThread *other = threads > 1 ? ptr_thread_start(partition_half, &half[1]) : NULL;
-    partition_half(&half[0]);
-    if (other)
-        ptr_thread_join(other);
-    else
-        partition_half(&half[1]);
-    for (int h = 0; sides && h < 2; h++)
-        for (int side = 0; side < 2; side++) {
-            sides->lower[side] = _mm_min_ps(sides->lower[side], half[h].sides.lower[side]);
-            sides->upper[side] = _mm_max_ps(sides->upper[side], half[h].sides.upper[side]);
-        }
-    /* [left A | right A | left B | right B]: swap right A with the end of
-     * left B, or left B with the start of right A. */
-    size_t right_a = mid - half[0].first_right, left_b = half[1].first_right - mid;
-    size_t moved = right_a < left_b ? right_a : left_b;
-    SwapRuns swap = { set->prims + half[0].first_right, set->prims + half[1].first_right - moved };
-    ptr_parallel_ranges(threads, 0, moved, swap_runs, &swap);
-    return half[0].first_right + left_b;
+        return partition_stable(set->prims, set->magnitude, c->begin, c->end, &test, scratch,
+                                sides);
+    return partition_blocks(set->prims, set->magnitude, c->begin, c->end, &test, sides);
 }
 
-PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, int middle,
-                    BvhPrim *scratch, BvhCandidate *left, BvhCandidate *right, PtrError *err)
+void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
+               BvhCandidate *left, BvhCandidate *right)
 {
     const size_t begin = c->begin, end = c->end;
     size_t mid = begin + (end - begin) / 2;
@@ -514,7 +345,7 @@ PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, i
     float side_box[2][2][3];
     const BvhCandidate whole = *c;
     if (!middle && whole.axis >= 0) {
-        mid = partition(set, threads, &whole, scratch, whole.sampled ? &sides : NULL);
+        mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
         for (int side = 0; side < 2; side++) {
             if (whole.sampled) {
                 store3(side_box[side][0], sides.lower[side]);
@@ -526,8 +357,6 @@ PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, i
                                          : side ? whole.right_upper : whole.left_upper;
         }
     }
-    PtrResult r = bvh_candidate_init(set, threads, left, begin, mid, box[0][0], box[0][1], err);
-    if (r != PTR_OK)
-        return r;
-    return bvh_candidate_init(set, threads, right, mid, end, box[1][0], box[1][1], err);
+    bvh_candidate_init(set, left, begin, mid, box[0][0], box[0][1]);
+    bvh_candidate_init(set, right, mid, end, box[1][0], box[1][1]);
 }

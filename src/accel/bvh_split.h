@@ -38,20 +38,17 @@ static inline float bvh_half_area(const float lo[3], const float hi[3])
 }
 
 /* Sets c to the range begin .. end - 1 with box lower, upper (NULL: find
- * it) and, if it has more prims than a leaf holds, finds its best split.
- * threads: how many may share the binning of a large range (1: the
- * calling thread's alone). Fails only for memory (see bvh_out_of_memory),
- * as bvh_split does. */
-PtrResult bvh_candidate_init(const BvhPrimSet *set, int threads, BvhCandidate *c, size_t begin,
-                             size_t end, const float lower[3], const float upper[3],
-                             PtrError *err);
+ * it) and, if it has more prims than a leaf holds, finds its best split. */
+void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
+                        const float lower[3], const float upper[3]);
+
+/* c's best split (c->axis at least 0) as its prims are tested against it. */
+BvhSplitTest bvh_split_test(const BvhCandidate *c);
 
 /* Splits c in two (into *left and *right, which may be c): by its best split,
  * or in the middle of its order if it has none or middle is set. scratch
- * (room for c's prims, or NULL) makes the partition faster. threads: how
- * many may share the partition and the halves' binning, as for
- * bvh_candidate_init. */
-PtrResult bvh_split(const BvhPrimSet *set, int threads, const BvhCandidate *c, int middle,
-                    BvhPrim *scratch, BvhCandidate *left, BvhCandidate *right, PtrError *err);
+ * (room for c's prims, or NULL) makes the partition faster. */
+void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
+               BvhCandidate *left, BvhCandidate *right);
 
 #endif /* PTR_BVH_SPLIT_H */
