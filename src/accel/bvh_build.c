@@ -632,14 +632,14 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
  * of the tree's spheres, evenly spaced, or all of them where they are no
  * more, each standing for as many of the tree's as there are to a sample.
  * Fails only for memory. */
-static PtrResult plan_root(const PtrSpheres *spheres, const size_t *huge_index,
+static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t *huge_index,
                            size_t huge_count, BvhRootChildren *plan, PtrError *err)
 {
     plan->count = 1;
     BvhPrimSet samples = { .prims = malloc(ROOT_SAMPLES * sizeof *samples.prims) };
     if (!samples.prims)
         return bvh_out_of_memory(err);
-    const size_t n = ptr_bvh_samples(spheres, huge_index, huge_count, samples.prims,
+    const size_t n = ptr_bvh_samples(spheres, threads, huge_index, huge_count, samples.prims,
                                      ROOT_SAMPLES, &samples.magnitude);
     if (n > 0) {
         BvhCandidate range, child[PTR_BVH_WIDTH];
@@ -672,7 +672,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK)
         r = ptr_bvh_huge(&tree_part, build.threads, huge, huge_index, &bvh->huge_count, err);
     if (r == PTR_OK)
-        r = plan_root(&tree_part, huge_index, bvh->huge_count, &root, err);
+        r = plan_root(&tree_part, build.threads, huge_index, bvh->huge_count, &root, err);
     if (r == PTR_OK)
         r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
                           build.set.prims, &prim_count, &build.set.magnitude, err);

@@ -178,25 +178,74 @@ PtrResult ptr_bvh_huge(const PtrSpheres *s, int threads, BvhPrim *huge, size_t *
 }
 
 /* What a sphere adds to the tree's magnitude. */
-static float sphere_magnitude(const PtrSpheres *s, size_t i)
+static float magnitude_of(PtrVec3 centre, float radius)
 {
-    return v3_max_abs(ptr_sphere_centre(s, i)) + s->radius[i];
+    return v3_max_abs(centre) + radius;
 }
 
-size_t ptr_bvh_samples(const PtrSpheres *s, const size_t *huge_index, size_t huge_count,
-                       BvhPrim *samples, size_t max, float *magnitude)
+static float sphere_magnitude(const PtrSpheres *s, size_t i)
 {
-    const size_t taken = s->count < max ? s->count : max;
+    return magnitude_of(ptr_sphere_centre(s, i), s->radius[i]);
+}
+
+/* Samples far apart are each a cache miss in every array: fetched this
+ * many samples ahead, they overlap. */
+enum { SAMPLES_AHEAD = 8 };
+
+typedef struct SampleCopy {
+    const PtrSpheres *spheres;
+    BvhPrim *samples;
+    size_t taken;
+} SampleCopy;
+
+/* The sphere sample j of taken is (no overflow: a tree takes fewer than
+ * 2^31 spheres, and taken is far below 2^32). */
+static size_t sample_sphere(const SampleCopy *c, size_t j)
+{
+    return j * c->spheres->count / c->taken;
+}
+
+static void copy_samples(void *arg, size_t begin, size_t end)
+{
+    const SampleCopy *c = arg;
+    const PtrSpheres *s = c->spheres;
+    for (size_t j = begin; j < end; j++) {
+        if (end - j > SAMPLES_AHEAD) {
+            const size_t i = sample_sphere(c, j + SAMPLES_AHEAD);
+            _mm_prefetch((const char *)&s->cx[i], _MM_HINT_T0);
+            _mm_prefetch((const char *)&s->cy[i], _MM_HINT_T0);
+            _mm_prefetch((const char *)&s->cz[i], _MM_HINT_T0);
+            _mm_prefetch((const char *)&s->radius[i], _MM_HINT_T0);
+            _mm_prefetch((const char *)s->material + i * s->material_size, _MM_HINT_T0);
+#define PREFETCH_ATTRIBUTE(name, type, per_sphere, none)                                   \
+    if (s->name)                                                                           \
+        _mm_prefetch((const char *)&s->name[(per_sphere) * i], _MM_HINT_T0);
+            PTR_SPHERE_ATTRIBUTES(PREFETCH_ATTRIBUTE)
+#undef PREFETCH_ATTRIBUTE
+        }
+        c->samples[j] = bvh_prim_of(s, sample_sphere(c, j));
+    }
+}
+
+size_t ptr_bvh_samples(const PtrSpheres *s, int threads, const size_t *huge_index,
+                       size_t huge_count, BvhPrim *samples, size_t max, float *magnitude)
+{
+    SampleCopy c = { s, samples, s->count < max ? s->count : max };
+    ptr_parallel_ranges(threads, 0, c.taken, copy_samples, &c);
+    /* The huge ones left out. */
     size_t count = 0, k = 0;
     *magnitude = 0.0f;
-    for (size_t j = 0; j < taken; j++) {
-        const size_t i = j * s->count / taken; /* below 2^15 * 2^31 */
+    for (size_t j = 0; j < c.taken; j++) {
+        const size_t i = sample_sphere(&c, j);
         while (k < huge_count && huge_index[k] < i)
             k++;
         if (k < huge_count && huge_index[k] == i)
             continue;
-        *magnitude = ptr_maxf(sphere_magnitude(s, i), *magnitude);
-        samples[count++] = bvh_prim_of(s, i);
+        const BvhPrim *p = &samples[j];
+        *magnitude = ptr_maxf(magnitude_of(v3(p->centre[0], p->centre[1], p->centre[2]),
+                                           p->radius),
+                              *magnitude);
+        samples[count++] = *p;
     }
     return count;
 }

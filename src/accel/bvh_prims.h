@@ -95,10 +95,11 @@ PtrResult ptr_bvh_huge(const PtrSpheres *spheres, int threads, BvhPrim *huge,
                        size_t *huge_index, size_t *huge_count, PtrError *err);
 
 /* Puts in samples up to max of the spheres but the huge ones (huge_index,
- * ascending), evenly spaced, or all of them if they are no more; returns
- * their count, and their magnitude (see ptr_bvh_prims) in *magnitude. */
-size_t ptr_bvh_samples(const PtrSpheres *spheres, const size_t *huge_index, size_t huge_count,
-                       BvhPrim *samples, size_t max, float *magnitude);
+ * ascending), evenly spaced, or all of them if they are no more, gathered
+ * on this many threads; returns their count, and their magnitude (see
+ * ptr_bvh_prims) in *magnitude. */
+size_t ptr_bvh_samples(const PtrSpheres *spheres, int threads, const size_t *huge_index,
+                       size_t huge_count, BvhPrim *samples, size_t max, float *magnitude);
 
 /* Puts a prim for each sphere but the huge ones (huge_index, ascending) in
  * prims, sorted into the children (in the arrays' order within each), their
