@@ -38,7 +38,8 @@ typedef struct PtrPageBank {
         char *at;
         size_t bytes;
     } run[PTR_PAGE_BANK_RUNS]; /* each one mapping of its own */
-    size_t runs, bytes;
+    size_t first, runs; /* those held: run[first .. runs - 1], oldest first */
+    size_t bytes;
     /* Moves the bank may still make (each may split a mapping), set at its
      * first put or take: see mapping_room in memory.c. */
     size_t moves_left;
