@@ -91,9 +91,9 @@ typedef struct Part {
     TaskList tasks;
 } Part;
 
-/* How build_node treats a node: the root, on all threads, makes parts of
- * its large children; a node of a part makes tasks of its small children
- * (both: its children of at most task_spheres); a node of a task splits on. */
+/* How make_node treats a node: the root makes parts of its large children;
+ * a node of a part makes tasks of its small children (both: its children of
+ * at most task_spheres); a node of a task splits on. */
 typedef enum NodeKind { NODE_ROOT, NODE_PART, NODE_TASK } NodeKind;
 
 /* The parts and tasks the threads share once the root is built: the parts
@@ -118,9 +118,9 @@ typedef struct Pool {
 
 typedef struct Build {
     BvhPrimSet set;
-    /* The build's threads: all of them split the root's ranges; a part or
-     * a task, run on one of them while the others run theirs, splits on its
-     * thread alone. */
+    /* The build's threads: all of them make the prims (ptr_bvh_prims); a
+     * part or a task, run on one of them while the others run theirs,
+     * splits on its thread alone. */
     int threads;
     size_t first_sphere; /* position of prims[0] in the reordered arrays */
     size_t task_spheres;
