@@ -26,10 +26,11 @@
  * which streamed memory at 1.8x on two threads (docs/intersectors.md, "The
  * root chosen before the copy").
  *
- * Threads: each of the root's children of more than task_spheres spheres (1/64 of all, at least
- * TASK_SPHERES_MIN: a rule of the sphere count alone) is a part: the rest
- * of the top level below it, built by one thread into its own node and task
- * arrays, while the other threads build other parts. (When every split of
+ * Threads: each of the root's children of more than task_spheres spheres
+ * (1/64 of all, at least TASK_SPHERES_MIN: a rule of the sphere count
+ * alone) is a part: the rest of the top level below it, built by one thread
+ * into its own node and task arrays, while the other threads build other
+ * parts. (When every split of
  * the top level was shared, each of some 300 at 10^6 handing work to the
  * others and back, the top level gained 1.2x from a second thread.) Every
  * subtree of at most task_spheres spheres is a task built by one thread
@@ -345,8 +346,8 @@ static int build_part(Build *build, Part *p)
     size_t root;
     bvh_candidate_init(&build->set, &range, p->range.begin, p->range.end, p->range.lower,
                        p->range.upper);
-    /* No scratch: a part is as large as 1/8 of the tree, the scratch of
-     * the tasks 1/64. */
+    /* No scratch: a part may hold most of the tree, a task's scratch is
+     * room for task_spheres. */
     return build_node(build, &p->nodes, &p->tasks, NULL, &range, NODE_PART, p->level, &root,
                       &p->nodes.depth, NULL) == PTR_OK;
 }
@@ -682,14 +683,23 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK && prim_count > 0) {
         /* Their ranges and boxes: the parts find their splits (build_part). */
         BvhCandidate child[PTR_BVH_WIDTH];
-        for (int k = 0; k < root.count; k++) {
+        int n = root.count;
+        for (int k = 0; k < n; k++) {
             child[k] = (BvhCandidate){ .begin = root.begin[k], .end = root.end[k], .axis = -1 };
             memcpy(child[k].lower, root.lower[k], sizeof child[k].lower);
             memcpy(child[k].upper, root.upper[k], sizeof child[k].upper);
         }
+        /* Samples that gave the root no split (all at one centre: the build
+         * splits such a range in the middle of its order, which no test of
+         * a prim can say) leave it to the prims, as any node. */
+        if (n == 1) {
+            BvhCandidate range;
+            bvh_candidate_init(&build.set, &range, 0, prim_count, root.lower[0], root.upper[0]);
+            grow_node(&build.set, NULL, &range, 0, 1.0, child, &n, NULL);
+        }
         size_t index;
-        r = make_node(&build, &top, &build.root_tasks, NULL, child, root.count, NODE_ROOT, 0,
-                      &index, &top.depth, err);
+        r = make_node(&build, &top, &build.root_tasks, NULL, child, n, NODE_ROOT, 0, &index,
+                      &top.depth, err);
         if (r == PTR_OK)
             r = run_pool(&build, err);
         if (r == PTR_OK)

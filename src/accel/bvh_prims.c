@@ -280,20 +280,16 @@ typedef struct RootSort {
 enum { CHUNK = 1024, NOT_IN_TREE = PTR_BVH_WIDTH };
 
 /* The children of spheres from .. to - 1 (at most CHUNK) in child[i -
- * from], NOT_IN_TREE for the huge ones: bvh_goes_right's arithmetic four
- * lanes at a time (centre + centre is 2 centre), each split moving the
- * lanes in its source that go right. Lanes past the last sphere read the
+ * from], NOT_IN_TREE for the huge ones: four at a time (bvh_bins4), each
+ * split moving the lanes in its source that go right. Lanes past the last sphere read the
  * arrays' padding (PTR_SPHERE_BLOCK entries) into child's last 3 entries. */
 static void children_of(const RootSort *r, size_t from, size_t to, uint8_t child[CHUNK + 3])
 {
     for (size_t i = from; i < to; i += 4) {
         __m128i in = _mm_setzero_si128();
         for (int s = 1; s < r->children; s++) {
-            const __m128 centre = _mm_loadu_ps(&r->key[s][i]);
-            const __m128 at = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(centre, centre), r->base[s]),
-                                         r->scale[s]);
             const __m128i bin =
-                _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(at, _mm_setzero_ps()), r->last[s]));
+                bvh_bins4(_mm_loadu_ps(&r->key[s][i]), r->base[s], r->scale[s], r->last[s]);
             const __m128i moves = _mm_and_si128(_mm_cmpgt_epi32(bin, r->split_bin[s]),
                                                 _mm_cmpeq_epi32(in, r->source[s]));
             in = _mm_or_si128(_mm_andnot_si128(moves, in),
@@ -309,6 +305,12 @@ static void children_of(const RootSort *r, size_t from, size_t to, uint8_t child
         child[r->huge_index[k] - from] = NOT_IN_TREE;
 }
 
+/* The end of block b's spheres. */
+static size_t block_end(const RootSort *r, size_t b)
+{
+    return r->spheres->count - b * BLOCK > BLOCK ? (b + 1) * BLOCK : r->spheres->count;
+}
+
 /* Counts blocks begin .. end - 1's prims in each child, and their
  * magnitude. */
 static void count_blocks(void *arg, size_t begin, size_t end)
@@ -320,9 +322,9 @@ static void count_blocks(void *arg, size_t begin, size_t end)
         size_t *count = r->place[b];
         float magnitude = 0.0f;
         memset(count, 0, PTR_BVH_WIDTH * sizeof *count);
-        const size_t block_end = s->count - b * BLOCK > BLOCK ? (b + 1) * BLOCK : s->count;
-        for (size_t from = b * BLOCK; from < block_end; from += CHUNK) {
-            const size_t to = block_end - from > CHUNK ? from + CHUNK : block_end;
+        const size_t end_b = block_end(r, b);
+        for (size_t from = b * BLOCK; from < end_b; from += CHUNK) {
+            const size_t to = end_b - from > CHUNK ? from + CHUNK : end_b;
             children_of(r, from, to, child);
             for (size_t i = from; i < to; i++)
                 if (child[i - from] != NOT_IN_TREE) {
@@ -350,9 +352,9 @@ static void copy_blocks(void *arg, size_t begin, size_t end)
             lower[k] = _mm_set1_ps(INFINITY);
             upper[k] = _mm_set1_ps(-INFINITY);
         }
-        const size_t block_end = s->count - b * BLOCK > BLOCK ? (b + 1) * BLOCK : s->count;
-        for (size_t from = b * BLOCK; from < block_end; from += CHUNK) {
-            const size_t to = block_end - from > CHUNK ? from + CHUNK : block_end;
+        const size_t end_b = block_end(r, b);
+        for (size_t from = b * BLOCK; from < end_b; from += CHUNK) {
+            const size_t to = end_b - from > CHUNK ? from + CHUNK : end_b;
             children_of(r, from, to, child);
             for (size_t i = from; i < to; i++) {
                 const int k = child[i - from];
@@ -375,6 +377,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
 {
     *prim_count = s->count - huge_count;
     *magnitude_out = 0.0f;
+    for (int k = 0; k < children->count; k++)
+        children->begin[k] = children->end[k] = 0;
     const size_t blocks = (s->count + BLOCK - 1) / BLOCK;
     RootSort r = { .spheres = s, .huge_index = huge_index, .huge_count = huge_count,
                    .children = children->count, .prims = prims };
@@ -444,11 +448,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
                 lower = _mm_min_ps(lower, r.lower[b][k]);
                 upper = _mm_max_ps(upper, r.upper[b][k]);
             }
-            float lanes[4];
-            _mm_storeu_ps(lanes, lower);
-            memcpy(children->lower[k], lanes, sizeof children->lower[k]);
-            _mm_storeu_ps(lanes, upper);
-            memcpy(children->upper[k], lanes, sizeof children->upper[k]);
+            bvh_store3(children->lower[k], lower);
+            bvh_store3(children->upper[k], upper);
         }
         *magnitude_out = blocks ? r.magnitude[0] : 0.0f;
     }

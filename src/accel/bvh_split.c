@@ -1,7 +1,6 @@
 #include "accel/bvh_split.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 enum { BINS = 32 };
@@ -45,14 +44,6 @@ static void bins_clear(Bins *b, int bins)
     bounds_empty(b->box_lo, b->box_hi);
 }
 
-/* The x, y and z lanes of v. */
-static void store3(float out[3], __m128 v)
-{
-    float lanes[4];
-    _mm_storeu_ps(lanes, v);
-    memcpy(out, lanes, 3 * sizeof *out);
-}
-
 /* bvh_half_area of the box in the x, y and z lanes of lo and hi: its
  * arithmetic in its order, (dx dy + dy dz) + dz dx, without storing the
  * lanes (the sweep over a candidate's bins asks it twice a bin). */
@@ -64,7 +55,7 @@ static inline float half_area4(__m128 lo, __m128 hi)
            _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
 }
 
-/* The box only (of a range split in the middle, or of the root). */
+/* The box only (of a task's range, or of the root's samples). */
 static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
 {
     for (size_t i = begin; i < end; i++) {
@@ -74,13 +65,11 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
     }
 }
 
-/* A prim's bins on the three axes at once, in k[0 .. 2]: bvh_goes_right's
- * arithmetic lane by lane (the radius lane, scaled by 0, gives bin 0). */
+/* A prim's bins on the three axes at once, in k[0 .. 2] (the radius lane,
+ * scaled by 0, gives bin 0). */
 static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre, int k[4])
 {
-    const __m128 at = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(centre, centre), base), scale);
-    const __m128i bins = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(at, _mm_setzero_ps()), last));
-    _mm_storeu_si128((__m128i *)k, bins);
+    _mm_storeu_si128((__m128i *)k, bvh_bins4(centre, base, scale, last));
 }
 
 /* Samples far apart are each a cache miss the hardware's prefetchers do
@@ -182,10 +171,10 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
                 best = cost;
                 c->axis = a;
                 c->split_bin = k;
-                store3(c->left_lower, lo4);
-                store3(c->left_upper, hi4);
-                store3(c->right_lower, right_lo[k + 1]);
-                store3(c->right_upper, right_hi[k + 1]);
+                bvh_store3(c->left_lower, lo4);
+                bvh_store3(c->left_upper, hi4);
+                bvh_store3(c->right_lower, right_lo[k + 1]);
+                bvh_store3(c->right_upper, right_hi[k + 1]);
             }
         }
     }
@@ -222,7 +211,7 @@ static inline void sides_add(SideBoxes *b, float magnitude, const BvhPrim *p, si
     b->upper[side] = _mm_max_ps(b->upper[side], upper);
 }
 
-/* Moves the prims begin .. end - 1 that go left by c's split before those
+/* Moves the prims begin .. end - 1 that go left by test before those
  * that go right, adding their boxes to *sides if given; returns the first
  * right one. Hoare's partition. */
 static size_t partition_run(BvhPrim *p, float magnitude, size_t begin, size_t end,
@@ -348,8 +337,8 @@ void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim
         mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
         for (int side = 0; side < 2; side++) {
             if (whole.sampled) {
-                store3(side_box[side][0], sides.lower[side]);
-                store3(side_box[side][1], sides.upper[side]);
+                bvh_store3(side_box[side][0], sides.lower[side]);
+                bvh_store3(side_box[side][1], sides.upper[side]);
             }
             box[side][0] = whole.sampled ? side_box[side][0]
                                          : side ? whole.right_lower : whole.left_lower;

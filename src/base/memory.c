@@ -99,8 +99,8 @@ static size_t count_lines(const char *path)
  * a mapping in two (the array's, or a run's), and a process holds at most
  * vm.max_map_count mappings (65,530 by default), past which most new
  * mappings (thread stacks, large blocks) fail: a bank takes at most a
- * quarter of the room left. At 10^8 spheres a stage makes about 8,500
- * moves and the process holds about 10,500 mappings at most. */
+ * quarter of the room left. At 10^8 spheres the tree's copy and its
+ * write-back each make all the moves they may, about 16,000. */
 static size_t mapping_room(void)
 {
     const uint64_t max = read_number("/proc/sys/vm/max_map_count");

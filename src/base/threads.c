@@ -176,9 +176,11 @@ void ptr_parallel_ranges(int threads, size_t begin, size_t end,
 {
     Piece pieces[PIECES_MAX];
     PtrThread *ids[PIECES_MAX];
-    const size_t n = threads < 1 ? 1 : threads > PIECES_MAX ? PIECES_MAX : (size_t)threads;
+    const size_t count = end - begin;
+    size_t n = threads < 1 ? 1 : threads > PIECES_MAX ? PIECES_MAX : (size_t)threads;
+    if (n > count) /* no thread started for an empty piece */
+        n = count ? count : 1;
     for (size_t i = 0; i < n; i++) {
-        const size_t count = end - begin;
         pieces[i] = (Piece){ fn, arg, begin + count * i / n, begin + count * (i + 1) / n };
         ids[i] = i > 0 ? ptr_thread_start(run_piece, &pieces[i]) : NULL;
     }
