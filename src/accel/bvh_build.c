@@ -30,11 +30,10 @@
  * (1/64 of all, at least TASK_SPHERES_MIN: a rule of the sphere count
  * alone) is a part: the rest of the top level below it, built by one thread
  * into its own node and task arrays, while the other threads build other
- * parts. (When every split of
- * the top level was shared, each of some 300 at 10^6 handing work to the
- * others and back, the top level gained 1.2x from a second thread.) Every
- * subtree of at most task_spheres spheres is a task built by one thread
- * into its own node array. The threads take the parts, then the tasks,
+ * parts. (When every split of the top level was shared, each of some 300
+ * at 10^6 handing work to the others and back, the top level gained 1.2x
+ * from a second thread.) Every subtree of at most task_spheres spheres is
+ * a task built by one thread into its own node array. The threads take the parts, then the tasks,
  * from one pool (see Pool). The arrays are laid out in the order a
  * depth-first build on one thread would have made them, so the tree's
  * bytes never depend on the number of threads. */

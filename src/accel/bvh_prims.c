@@ -281,8 +281,9 @@ enum { CHUNK = 1024, NOT_IN_TREE = PTR_BVH_WIDTH };
 
 /* The children of spheres from .. to - 1 (at most CHUNK) in child[i -
  * from], NOT_IN_TREE for the huge ones: four at a time (bvh_bins4), each
- * split moving the lanes in its source that go right. Lanes past the last sphere read the
- * arrays' padding (PTR_SPHERE_BLOCK entries) into child's last 3 entries. */
+ * split moving the lanes in its source that go right. Lanes past the last
+ * sphere read the arrays' padding (PTR_SPHERE_BLOCK entries) into child's
+ * last 3 entries. */
 static void children_of(const RootSort *r, size_t from, size_t to, uint8_t child[CHUNK + 3])
 {
     for (size_t i = from; i < to; i += 4) {
