@@ -17,6 +17,7 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
     memset(builder, 0, sizeof *builder);
     builder->scene = scene;
     builder->material_size = scene->spheres.material_size;
+    atomic_init(&builder->lost, 0);
     if (options) {
         builder->override = options->camera;
         builder->auto_projection = options->auto_projection;
@@ -93,13 +94,43 @@ static PtrResult start_optional(PtrSceneBuilder *b, size_t k, size_t filled, Ptr
     return PTR_OK;
 }
 
+/* Bytes of a sphere's centre and radius. */
+static size_t sphere_bytes(const PtrSceneBuilder *b)
+{
+    return 4 * (b->wide ? sizeof(double) : sizeof(float));
+}
+
+/* Whether the builder can keep x, y, z and radius as they are: doubles
+ * always, floats where each is one exactly (NaN is not, and so stays
+ * NaN for the checks that refuse it). */
+static int keeps(const PtrSceneBuilder *b, const double centre[3], double radius)
+{
+    return b->wide || ((double)(float)centre[0] == centre[0] &&
+                       (double)(float)centre[1] == centre[1] &&
+                       (double)(float)centre[2] == centre[2] && (double)(float)radius == radius);
+}
+
+static void set_sphere(PtrSceneBuilder *b, size_t i, const double centre[3], double radius)
+{
+    if (b->wide) {
+        double *d = (double *)b->spheres + 4 * i;
+        memcpy(d, centre, 3 * sizeof *d);
+        d[3] = radius;
+        return;
+    }
+    float *f = (float *)b->spheres + 4 * i;
+    for (int k = 0; k < 3; k++)
+        f[k] = (float)centre[k];
+    f[3] = (float)radius;
+}
+
 /* Resizes every array to capacity spheres (count stays below it). */
 static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
 {
-    if (capacity > SIZE_MAX / (4 * sizeof *b->spheres))
+    if (capacity > SIZE_MAX / (4 * sizeof(double)))
         return no_room(capacity, err);
     const size_t entries = capacity ? capacity : 1;
-    double *spheres = realloc(b->spheres, entries * 4 * sizeof *spheres);
+    void *spheres = realloc(b->spheres, entries * sphere_bytes(b));
     if (!spheres)
         return no_room(capacity, err);
     b->spheres = spheres;
@@ -152,11 +183,38 @@ static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
     return PTR_OK;
 }
 
+/* Makes the builder keep doubles: the floats of spheres 0 .. filled - 1
+ * (those after hold nothing yet) become the doubles they were given as, in
+ * place, from the last back (double k covers floats 2k and 2k + 1, read by
+ * then). */
+static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
+{
+    const size_t entries = b->capacity ? b->capacity : 1;
+    void *spheres = realloc(b->spheres, entries * 4 * sizeof(double));
+    if (!spheres)
+        return no_room(b->capacity, err);
+    const float *f = spheres;
+    double *d = spheres;
+    for (size_t i = 4 * filled; i-- > 0;)
+        d[i] = f[i];
+    b->spheres = spheres;
+    b->wide = 1;
+    return PTR_OK;
+}
+
+PtrResult ptr_builder_refill(PtrSceneBuilder *b, size_t filled, int *refill, PtrError *err)
+{
+    *refill = atomic_exchange(&b->lost, 0);
+    return *refill ? widen_spheres(b, filled, err) : PTR_OK;
+}
+
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,
                                  uint32_t material, PtrError *err)
 {
     assert(material < b->scene->material_count);
     PtrResult r = widen_to_scene(b, err);
+    if (r == PTR_OK && !keeps(b, centre, radius))
+        r = widen_spheres(b, b->count, err);
     if (r != PTR_OK)
         return r;
     if (b->count == b->capacity) {
@@ -167,11 +225,7 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], dou
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k))
             fill_none(b, k, b->count, b->count + 1);
-    double *s = &b->spheres[4 * b->count];
-    s[0] = centre[0];
-    s[1] = centre[1];
-    s[2] = centre[2];
-    s[3] = radius;
+    set_sphere(b, b->count, centre, radius);
     PtrSpheres column = material_column(b);
     ptr_sphere_set_material(&column, b->count++, material);
     return PTR_OK;
@@ -211,9 +265,10 @@ static void quantize_color(const double rgb[3], uint16_t *entry)
 void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3], double radius,
                              uint32_t material, const double *rgb)
 {
-    double *out = &b->spheres[4 * n];
-    memcpy(out, centre, 3 * sizeof *centre);
-    out[3] = radius;
+    if (keeps(b, centre, radius))
+        set_sphere(b, n, centre, radius);
+    else
+        atomic_store_explicit(&b->lost, 1, memory_order_relaxed);
     /* A material added since the spheres were would not fit their entries. */
     assert(material < b->scene->material_count);
     PtrSpheres column = material_column(b);
@@ -333,7 +388,8 @@ typedef struct Radii {
 } Radii;
 
 typedef struct RadiiPass {
-    const double *spheres;
+    const void *spheres; /* and wide: the builder's */
+    int wide;
     Radii radii[PIECES_MAX];
 } RadiiPass;
 
@@ -341,16 +397,20 @@ static void radii_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     RadiiPass *p = arg;
     Radii r = { INFINITY, -INFINITY };
+    const void *spheres = p->spheres;
+    const int wide = p->wide;
     for (size_t i = from; i < to; i++) {
-        r.smallest = least(r.smallest, p->spheres[4 * i + 3]);
-        r.largest = most(r.largest, p->spheres[4 * i + 3]);
+        double s[4];
+        ptr_builder_sphere(spheres, wide, i, s);
+        r.smallest = least(r.smallest, s[3]);
+        r.largest = most(r.largest, s[3]);
     }
     p->radii[piece] = r;
 }
 
 static Radii radii_of(const PtrSceneBuilder *b)
 {
-    RadiiPass p = { .spheres = b->spheres };
+    RadiiPass p = { .spheres = b->spheres, .wide = b->wide };
     const size_t pieces = over_pieces(b, radii_of_piece, &p);
     Radii r = { INFINITY, -INFINITY };
     for (size_t k = 0; k < pieces; k++) {
@@ -364,13 +424,14 @@ static Radii radii_of(const PtrSceneBuilder *b)
  * scene's origin is known (and for the scene's, when not recentred). */
 static const double world_origin[3] = { 0, 0, 0 };
 
-static int is_framed(const double *sphere, double smallest)
+static int is_framed(double radius, double smallest)
 {
-    return !(sphere[3] > SMALL_RATIO * smallest);
+    return !(radius > SMALL_RATIO * smallest);
 }
 
 typedef struct BoxPass {
-    const double *spheres;
+    const void *spheres; /* and wide: the builder's */
+    int wide;
     const double *origin; /* the box is of the spheres less this */
     double smallest;
     double lo[PIECES_MAX][3], hi[PIECES_MAX][3];
@@ -391,12 +452,24 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
     const __m128d origin_xy = _mm_loadu_pd(p->origin), origin_z = _mm_set_pd(0.0, p->origin[2]);
     __m128d lo_xy = _mm_setzero_pd(), lo_z = lo_xy, hi_xy = lo_xy, hi_z = lo_xy;
     int any = 0;
+    const void *spheres = p->spheres;
+    const int wide = p->wide;
     for (size_t i = from; i < to; i++) {
-        const double *s = &p->spheres[4 * i];
-        if (!is_framed(s, p->smallest))
+        /* Loaded as vectors: the four doubles stored one by one and loaded
+         * two at a time took two and a half times as long. */
+        __m128d xy, zr;
+        if (wide) {
+            xy = _mm_loadu_pd((const double *)spheres + 4 * i);
+            zr = _mm_loadu_pd((const double *)spheres + 4 * i + 2);
+        } else {
+            const __m128 f = _mm_loadu_ps((const float *)spheres + 4 * i);
+            xy = _mm_cvtps_pd(f);
+            zr = _mm_cvtps_pd(_mm_movehl_ps(f, f));
+        }
+        const __m128d r = _mm_unpackhi_pd(zr, zr);
+        if (!is_framed(_mm_cvtsd_f64(r), p->smallest))
             continue;
-        const __m128d zr = _mm_loadu_pd(s + 2), r = _mm_unpackhi_pd(zr, zr);
-        const __m128d c_xy = _mm_sub_pd(_mm_loadu_pd(s), origin_xy);
+        const __m128d c_xy = _mm_sub_pd(xy, origin_xy);
         const __m128d c_z = _mm_sub_pd(zr, origin_z);
         const __m128d l_xy = _mm_sub_pd(c_xy, r), l_z = _mm_sub_pd(c_z, r);
         const __m128d h_xy = _mm_add_pd(c_xy, r), h_z = _mm_add_pd(c_z, r);
@@ -420,7 +493,7 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 static int framed_box(const PtrSceneBuilder *b, double smallest, const double origin[3],
                       double lo[3], double hi[3])
 {
-    BoxPass p = { .spheres = b->spheres, .origin = origin, .smallest = smallest };
+    BoxPass p = { .spheres = b->spheres, .wide = b->wide, .origin = origin, .smallest = smallest };
     const size_t pieces = over_pieces(b, box_of_piece, &p);
     int any = 0;
     for (size_t piece = 0; piece < pieces; piece++) {
@@ -436,7 +509,8 @@ static int framed_box(const PtrSceneBuilder *b, double smallest, const double or
 }
 
 typedef struct PlanesPass {
-    const double *spheres;
+    const void *spheres; /* and wide: the builder's */
+    int wide;
     double smallest, ca, sa;
     int axis;
     double hi[PIECES_MAX], lo[PIECES_MAX];
@@ -447,9 +521,12 @@ static void planes_of_piece(void *arg, size_t piece, size_t from, size_t to)
     PlanesPass *p = arg;
     const int axis = p->axis;
     double hi = -INFINITY, lo = -INFINITY;
+    const void *spheres = p->spheres;
+    const int wide = p->wide;
     for (size_t i = from; i < to; i++) {
-        const double *s = &p->spheres[4 * i];
-        if (!is_framed(s, p->smallest))
+        double s[4];
+        ptr_builder_sphere(spheres, wide, i, s);
+        if (!is_framed(s[3], p->smallest))
             continue;
         hi = most(hi, s[axis] * p->ca + s[2] * p->sa + s[3]);
         lo = most(lo, -s[axis] * p->ca + s[2] * p->sa + s[3]);
@@ -469,8 +546,8 @@ static void planes_of_piece(void *arg, size_t piece, size_t from, size_t to)
 static void fit_axis(const PtrSceneBuilder *b, double smallest, int axis, double half_angle,
                      double *eye_axis, double *eye_z)
 {
-    PlanesPass p = { .spheres = b->spheres, .smallest = smallest, .ca = cos(half_angle),
-                     .sa = sin(half_angle), .axis = axis };
+    PlanesPass p = { .spheres = b->spheres, .wide = b->wide, .smallest = smallest,
+                     .ca = cos(half_angle), .sa = sin(half_angle), .axis = axis };
     const size_t pieces = over_pieces(b, planes_of_piece, &p);
     double hi = -INFINITY, lo = -INFINITY;
     for (size_t k = 0; k < pieces; k++) {
@@ -555,15 +632,21 @@ static PtrVec3 relative(const double p[3], const double origin[3])
 }
 
 typedef struct HugePass {
-    const double *spheres;
+    const void *spheres; /* and wide: the builder's */
+    int wide;
     PtrHugeChoice choice[PIECES_MAX];
 } HugePass;
 
 static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     HugePass *p = arg;
-    for (size_t i = from; i < to; i++)
-        ptr_huge_offer(&p->choice[piece], i, i, p->spheres[4 * i + 3]);
+    const void *spheres = p->spheres;
+    const int wide = p->wide;
+    for (size_t i = from; i < to; i++) {
+        double s[4];
+        ptr_builder_sphere(spheres, wide, i, s);
+        ptr_huge_offer(&p->choice[piece], i, i, s[3]);
+    }
 }
 
 /* The huge spheres (scene.h's rule) kept in double (accel/huge.h says why):
@@ -579,8 +662,8 @@ static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
  * out of its boxes). The box is taken relative to origin, as the scene
  * holds the spheres, and eye is too. Puts their indices in huge[],
  * ascending, and returns how many: none, without a pass of its own over
- * the spheres (3.2 GB at 10^8), if the largest radius is within the limit,
- * as in most scenes. */
+ * the spheres (1.6 GB at 10^8, 3.2 in doubles), if the largest radius is
+ * within the limit, as in most scenes. */
 #define HUGE_RATIO 256.0
 
 static size_t choose_huge(const PtrSceneBuilder *b, Radii radii, const double origin[3],
@@ -601,7 +684,7 @@ static size_t choose_huge(const PtrSceneBuilder *b, Radii radii, const double or
     const PtrHugeChoice choice_of_none = { .limit = HUGE_RATIO * extent };
     if (!(radii.largest > choice_of_none.limit)) /* ptr_huge_offer's test */
         return 0;
-    HugePass p = { .spheres = b->spheres };
+    HugePass p = { .spheres = b->spheres, .wide = b->wide };
     for (size_t k = 0; k < PIECES_MAX; k++)
         p.choice[k] = choice_of_none;
     const size_t pieces = over_pieces(b, huge_of_piece, &p);
@@ -613,13 +696,13 @@ static size_t choose_huge(const PtrSceneBuilder *b, Radii radii, const double or
     return choice.count;
 }
 
-/* Puts sphere i of the builder, its centre less origin (the scene's), at
- * entry at of the scene's arrays (its value at entry i: see PtrSpheres),
- * whose attributes and values exist if the builder's do. */
-static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, size_t at, const double origin[3],
-                            PtrError *err)
+/* Puts sphere i of the builder, d its centre and radius, its centre less
+ * origin (the scene's), at entry at of the scene's arrays (its value at
+ * entry i: see PtrSpheres), whose attributes and values exist if the
+ * builder's do. */
+static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, const double d[4], size_t at,
+                            const double origin[3], PtrError *err)
 {
-    const double *d = &b->spheres[4 * i];
     PtrVec3 c = relative(d, origin);
     float r = (float)d[3];
     if (!isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z) || !(r > 0.0f) || !isfinite(r))
@@ -660,11 +743,16 @@ static void move_spheres(void *arg, size_t begin, size_t end)
     SphereMove *m = arg;
     size_t before = ptr_huge_before(m->huge, m->huge_count, begin);
     int invalid = 0;
+    const void *spheres = m->builder->spheres;
+    const int wide = m->builder->wide;
     for (size_t i = begin; i < end; i++) {
-        if (before < m->huge_count && m->huge[before] == i)
+        if (before < m->huge_count && m->huge[before] == i) {
             before++;
-        else
-            invalid |= add_sphere(m->builder, i, i - before, m->origin, NULL) != PTR_OK;
+            continue;
+        }
+        double d[4];
+        ptr_builder_sphere(spheres, wide, i, d);
+        invalid |= add_sphere(m->builder, i, d, i - before, m->origin, NULL) != PTR_OK;
     }
     if (invalid)
         atomic_store(&m->invalid, 1);
@@ -674,7 +762,7 @@ static void move_spheres(void *arg, size_t begin, size_t end)
  * bank (see ptr_pages_put), for add_spheres, which has moved them. */
 static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_t end)
 {
-    ptr_pages_put(bank, b->spheres, begin * 4 * sizeof *b->spheres, end * 4 * sizeof *b->spheres);
+    ptr_pages_put(bank, b->spheres, begin * sphere_bytes(b), end * sphere_bytes(b));
     ptr_pages_put(bank, b->materials, begin * b->material_size, end * b->material_size);
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k)) {
@@ -686,10 +774,10 @@ static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_
 /* The spheres in file order, the huge ones last (then ids keep the file's
  * order; see PtrSpheres.id), with the huge ones in double as well, all
  * relative to origin: each centre less origin as it is moved (a pass of its
- * own over the builder's 32 bytes a sphere cost more than the subtraction).
- * Moved on all cores a step at a time, the builder's pages going to the
- * scene's arrays as they empty, so that 10^8 spheres are never in memory
- * twice. */
+ * own over the builder's 16 or 32 bytes a sphere cost more than the
+ * subtraction). Moved on all cores a step at a time, the builder's pages
+ * going to the scene's arrays as they empty, so that 10^8 spheres are
+ * never in memory twice. */
 static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origin[3],
                              int huge_in_double, PtrError *err)
 {
@@ -715,11 +803,12 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
             res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for the huge spheres");
     }
     for (size_t k = 0; k < huge_count && res == PTR_OK; k++) {
-        double *centre_radius = &scene->huge.centre_radius[4 * k];
+        double d[4], *centre_radius = &scene->huge.centre_radius[4 * k];
+        ptr_builder_sphere(b->spheres, b->wide, huge[k], d);
         for (int a = 0; a < 3; a++)
-            centre_radius[a] = b->spheres[4 * huge[k] + a] - origin[a];
-        centre_radius[3] = b->spheres[4 * huge[k] + 3];
-        res = add_sphere(b, huge[k], count - huge_count + k, origin, err);
+            centre_radius[a] = d[a] - origin[a];
+        centre_radius[3] = d[3];
+        res = add_sphere(b, huge[k], d, count - huge_count + k, origin, err);
     }
     SphereMove move = { .builder = b, .origin = origin, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
@@ -748,6 +837,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
 
 PtrResult ptr_builder_finish(PtrSceneBuilder *b, unsigned flags, PtrError *err)
 {
+    assert(!atomic_load(&b->lost)); /* every fill was followed by ptr_builder_refill */
     PtrScene *scene = b->scene;
     PtrResult res = PTR_OK;
     /* The framing, the orbit and the huge choice look at the spheres whose

@@ -285,9 +285,9 @@ static void convert_slots(void *arg, size_t begin, size_t end)
 }
 
 /* A node of this many slots or more is converted on all cores, and every
- * node PARALLEL_BLOCK slots at a time, the file's pages read given back
- * after each block. */
-enum { PARALLEL_PARTS = 1 << 15, PARALLEL_BLOCK = 1 << 20 };
+ * node a block at a time (ptr_builder_block_end), the file's pages read
+ * given back after each block. */
+enum { PARALLEL_PARTS = 1 << 15 };
 
 /* Gives back the file's pages read for slots begin .. end - 1 (see
  * gltf_doc_release): the instances' attributes, or the points' where no
@@ -505,17 +505,25 @@ static PtrResult start_run(Importer *im, NodeRun *run)
 }
 
 /* Converts the run's slots, on all cores where there are PARALLEL_PARTS or
- * more, a block at a time, and stops after a block where a slot failed. */
-static void convert_run(const Importer *im, NodeRun *run)
+ * more, a block at a time (again where the builder asks: see
+ * ptr_builder_refill), and stops after a block where a slot failed. Fails
+ * only for memory. */
+static PtrResult convert_run(const Importer *im, NodeRun *run)
 {
     const size_t slots = run->instances * run->slots;
     const int threads = slots >= PARALLEL_PARTS ? ptr_usable_cpus() : 1;
-    for (size_t begin = 0; begin < slots && atomic_load(&run->failed) == SIZE_MAX;
-         begin += PARALLEL_BLOCK) {
-        const size_t end = slots - begin > PARALLEL_BLOCK ? begin + PARALLEL_BLOCK : slots;
+    for (size_t begin = 0; begin < slots && atomic_load(&run->failed) == SIZE_MAX;) {
+        const size_t end = ptr_builder_block_end(begin, slots);
         ptr_parallel_ranges(threads, begin, end, convert_slots, run);
+        int refill;
+        if (ptr_builder_refill(run->builder, run->first + end, &refill, NULL) != PTR_OK)
+            return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
+        if (refill)
+            continue;
         release_slots(im, run, begin, end);
+        begin = end;
     }
+    return PTR_OK;
 }
 
 PtrResult gltf_add_node_spheres(Importer *im, size_t node_index, const GltfNode *node,
@@ -551,8 +559,9 @@ PtrResult gltf_add_node_spheres(Importer *im, size_t node_index, const GltfNode 
         res = run_mesh(im, &instance, &run, &first, &warned);
     if (res == PTR_OK)
         res = start_run(im, &run);
+    if (res == PTR_OK)
+        res = convert_run(im, &run);
     if (res == PTR_OK) {
-        convert_run(im, &run);
         const size_t failed = atomic_load(&run.failed);
         if (failed != SIZE_MAX)
             res = slot_error(im, &run, &instance, failed);

@@ -217,7 +217,10 @@ static PtrResult list_members(Expansion *e)
     return PTR_OK;
 }
 
-/* A block of this many spheres or more is filled on all cores. */
+/* A structure of this many spheres or more is filled on all cores, a
+ * block at a time (ptr_builder_block_end): where the builder stops keeping
+ * floats (a decimal coordinate seldom is one), that block is filled again,
+ * not the whole structure (ptr_builder_refill). */
 enum { PARALLEL_SPHERES = 1 << 15 };
 
 /* The spheres of the doc's atoms, or of its assembly: one white diffuse
@@ -255,9 +258,16 @@ static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const Str
           (valued && ptr_builder_keep_attributes(builder, 0, 1, NULL) != PTR_OK) ||
           ptr_builder_add_spheres(builder, spheres, 1, &e.first, NULL) != PTR_OK)))
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
-    if (res == PTR_OK)
-        ptr_parallel_ranges(spheres >= PARALLEL_SPHERES ? ptr_usable_cpus() : 1, 0, spheres,
-                            fill_slots, &e);
+    const int threads = spheres >= PARALLEL_SPHERES ? ptr_usable_cpus() : 1;
+    for (size_t begin = 0; res == PTR_OK && begin < spheres;) {
+        const size_t end = ptr_builder_block_end(begin, spheres);
+        ptr_parallel_ranges(threads, begin, end, fill_slots, &e);
+        int refill;
+        if (ptr_builder_refill(builder, e.first + end, &refill, NULL) != PTR_OK)
+            res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
+        else if (!refill)
+            begin = end;
+    }
     free(looks);
     free(e.slot_start);
     free(e.members);

@@ -1,7 +1,8 @@
 /* What every importer builds with (importers/builder.h): each sphere keeps
  * its material through the builder's entries, which are as wide as the
- * scene's and widen with it, whether a sphere is added alone or a batch is
- * added and filled. */
+ * scene's and widen with it, and its centre and radius through floats that
+ * widen to doubles, whether a sphere is added alone or a batch is added and
+ * filled. */
 #include <stdint.h>
 
 #include "builder.h"
@@ -63,10 +64,77 @@ static void test_material_widths(void)
     ptr_scene_free(&scene);
 }
 
+/* Each sphere of the finished scene is its centre less the camera's
+ * position, worked out in double and then rounded, and its radius rounded:
+ * the builder kept them all as they were given, floats or not. */
+static void check_kept(const PtrScene *scene, const double (*given)[4], size_t count,
+                       const double eye[3])
+{
+    CHECK_INT(scene->spheres.count, count);
+    size_t kept = 0;
+    for (size_t i = 0; i < count && i < scene->spheres.count; i++)
+        kept += scene->spheres.cx[i] == (float)(given[i][0] - eye[0]) &&
+                scene->spheres.cy[i] == (float)(given[i][1] - eye[1]) &&
+                scene->spheres.cz[i] == (float)(given[i][2] - eye[2]) &&
+                scene->spheres.radius[i] == (float)given[i][3];
+    CHECK_INT(kept, count);
+}
+
+/* Spheres whose values are all floats are kept as floats; the first value
+ * that is not one makes the builder keep doubles: added alone, at once;
+ * filled in a batch, once the filling is over, when the batch is filled
+ * again (ptr_builder_refill). Every value comes out as it was given, seen
+ * from a camera 2^24 + 1 from the origin, where floats are 2 apart and a
+ * value that went through a float would show. */
+static void test_float_until_not(void)
+{
+    enum { ALONE = 3, BATCH = 3, SPHERES = ALONE + BATCH + 1 };
+    const double given[SPHERES][4] = {
+        { 16777216.0, 0.5, -3.0, 0.25 },     /* floats: kept as floats */
+        { 16777218.0, -0.75, -3.0, 1.5 },
+        { 16777220.0, 1.0, -3.0, 0.125 },
+        { 16777222.0, 2.0, -3.0, 0.5 },      /* the batch: floats, */
+        { 16777217.0, 0.1, -3.0, 0.3 },      /* then values that are not */
+        { 16777224.0, -2.0, -3.0, 0.75 },
+        { 16777219.0, 3.0, -3.0, 0.2 },      /* alone, once wide */
+    };
+    PtrScene scene;
+    ptr_scene_init(&scene);
+    const uint32_t material = add_material(&scene);
+    PtrSceneBuilder b;
+    ptr_builder_init(&b, &scene, NULL);
+    for (size_t i = 0; i < ALONE; i++)
+        CHECK_INT(ptr_builder_add_sphere(&b, given[i], given[i][3], material, NULL), PTR_OK);
+    CHECK_INT(b.wide, 0);
+    size_t first = 0;
+    CHECK_INT(ptr_builder_add_spheres(&b, BATCH, 0, &first, NULL), PTR_OK);
+    int refill = -1, fills = 0;
+    do {
+        for (size_t k = 0; k < BATCH; k++)
+            ptr_builder_fill_sphere(&b, first + k, given[first + k], given[first + k][3],
+                                    material, NULL);
+        fills++;
+        CHECK_INT(ptr_builder_refill(&b, first + BATCH, &refill, NULL), PTR_OK);
+    } while (refill && fills < 3);
+    CHECK_INT(fills, 2);
+    CHECK_INT(b.wide, 1);
+    CHECK_INT(ptr_builder_add_sphere(&b, given[SPHERES - 1], given[SPHERES - 1][3], material,
+                                     NULL),
+              PTR_OK);
+    const double eye[3] = { 16777217.0, 0, 10 }, at[3] = { 16777217.0, 0, -3 },
+                 up[3] = { 0, 1, 0 };
+    const PtrCamera lens = { .vfov_deg = 40.0f, .focus_distance = 13.0f };
+    ptr_builder_set_camera(&b, eye, at, up, &lens);
+    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
+    check_kept(&scene, given, SPHERES, eye);
+    ptr_scene_free(&scene);
+}
+
 int main(void)
 {
     const TestCase cases[] = {
         TEST_CASE(test_material_widths),
+        TEST_CASE(test_float_until_not),
     };
     TEST_RUN(cases);
     return test_report();
