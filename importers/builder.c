@@ -186,17 +186,20 @@ static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
 /* Makes the builder keep doubles: the floats of spheres 0 .. filled - 1
  * (those after hold nothing yet) become the doubles they were given as, in
  * place, from the last back (double k covers floats 2k and 2k + 1, read by
- * then). */
+ * then; each through memcpy, which tells the compiler that a double's store
+ * may change the floats it reads next). */
 static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
 {
     const size_t entries = b->capacity ? b->capacity : 1;
-    void *spheres = realloc(b->spheres, entries * 4 * sizeof(double));
+    unsigned char *spheres = realloc(b->spheres, entries * 4 * sizeof(double));
     if (!spheres)
         return no_room(b->capacity, err);
-    const float *f = spheres;
-    double *d = spheres;
-    for (size_t i = 4 * filled; i-- > 0;)
-        d[i] = f[i];
+    for (size_t k = 4 * (filled < b->count ? filled : b->count); k-- > 0;) {
+        float f;
+        memcpy(&f, spheres + k * sizeof f, sizeof f);
+        const double d = f;
+        memcpy(spheres + k * sizeof d, &d, sizeof d);
+    }
     b->spheres = spheres;
     b->wide = 1;
     return PTR_OK;
