@@ -187,9 +187,13 @@ static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
  * (those after hold nothing yet) become the doubles they were given as, in
  * place, from the last back (double k covers floats 2k and 2k + 1, read by
  * then; each through memcpy, which tells the compiler that a double's store
- * may change the floats it reads next). */
+ * may change the floats it reads next). The spheres a lost fill left
+ * unwritten are converted too, from whatever their bytes were: they are
+ * filled again. */
 static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
 {
+    if (b->wide)
+        return PTR_OK;
     const size_t entries = b->capacity ? b->capacity : 1;
     unsigned char *spheres = realloc(b->spheres, entries * 4 * sizeof(double));
     if (!spheres)
@@ -207,8 +211,14 @@ static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
 
 PtrResult ptr_builder_refill(PtrSceneBuilder *b, size_t filled, int *refill, PtrError *err)
 {
-    *refill = atomic_exchange(&b->lost, 0);
-    return *refill ? widen_spheres(b, filled, err) : PTR_OK;
+    *refill = atomic_load(&b->lost);
+    if (!*refill)
+        return PTR_OK;
+    /* Lost stays set where widening fails: the spheres are not all kept. */
+    const PtrResult r = widen_spheres(b, filled, err);
+    if (r == PTR_OK)
+        atomic_store(&b->lost, 0);
+    return r;
 }
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,

@@ -58,9 +58,10 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
 void ptr_builder_free(PtrSceneBuilder *builder);
 
 /* Makes room for count spheres, for an importer that knows how many it will
- * add: its arrays are then allocated once, not doubled as they fill. This
- * and the functions below that add to the builder fail only for memory
- * (PTR_ERR_NOMEM, said in err, which may be NULL). */
+ * add: its arrays are then allocated once (the centres once more if they
+ * widen to doubles), not doubled as they fill. This and the functions below
+ * that add to the builder fail only for memory (PTR_ERR_NOMEM, said in err,
+ * which may be NULL). */
 PtrResult ptr_builder_reserve(PtrSceneBuilder *builder, size_t count, PtrError *err);
 
 /* material: an index the scene has when the sphere is added, here or by
@@ -70,9 +71,10 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
                                  double radius, uint32_t material, PtrError *err);
 
 /* Adds count spheres at once for an importer that fills them itself, on as
- * many threads as it likes: for each sphere first + i, the centre and radius
- * at spheres[4 * (first + i)], the material, and with with_colors the
- * colour at color[4 * (first + i)] (see ptr_color_quantize). */
+ * many threads as it likes (ptr_builder_fill_sphere, then
+ * ptr_builder_refill): for each sphere first + i, the centre and radius,
+ * the material, and with with_colors the colour at color[4 * (first + i)]
+ * (see ptr_color_quantize). */
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
                                   size_t *first, PtrError *err);
 

@@ -19,10 +19,11 @@ PtrResult ptr_import_structure(const char *path, const PtrImportOptions *options
 PtrResult ptr_import_finish(PtrSceneBuilder *builder, const char *path, PtrError *err);
 
 /* Bytes a sphere takes at the peak of its import and the tree's build
- * (bench/scale.sh measures 41 to 44 a sphere above a one-sphere render from
- * 10^6 to 10^8 spheres with their own colours: the import's builder, 32 of
- * centre and radius in double, 8 of colour and the material's index, just
- * before it is moved into the scene), with room for a --color-by value. */
+ * (bench/scale.sh measures 37 to 44 a sphere above a one-sphere render from
+ * 10^6 to 10^8 spheres with their own colours: the tree's prims, 32, and
+ * its nodes; an import whose coordinates are not floats holds 41 at its
+ * own peak, the builder's 32 of centre and radius in double, 8 of colour
+ * and the material's index), with room for a --color-by value. */
 #define PTR_SPHERE_PEAK_BYTES 64
 
 /* Before a file's spheres are allocated: refuses (PTR_ERR_NOMEM, one line

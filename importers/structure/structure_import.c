@@ -217,10 +217,10 @@ static PtrResult list_members(Expansion *e)
     return PTR_OK;
 }
 
-/* A structure of this many spheres or more is filled on all cores, a
- * block at a time (ptr_builder_block_end): where the builder stops keeping
- * floats (a decimal coordinate seldom is one), that block is filled again,
- * not the whole structure (ptr_builder_refill). */
+/* A structure of this many spheres or more is filled on all cores. Every
+ * structure is filled a block at a time (ptr_builder_block_end): where the
+ * builder stops keeping floats (a decimal coordinate seldom is one), that
+ * block is filled again, not the whole structure (ptr_builder_refill). */
 enum { PARALLEL_SPHERES = 1 << 15 };
 
 /* The spheres of the doc's atoms, or of its assembly: one white diffuse

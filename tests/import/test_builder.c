@@ -80,12 +80,24 @@ static void check_kept(const PtrScene *scene, const double (*given)[4], size_t c
     CHECK_INT(kept, count);
 }
 
+/* The camera test_float_until_not's spheres are seen from, 2^24 + 1 from
+ * the origin, where floats are 2 apart and a value that went through a float
+ * would show. */
+static void finish_far(PtrSceneBuilder *b, const double eye[3])
+{
+    const double at[3] = { eye[0], eye[1], -3 }, up[3] = { 0, 1, 0 };
+    const PtrCamera lens = { .vfov_deg = 40.0f, .focus_distance = 13.0f };
+    ptr_builder_set_camera(b, eye, at, up, &lens);
+    CHECK_INT(ptr_builder_finish(b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
+}
+
 /* Spheres whose values are all floats are kept as floats; the first value
- * that is not one makes the builder keep doubles: added alone, at once;
- * filled in a batch, once the filling is over, when the batch is filled
- * again (ptr_builder_refill). Every value comes out as it was given, seen
- * from a camera 2^24 + 1 from the origin, where floats are 2 apart and a
- * value that went through a float would show. */
+ * that is not one makes the builder keep doubles. Filled in a batch, once
+ * the filling is over: the batch is filled in two blocks, of which the
+ * second, which has the value, is filled again (ptr_builder_refill), the
+ * first's floats kept through the widening. Added alone, at once: also
+ * where the builder is full, so that widening and growing follow each
+ * other. Every value comes out as it was given. */
 static void test_float_until_not(void)
 {
     enum { ALONE = 3, BATCH = 3, SPHERES = ALONE + BATCH + 1 };
@@ -93,11 +105,12 @@ static void test_float_until_not(void)
         { 16777216.0, 0.5, -3.0, 0.25 },     /* floats: kept as floats */
         { 16777218.0, -0.75, -3.0, 1.5 },
         { 16777220.0, 1.0, -3.0, 0.125 },
-        { 16777222.0, 2.0, -3.0, 0.5 },      /* the batch: floats, */
-        { 16777217.0, 0.1, -3.0, 0.3 },      /* then values that are not */
+        { 16777222.0, 2.0, -3.0, 0.5 },      /* the batch's first block: floats */
+        { 16777217.0, 0.1, -3.0, 0.3 },      /* its second: values that are not */
         { 16777224.0, -2.0, -3.0, 0.75 },
         { 16777219.0, 3.0, -3.0, 0.2 },      /* alone, once wide */
     };
+    const double eye[3] = { 16777217.0, 0, 10 };
     PtrScene scene;
     ptr_scene_init(&scene);
     const uint32_t material = add_material(&scene);
@@ -108,25 +121,42 @@ static void test_float_until_not(void)
     CHECK_INT(b.wide, 0);
     size_t first = 0;
     CHECK_INT(ptr_builder_add_spheres(&b, BATCH, 0, &first, NULL), PTR_OK);
-    int refill = -1, fills = 0;
-    do {
-        for (size_t k = 0; k < BATCH; k++)
-            ptr_builder_fill_sphere(&b, first + k, given[first + k], given[first + k][3],
-                                    material, NULL);
-        fills++;
-        CHECK_INT(ptr_builder_refill(&b, first + BATCH, &refill, NULL), PTR_OK);
-    } while (refill && fills < 3);
-    CHECK_INT(fills, 2);
-    CHECK_INT(b.wide, 1);
+    const size_t blocks[][2] = { { first, first + 1 }, { first + 1, first + BATCH } };
+    int fills[2] = { 0, 0 };
+    for (size_t k = 0; k < 2; k++) {
+        int refill = 1;
+        while (refill && fills[k] < 3) {
+            for (size_t n = blocks[k][0]; n < blocks[k][1]; n++)
+                ptr_builder_fill_sphere(&b, n, given[n], given[n][3], material, NULL);
+            fills[k]++;
+            CHECK_INT(ptr_builder_refill(&b, blocks[k][1], &refill, NULL), PTR_OK);
+        }
+        CHECK_INT(b.wide, (int)k);
+    }
+    CHECK_INT(fills[0], 1);
+    CHECK_INT(fills[1], 2);
     CHECK_INT(ptr_builder_add_sphere(&b, given[SPHERES - 1], given[SPHERES - 1][3], material,
                                      NULL),
               PTR_OK);
-    const double eye[3] = { 16777217.0, 0, 10 }, at[3] = { 16777217.0, 0, -3 },
-                 up[3] = { 0, 1, 0 };
-    const PtrCamera lens = { .vfov_deg = 40.0f, .focus_distance = 13.0f };
-    ptr_builder_set_camera(&b, eye, at, up, &lens);
-    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
+    finish_far(&b, eye);
     check_kept(&scene, given, SPHERES, eye);
+    ptr_scene_free(&scene);
+
+    /* Alone into a full builder of floats. */
+    const double alone[3][4] = { { 16777216.0, 0.5, -3.0, 0.25 },
+                                 { 16777218.0, -0.75, -3.0, 1.5 },
+                                 { 16777217.0, 0.1, -3.0, 0.3 } };
+    ptr_scene_init(&scene);
+    const uint32_t grey = add_material(&scene);
+    ptr_builder_init(&b, &scene, NULL);
+    CHECK_INT(ptr_builder_reserve(&b, 2, NULL), PTR_OK);
+    for (size_t i = 0; i < 3; i++) {
+        CHECK_INT(b.count == b.capacity, i == 2);
+        CHECK_INT(ptr_builder_add_sphere(&b, alone[i], alone[i][3], grey, NULL), PTR_OK);
+        CHECK_INT(b.wide, i == 2);
+    }
+    finish_far(&b, eye);
+    check_kept(&scene, alone, 3, eye);
     ptr_scene_free(&scene);
 }
 
