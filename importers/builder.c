@@ -58,9 +58,9 @@ static uint32_t **optional_array(PtrSceneBuilder *b, size_t k)
 
 void ptr_builder_free(PtrSceneBuilder *builder)
 {
-    free(builder->spheres);
+    free(builder->spheres.data);
     free(builder->materials);
-    builder->spheres = NULL;
+    builder->spheres = (PtrBuilderSpheres){ 0 };
     builder->materials = NULL;
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
         free(*optional_array(builder, k));
@@ -97,7 +97,7 @@ static PtrResult start_optional(PtrSceneBuilder *b, size_t k, size_t filled, Ptr
 /* Bytes of a sphere's centre and radius. */
 static size_t sphere_bytes(const PtrSceneBuilder *b)
 {
-    return 4 * (b->wide ? sizeof(double) : sizeof(float));
+    return 4 * (b->spheres.wide ? sizeof(double) : sizeof(float));
 }
 
 /* Whether the builder can keep x, y, z and radius as they are: doubles
@@ -105,20 +105,20 @@ static size_t sphere_bytes(const PtrSceneBuilder *b)
  * NaN for the checks that refuse it). */
 static int keeps(const PtrSceneBuilder *b, const double centre[3], double radius)
 {
-    return b->wide || ((double)(float)centre[0] == centre[0] &&
+    return b->spheres.wide || ((double)(float)centre[0] == centre[0] &&
                        (double)(float)centre[1] == centre[1] &&
                        (double)(float)centre[2] == centre[2] && (double)(float)radius == radius);
 }
 
 static void set_sphere(PtrSceneBuilder *b, size_t i, const double centre[3], double radius)
 {
-    if (b->wide) {
-        double *d = (double *)b->spheres + 4 * i;
+    if (b->spheres.wide) {
+        double *d = (double *)b->spheres.data + 4 * i;
         memcpy(d, centre, 3 * sizeof *d);
         d[3] = radius;
         return;
     }
-    float *f = (float *)b->spheres + 4 * i;
+    float *f = (float *)b->spheres.data + 4 * i;
     for (int k = 0; k < 3; k++)
         f[k] = (float)centre[k];
     f[3] = (float)radius;
@@ -130,10 +130,10 @@ static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
     if (capacity > SIZE_MAX / (4 * sizeof(double)))
         return no_room(capacity, err);
     const size_t entries = capacity ? capacity : 1;
-    void *spheres = realloc(b->spheres, entries * sphere_bytes(b));
+    void *spheres = realloc(b->spheres.data, entries * sphere_bytes(b));
     if (!spheres)
         return no_room(capacity, err);
-    b->spheres = spheres;
+    b->spheres.data = spheres;
     void *materials = realloc(b->materials, entries * b->material_size);
     if (!materials)
         return no_room(capacity, err);
@@ -192,10 +192,10 @@ static PtrResult widen_to_scene(PtrSceneBuilder *b, PtrError *err)
  * filled again. */
 static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
 {
-    if (b->wide)
+    if (b->spheres.wide)
         return PTR_OK;
     const size_t entries = b->capacity ? b->capacity : 1;
-    unsigned char *spheres = realloc(b->spheres, entries * 4 * sizeof(double));
+    unsigned char *spheres = realloc(b->spheres.data, entries * 4 * sizeof(double));
     if (!spheres)
         return no_room(b->capacity, err);
     for (size_t k = 4 * (filled < b->count ? filled : b->count); k-- > 0;) {
@@ -204,8 +204,7 @@ static PtrResult widen_spheres(PtrSceneBuilder *b, size_t filled, PtrError *err)
         const double d = f;
         memcpy(spheres + k * sizeof d, &d, sizeof d);
     }
-    b->spheres = spheres;
-    b->wide = 1;
+    b->spheres = (PtrBuilderSpheres){ spheres, 1 };
     return PTR_OK;
 }
 
@@ -401,8 +400,7 @@ typedef struct Radii {
 } Radii;
 
 typedef struct RadiiPass {
-    const void *spheres; /* and wide: the builder's */
-    int wide;
+    PtrBuilderSpheres spheres;
     Radii radii[PIECES_MAX];
 } RadiiPass;
 
@@ -410,11 +408,10 @@ static void radii_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     RadiiPass *p = arg;
     Radii r = { INFINITY, -INFINITY };
-    const void *spheres = p->spheres;
-    const int wide = p->wide;
+    const PtrBuilderSpheres spheres = p->spheres;
     for (size_t i = from; i < to; i++) {
         double s[4];
-        ptr_builder_sphere(spheres, wide, i, s);
+        ptr_builder_sphere(spheres, i, s);
         r.smallest = least(r.smallest, s[3]);
         r.largest = most(r.largest, s[3]);
     }
@@ -423,7 +420,7 @@ static void radii_of_piece(void *arg, size_t piece, size_t from, size_t to)
 
 static Radii radii_of(const PtrSceneBuilder *b)
 {
-    RadiiPass p = { .spheres = b->spheres, .wide = b->wide };
+    RadiiPass p = { .spheres = b->spheres };
     const size_t pieces = over_pieces(b, radii_of_piece, &p);
     Radii r = { INFINITY, -INFINITY };
     for (size_t k = 0; k < pieces; k++) {
@@ -443,8 +440,7 @@ static int is_framed(double radius, double smallest)
 }
 
 typedef struct BoxPass {
-    const void *spheres; /* and wide: the builder's */
-    int wide;
+    PtrBuilderSpheres spheres;
     const double *origin; /* the box is of the spheres less this */
     double smallest;
     double lo[PIECES_MAX][3], hi[PIECES_MAX][3];
@@ -465,17 +461,16 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
     const __m128d origin_xy = _mm_loadu_pd(p->origin), origin_z = _mm_set_pd(0.0, p->origin[2]);
     __m128d lo_xy = _mm_setzero_pd(), lo_z = lo_xy, hi_xy = lo_xy, hi_z = lo_xy;
     int any = 0;
-    const void *spheres = p->spheres;
-    const int wide = p->wide;
+    const PtrBuilderSpheres spheres = p->spheres;
     for (size_t i = from; i < to; i++) {
         /* Loaded as vectors: the four doubles stored one by one and loaded
          * two at a time took two and a half times as long. */
         __m128d xy, zr;
-        if (wide) {
-            xy = _mm_loadu_pd((const double *)spheres + 4 * i);
-            zr = _mm_loadu_pd((const double *)spheres + 4 * i + 2);
+        if (spheres.wide) {
+            xy = _mm_loadu_pd((const double *)spheres.data + 4 * i);
+            zr = _mm_loadu_pd((const double *)spheres.data + 4 * i + 2);
         } else {
-            const __m128 f = _mm_loadu_ps((const float *)spheres + 4 * i);
+            const __m128 f = _mm_loadu_ps((const float *)spheres.data + 4 * i);
             xy = _mm_cvtps_pd(f);
             zr = _mm_cvtps_pd(_mm_movehl_ps(f, f));
         }
@@ -506,7 +501,7 @@ static void box_of_piece(void *arg, size_t piece, size_t from, size_t to)
 static int framed_box(const PtrSceneBuilder *b, double smallest, const double origin[3],
                       double lo[3], double hi[3])
 {
-    BoxPass p = { .spheres = b->spheres, .wide = b->wide, .origin = origin, .smallest = smallest };
+    BoxPass p = { .spheres = b->spheres, .origin = origin, .smallest = smallest };
     const size_t pieces = over_pieces(b, box_of_piece, &p);
     int any = 0;
     for (size_t piece = 0; piece < pieces; piece++) {
@@ -522,8 +517,7 @@ static int framed_box(const PtrSceneBuilder *b, double smallest, const double or
 }
 
 typedef struct PlanesPass {
-    const void *spheres; /* and wide: the builder's */
-    int wide;
+    PtrBuilderSpheres spheres;
     double smallest, ca, sa;
     int axis;
     double hi[PIECES_MAX], lo[PIECES_MAX];
@@ -534,11 +528,10 @@ static void planes_of_piece(void *arg, size_t piece, size_t from, size_t to)
     PlanesPass *p = arg;
     const int axis = p->axis;
     double hi = -INFINITY, lo = -INFINITY;
-    const void *spheres = p->spheres;
-    const int wide = p->wide;
+    const PtrBuilderSpheres spheres = p->spheres;
     for (size_t i = from; i < to; i++) {
         double s[4];
-        ptr_builder_sphere(spheres, wide, i, s);
+        ptr_builder_sphere(spheres, i, s);
         if (!is_framed(s[3], p->smallest))
             continue;
         hi = most(hi, s[axis] * p->ca + s[2] * p->sa + s[3]);
@@ -559,7 +552,7 @@ static void planes_of_piece(void *arg, size_t piece, size_t from, size_t to)
 static void fit_axis(const PtrSceneBuilder *b, double smallest, int axis, double half_angle,
                      double *eye_axis, double *eye_z)
 {
-    PlanesPass p = { .spheres = b->spheres, .wide = b->wide, .smallest = smallest,
+    PlanesPass p = { .spheres = b->spheres, .smallest = smallest,
                      .ca = cos(half_angle), .sa = sin(half_angle), .axis = axis };
     const size_t pieces = over_pieces(b, planes_of_piece, &p);
     double hi = -INFINITY, lo = -INFINITY;
@@ -645,19 +638,17 @@ static PtrVec3 relative(const double p[3], const double origin[3])
 }
 
 typedef struct HugePass {
-    const void *spheres; /* and wide: the builder's */
-    int wide;
+    PtrBuilderSpheres spheres;
     PtrHugeChoice choice[PIECES_MAX];
 } HugePass;
 
 static void huge_of_piece(void *arg, size_t piece, size_t from, size_t to)
 {
     HugePass *p = arg;
-    const void *spheres = p->spheres;
-    const int wide = p->wide;
+    const PtrBuilderSpheres spheres = p->spheres;
     for (size_t i = from; i < to; i++) {
         double s[4];
-        ptr_builder_sphere(spheres, wide, i, s);
+        ptr_builder_sphere(spheres, i, s);
         ptr_huge_offer(&p->choice[piece], i, i, s[3]);
     }
 }
@@ -697,7 +688,7 @@ static size_t choose_huge(const PtrSceneBuilder *b, Radii radii, const double or
     const PtrHugeChoice choice_of_none = { .limit = HUGE_RATIO * extent };
     if (!(radii.largest > choice_of_none.limit)) /* ptr_huge_offer's test */
         return 0;
-    HugePass p = { .spheres = b->spheres, .wide = b->wide };
+    HugePass p = { .spheres = b->spheres };
     for (size_t k = 0; k < PIECES_MAX; k++)
         p.choice[k] = choice_of_none;
     const size_t pieces = over_pieces(b, huge_of_piece, &p);
@@ -756,15 +747,14 @@ static void move_spheres(void *arg, size_t begin, size_t end)
     SphereMove *m = arg;
     size_t before = ptr_huge_before(m->huge, m->huge_count, begin);
     int invalid = 0;
-    const void *spheres = m->builder->spheres;
-    const int wide = m->builder->wide;
+    const PtrBuilderSpheres spheres = m->builder->spheres;
     for (size_t i = begin; i < end; i++) {
         if (before < m->huge_count && m->huge[before] == i) {
             before++;
             continue;
         }
         double d[4];
-        ptr_builder_sphere(spheres, wide, i, d);
+        ptr_builder_sphere(spheres, i, d);
         invalid |= add_sphere(m->builder, i, d, i - before, m->origin, NULL) != PTR_OK;
     }
     if (invalid)
@@ -775,7 +765,7 @@ static void move_spheres(void *arg, size_t begin, size_t end)
  * bank (see ptr_pages_put), for add_spheres, which has moved them. */
 static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_t end)
 {
-    ptr_pages_put(bank, b->spheres, begin * sphere_bytes(b), end * sphere_bytes(b));
+    ptr_pages_put(bank, b->spheres.data, begin * sphere_bytes(b), end * sphere_bytes(b));
     ptr_pages_put(bank, b->materials, begin * b->material_size, end * b->material_size);
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k)) {
@@ -817,7 +807,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
     }
     for (size_t k = 0; k < huge_count && res == PTR_OK; k++) {
         double d[4], *centre_radius = &scene->huge.centre_radius[4 * k];
-        ptr_builder_sphere(b->spheres, b->wide, huge[k], d);
+        ptr_builder_sphere(b->spheres, huge[k], d);
         for (int a = 0; a < 3; a++)
             centre_radius[a] = d[a] - origin[a];
         centre_radius[3] = d[3];

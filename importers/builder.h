@@ -20,14 +20,18 @@
 #include "import_options.h"
 #include "scene/scene.h"
 
+/* x, y, z, radius of each sphere: floats while every value given is a
+ * float exactly (as a file's float coordinates under no transform are),
+ * else doubles (wide). Either way they are the doubles given: at 10^8
+ * spheres, 1.6 GB where doubles took 3.2. */
+typedef struct PtrBuilderSpheres {
+    void *data;
+    int wide;
+} PtrBuilderSpheres;
+
 typedef struct PtrSceneBuilder {
     PtrScene *scene;  /* materials, sky and size go to it directly */
-    /* x, y, z, radius of each sphere: floats while every value given is a
-     * float exactly (as a file's float coordinates under no transform
-     * are), else doubles (wide). Either way they are the doubles given: at
-     * 10^8 spheres, 1.6 GB where doubles took 3.2. */
-    void *spheres;
-    int wide;
+    PtrBuilderSpheres spheres;
     /* A fill in floats met a value that is not one (see ptr_builder_refill). */
     atomic_int lost;
     /* Each sphere's material, material_size bytes an entry: as wide as the
@@ -106,18 +110,18 @@ static inline size_t ptr_builder_block_end(size_t begin, size_t count)
 PtrResult ptr_builder_refill(PtrSceneBuilder *builder, size_t filled, int *refill,
                              PtrError *err);
 
-/* Sphere i's x, y, z and radius, as they were given, from the builder's
- * spheres and wide: a loop over many keeps those two in locals, so that the
- * compiler can make a loop of each kind. */
-static inline void ptr_builder_sphere(const void *spheres, int wide, size_t i, double s[4])
+/* Sphere i's x, y, z and radius, as they were given. Taken by value, so
+ * that a loop over many holds the array and its width in locals, and the
+ * compiler can make a loop of each width. */
+static inline void ptr_builder_sphere(PtrBuilderSpheres spheres, size_t i, double s[4])
 {
-    if (wide) {
-        const double *d = (const double *)spheres + 4 * i;
+    if (spheres.wide) {
+        const double *d = (const double *)spheres.data + 4 * i;
         for (int k = 0; k < 4; k++)
             s[k] = d[k];
         return;
     }
-    const float *f = (const float *)spheres + 4 * i;
+    const float *f = (const float *)spheres.data + 4 * i;
     for (int k = 0; k < 4; k++)
         s[k] = f[k];
 }

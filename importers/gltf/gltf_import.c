@@ -86,11 +86,10 @@ static void check_far_plane(Importer *im)
     }
     len = sqrt(len);
     size_t beyond = 0;
-    const void *spheres = b->spheres;
-    const int wide = b->wide;
+    const PtrBuilderSpheres spheres = b->spheres;
     for (size_t i = 0; i < b->count; i++) {
         double s[4];
-        ptr_builder_sphere(spheres, wide, i, s);
+        ptr_builder_sphere(spheres, i, s);
         double depth = 0;
         for (int k = 0; k < 3; k++)
             depth += (s[k] - b->eye[k]) * fwd[k] / len;

@@ -33,10 +33,10 @@
  * parts. (When every split of the top level was shared, each of some 300
  * at 10^6 handing work to the others and back, the top level gained 1.2x
  * from a second thread.) Every subtree of at most task_spheres spheres is
- * a task built by one thread into its own node array. The threads take the parts, then the tasks,
- * from one pool (see Pool). The arrays are laid out in the order a
- * depth-first build on one thread would have made them, so the tree's
- * bytes never depend on the number of threads. */
+ * a task built by one thread into its own node array. The threads take the
+ * parts, then the tasks, from one pool (see Pool). The arrays are laid out
+ * in the order a depth-first build on one thread would have made them, so
+ * the tree's bytes never depend on the number of threads. */
 #include "accel/bvh.h"
 
 #include <malloc.h>

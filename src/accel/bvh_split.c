@@ -65,13 +65,6 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
     }
 }
 
-/* A prim's bins on the three axes at once, in k[0 .. 2] (the radius lane,
- * scaled by 0, gives bin 0). */
-static inline void bins_of(__m128 base, __m128 scale, __m128 last, __m128 centre, int k[4])
-{
-    _mm_storeu_si128((__m128i *)k, bvh_bins4(centre, base, scale, last));
-}
-
 /* Samples far apart are each a cache miss the hardware's prefetchers do
  * not foresee: fetched this many samples ahead, they overlap. */
 enum { PREFETCH_SAMPLES = 16 };
@@ -90,8 +83,10 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stri
         const BvhPrim *p = &set->prims[i];
         __m128 lower, upper;
         bvh_prim_box4(p, set->magnitude, &lower, &upper);
+        /* Its bins on the three axes at once (the radius lane, scaled by
+         * 0, gives bin 0). */
         int k[4];
-        bins_of(base, scale, last, _mm_loadu_ps(p->centre), k);
+        _mm_storeu_si128((__m128i *)k, bvh_bins4(_mm_loadu_ps(p->centre), base, scale, last));
         for (int a = 0; a < 3; a++) {
             b->lower[a][k[a]] = _mm_min_ps(b->lower[a][k[a]], lower);
             b->upper[a][k[a]] = _mm_max_ps(b->upper[a][k[a]], upper);

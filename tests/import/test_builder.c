@@ -118,7 +118,7 @@ static void test_float_until_not(void)
     ptr_builder_init(&b, &scene, NULL);
     for (size_t i = 0; i < ALONE; i++)
         CHECK_INT(ptr_builder_add_sphere(&b, given[i], given[i][3], material, NULL), PTR_OK);
-    CHECK_INT(b.wide, 0);
+    CHECK_INT(b.spheres.wide, 0);
     size_t first = 0;
     CHECK_INT(ptr_builder_add_spheres(&b, BATCH, 0, &first, NULL), PTR_OK);
     const size_t blocks[][2] = { { first, first + 1 }, { first + 1, first + BATCH } };
@@ -131,7 +131,7 @@ static void test_float_until_not(void)
             fills[k]++;
             CHECK_INT(ptr_builder_refill(&b, blocks[k][1], &refill, NULL), PTR_OK);
         }
-        CHECK_INT(b.wide, (int)k);
+        CHECK_INT(b.spheres.wide, (int)k);
     }
     CHECK_INT(fills[0], 1);
     CHECK_INT(fills[1], 2);
@@ -153,7 +153,7 @@ static void test_float_until_not(void)
     for (size_t i = 0; i < 3; i++) {
         CHECK_INT(b.count == b.capacity, i == 2);
         CHECK_INT(ptr_builder_add_sphere(&b, alone[i], alone[i][3], grey, NULL), PTR_OK);
-        CHECK_INT(b.wide, i == 2);
+        CHECK_INT(b.spheres.wide, i == 2);
     }
     finish_far(&b, eye);
     check_kept(&scene, alone, 3, eye);
