@@ -270,7 +270,8 @@ typedef struct RootSort {
     /* Per block: its prims in each child, then, before the copy, the place
      * of its first prim in each; a row more for the children's ends. */
     size_t (*place)[PTR_BVH_WIDTH];
-    float *magnitude; /* per block, then the tree's in [0] */
+    float *magnitude; /* per block */
+    float tree_magnitude; /* the blocks' largest, for the copy's boxes */
     BvhPrim *prims;
     __m128 (*lower)[PTR_BVH_WIDTH], (*upper)[PTR_BVH_WIDTH]; /* per block */
 } RootSort;
@@ -343,7 +344,7 @@ static void copy_blocks(void *arg, size_t begin, size_t end)
 {
     RootSort *r = arg;
     const PtrSpheres *s = r->spheres;
-    const float magnitude = r->magnitude[0];
+    const float magnitude = r->tree_magnitude;
     uint8_t child[CHUNK + 3];
     for (size_t b = begin; b < end; b++) {
         size_t at[PTR_BVH_WIDTH];
@@ -422,8 +423,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
             }
             children->end[k] = next;
         }
-        for (size_t b = 1; b < blocks; b++)
-            r.magnitude[0] = ptr_maxf(r.magnitude[b], r.magnitude[0]);
+        for (size_t b = 0; b < blocks; b++)
+            r.tree_magnitude = ptr_maxf(r.magnitude[b], r.tree_magnitude);
         /* Each step's prims on the pages of the spheres the step before
          * copied. */
         PtrPageBank bank = { 0 };
@@ -452,7 +453,7 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
             bvh_store3(children->lower[k], lower);
             bvh_store3(children->upper[k], upper);
         }
-        *magnitude_out = blocks ? r.magnitude[0] : 0.0f;
+        *magnitude_out = r.tree_magnitude;
     }
     free(r.place);
     free(r.magnitude);
