@@ -61,7 +61,7 @@ enum {
     /* See the head: 6 leaves' worth (7 or 5 gave 0.2 and 0.05 bytes a sphere
      * more on a uniform 10^6 cloud). */
     BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
-    ROOT_SAMPLES = 1 << 15, /* see plan_root */
+    PLAN_SAMPLES = 1 << 15, /* see plan_children */
 };
 
 /* Node arrays: the root's, one per part and one per task. */
@@ -73,6 +73,7 @@ typedef struct NodeArray {
 
 typedef struct Task {
     size_t begin, end;
+    float lower[3], upper[3]; /* its box */
     int level; /* of its root node */
     NodeArray nodes;
 } Task;
@@ -130,6 +131,15 @@ typedef struct Build {
     TaskList tasks;           /* all, in the order of a depth-first build */
 } Build;
 
+/* What a thread of the build keeps from one part or task to the next: fresh
+ * memory for each would be cleared page by page. */
+typedef struct Worker {
+    BvhPrim *scratch;  /* room for task_spheres: see bvh_split */
+    BvhPrim *samples;  /* room for PLAN_SAMPLES: see plan_node */
+    uint8_t *child;    /* a byte a prim of the largest range planned */
+    size_t child_room;
+} Worker;
+
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 {
     if (a->count == a->capacity) {
@@ -147,7 +157,7 @@ static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
     return PTR_OK;
 }
 
-static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, uint32_t *task,
+static PtrResult add_task(TaskList *list, const BvhCandidate *range, int level, uint32_t *task,
                           PtrError *err)
 {
     if (list->count == list->capacity) {
@@ -159,7 +169,10 @@ static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, u
         list->capacity = capacity;
     }
     *task = (uint32_t)list->count;
-    list->tasks[list->count++] = (Task){ .begin = begin, .end = end, .level = level };
+    Task *t = &list->tasks[list->count++];
+    *t = (Task){ .begin = range->begin, .end = range->end, .level = level };
+    memcpy(t->lower, range->lower, sizeof t->lower);
+    memcpy(t->upper, range->upper, sizeof t->upper);
     return PTR_OK;
 }
 
@@ -172,7 +185,7 @@ static PtrResult add_task(TaskList *list, size_t begin, size_t end, int level, u
  * scratch: see bvh_split. */
 static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidate *range,
                       int level, double per_prim, BvhCandidate child[PTR_BVH_WIDTH],
-                      int *count, BvhRootChildren *plan)
+                      int *count, BvhChildren *plan)
 {
     int n = 1;
     child[0] = *range;
@@ -202,16 +215,30 @@ static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidat
     *count = n;
 }
 
-static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+/* A node's children at this level as n samples of its prims split them,
+ * each standing for per_prim prims (see grow_node), in plan: the prims are
+ * then sorted into them in one pass, where splitting them in place took a
+ * pass for each level of the node's splits, about three, each moving every
+ * prim (docs/intersectors.md, "Nodes planned from samples"). plan->count
+ * is 1 where the samples give no split (all at one centre). */
+static void plan_children(const BvhPrimSet *samples, size_t n, int level, double per_prim,
+                          BvhChildren *plan)
+{
+    BvhCandidate range, child[PTR_BVH_WIDTH];
+    bvh_candidate_init(samples, &range, 0, n, NULL, NULL);
+    grow_node(samples, NULL, &range, level, per_prim, child, &plan->count, plan);
+}
+
+static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
                             const BvhCandidate *range, NodeKind kind, int level,
                             size_t *index, int *depth, PtrError *err);
 
 /* Makes the node of this kind at this level over the children child[0 .. n
  * - 1] in nodes (its index in *index), and its inner children below it that
- * are neither parts nor tasks; depth: levels below the node, not counting
- * parts and tasks. tasks: where a node of the top level puts its tasks.
- * scratch: see bvh_split (tasks have it, the top level not). */
-static PtrResult make_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+ * are neither parts nor tasks, on the thread w (NULL for the root, which
+ * has none); depth: levels below the node, not counting parts and tasks.
+ * tasks: where a node of the top level puts its tasks. */
+static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
                            const BvhCandidate child[PTR_BVH_WIDTH], int n, NodeKind kind,
                            int level, size_t *index, int *depth, PtrError *err)
 {
@@ -246,7 +273,7 @@ static PtrResult make_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhP
         node.leaf_count[k] = 0;
         if (kind != NODE_TASK && count <= build->task_spheres) {
             uint32_t task;
-            if ((r = add_task(tasks, c->begin, c->end, level + 1, &task, err)) != PTR_OK)
+            if ((r = add_task(tasks, c, level + 1, &task, err)) != PTR_OK)
                 return r;
             node.child[k] = TASK_FLAG | task;
             continue;
@@ -258,8 +285,7 @@ static PtrResult make_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhP
         }
         size_t below;
         int below_depth;
-        r = build_node(build, nodes, tasks, scratch, c, kind, level + 1, &below, &below_depth,
-                       err);
+        r = build_node(build, w, nodes, tasks, c, kind, level + 1, &below, &below_depth, err);
         if (r != PTR_OK)
             return r;
         node.child[k] = (uint32_t)below;
@@ -270,16 +296,58 @@ static PtrResult make_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhP
     return PTR_OK;
 }
 
-/* Builds the node of this kind at this level over range (its split found)
- * into nodes: see make_node. */
-static PtrResult build_node(Build *build, NodeArray *nodes, TaskList *tasks, BvhPrim *scratch,
+/* The node's children as PLAN_SAMPLES samples of its prims, evenly spaced,
+ * split them, each sample standing for as many prims as there are to a
+ * sample, in plan, and the prims sorted into them, in child[0 .. *count -
+ * 1]. *count is 1 where the samples gave no split (all at one centre):
+ * the prims as they were. Fails only for memory. */
+static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, int level,
+                           BvhCandidate child[PTR_BVH_WIDTH], int *count, PtrError *err)
+{
+    const size_t n = range->end - range->begin;
+    if (!w->samples && !(w->samples = malloc(PLAN_SAMPLES * sizeof *w->samples)))
+        return bvh_out_of_memory(err);
+    const BvhPrimSet samples = { w->samples, build->set.magnitude };
+    for (size_t j = 0; j < PLAN_SAMPLES; j++)
+        w->samples[j] = build->set.prims[range->begin + j * n / PLAN_SAMPLES];
+    BvhChildren plan;
+    plan_children(&samples, PLAN_SAMPLES, level, (double)n / PLAN_SAMPLES, &plan);
+    *count = 1;
+    child[0] = *range;
+    if (plan.count == 1)
+        return PTR_OK;
+    if (w->child_room < n) {
+        free(w->child);
+        if (!(w->child = malloc(n)))
+            return w->child_room = 0, bvh_out_of_memory(err);
+        w->child_room = n;
+    }
+    bvh_split_children(&build->set, range->begin, range->end, &plan, w->child);
+    for (int k = 0; k < plan.count; k++)
+        bvh_candidate_init(&build->set, &child[k], plan.begin[k], plan.end[k], plan.lower[k],
+                           plan.upper[k]);
+    *count = plan.count;
+    return PTR_OK;
+}
+
+/* Builds the node of this kind at this level over range (its split found,
+ * where it has one: see bvh_candidate_init) into nodes: see make_node. */
+static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
                             const BvhCandidate *range, NodeKind kind, int level,
                             size_t *index, int *depth, PtrError *err)
 {
     BvhCandidate child[PTR_BVH_WIDTH];
-    int n;
-    grow_node(&build->set, scratch, range, level, 1.0, child, &n, NULL);
-    return make_node(build, nodes, tasks, scratch, child, n, kind, level, index, depth, err);
+    int n = 1;
+    /* A task's scratch is room for task_spheres; a part may hold more. */
+    BvhPrim *scratch = kind == NODE_TASK ? w->scratch : NULL;
+    if (range->end - range->begin > BVH_PLANNED_ABOVE && level < MIDDLE_SPLIT_LEVEL) {
+        PtrResult r = plan_node(build, w, range, level, child, &n, err);
+        if (r != PTR_OK)
+            return r;
+    }
+    if (n == 1)
+        grow_node(&build->set, scratch, range, level, 1.0, child, &n, NULL);
+    return make_node(build, w, nodes, tasks, child, n, kind, level, index, depth, err);
 }
 
 static size_t part_size(const Part *p)
@@ -338,32 +406,28 @@ static Task *pool_take_task(Pool *pool)
     return largest;
 }
 
-/* Whether part p was built (else it ran out of memory). */
-static int build_part(Build *build, Part *p)
+/* Whether part p was built on the thread w (else it ran out of memory). */
+static int build_part(Build *build, Worker *w, Part *p)
 {
     BvhCandidate range;
     size_t root;
     bvh_candidate_init(&build->set, &range, p->range.begin, p->range.end, p->range.lower,
                        p->range.upper);
-    /* No scratch: a part may hold most of the tree, a task's scratch is
-     * room for task_spheres. */
-    return build_node(build, &p->nodes, &p->tasks, NULL, &range, NODE_PART, p->level, &root,
+    return build_node(build, w, &p->nodes, &p->tasks, &range, NODE_PART, p->level, &root,
                       &p->nodes.depth, NULL) == PTR_OK;
 }
 
-/* Whether task t was built (else it ran out of memory). */
-static int build_task(Build *build, Task *t, BvhPrim **scratch)
+/* Whether task t was built on the thread w (else it ran out of memory). */
+static int build_task(Build *build, Worker *w, Task *t)
 {
     /* One scratch for all of a thread's tasks (none is larger than
-     * task_spheres): fresh memory for each would be cleared page by page. */
-    if (!*scratch)
-        *scratch = malloc(build->task_spheres * sizeof **scratch);
-    if (!*scratch)
+     * task_spheres). */
+    if (!w->scratch && !(w->scratch = malloc(build->task_spheres * sizeof *w->scratch)))
         return 0;
     BvhCandidate range;
     size_t root;
-    bvh_candidate_init(&build->set, &range, t->begin, t->end, NULL, NULL);
-    return build_node(build, &t->nodes, NULL, *scratch, &range, NODE_TASK, t->level, &root,
+    bvh_candidate_init(&build->set, &range, t->begin, t->end, t->lower, t->upper);
+    return build_node(build, w, &t->nodes, NULL, &range, NODE_TASK, t->level, &root,
                       &t->nodes.depth, NULL) == PTR_OK;
 }
 
@@ -373,14 +437,14 @@ static void *pool_worker(void *arg)
 {
     Pool *pool = arg;
     Build *build = pool->build;
-    BvhPrim *scratch = NULL;
+    Worker w = { 0 };
     pthread_mutex_lock(&pool->lock);
     for (;;) {
         if (!pool->failed && pool->next_part < build->part_count) {
             Part *p = &build->parts[pool->part_order[pool->next_part++]];
             pool->parts_running++;
             pthread_mutex_unlock(&pool->lock);
-            const int built = build_part(build, p);
+            const int built = build_part(build, &w, p);
             pthread_mutex_lock(&pool->lock);
             pool->parts_running--;
             if (!built || !pool_add_ready(pool, &p->tasks))
@@ -391,7 +455,7 @@ static void *pool_worker(void *arg)
         Task *t = pool->failed ? NULL : pool_take_task(pool);
         if (t) {
             pthread_mutex_unlock(&pool->lock);
-            const int built = build_task(build, t, &scratch);
+            const int built = build_task(build, &w, t);
             pthread_mutex_lock(&pool->lock);
             pool->failed |= !built;
             continue;
@@ -401,7 +465,9 @@ static void *pool_worker(void *arg)
         pthread_cond_wait(&pool->wake, &pool->lock);
     }
     pthread_mutex_unlock(&pool->lock);
-    free(scratch);
+    free(w.scratch);
+    free(w.samples);
+    free(w.child);
     return NULL;
 }
 
@@ -628,25 +694,20 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
     return r;
 }
 
-/* The root's children (see the head): its splits chosen from ROOT_SAMPLES
+/* The root's children (see the head): its splits planned from PLAN_SAMPLES
  * of the tree's spheres, evenly spaced, or all of them where they are no
- * more, each standing for as many of the tree's as there are to a sample.
- * Fails only for memory. */
+ * more. Fails only for memory. */
 static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t *huge_index,
-                           size_t huge_count, BvhRootChildren *plan, PtrError *err)
+                           size_t huge_count, BvhChildren *plan, PtrError *err)
 {
     plan->count = 1;
-    BvhPrimSet samples = { .prims = malloc(ROOT_SAMPLES * sizeof *samples.prims) };
+    BvhPrimSet samples = { .prims = malloc(PLAN_SAMPLES * sizeof *samples.prims) };
     if (!samples.prims)
         return bvh_out_of_memory(err);
     const size_t n = ptr_bvh_samples(spheres, threads, huge_index, huge_count, samples.prims,
-                                     ROOT_SAMPLES, &samples.magnitude);
-    if (n > 0) {
-        BvhCandidate range, child[PTR_BVH_WIDTH];
-        bvh_candidate_init(&samples, &range, 0, n, NULL, NULL);
-        grow_node(&samples, NULL, &range, 0, (double)(spheres->count - huge_count) / (double)n,
-                  child, &plan->count, plan);
-    }
+                                     PLAN_SAMPLES, &samples.magnitude);
+    if (n > 0)
+        plan_children(&samples, n, 0, (double)(spheres->count - huge_count) / (double)n, plan);
     free(samples.prims);
     return PTR_OK;
 }
@@ -662,7 +723,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
      * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
     size_t huge_index[PTR_HUGE_MAX];
-    BvhRootChildren root;
+    BvhChildren root;
     PtrSpheres tree_part = *spheres;
     tree_part.count = count;
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
@@ -697,7 +758,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             grow_node(&build.set, NULL, &range, 0, 1.0, child, &n, NULL);
         }
         size_t index;
-        r = make_node(&build, &top, &build.root_tasks, NULL, child, n, NODE_ROOT, 0, &index,
+        r = make_node(&build, NULL, &top, &build.root_tasks, child, n, NODE_ROOT, 0, &index,
                       &top.depth, err);
         if (r == PTR_OK)
             r = run_pool(&build, err);

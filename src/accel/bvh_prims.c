@@ -261,12 +261,7 @@ typedef struct RootSort {
     const PtrSpheres *spheres;
     const size_t *huge_index; /* ascending */
     size_t huge_count;
-    int children;
-    /* Each split's test (BvhRootChildren) in four lanes, and its axis's
-     * array of centres. */
-    const float *key[PTR_BVH_WIDTH];
-    __m128 base[PTR_BVH_WIDTH], scale[PTR_BVH_WIDTH], last[PTR_BVH_WIDTH];
-    __m128i split_bin[PTR_BVH_WIDTH], source[PTR_BVH_WIDTH];
+    BvhChildLanes lanes;
     /* Per block: its prims in each child, then, before the copy, the place
      * of its first prim in each; a row more for the children's ends. */
     size_t (*place)[PTR_BVH_WIDTH];
@@ -281,26 +276,16 @@ typedef struct RootSort {
 enum { CHUNK = 1024, NOT_IN_TREE = PTR_BVH_WIDTH };
 
 /* The children of spheres from .. to - 1 (at most CHUNK) in child[i -
- * from], NOT_IN_TREE for the huge ones: four at a time (bvh_bins4), each
- * split moving the lanes in its source that go right. Lanes past the last
+ * from], NOT_IN_TREE for the huge ones, four at a time. Lanes past the last
  * sphere read the arrays' padding (PTR_SPHERE_BLOCK entries) into child's
  * last 3 entries. */
 static void children_of(const RootSort *r, size_t from, size_t to, uint8_t child[CHUNK + 3])
 {
+    const PtrSpheres *s = r->spheres;
     for (size_t i = from; i < to; i += 4) {
-        __m128i in = _mm_setzero_si128();
-        for (int s = 1; s < r->children; s++) {
-            const __m128i bin =
-                bvh_bins4(_mm_loadu_ps(&r->key[s][i]), r->base[s], r->scale[s], r->last[s]);
-            const __m128i moves = _mm_and_si128(_mm_cmpgt_epi32(bin, r->split_bin[s]),
-                                                _mm_cmpeq_epi32(in, r->source[s]));
-            in = _mm_or_si128(_mm_andnot_si128(moves, in),
-                              _mm_and_si128(moves, _mm_set1_epi32(s)));
-        }
-        /* The four children, each below 8, in the four low bytes. */
-        const __m128i words = _mm_packs_epi32(in, in);
-        const uint32_t four = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(words, words));
-        memcpy(&child[i - from], &four, sizeof four);
+        const __m128 centre[3] = { _mm_loadu_ps(&s->cx[i]), _mm_loadu_ps(&s->cy[i]),
+                                   _mm_loadu_ps(&s->cz[i]) };
+        bvh_children4(&r->lanes, centre, &child[i - from]);
     }
     for (size_t k = ptr_huge_before(r->huge_index, r->huge_count, from);
          k < r->huge_count && r->huge_index[k] < to; k++)
@@ -350,7 +335,7 @@ static void copy_blocks(void *arg, size_t begin, size_t end)
         size_t at[PTR_BVH_WIDTH];
         __m128 *lower = r->lower[b], *upper = r->upper[b];
         memcpy(at, r->place[b], sizeof at);
-        for (int k = 0; k < r->children; k++) {
+        for (int k = 0; k < r->lanes.count; k++) {
             lower[k] = _mm_set1_ps(INFINITY);
             upper[k] = _mm_set1_ps(-INFINITY);
         }
@@ -374,7 +359,7 @@ static void copy_blocks(void *arg, size_t begin, size_t end)
 }
 
 PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
-                        size_t huge_count, BvhRootChildren *children, BvhPrim *prims,
+                        size_t huge_count, BvhChildren *children, BvhPrim *prims,
                         size_t *prim_count, float *magnitude_out, PtrError *err)
 {
     *prim_count = s->count - huge_count;
@@ -383,16 +368,8 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
         children->begin[k] = children->end[k] = 0;
     const size_t blocks = (s->count + BLOCK - 1) / BLOCK;
     RootSort r = { .spheres = s, .huge_index = huge_index, .huge_count = huge_count,
-                   .children = children->count, .prims = prims };
-    for (int k = 1; k < children->count; k++) {
-        const BvhSplitTest *t = &children->test[k];
-        r.key[k] = t->axis == 0 ? s->cx : t->axis == 1 ? s->cy : s->cz;
-        r.base[k] = _mm_set1_ps(t->base);
-        r.scale[k] = _mm_set1_ps(t->scale);
-        r.last[k] = _mm_set1_ps(t->last);
-        r.split_bin[k] = _mm_set1_epi32(t->split_bin);
-        r.source[k] = _mm_set1_epi32(children->source[k]);
-    }
+                   .prims = prims };
+    bvh_child_lanes(children, &r.lanes);
     r.place = malloc((blocks + 1) * sizeof *r.place);
     r.magnitude = malloc((blocks ? blocks : 1) * sizeof *r.magnitude);
     r.lower = malloc((blocks ? blocks : 1) * sizeof *r.lower);
@@ -401,17 +378,11 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
                                                                  : bvh_out_of_memory(err);
     if (res == PTR_OK && blocks) {
         ptr_parallel_ranges(threads, 0, blocks, count_blocks, &r);
-        /* The children in the order a split in place leaves them: the prims
-         * a split sends right follow those it leaves in its source. */
-        int order[PTR_BVH_WIDTH] = { 0 };
-        for (int k = 1; k < children->count; k++) {
-            int at = k;
-            for (; order[at - 1] != children->source[k]; at--)
-                order[at] = order[at - 1];
-            order[at] = k;
-        }
-        /* Each child's prims follow those of the child before it in that
-         * order; within a child, each block's follow the block's before. */
+        /* Each child's prims follow those of the child before it in
+         * bvh_children_order's order; within a child, each block's follow
+         * the block's before. */
+        int order[PTR_BVH_WIDTH];
+        bvh_children_order(children, order);
         size_t next = 0;
         for (int j = 0; j < children->count; j++) {
             const int k = order[j];
@@ -460,6 +431,31 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
     free(r.lower);
     free(r.upper);
     return res;
+}
+
+void bvh_child_lanes(const BvhChildren *children, BvhChildLanes *lanes)
+{
+    lanes->count = children->count;
+    for (int k = 1; k < children->count; k++) {
+        const BvhSplitTest *t = &children->test[k];
+        lanes->axis[k] = t->axis;
+        lanes->base[k] = _mm_set1_ps(t->base);
+        lanes->scale[k] = _mm_set1_ps(t->scale);
+        lanes->last[k] = _mm_set1_ps(t->last);
+        lanes->split_bin[k] = _mm_set1_epi32(t->split_bin);
+        lanes->source[k] = _mm_set1_epi32(children->source[k]);
+    }
+}
+
+void bvh_children_order(const BvhChildren *children, int order[PTR_BVH_WIDTH])
+{
+    order[0] = 0;
+    for (int k = 1; k < children->count; k++) {
+        int at = k;
+        for (; order[at - 1] != children->source[k]; at--)
+            order[at] = order[at - 1];
+        order[at] = k;
+    }
 }
 
 void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)

@@ -91,19 +91,53 @@ static inline void bvh_store3(float out[3], __m128 v)
     memcpy(out, lanes, 3 * sizeof *out);
 }
 
-/* The root's children as its splits make them, chosen from samples before
- * the prims exist (bvh_build.c): split s, for s from 1 to count - 1 in
- * turn, sends the prims of child source[s] that go right by test[s] to
- * child s; every prim starts in child 0. ptr_bvh_prims sorts the prims into
- * the children as it copies them, and fills in each child's prims, begin
- * .. end - 1, and padded box. */
-typedef struct BvhRootChildren {
+/* A node's children as its splits make them, chosen from samples of its
+ * prims before the prims are sorted into them (bvh_build.c's plans): split
+ * s, for s from 1 to count - 1 in turn, sends the prims of child source[s]
+ * that go right by test[s] to child s; every prim starts in child 0. The
+ * sort (ptr_bvh_prims for the root, bvh_split_children for a node) fills
+ * in each child's prims, begin .. end - 1, and padded box. */
+typedef struct BvhChildren {
     int count;
     int source[PTR_BVH_WIDTH];
     BvhSplitTest test[PTR_BVH_WIDTH];
     size_t begin[PTR_BVH_WIDTH], end[PTR_BVH_WIDTH];
     float lower[PTR_BVH_WIDTH][3], upper[PTR_BVH_WIDTH][3];
-} BvhRootChildren;
+} BvhChildren;
+
+/* A BvhChildren's splits in four lanes each, to find the children of four
+ * prims at once. */
+typedef struct BvhChildLanes {
+    int count;
+    int axis[PTR_BVH_WIDTH];
+    __m128 base[PTR_BVH_WIDTH], scale[PTR_BVH_WIDTH], last[PTR_BVH_WIDTH];
+    __m128i split_bin[PTR_BVH_WIDTH], source[PTR_BVH_WIDTH];
+} BvhChildLanes;
+
+void bvh_child_lanes(const BvhChildren *children, BvhChildLanes *lanes);
+
+/* The children of four prims whose centres' x, y and z are centre[0], [1]
+ * and [2], in child[0 .. 3]: each split moves the lanes in its source that
+ * go right (bvh_goes_right's arithmetic, bvh_bins4). */
+static inline void bvh_children4(const BvhChildLanes *l, const __m128 centre[3], uint8_t child[4])
+{
+    __m128i in = _mm_setzero_si128();
+    for (int s = 1; s < l->count; s++) {
+        const __m128i bin = bvh_bins4(centre[l->axis[s]], l->base[s], l->scale[s], l->last[s]);
+        const __m128i moves = _mm_and_si128(_mm_cmpgt_epi32(bin, l->split_bin[s]),
+                                            _mm_cmpeq_epi32(in, l->source[s]));
+        in = _mm_or_si128(_mm_andnot_si128(moves, in), _mm_and_si128(moves, _mm_set1_epi32(s)));
+    }
+    /* The four children, each below 8, in the four low bytes. */
+    const __m128i words = _mm_packs_epi32(in, in);
+    const uint32_t four = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(words, words));
+    memcpy(child, &four, sizeof four);
+}
+
+/* The children in the order a split in place leaves them, order[0 ..
+ * count - 1]: the prims a split sends right follow those it leaves in its
+ * source. */
+void bvh_children_order(const BvhChildren *children, int order[PTR_BVH_WIDTH]);
 
 /* Puts the huge spheres (scene.h's rule, with the tree's limit) in
  * huge[0 .. *huge_count - 1] (by ascending id; room for PTR_HUGE_MAX) and
@@ -132,7 +166,7 @@ size_t ptr_bvh_samples(const PtrSpheres *spheres, int threads, const size_t *hug
  * the kernel ran out of memory moving pages (ptr_pages_take), when some are
  * already given up, as they are where the build fails after this. */
 PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, const size_t *huge_index,
-                        size_t huge_count, BvhRootChildren *children, BvhPrim *prims,
+                        size_t huge_count, BvhChildren *children, BvhPrim *prims,
                         size_t *prim_count, float *magnitude, PtrError *err);
 
 /* Fails for memory the tree's build cannot have: every failure of the

@@ -65,21 +65,13 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
     }
 }
 
-/* Samples far apart are each a cache miss the hardware's prefetchers do
- * not foresee: fetched this many samples ahead, they overlap. */
-enum { PREFETCH_SAMPLES = 16 };
-
-/* Every stride-th prim of the run. */
-static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stride,
-                    const BvhCandidate *c, Bins *b)
+static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, const BvhCandidate *c,
+                    Bins *b)
 {
     const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
     const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
     const __m128 last = _mm_set1_ps((float)(c->bins - 1));
-    const size_t ahead = stride > 1 ? PREFETCH_SAMPLES * stride : 0;
-    for (size_t i = begin; i < end; i += stride) {
-        if (ahead && end - i > ahead)
-            _mm_prefetch((const char *)&set->prims[i + ahead], _MM_HINT_T0);
+    for (size_t i = begin; i < end; i++) {
         const BvhPrim *p = &set->prims[i];
         __m128 lower, upper;
         bvh_prim_box4(p, set->magnitude, &lower, &upper);
@@ -95,12 +87,6 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, size_t stri
     }
 }
 
-/* Runs of more than SAMPLED_ABOVE prims choose their split from about
- * SAMPLES of them, evenly spaced: at the top of a tree of 10^7 spheres,
- * binning every prim took a third of the build and chose much the same
- * splits. */
-enum { SAMPLED_ABOVE = 1 << 16, SAMPLES = 1 << 14 };
-
 void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
                         const float lower[3], const float upper[3])
 {
@@ -108,7 +94,6 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     c->begin = begin;
     c->end = end;
     c->axis = -1;
-    c->sampled = 0;
     if (!lower) {
         bins_clear(&bins, 0);
         bound_run(set, begin, end, &bins);
@@ -117,7 +102,7 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     }
     memcpy(c->lower, lower, sizeof c->lower);
     memcpy(c->upper, upper, sizeof c->upper);
-    if (end - begin <= PTR_BVH_LEAF_MAX)
+    if (end - begin <= PTR_BVH_LEAF_MAX || end - begin > BVH_PLANNED_ABOVE)
         return;
     /* Embree's rule: few bins for few prims, where more would mostly be
      * empty and only cost time. */
@@ -134,9 +119,8 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     }
     if (!spread)
         return;
-    c->sampled = end - begin > SAMPLED_ABOVE;
     bins_clear(&bins, c->bins);
-    bin_run(set, begin, end, c->sampled ? (end - begin) / SAMPLES : 1, c, &bins);
+    bin_run(set, begin, end, c, &bins);
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
         __m128 right_lo[BINS], right_hi[BINS];
@@ -181,50 +165,21 @@ BvhSplitTest bvh_split_test(const BvhCandidate *c)
                            (float)(c->bins - 1) };
 }
 
-/* The boxes of the prims a partition sends left ([0]) and right ([1]): a
- * split chosen from samples learns its halves' boxes in the pass that moves
- * them, not in one more over all of them. */
-typedef struct SideBoxes {
-    __m128 lower[2], upper[2]; /* x, y, z and an unused lane, as a bin's */
-} SideBoxes;
-
-static void sides_empty(SideBoxes *b)
-{
-    for (int side = 0; side < 2; side++) {
-        b->lower[side] = _mm_set1_ps(INFINITY);
-        b->upper[side] = _mm_set1_ps(-INFINITY);
-    }
-}
-
-static inline void sides_add(SideBoxes *b, float magnitude, const BvhPrim *p, size_t side)
-{
-    if (!b)
-        return;
-    __m128 lower, upper;
-    bvh_prim_box4(p, magnitude, &lower, &upper);
-    b->lower[side] = _mm_min_ps(b->lower[side], lower);
-    b->upper[side] = _mm_max_ps(b->upper[side], upper);
-}
-
 /* Moves the prims begin .. end - 1 that go left by test before those
- * that go right, adding their boxes to *sides if given; returns the first
- * right one. Hoare's partition. */
-static size_t partition_run(BvhPrim *p, float magnitude, size_t begin, size_t end,
-                            const BvhSplitTest *test, SideBoxes *sides)
+ * that go right; returns the first right one. Hoare's partition. */
+static size_t partition_run(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test)
 {
     size_t i = begin, j = end;
     for (;;) {
         while (i < j && !bvh_goes_right(test, &p[i]))
-            sides_add(sides, magnitude, &p[i++], 0);
+            i++;
         while (i < j && bvh_goes_right(test, &p[j - 1]))
-            sides_add(sides, magnitude, &p[--j], 1);
+            j--;
         if (i >= j)
             return i;
         BvhPrim t = p[i];
-        p[i] = p[j - 1];
-        p[j - 1] = t;
-        sides_add(sides, magnitude, &p[i++], 0);
-        sides_add(sides, magnitude, &p[--j], 1);
+        p[i++] = p[j - 1];
+        p[--j] = t;
     }
 }
 
@@ -234,8 +189,7 @@ static size_t partition_run(BvhPrim *p, float magnitude, size_t begin, size_t en
  * lists swapped pairwise; the few prims left in the middle go to
  * partition_run. Everything before the left block belongs left, everything
  * after the right block right. */
-static size_t partition_blocks(BvhPrim *p, float magnitude, size_t begin, size_t end,
-                               const BvhSplitTest *test, SideBoxes *sides)
+static size_t partition_blocks(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test)
 {
     enum { BLOCK = 128 };
     unsigned char wrong_left[BLOCK], wrong_right[BLOCK]; /* offsets in each block */
@@ -244,19 +198,15 @@ static size_t partition_blocks(BvhPrim *p, float magnitude, size_t begin, size_t
         if (left_count == 0) {
             left_at = 0;
             for (size_t i = 0; i < BLOCK; i++) {
-                const size_t right = (size_t)bvh_goes_right(test, &p[l + i]);
                 wrong_left[left_count] = (unsigned char)i;
-                left_count += right;
-                sides_add(sides, magnitude, &p[l + i], right);
+                left_count += (size_t)bvh_goes_right(test, &p[l + i]);
             }
         }
         if (right_count == 0) {
             right_at = 0;
             for (size_t i = 0; i < BLOCK; i++) {
-                const size_t right = (size_t)bvh_goes_right(test, &p[r - 1 - i]);
                 wrong_right[right_count] = (unsigned char)i;
-                right_count += 1 - right;
-                sides_add(sides, magnitude, &p[r - 1 - i], right);
+                right_count += 1 - (size_t)bvh_goes_right(test, &p[r - 1 - i]);
             }
         }
         const size_t swaps = left_count < right_count ? left_count : right_count;
@@ -275,17 +225,15 @@ static size_t partition_blocks(BvhPrim *p, float magnitude, size_t begin, size_t
         if (right_count == 0)
             r -= BLOCK;
     }
-    /* A block half done is classified again: its boxes are added again to
-     * the same side, which changes no box. */
-    return partition_run(p, magnitude, l, r, test, sides);
+    return partition_run(p, l, r, test);
 }
 
 /* The same split as partition_run, keeping each side's order, through
  * scratch (room for the run): no branch on the side a prim goes to, which
  * for a random cloud is a coin toss the processor mispredicts half the
  * time. */
-static size_t partition_stable(BvhPrim *p, float magnitude, size_t begin, size_t end,
-                               const BvhSplitTest *test, BvhPrim *scratch, SideBoxes *sides)
+static size_t partition_stable(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test,
+                               BvhPrim *scratch)
 {
     size_t left = begin, right = 0;
     for (size_t i = begin; i < end; i++) {
@@ -295,52 +243,126 @@ static size_t partition_stable(BvhPrim *p, float magnitude, size_t begin, size_t
         scratch[right] = prim;
         left += 1 - goes_right;
         right += goes_right;
-        sides_add(sides, magnitude, &prim, goes_right);
     }
     memcpy(p + left, scratch, right * sizeof *p);
     return left;
 }
 
-/* Moves the prims of c that go left before those that go right, adding
- * their boxes to *sides if given (emptied first); returns the first right
- * one. With scratch, partition_stable, else partition_blocks. */
-static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch,
-                        SideBoxes *sides)
+/* Moves the prims of c that go left before those that go right; returns
+ * the first right one. With scratch, partition_stable, else
+ * partition_blocks. */
+static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch)
 {
     const BvhSplitTest test = bvh_split_test(c);
-    if (sides)
-        sides_empty(sides);
     if (scratch)
-        return partition_stable(set->prims, set->magnitude, c->begin, c->end, &test, scratch,
-                                sides);
-    return partition_blocks(set->prims, set->magnitude, c->begin, c->end, &test, sides);
+        return partition_stable(set->prims, c->begin, c->end, &test, scratch);
+    return partition_blocks(set->prims, c->begin, c->end, &test);
 }
 
 void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
                BvhCandidate *left, BvhCandidate *right)
 {
-    const size_t begin = c->begin, end = c->end;
-    size_t mid = begin + (end - begin) / 2;
-    /* The halves' boxes: unknown (NULL) for a split in the middle or one
-     * chosen from samples, which knows them only once its prims are moved;
-     * the bins of one from every prim know them already. */
-    const float *box[2][2] = { { NULL, NULL }, { NULL, NULL } };
-    SideBoxes sides;
-    float side_box[2][2][3];
     const BvhCandidate whole = *c;
-    if (!middle && whole.axis >= 0) {
-        mid = partition(set, &whole, scratch, whole.sampled ? &sides : NULL);
-        for (int side = 0; side < 2; side++) {
-            if (whole.sampled) {
-                bvh_store3(side_box[side][0], sides.lower[side]);
-                bvh_store3(side_box[side][1], sides.upper[side]);
+    const int binned = !middle && whole.axis >= 0;
+    /* The halves' boxes are the bins' for a binned split, and unknown
+     * (NULL) for one in the middle. */
+    const size_t mid = binned ? partition(set, &whole, scratch)
+                              : whole.begin + (whole.end - whole.begin) / 2;
+    bvh_candidate_init(set, left, whole.begin, mid, binned ? whole.left_lower : NULL,
+                       binned ? whole.left_upper : NULL);
+    bvh_candidate_init(set, right, mid, whole.end, binned ? whole.right_lower : NULL,
+                       binned ? whole.right_upper : NULL);
+}
+
+/* The children of the prims p[0 .. 3] in child[0 .. 3], four at once: their
+ * centres' rows turned into columns. */
+static void prim_children4(const BvhChildLanes *lanes, const BvhPrim *p, uint8_t child[4])
+{
+    __m128 x = _mm_loadu_ps(p[0].centre), y = _mm_loadu_ps(p[1].centre),
+           z = _mm_loadu_ps(p[2].centre), radius = _mm_loadu_ps(p[3].centre);
+    _MM_TRANSPOSE4_PS(x, y, z, radius);
+    const __m128 centre[3] = { x, y, z };
+    bvh_children4(lanes, centre, child);
+}
+
+/* The children's counts and boxes, growing with each prim. */
+typedef struct ChildBoxes {
+    size_t count[PTR_BVH_WIDTH];
+    __m128 lower[PTR_BVH_WIDTH], upper[PTR_BVH_WIDTH];
+} ChildBoxes;
+
+/* Finds the children of the first n (at most 4) of the prims p, in child,
+ * and adds the prims to their children's counts and boxes. */
+static void add_children4(const BvhChildLanes *lanes, float magnitude, const BvhPrim *p,
+                          size_t n, uint8_t *child, ChildBoxes *b)
+{
+    uint8_t four[4];
+    if (n == 4) {
+        prim_children4(lanes, p, four);
+    } else {
+        /* The last prims of a range: the lanes past them repeat the last. */
+        BvhPrim last[4];
+        for (size_t i = 0; i < 4; i++)
+            last[i] = p[i < n ? i : n - 1];
+        prim_children4(lanes, last, four);
+    }
+    for (size_t i = 0; i < n; i++) {
+        const int k = four[i];
+        __m128 lower, upper;
+        bvh_prim_box4(&p[i], magnitude, &lower, &upper);
+        b->lower[k] = _mm_min_ps(b->lower[k], lower);
+        b->upper[k] = _mm_max_ps(b->upper[k], upper);
+        b->count[k]++;
+        child[i] = (uint8_t)k;
+    }
+}
+
+void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
+                        uint8_t *child)
+{
+    BvhChildLanes lanes;
+    bvh_child_lanes(children, &lanes);
+    BvhPrim *p = set->prims + begin;
+    const size_t n = end - begin;
+    ChildBoxes b = { .count = { 0 } };
+    for (int k = 0; k < children->count; k++) {
+        b.lower[k] = _mm_set1_ps(INFINITY);
+        b.upper[k] = _mm_set1_ps(-INFINITY);
+    }
+    for (size_t i = 0; i < n; i += 4)
+        add_children4(&lanes, set->magnitude, &p[i], n - i < 4 ? n - i : 4, &child[i], &b);
+    /* Each child's place, and the next of its places to fill (head). */
+    int order[PTR_BVH_WIDTH];
+    size_t head[PTR_BVH_WIDTH], stop[PTR_BVH_WIDTH], next = 0;
+    bvh_children_order(children, order);
+    for (int j = 0; j < children->count; j++) {
+        const int k = order[j];
+        head[k] = next;
+        next += b.count[k];
+        stop[k] = next;
+        children->begin[k] = begin + head[k];
+        children->end[k] = begin + next;
+        bvh_store3(children->lower[k], b.lower[k]);
+        bvh_store3(children->upper[k], b.upper[k]);
+    }
+    /* Each child's places in turn, filled by swaps (American flag sort):
+     * a prim that belongs elsewhere goes to its child's next place, whose
+     * prim is looked at next. Each swap puts one prim in its child. */
+    for (int j = 0; j < children->count; j++) {
+        const int k = order[j];
+        while (head[k] < stop[k]) {
+            const size_t at = head[k];
+            const int to = child[at];
+            if (to == k) {
+                head[k]++;
+                continue;
             }
-            box[side][0] = whole.sampled ? side_box[side][0]
-                                         : side ? whole.right_lower : whole.left_lower;
-            box[side][1] = whole.sampled ? side_box[side][1]
-                                         : side ? whole.right_upper : whole.left_upper;
+            const size_t there = head[to]++;
+            const BvhPrim moved = p[there];
+            p[there] = p[at];
+            p[at] = moved;
+            child[at] = child[there];
+            child[there] = (uint8_t)to;
         }
     }
-    bvh_candidate_init(set, left, begin, mid, box[0][0], box[0][1]);
-    bvh_candidate_init(set, right, mid, end, box[1][0], box[1][1]);
 }

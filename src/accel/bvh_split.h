@@ -1,5 +1,6 @@
-/* Splitting a range of prims in two by the binned surface area heuristic:
- * the building block of the tree's build (bvh_build.c). */
+/* Splitting a range of prims in two by the binned surface area heuristic,
+ * and into a node's children as a plan from samples says: the building
+ * blocks of the tree's build (bvh_build.c). */
 #ifndef PTR_BVH_SPLIT_H
 #define PTR_BVH_SPLIT_H
 
@@ -22,7 +23,6 @@ typedef struct BvhCandidate {
     int axis;         /* of the best split; -1: split in the middle of the range */
     int bins;         /* BINS, fewer for small ranges */
     int split_bin;    /* prims in bins <= split_bin go left */
-    int sampled;      /* the split was chosen from samples, the halves' boxes are not known */
     float left_lower[3], left_upper[3], right_lower[3], right_upper[3];
     /* Binning: a prim's bin on axis a is (lower + upper - bin_base) * bin_scale,
      * over the candidate's box (cheaper than the box of the centres, which
@@ -37,8 +37,15 @@ static inline float bvh_half_area(const float lo[3], const float hi[3])
     return dx * dy + dy * dz + dz * dx;
 }
 
+/* Ranges of more than this many prims are split into a node's children
+ * by a plan from samples (bvh_build.c), not a split at a time: at the top
+ * of a tree of 10^8 spheres, a pass over a range's prims for each of its
+ * node's three levels of splits took a third of the build. */
+enum { BVH_PLANNED_ABOVE = 1 << 16 };
+
 /* Sets c to the range begin .. end - 1 with box lower, upper (NULL: find
- * it) and, if it has more prims than a leaf holds, finds its best split. */
+ * it) and, if it has more prims than a leaf holds and no more than
+ * BVH_PLANNED_ABOVE, finds its best split (else c->axis is -1). */
 void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
                         const float lower[3], const float upper[3]);
 
@@ -50,5 +57,11 @@ BvhSplitTest bvh_split_test(const BvhCandidate *c);
  * (room for c's prims, or NULL) makes the partition faster. */
 void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
                BvhCandidate *left, BvhCandidate *right);
+
+/* Sorts the prims begin .. end - 1 into children (its splits set, from
+ * samples), in place, in bvh_children_order's order, and fills in each
+ * child's range and box. child: room for a byte a prim. */
+void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
+                        uint8_t *child);
 
 #endif /* PTR_BVH_SPLIT_H */

@@ -8,6 +8,7 @@
 
 #include "accel/accel.h"
 #include "accel/bvh.h"
+#include "accel/bvh_split.h"
 #include "accel/isect.h"
 #include "base/memory.h"
 #include "bvh_scenes.h"
@@ -384,6 +385,79 @@ static void test_root_sort(void)
     ptr_scene_free(&file);
 }
 
+/* bvh_split_children against the plan's splits made one at a time with
+ * bvh_goes_right: every prim of a child goes there by the splits, the
+ * children tile the range in bvh_children_order's order, each box is its
+ * prims' to the bit, and no prim is lost or copied. The prims: random
+ * centres, some on bin edges, in ranges whose length leaves 0 to 3 at the
+ * end of the four-at-a-time pass, inside a larger array. */
+static void test_split_children(void)
+{
+    enum { TOTAL = 20000 };
+    BvhPrim *prims = malloc(TOTAL * sizeof *prims);
+    uint8_t *child = malloc(TOTAL);
+    CHECK(prims && child);
+    PtrRng rng = ptr_rng_for_sample(11, 0, 0);
+    const size_t ranges[][2] = { { 0, TOTAL }, { 3, 9001 }, { 100, 102 }, { 17, 18 },
+                                 { 5000, 5003 } };
+    for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
+        for (uint32_t i = 0; i < TOTAL; i++) {
+            prims[i] = (BvhPrim){ .id = i, .radius = bvh_uniform(&rng, 0.01f, 0.5f) };
+            for (int a = 0; a < 3; a++)
+                /* One in eight on the grid of the splits' bin edges. */
+                prims[i].centre[a] = ptr_rng_float(&rng) < 0.125f
+                                         ? (float)(int)bvh_uniform(&rng, -8, 8)
+                                         : bvh_uniform(&rng, -8, 8);
+        }
+        const BvhPrimSet set = { prims, 8.5f };
+        BvhChildren plan = { .count = r == 3 ? 1 : PTR_BVH_WIDTH };
+        for (int s = 1; s < plan.count; s++) {
+            plan.source[s] = (int)(ptr_rng_float(&rng) * (float)s);
+            plan.test[s] = (BvhSplitTest){ .axis = s % 3,
+                                           .split_bin = (int)(ptr_rng_float(&rng) * 16.0f),
+                                           .base = -16.0f, .scale = 1.0f, .last = 31.0f };
+        }
+        const size_t begin = ranges[r][0], end = ranges[r][1];
+        bvh_split_children(&set, begin, end, &plan, child);
+        int order[PTR_BVH_WIDTH];
+        bvh_children_order(&plan, order);
+        size_t next = begin;
+        unsigned char *seen = calloc(TOTAL, 1);
+        CHECK(seen != NULL);
+        for (int j = 0; j < plan.count; j++) {
+            const int k = order[j];
+            CHECK_INT(plan.begin[k], next);
+            next = plan.end[k];
+            float lower[3] = { INFINITY, INFINITY, INFINITY },
+                  upper[3] = { -INFINITY, -INFINITY, -INFINITY };
+            for (size_t i = plan.begin[k]; i < plan.end[k]; i++) {
+                int in = 0;
+                for (int s = 1; s < plan.count; s++)
+                    if (in == plan.source[s] && bvh_goes_right(&plan.test[s], &prims[i]))
+                        in = s;
+                CHECK_INT(in, k);
+                CHECK(prims[i].id >= begin && prims[i].id < end && !seen[prims[i].id]);
+                seen[prims[i].id] = 1;
+                float lo[3], hi[3];
+                bvh_prim_box(&prims[i], set.magnitude, lo, hi);
+                for (int a = 0; a < 3; a++) {
+                    lower[a] = ptr_minf(lower[a], lo[a]);
+                    upper[a] = ptr_maxf(upper[a], hi[a]);
+                }
+            }
+            CHECK(!memcmp(lower, plan.lower[k], sizeof lower));
+            CHECK(!memcmp(upper, plan.upper[k], sizeof upper));
+        }
+        CHECK_INT(next, end);
+        for (size_t i = 0; i < TOTAL; i++)
+            if (i < begin || i >= end)
+                CHECK_INT(prims[i].id, i);
+        free(seen);
+    }
+    free(prims);
+    free(child);
+}
+
 /* FNV-1a over bytes, for test_tree_bytes. */
 static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
 {
@@ -400,16 +474,19 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
  * promised the same from one build to the next: a change that moves any
  * split shows here, and one meant to updates these values and says why. The
  * sets take every path of the build: the clusters' 300,000 spheres a root
- * chosen from samples, the sampled splits of its parts and the tasks; the
- * random 5,000 a root chosen from all of them and the binning of every
- * prim; the sheet's 19,881 centres on a regular grid the same. The
+ * chosen from samples, its parts and the tasks; the clusters' 1,000,000
+ * the nodes of its parts planned from samples; the random 5,000 a root
+ * chosen from all of them and the binning of every prim; the sheet's
+ * 19,881 centres on a regular grid the same. The
  * root's split tests, made four spheres at once where the partitions test
  * one, must agree with them to leave the last two as the build made them
  * when it split the root in place. (The random set's value is that of the
  * build before the binning moved into SSE registers, which left it
  * unchanged; the sheet's that of the build just before the root was chosen
  * before the copy. The clusters' changed with that: the root's splits came
- * from samples of each range, and now of the whole.) */
+ * from samples of each range, and now of the whole. The 300,000 clusters'
+ * value held when the nodes of more than 65,536 spheres came to be planned
+ * from samples, since none of its nodes has so many.) */
 static void test_tree_bytes(void)
 {
     const struct {
@@ -419,6 +496,7 @@ static void test_tree_bytes(void)
         int depth; /* the traversal's stack is sized by it */
     } sets[] = {
         { BVH_SCENE_CLUSTERS, 300000, UINT64_C(0x93a4cf762059b65c), 7 },
+        { BVH_SCENE_CLUSTERS, 1000000, UINT64_C(0x3fd5ad065c9aef4a), 8 },
         { BVH_SCENE_RANDOM, 5000, UINT64_C(0xdf3f94129d98524b), 3 },
         { BVH_SCENE_SHEET, 20000, UINT64_C(0x9c7e43ec4479f434), 3 },
     };
@@ -642,6 +720,7 @@ int main(void)
         TEST_CASE(test_scenes),
         TEST_CASE(test_threads),
         TEST_CASE(test_root_sort),
+        TEST_CASE(test_split_children),
         TEST_CASE(test_tree_bytes),
         TEST_CASE(test_auto),
         TEST_CASE(test_renders_files),
