@@ -24,7 +24,9 @@
  * it makes anyway. Split in place, the root's ranges took a pass over every
  * prim for their box and one for each level of its splits, about three,
  * which streamed memory at 1.8x on two threads (docs/intersectors.md, "The
- * root chosen before the copy").
+ * root chosen before the copy"). Every node of more than BVH_PLANNED_ABOVE
+ * prims is grown so from samples of its prims, which are then sorted into
+ * its children in place (plan_node).
  *
  * Threads: each of the root's children of more than task_spheres spheres
  * (1/64 of all, at least TASK_SPHERES_MIN: a rule of the sphere count
@@ -217,10 +219,11 @@ static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidat
 
 /* A node's children at this level as n samples of its prims split them,
  * each standing for per_prim prims (see grow_node), in plan: the prims are
- * then sorted into them in one pass, where splitting them in place took a
- * pass for each level of the node's splits, about three, each moving every
- * prim (docs/intersectors.md, "Nodes planned from samples"). plan->count
- * is 1 where the samples give no split (all at one centre). */
+ * then sorted into them in two passes (bvh_split_children), where splitting
+ * them one split at a time took a pass for each level of the node's splits,
+ * about three, each moving every prim (docs/intersectors.md, "Nodes planned
+ * from samples"). plan->count is 1 where the samples give no split (all at
+ * one centre). */
 static void plan_children(const BvhPrimSet *samples, size_t n, int level, double per_prim,
                           BvhChildren *plan)
 {
@@ -318,9 +321,10 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
         return PTR_OK;
     if (w->child_room < n) {
         free(w->child);
-        if (!(w->child = malloc(n)))
-            return w->child_room = 0, bvh_out_of_memory(err);
-        w->child_room = n;
+        w->child = malloc(n);
+        w->child_room = w->child ? n : 0;
+        if (!w->child)
+            return bvh_out_of_memory(err);
     }
     bvh_split_children(&build->set, range->begin, range->end, &plan, w->child);
     for (int k = 0; k < plan.count; k++)
