@@ -22,14 +22,16 @@ static void bounds_grow(float lo[3], float hi[3], const float plo[3], const floa
 }
 
 /* The bins of one run of prims: boxes and counts per axis, plus the run's
- * box. A bin's box is x, y, z and an unused lane in one SSE register, so
+ * box. A bin's box is x, y, z and a fourth lane in one SSE register, so
  * that growing it is one minimum and one maximum, where three scalar lanes
  * took six (binning is most of a build). _mm_min_ps(a, b) and
  * _mm_max_ps(a, b) are ptr_minf(a, b) and ptr_maxf(a, b) lane by lane, so
- * the boxes have the bits the scalar code gives. */
+ * the boxes have the bits the scalar code gives. The bin's count is the
+ * upper box's fourth lane, a float (exact: a range binned has at most
+ * BVH_PLANNED_ABOVE prims), so that counting a prim is no load and store of
+ * its own. */
 typedef struct Bins {
     __m128 lower[3][BINS], upper[3][BINS];
-    size_t count[3][BINS];
     float box_lo[3], box_hi[3];
 } Bins;
 
@@ -38,8 +40,7 @@ static void bins_clear(Bins *b, int bins)
     for (int a = 0; a < 3; a++)
         for (int k = 0; k < bins; k++) {
             b->lower[a][k] = _mm_set1_ps(INFINITY);
-            b->upper[a][k] = _mm_set1_ps(-INFINITY);
-            b->count[a][k] = 0;
+            b->upper[a][k] = _mm_setr_ps(-INFINITY, -INFINITY, -INFINITY, 0.0f);
         }
     bounds_empty(b->box_lo, b->box_hi);
 }
@@ -53,6 +54,12 @@ static inline float half_area4(__m128 lo, __m128 hi)
     const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));
     return _mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1))) +
            _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
+}
+
+/* A bin's count, or a sum of them: the fourth lane (see Bins). */
+static inline float count_lane(__m128 upper)
+{
+    return _mm_cvtss_f32(_mm_shuffle_ps(upper, upper, _MM_SHUFFLE(3, 3, 3, 3)));
 }
 
 /* The box only (of a task's range, or of the root's samples). */
@@ -71,18 +78,23 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, const BvhCa
     const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
     const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
     const __m128 last = _mm_set1_ps((float)(c->bins - 1));
+    /* The box's upper x, y and z, and 0 under the count; then one more on
+     * the count, 0 on the box (x + 0 is x: a box has no -0, its extent
+     * being above 0). */
+    const __m128 box_lanes = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)),
+                 one_more = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
     for (size_t i = begin; i < end; i++) {
         const BvhPrim *p = &set->prims[i];
         __m128 lower, upper;
         bvh_prim_box4(p, set->magnitude, &lower, &upper);
+        upper = _mm_and_ps(upper, box_lanes);
         /* Its bins on the three axes at once (the radius lane, scaled by
          * 0, gives bin 0). */
         int k[4];
         _mm_storeu_si128((__m128i *)k, bvh_bins4(_mm_loadu_ps(p->centre), base, scale, last));
         for (int a = 0; a < 3; a++) {
             b->lower[a][k[a]] = _mm_min_ps(b->lower[a][k[a]], lower);
-            b->upper[a][k[a]] = _mm_max_ps(b->upper[a][k[a]], upper);
-            b->count[a][k[a]]++;
+            b->upper[a][k[a]] = _mm_add_ps(_mm_max_ps(b->upper[a][k[a]], upper), one_more);
         }
     }
 }
@@ -123,29 +135,32 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     bin_run(set, begin, end, c, &bins);
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
+        /* The boxes of the bins from each end, and their counts summed in
+         * the fourth lane of sum (hi4's fourth lane, their largest count,
+         * is no box's). */
         __m128 right_lo[BINS], right_hi[BINS];
-        size_t right_count[BINS];
-        __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
-        size_t n = 0;
+        float right_count[BINS];
+        __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY), sum = _mm_setzero_ps();
         for (int k = c->bins - 1; k > 0; k--) {
             lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
             hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
-            n += bins.count[a][k];
+            sum = _mm_add_ps(sum, bins.upper[a][k]);
             right_lo[k] = lo4;
             right_hi[k] = hi4;
-            right_count[k] = n;
+            right_count[k] = count_lane(sum);
         }
         lo4 = _mm_set1_ps(INFINITY);
         hi4 = _mm_set1_ps(-INFINITY);
-        n = 0;
+        sum = _mm_setzero_ps();
         for (int k = 0; k < c->bins - 1; k++) {
             lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
             hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
-            n += bins.count[a][k];
+            sum = _mm_add_ps(sum, bins.upper[a][k]);
+            const float n = count_lane(sum);
             if (n == 0 || right_count[k + 1] == 0)
                 continue;
-            float cost = half_area4(lo4, hi4) * (float)n +
-                         half_area4(right_lo[k + 1], right_hi[k + 1]) * (float)right_count[k + 1];
+            float cost = half_area4(lo4, hi4) * n +
+                         half_area4(right_lo[k + 1], right_hi[k + 1]) * right_count[k + 1];
             if (cost < best) {
                 best = cost;
                 c->axis = a;
