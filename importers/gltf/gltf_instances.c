@@ -166,10 +166,44 @@ typedef struct Instance {
 /* Why a slot gives no sphere. */
 typedef enum Fault { NO_FAULT, TRANSFORM_FAULT, VALUE_FAULT, SPHERE_FAULT } Fault;
 
+/* The world of instance i of a run under an identity world whose instances
+ * have no rotation, and its largest axis scale (*uneven set if they
+ * differ); 0 where instance_local refuses the instance. The entries are
+ * those of gltf_mat4_identity_mul(instance_local), without its products:
+ * for the quaternion (0, 0, 0, 1), gltf_trs_matrix's rotation terms are
+ * products and sums of 0 and 1, so exactly 1 on the diagonal and +0 off it,
+ * and the columns are the scale (above 0, times 1) and +0s, then the
+ * translation. Adding 0.0, as the identity's product does, turns a -0
+ * translation into +0 and changes nothing else. An axis's scale, the length
+ * of its column, is then sqrt(s s + 0 + 0): sqrt(s s), once where all three
+ * are one. Large clouds' instances are so, and the general product and
+ * lengths were a sixth of their import (docs/intersectors.md, "Instances
+ * without rotations"). */
+static int moved_and_scaled(const NodeRun *run, size_t i, Mat4 *world, double *scale,
+                            int *uneven)
+{
+    double t[4] = { 0, 0, 0, 0 }, s[4] = { 1, 1, 1, 1 };
+    if (run->has_t)
+        gltf_element(&run->t, i, t);
+    if (run->has_s)
+        gltf_element(&run->s, i, s);
+    for (int k = 0; k < 3; k++)
+        if (!(s[k] > 0) || !isfinite(s[k]) || !isfinite(t[k]))
+            return 0;
+    *world = (Mat4){ { s[0], 0.0, 0.0, 0.0, 0.0, s[1], 0.0, 0.0, 0.0, 0.0, s[2], 0.0,
+                       t[0] + 0.0, t[1] + 0.0, t[2] + 0.0, 1.0 } };
+    *scale = s[0] == s[1] && s[1] == s[2] ? sqrt(s[0] * s[0]) : gltf_axis_scale(world, uneven);
+    return 1;
+}
+
 /* Instance i of the run, or why it gives no spheres. */
 static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
 {
-    if (run->instanced) {
+    out->uneven = 0;
+    if (run->instanced && run->world_identity && !run->has_r) {
+        if (!moved_and_scaled(run, i, &out->world, &out->scale, &out->uneven))
+            return TRANSFORM_FAULT;
+    } else if (run->instanced) {
         Mat4 local;
         if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
                             run->has_s ? &run->s : NULL, i, &local))
@@ -178,8 +212,10 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
          * product without its products needs. */
         out->world = run->world_identity ? gltf_mat4_identity_mul(&local)
                                          : gltf_mat4_mul(run->world, &local);
+        out->scale = gltf_axis_scale(&out->world, &out->uneven);
     } else {
         out->world = *run->world;
+        out->scale = gltf_axis_scale(&out->world, &out->uneven);
     }
     out->has_color = run->has_c;
     if (run->has_c)
@@ -187,8 +223,6 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
     out->has_value = run->has_v;
     if (run->has_v && !element_value(&run->v, i, &out->value))
         return VALUE_FAULT;
-    out->uneven = 0;
-    out->scale = gltf_axis_scale(&out->world, &out->uneven);
     return NO_FAULT;
 }
 
