@@ -11,9 +11,7 @@ usage: check_instance_transforms.py PTR"""
 import json, math, os, random, struct, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from glb import write_glb  # noqa: E402
-from mesh_files import sphere_bytes  # noqa: E402
-from parallel_import import report  # noqa: E402
+from parallel_import import report, write_instanced_spheres  # noqa: E402
 
 ptr = sys.argv[1]
 COUNT = 40_000  # above importers' PARALLEL_PARTS (32,768): converted on all cores
@@ -37,41 +35,11 @@ def instances(broken):
 
 def write_cloud(path, attributes, rotated, broken):
     t, s = instances(broken)
-    columns = {"TRANSLATION": (b"".join(struct.pack("<3f", *v) for v in t), "VEC3"),
-               "SCALE": (b"".join(struct.pack("<3f", *v) for v in s), "VEC3"),
-               "ROTATION": (struct.pack("<4f", 0, 0, 0, 1) * COUNT, "VEC4")}
+    columns = {"TRANSLATION": ("VEC3", b"".join(struct.pack("<3f", *v) for v in t)),
+               "SCALE": ("VEC3", b"".join(struct.pack("<3f", *v) for v in s)),
+               "ROTATION": ("VEC4", struct.pack("<4f", 0, 0, 0, 1) * COUNT)}
     names = list(attributes) + (["ROTATION"] if rotated else [])
-    sphere, indices, vertices, index_count = sphere_bytes(0.05)
-    binary, views, accessors, instancing = b"", [], [], {}
-    for block in [columns[n][0] for n in names] + [sphere, indices]:
-        views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
-        binary += block
-    for k, n in enumerate(names):
-        instancing[n] = len(accessors)
-        accessors.append({"bufferView": k, "componentType": 5126, "count": COUNT,
-                          "type": columns[n][1]})
-    accessors.append({"bufferView": len(names), "componentType": 5126, "count": vertices,
-                      "type": "VEC3", "min": [-0.05] * 3, "max": [0.05] * 3})
-    accessors.append({"bufferView": len(names) + 1, "componentType": 5123,
-                      "count": index_count, "type": "SCALAR"})
-    doc = {
-        "asset": {"version": "2.0"},
-        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
-        "buffers": [{"byteLength": len(binary)}],
-        "bufferViews": views,
-        "accessors": accessors,
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
-                                                "metallicFactor": 0}}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 2},
-                                    "indices": len(accessors) - 1, "material": 0}]}],
-        "nodes": [{"mesh": 0, "name": "cloud",
-                   "extensions": {"EXT_mesh_gpu_instancing": {"attributes": instancing}}},
-                  {"camera": 0, "translation": [0, 3, 10]}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
-        "scenes": [{"nodes": [0, 1]}],
-        "scene": 0,
-    }
-    write_glb(path, doc, binary)
+    write_instanced_spheres(path, [(n, *columns[n]) for n in names], COUNT, 1)
 
 
 def dump(d, attributes, rotated, broken):

@@ -10,9 +10,8 @@ usage: check_parallel_instances.py PTR"""
 import math, os, random, struct, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from glb import write_glb  # noqa: E402
-from mesh_files import sphere_bytes  # noqa: E402
-from parallel_import import dump_clouds, report, spheres_differ  # noqa: E402
+from parallel_import import (dump_clouds, report, spheres_differ,  # noqa: E402
+                             write_instanced_spheres)
 
 ptr = sys.argv[1]
 COUNT = 40_000  # above importers' PARALLEL_PARTS (32,768); each half below it
@@ -36,42 +35,11 @@ def instances(broken):
 
 def write_cloud(path, nodes, broken):
     t, r, s, c = instances(broken)
-    blocks = [b"".join(struct.pack("<3f", *v) for v in t), b"".join(struct.pack("<4f", *v) for v in r),
-              b"".join(struct.pack("<3f", *v) for v in s), b"".join(struct.pack("<3f", *v) for v in c)]
-    sphere, indices, vertices, index_count = sphere_bytes(0.05)
-    binary, views = b"", []
-    for block in blocks + [sphere, indices]:
-        views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
-        binary += block
-    per = COUNT // nodes
-    accessors, node_list = [], []
-    for n in range(nodes):
-        first = len(accessors)
-        for k, (width, kind) in enumerate([(12, "VEC3"), (16, "VEC4"), (12, "VEC3"), (12, "VEC3")]):
-            accessors.append({"bufferView": k, "byteOffset": n * per * width, "componentType": 5126,
-                              "count": per, "type": kind})
-        node_list.append({"mesh": 0, "name": "cloud", "extensions": {"EXT_mesh_gpu_instancing": {
-            "attributes": {"TRANSLATION": first, "ROTATION": first + 1, "SCALE": first + 2,
-                           "_COLOR_0": first + 3}}}})
-    accessors.append({"bufferView": 4, "componentType": 5126, "count": vertices, "type": "VEC3",
-                      "min": [-0.05, -0.05, -0.05], "max": [0.05, 0.05, 0.05]})
-    accessors.append({"bufferView": 5, "componentType": 5123, "count": index_count,
-                      "type": "SCALAR"})
-    doc = {
-        "asset": {"version": "2.0"},
-        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
-        "buffers": [{"byteLength": len(binary)}],
-        "bufferViews": views,
-        "accessors": accessors,
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 2},
-                                    "indices": len(accessors) - 1, "material": 0}]}],
-        "nodes": node_list + [{"camera": 0, "translation": [0, 3, 10]}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
-        "scenes": [{"nodes": list(range(nodes + 1))}],
-        "scene": 0,
-    }
-    write_glb(path, doc, binary)
+    write_instanced_spheres(path, [
+        ("TRANSLATION", "VEC3", b"".join(struct.pack("<3f", *v) for v in t)),
+        ("ROTATION", "VEC4", b"".join(struct.pack("<4f", *v) for v in r)),
+        ("SCALE", "VEC3", b"".join(struct.pack("<3f", *v) for v in s)),
+        ("_COLOR_0", "VEC3", b"".join(struct.pack("<3f", *v) for v in c))], COUNT, nodes)
 
 
 runs = dump_clouds(ptr, write_cloud)

@@ -8,6 +8,51 @@ import subprocess
 import sys
 import tempfile
 
+from glb import write_glb
+from mesh_files import sphere_bytes
+
+
+def write_instanced_spheres(path, columns, count, parts):
+    """A .glb of a sphere mesh (radius 0.05, white diffuse) instanced by
+    parts nodes named 'cloud', each taking count / parts of the instances in
+    order, and a camera: columns is a list of (EXT_mesh_gpu_instancing
+    attribute, float32 VEC3 or VEC4, the bytes of all count instances)."""
+    sphere, indices, vertices, index_count = sphere_bytes(0.05)
+    binary, views = b"", []
+    for block in [c[2] for c in columns] + [sphere, indices]:
+        views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(block)})
+        binary += block
+    per = count // parts
+    accessors, nodes = [], []
+    for n in range(parts):
+        attributes = {}
+        for k, (name, kind, block) in enumerate(columns):
+            attributes[name] = len(accessors)
+            accessors.append({"bufferView": k, "byteOffset": n * per * len(block) // count,
+                              "componentType": 5126, "count": per, "type": kind})
+        nodes.append({"mesh": 0, "name": "cloud",
+                      "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attributes}}})
+    accessors.append({"bufferView": len(columns), "componentType": 5126, "count": vertices,
+                      "type": "VEC3", "min": [-0.05, -0.05, -0.05], "max": [0.05, 0.05, 0.05]})
+    accessors.append({"bufferView": len(columns) + 1, "componentType": 5123,
+                      "count": index_count, "type": "SCALAR"})
+    doc = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+        "buffers": [{"byteLength": len(binary)}],
+        "bufferViews": views,
+        "accessors": accessors,
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+                                                "metallicFactor": 0}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                    "indices": len(accessors) - 1, "material": 0}]}],
+        "nodes": nodes + [{"camera": 0, "translation": [0, 3, 10]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
+        "scenes": [{"nodes": list(range(parts + 1))}],
+        "scene": 0,
+    }
+    write_glb(path, doc, binary)
+
 
 def dump_clouds(ptr, write_cloud, options=()):
     """ptr --dump-scene (with options) of write_cloud(path, parts, broken)
