@@ -81,6 +81,15 @@ static int element_value(const GltfAccessor *a, size_t i, double *value)
     return isfinite(*value);
 }
 
+/* Whether an instance's SCALE is one: each axis's above 0 and finite. */
+static int scale_ok(const double scale[3])
+{
+    for (int k = 0; k < 3; k++)
+        if (!(scale[k] > 0) || !isfinite(scale[k]))
+            return 0;
+    return 1;
+}
+
 /* T * R * S of instance i, from the attributes present. */
 static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const GltfAccessor *s,
                           size_t i, Mat4 *out)
@@ -101,9 +110,8 @@ static int instance_local(const GltfAccessor *t, const GltfAccessor *r, const Gl
     }
     if (s) {
         gltf_element(s, i, v);
-        for (int k = 0; k < 3; k++)
-            if (!(v[k] > 0) || !isfinite(v[k]))
-                return 0;
+        if (!scale_ok(v))
+            return 0;
         memcpy(scale, v, sizeof scale);
     }
     *out = gltf_trs_matrix(translation, rotation, scale);
@@ -187,9 +195,8 @@ static int moved_and_scaled(const NodeRun *run, size_t i, Mat4 *world, double *s
         gltf_element(&run->t, i, t);
     if (run->has_s)
         gltf_element(&run->s, i, s);
-    for (int k = 0; k < 3; k++)
-        if (!(s[k] > 0) || !isfinite(s[k]) || !isfinite(t[k]))
-            return 0;
+    if (!scale_ok(s) || !all_finite(t, 3))
+        return 0;
     *world = (Mat4){ { s[0], 0.0, 0.0, 0.0, 0.0, s[1], 0.0, 0.0, 0.0, 0.0, s[2], 0.0,
                        t[0] + 0.0, t[1] + 0.0, t[2] + 0.0, 1.0 } };
     *scale = s[0] == s[1] && s[1] == s[2] ? sqrt(s[0] * s[0]) : gltf_axis_scale(world, uneven);

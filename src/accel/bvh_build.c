@@ -75,8 +75,11 @@ typedef struct NodeArray {
 } NodeArray;
 
 typedef struct Task {
-    size_t begin, end;
-    float lower[3], upper[3]; /* its box */
+    /* Its prims, their box and their split, found where the task was made
+     * but for the root's children, which ptr_bvh_build gives their boxes
+     * only (split_found 0): the task's thread finds theirs. */
+    BvhCandidate range;
+    int split_found;
     int level; /* of its root node */
     NodeArray nodes;
 } Task;
@@ -160,8 +163,8 @@ static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
     return PTR_OK;
 }
 
-static PtrResult add_task(TaskList *list, const BvhCandidate *range, int level, uint32_t *task,
-                          PtrError *err)
+static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_found, int level,
+                          uint32_t *task, PtrError *err)
 {
     if (list->count == list->capacity) {
         size_t capacity = list->capacity ? list->capacity * 2 : 64;
@@ -172,16 +175,14 @@ static PtrResult add_task(TaskList *list, const BvhCandidate *range, int level, 
         list->capacity = capacity;
     }
     *task = (uint32_t)list->count;
-    Task *t = &list->tasks[list->count++];
-    *t = (Task){ .begin = range->begin, .end = range->end, .level = level };
-    memcpy(t->lower, range->lower, sizeof t->lower);
-    memcpy(t->upper, range->upper, sizeof t->upper);
+    list->tasks[list->count++] =
+        (Task){ .range = *range, .split_found = split_found, .level = level };
     return PTR_OK;
 }
 
 /* Splits range, at this level, into a node's children, child[0 .. *count -
  * 1], Embree's way (see the head). Each prim of range stands for per_prim
- * of the tree's (1 but for the root's samples, see plan_root), in the
+ * of the tree's (1 but for samples, see plan_children), in the
  * counts that decide which children are split. With plan, each split is
  * recorded in it, and a child is split only by its best split, against
  * which a prim can be tested (bvh_split_test), never in the middle.
@@ -277,7 +278,7 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
         node.leaf_count[k] = 0;
         if (kind != NODE_TASK && count <= build->task_spheres) {
             uint32_t task;
-            if ((r = add_task(tasks, c, level + 1, &task, err)) != PTR_OK)
+            if ((r = add_task(tasks, c, kind != NODE_ROOT, level + 1, &task, err)) != PTR_OK)
                 return r;
             node.child[k] = TASK_FLAG | task;
             continue;
@@ -315,7 +316,7 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
     const BvhPrim *prims = build->set.prims + range->begin;
     for (size_t j = 0; j < PLAN_SAMPLES; j++) {
         /* Each a cache miss the prefetchers do not foresee: fetched ahead,
-         * they overlap. */
+         * they overlap. (j n is below 2^15 2^31: no overflow.) */
         if (j + PLAN_AHEAD < PLAN_SAMPLES)
             _mm_prefetch((const char *)&prims[(j + PLAN_AHEAD) * n / PLAN_SAMPLES], _MM_HINT_T0);
         w->samples[j] = prims[j * n / PLAN_SAMPLES];
@@ -333,6 +334,8 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
         if (!w->child)
             return bvh_out_of_memory(err);
     }
+    /* Every child holds a prim: each holds a sample (the heuristic makes
+     * no empty side), which is one of the prims, tested the same way. */
     bvh_split_children(&build->set, range->begin, range->end, &plan, w->child);
     for (int k = 0; k < plan.count; k++)
         bvh_candidate_init(&build->set, &child[k], plan.begin[k], plan.end[k], plan.lower[k],
@@ -368,7 +371,7 @@ static size_t part_size(const Part *p)
 
 static size_t task_size(const Task *t)
 {
-    return t->end - t->begin;
+    return t->range.end - t->range.begin;
 }
 
 /* Makes tasks ready to take, kept as a heap with the largest first; under
@@ -435,9 +438,11 @@ static int build_task(Build *build, Worker *w, Task *t)
      * task_spheres). */
     if (!w->scratch && !(w->scratch = malloc(build->task_spheres * sizeof *w->scratch)))
         return 0;
-    BvhCandidate range;
+    BvhCandidate range = t->range;
     size_t root;
-    bvh_candidate_init(&build->set, &range, t->begin, t->end, t->lower, t->upper);
+    if (!t->split_found)
+        bvh_candidate_init(&build->set, &range, range.begin, range.end, range.lower,
+                           range.upper);
     return build_node(build, w, &t->nodes, NULL, &range, NODE_TASK, t->level, &root,
                       &t->nodes.depth, NULL) == PTR_OK;
 }
@@ -752,7 +757,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
     if (r == PTR_OK && prim_count > 0) {
-        /* Their ranges and boxes: the parts find their splits (build_part). */
+        /* Their ranges and boxes: the parts and tasks find their splits on
+         * their threads (build_part, build_task). */
         BvhCandidate child[PTR_BVH_WIDTH];
         int n = root.count;
         for (int k = 0; k < n; k++) {
@@ -762,7 +768,10 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         }
         /* Samples that gave the root no split (all at one centre: the build
          * splits such a range in the middle of its order, which no test of
-         * a prim can say) leave it to the prims, as any node. */
+         * a prim can say) leave it to the prims: their best split where
+         * they are few enough to bin, else the middle of their order (see
+         * bvh_candidate_init), as for a planned node whose samples give
+         * none. */
         if (n == 1) {
             BvhCandidate range;
             bvh_candidate_init(&build.set, &range, 0, prim_count, root.lower[0], root.upper[0]);

@@ -1,6 +1,7 @@
 /* What the tree is built from: a padded box per sphere, the choice of the
- * huge spheres it keeps out of its boxes, and the copy that sorts the
- * others into the root's children. */
+ * huge spheres it keeps out of its boxes, the copy that sorts the others
+ * into the root's children, and the splits of a node planned from samples
+ * (BvhChildren), with which the copy and bvh_split_children sort. */
 #ifndef PTR_BVH_PRIMS_H
 #define PTR_BVH_PRIMS_H
 

@@ -62,7 +62,8 @@ static inline float count_lane(__m128 upper)
     return _mm_cvtss_f32(_mm_shuffle_ps(upper, upper, _MM_SHUFFLE(3, 3, 3, 3)));
 }
 
-/* The box only (of a task's range, or of the root's samples). */
+/* The box only (of a plan's samples, or of the halves of a split in the
+ * middle). */
 static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
 {
     for (size_t i = begin; i < end; i++) {
@@ -79,8 +80,9 @@ static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, const BvhCa
     const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
     const __m128 last = _mm_set1_ps((float)(c->bins - 1));
     /* The box's upper x, y and z, and 0 under the count; then one more on
-     * the count, 0 on the box (x + 0 is x: a box has no -0, its extent
-     * being above 0). */
+     * the count, 0 on the box (x + 0 is x but for x = -0, and no box has a
+     * -0: the extent is never -0, so centre + extent is -0 only for a
+     * centre of -0 and an extent of -0). */
     const __m128 box_lanes = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)),
                  one_more = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
     for (size_t i = begin; i < end; i++) {

@@ -385,6 +385,27 @@ static void test_root_sort(void)
     ptr_scene_free(&file);
 }
 
+/* 600,000 spheres at one centre: the root's samples give no split, nor do
+ * those of its children (75,000 each, over the 65,536 a node is planned
+ * above), so both are split in the middle of their order; the tree is
+ * still whole, and answers as brute force does. */
+static void test_plans_without_split(void)
+{
+    PtrScene file, s;
+    ptr_scene_init(&file);
+    ptr_scene_init(&s);
+    CHECK(bvh_scene_make(&file, BVH_SCENE_SAME_CENTRE, 600000, 3));
+    CHECK(bvh_scene_make(&s, BVH_SCENE_SAME_CENTRE, 600000, 3));
+    tag_file_order(&s);
+    PtrBvh bvh;
+    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, NULL), PTR_OK);
+    check_structure(&bvh, &s.spheres, (FileOrder){ 0 }, "one centre, planned");
+    check_rays(&file, &s, &bvh, 100, "one centre, planned");
+    ptr_bvh_free(&bvh);
+    ptr_scene_free(&s);
+    ptr_scene_free(&file);
+}
+
 /* bvh_split_children against the plan's splits made one at a time with
  * bvh_goes_right: every prim of a child goes there by the splits, the
  * children tile the range in bvh_children_order's order, each box is its
@@ -721,6 +742,7 @@ int main(void)
         TEST_CASE(test_threads),
         TEST_CASE(test_root_sort),
         TEST_CASE(test_split_children),
+        TEST_CASE(test_plans_without_split),
         TEST_CASE(test_tree_bytes),
         TEST_CASE(test_auto),
         TEST_CASE(test_renders_files),
