@@ -105,9 +105,9 @@ static size_t sphere_bytes(const PtrSceneBuilder *b)
  * NaN for the checks that refuse it). */
 static int keeps(const PtrSceneBuilder *b, const double centre[3], double radius)
 {
-    return b->spheres.wide || ((double)(float)centre[0] == centre[0] &&
-                       (double)(float)centre[1] == centre[1] &&
-                       (double)(float)centre[2] == centre[2] && (double)(float)radius == radius);
+    return b->spheres.wide ||
+           ((double)(float)centre[0] == centre[0] && (double)(float)centre[1] == centre[1] &&
+            (double)(float)centre[2] == centre[2] && (double)(float)radius == radius);
 }
 
 static void set_sphere(PtrSceneBuilder *b, size_t i, const double centre[3], double radius)
@@ -218,6 +218,25 @@ PtrResult ptr_builder_refill(PtrSceneBuilder *b, size_t filled, int *refill, Ptr
     if (r == PTR_OK)
         atomic_store(&b->lost, 0);
     return r;
+}
+
+PtrResult ptr_builder_fill_blocks(PtrSceneBuilder *b, size_t first, size_t count, int threads,
+                                  void (*fill)(void *, size_t, size_t),
+                                  int (*done)(void *, size_t, size_t), void *arg)
+{
+    for (size_t begin = 0; begin < count;) {
+        const size_t end = ptr_builder_block_end(begin, count);
+        ptr_parallel_ranges(threads, begin, end, fill, arg);
+        int refill;
+        if (ptr_builder_refill(b, first + end, &refill, NULL) != PTR_OK)
+            return PTR_ERR_NOMEM;
+        if (refill)
+            continue;
+        if (done && !done(arg, begin, end))
+            break;
+        begin = end;
+    }
+    return PTR_OK;
 }
 
 PtrResult ptr_builder_add_sphere(PtrSceneBuilder *b, const double centre[3], double radius,

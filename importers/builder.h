@@ -110,6 +110,17 @@ static inline size_t ptr_builder_block_end(size_t begin, size_t count)
 PtrResult ptr_builder_refill(PtrSceneBuilder *builder, size_t filled, int *refill,
                              PtrError *err);
 
+/* Fills count spheres of a batch that ptr_builder_add_spheres added from
+ * first: fill(arg, begin, end), run on threads threads over ranges of
+ * 0 .. count - 1 (ptr_parallel_ranges), fills spheres first + begin ..
+ * first + end - 1 (ptr_builder_fill_sphere). A block at a time
+ * (ptr_builder_block_end), each filled again where ptr_builder_refill asks;
+ * after each, done(arg, begin, end), if not NULL, says whether to go on.
+ * Fails only for memory (PTR_ERR_NOMEM; the caller says so). */
+PtrResult ptr_builder_fill_blocks(PtrSceneBuilder *builder, size_t first, size_t count,
+                                  int threads, void (*fill)(void *, size_t, size_t),
+                                  int (*done)(void *, size_t, size_t), void *arg);
+
 /* Sphere i's x, y, z and radius, as they were given. Taken by value, so
  * that a loop over many holds the array and its width in locals, and the
  * compiler can make a loop of each width. */

@@ -144,6 +144,7 @@ typedef struct PointSet {
  * do not depend on how many convert them. */
 typedef struct NodeRun {
     PtrSceneBuilder *builder;
+    const GltfDoc *doc; /* whose pages each block gives back (release_slots) */
     const GltfNode *node;
     const GltfMesh *mesh;
     const SurfaceSpheres *surface;
@@ -210,18 +211,17 @@ static Fault instance_at(const NodeRun *run, size_t i, Instance *out)
     if (run->instanced && run->world_identity && !run->has_r) {
         if (!moved_and_scaled(run, i, &out->world, &out->scale, &out->uneven))
             return TRANSFORM_FAULT;
-    } else if (run->instanced) {
+    } else {
         Mat4 local;
-        if (!instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
+        if (run->instanced &&
+            !instance_local(run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
                             run->has_s ? &run->s : NULL, i, &local))
             return TRANSFORM_FAULT;
         /* local is finite (instance_local checks it), as the identity's
          * product without its products needs. */
-        out->world = run->world_identity ? gltf_mat4_identity_mul(&local)
-                                         : gltf_mat4_mul(run->world, &local);
-        out->scale = gltf_axis_scale(&out->world, &out->uneven);
-    } else {
-        out->world = *run->world;
+        out->world = !run->instanced      ? *run->world
+                     : run->world_identity ? gltf_mat4_identity_mul(&local)
+                                           : gltf_mat4_mul(run->world, &local);
         out->scale = gltf_axis_scale(&out->world, &out->uneven);
     }
     out->has_color = run->has_c;
@@ -333,7 +333,7 @@ enum { PARALLEL_PARTS = 1 << 15 };
 /* Gives back the file's pages read for slots begin .. end - 1 (see
  * gltf_doc_release): the instances' attributes, or the points' where no
  * other instance reads them again. */
-static void release_slots(const Importer *im, const NodeRun *run, size_t begin, size_t end)
+static void release_slots(const NodeRun *run, size_t begin, size_t end)
 {
     if (run->instanced) {
         const GltfAccessor *read[] = { run->has_t ? &run->t : NULL, run->has_r ? &run->r : NULL,
@@ -341,7 +341,7 @@ static void release_slots(const Importer *im, const NodeRun *run, size_t begin, 
                                        run->has_v ? &run->v : NULL };
         for (size_t a = 0; a < sizeof read / sizeof read[0]; a++)
             if (read[a])
-                gltf_doc_release(im->doc, read[a], begin / run->slots, end / run->slots);
+                gltf_doc_release(run->doc, read[a], begin / run->slots, end / run->slots);
         return;
     }
     size_t from = run->surface_count; /* the slot of the set's point 0 */
@@ -356,7 +356,7 @@ static void release_slots(const Importer *im, const NodeRun *run, size_t begin, 
                                        ps->has_val ? &ps->val : NULL };
         for (size_t a = 0; a < sizeof read / sizeof read[0]; a++)
             if (read[a])
-                gltf_doc_release(im->doc, read[a], lo, hi);
+                gltf_doc_release(run->doc, read[a], lo, hi);
     }
 }
 
@@ -545,25 +545,25 @@ static PtrResult start_run(Importer *im, NodeRun *run)
     return PTR_OK;
 }
 
+/* After a block of the run's slots is converted: gives back its pages,
+ * and says whether to go on (no slot failed). */
+static int slots_done(void *arg, size_t begin, size_t end)
+{
+    const NodeRun *run = arg;
+    release_slots(run, begin, end);
+    return atomic_load(&run->failed) == SIZE_MAX;
+}
+
 /* Converts the run's slots, on all cores where there are PARALLEL_PARTS or
- * more, a block at a time (again where the builder asks: see
- * ptr_builder_refill), and stops after a block where a slot failed. Fails
- * only for memory. */
+ * more, a block at a time (ptr_builder_fill_blocks), and stops after a
+ * block where a slot failed. Fails only for memory. */
 static PtrResult convert_run(const Importer *im, NodeRun *run)
 {
     const size_t slots = run->instances * run->slots;
     const int threads = slots >= PARALLEL_PARTS ? ptr_usable_cpus() : 1;
-    for (size_t begin = 0; begin < slots && atomic_load(&run->failed) == SIZE_MAX;) {
-        const size_t end = ptr_builder_block_end(begin, slots);
-        ptr_parallel_ranges(threads, begin, end, convert_slots, run);
-        int refill;
-        if (ptr_builder_refill(run->builder, run->first + end, &refill, NULL) != PTR_OK)
-            return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
-        if (refill)
-            continue;
-        release_slots(im, run, begin, end);
-        begin = end;
-    }
+    if (ptr_builder_fill_blocks(run->builder, run->first, slots, threads, convert_slots,
+                                slots_done, run) != PTR_OK)
+        return ptr_error_set(im->err, PTR_ERR_NOMEM, "%s: out of memory", im->path);
     return PTR_OK;
 }
 
@@ -574,8 +574,8 @@ PtrResult gltf_add_node_spheres(Importer *im, size_t node_index, const GltfNode 
     gltf_doc_mesh(im->doc, (size_t)node->mesh, &mesh);
     const Origin o = { node_index, label(node->name, "unnamed"), NULL, 0 };
     const Origin instance = { node_index, o.node_name, node->instanced ? "instance" : NULL, 0 };
-    NodeRun run = { .builder = &im->builder, .node = node, .mesh = &mesh, .world = world,
-                    .world_identity = gltf_mat4_is_identity(world),
+    NodeRun run = { .builder = &im->builder, .doc = im->doc, .node = node, .mesh = &mesh,
+                    .world = world, .world_identity = gltf_mat4_is_identity(world),
                     .instanced = node->instanced, .instances = 1, .slots = 1 };
     atomic_init(&run.failed, SIZE_MAX);
     atomic_init(&run.nonuniform, 0);

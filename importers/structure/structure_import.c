@@ -259,15 +259,9 @@ static PtrResult add_atoms(PtrSceneBuilder *builder, const char *path, const Str
           ptr_builder_add_spheres(builder, spheres, 1, &e.first, NULL) != PTR_OK)))
         res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     const int threads = spheres >= PARALLEL_SPHERES ? ptr_usable_cpus() : 1;
-    for (size_t begin = 0; res == PTR_OK && begin < spheres;) {
-        const size_t end = ptr_builder_block_end(begin, spheres);
-        ptr_parallel_ranges(threads, begin, end, fill_slots, &e);
-        int refill;
-        if (ptr_builder_refill(builder, e.first + end, &refill, NULL) != PTR_OK)
-            res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
-        else if (!refill)
-            begin = end;
-    }
+    if (res == PTR_OK &&
+        ptr_builder_fill_blocks(builder, e.first, spheres, threads, fill_slots, NULL, &e) != PTR_OK)
+        res = ptr_error_set(err, PTR_ERR_NOMEM, "%s: out of memory", path);
     free(looks);
     free(e.slot_start);
     free(e.members);
