@@ -140,11 +140,21 @@ typedef struct Build {
 /* What a thread of the build keeps from one part or task to the next: fresh
  * memory for each would be cleared page by page. */
 typedef struct Worker {
-    BvhPrim *scratch;  /* room for task_spheres: see bvh_split */
-    BvhPrim *samples;  /* room for PLAN_SAMPLES: see plan_node */
-    uint8_t *child;    /* a byte a prim of the largest range planned */
-    size_t child_room;
+    BvhPrim *scratch; /* room for BVH_PLANNED_ABOVE: see bvh_split */
+    BvhPrim *samples; /* room for PLAN_SAMPLES: see plan_node */
+    BvhSortRoom sort; /* for the largest range planned */
 } Worker;
+
+/* A thread's scratch and samples, made for its first node: whether there
+ * is memory for them. */
+static int worker_ready(Worker *w)
+{
+    if (!w->scratch)
+        w->scratch = malloc(BVH_PLANNED_ABOVE * sizeof *w->scratch);
+    if (!w->samples)
+        w->samples = malloc(PLAN_SAMPLES * sizeof *w->samples);
+    return w->scratch && w->samples;
+}
 
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 {
@@ -186,7 +196,7 @@ static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_f
  * counts that decide which children are split. With plan, each split is
  * recorded in it, and a child is split only by its best split, against
  * which a prim can be tested (bvh_split_test), never in the middle.
- * scratch: see bvh_split. */
+ * scratch: room for BVH_PLANNED_ABOVE prims, see bvh_split. */
 static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidate *range,
                       int level, double per_prim, BvhCandidate child[PTR_BVH_WIDTH],
                       int *count, BvhChildren *plan)
@@ -227,11 +237,11 @@ static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidat
  * from samples"). plan->count is 1 where the samples give no split (all at
  * one centre). */
 static void plan_children(const BvhPrimSet *samples, size_t n, int level, double per_prim,
-                          BvhChildren *plan)
+                          BvhPrim *scratch, BvhChildren *plan)
 {
     BvhCandidate range, child[PTR_BVH_WIDTH];
     bvh_candidate_init(samples, &range, 0, n, NULL, NULL);
-    grow_node(samples, NULL, &range, level, per_prim, child, &plan->count, plan);
+    grow_node(samples, scratch, &range, level, per_prim, child, &plan->count, plan);
 }
 
 static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
@@ -310,8 +320,6 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
                            BvhCandidate child[PTR_BVH_WIDTH], int *count, PtrError *err)
 {
     const size_t n = range->end - range->begin;
-    if (!w->samples && !(w->samples = malloc(PLAN_SAMPLES * sizeof *w->samples)))
-        return bvh_out_of_memory(err);
     const BvhPrimSet samples = { w->samples, build->set.magnitude };
     const BvhPrim *prims = build->set.prims + range->begin;
     for (size_t j = 0; j < PLAN_SAMPLES; j++) {
@@ -322,21 +330,16 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
         w->samples[j] = prims[j * n / PLAN_SAMPLES];
     }
     BvhChildren plan;
-    plan_children(&samples, PLAN_SAMPLES, level, (double)n / PLAN_SAMPLES, &plan);
+    plan_children(&samples, PLAN_SAMPLES, level, (double)n / PLAN_SAMPLES, w->scratch, &plan);
     *count = 1;
     child[0] = *range;
     if (plan.count == 1)
         return PTR_OK;
-    if (w->child_room < n) {
-        free(w->child);
-        w->child = malloc(n);
-        w->child_room = w->child ? n : 0;
-        if (!w->child)
-            return bvh_out_of_memory(err);
-    }
+    if (bvh_sort_room_reserve(&w->sort, n) != PTR_OK)
+        return bvh_out_of_memory(err);
     /* Every child holds a prim: each holds a sample (the heuristic makes
      * no empty side), which is one of the prims, tested the same way. */
-    bvh_split_children(&build->set, range->begin, range->end, &plan, w->child);
+    bvh_split_children(&build->set, range->begin, range->end, &plan, &w->sort);
     for (int k = 0; k < plan.count; k++)
         bvh_candidate_init(&build->set, &child[k], plan.begin[k], plan.end[k], plan.lower[k],
                            plan.upper[k]);
@@ -352,15 +355,13 @@ static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList 
 {
     BvhCandidate child[PTR_BVH_WIDTH];
     int n = 1;
-    /* A task's scratch is room for task_spheres; a part may hold more. */
-    BvhPrim *scratch = kind == NODE_TASK ? w->scratch : NULL;
     if (range->end - range->begin > BVH_PLANNED_ABOVE && level < MIDDLE_SPLIT_LEVEL) {
         PtrResult r = plan_node(build, w, range, level, child, &n, err);
         if (r != PTR_OK)
             return r;
     }
     if (n == 1)
-        grow_node(&build->set, scratch, range, level, 1.0, child, &n, NULL);
+        grow_node(&build->set, w->scratch, range, level, 1.0, child, &n, NULL);
     return make_node(build, w, nodes, tasks, child, n, kind, level, index, depth, err);
 }
 
@@ -423,6 +424,8 @@ static Task *pool_take_task(Pool *pool)
 /* Whether part p was built on the thread w (else it ran out of memory). */
 static int build_part(Build *build, Worker *w, Part *p)
 {
+    if (!worker_ready(w))
+        return 0;
     BvhCandidate range;
     size_t root;
     bvh_candidate_init(&build->set, &range, p->range.begin, p->range.end, p->range.lower,
@@ -434,9 +437,7 @@ static int build_part(Build *build, Worker *w, Part *p)
 /* Whether task t was built on the thread w (else it ran out of memory). */
 static int build_task(Build *build, Worker *w, Task *t)
 {
-    /* One scratch for all of a thread's tasks (none is larger than
-     * task_spheres). */
-    if (!w->scratch && !(w->scratch = malloc(build->task_spheres * sizeof *w->scratch)))
+    if (!worker_ready(w))
         return 0;
     BvhCandidate range = t->range;
     size_t root;
@@ -448,19 +449,17 @@ static int build_task(Build *build, Worker *w, Task *t)
 }
 
 /* Takes parts, then tasks, until none is left or will be, or the pool
- * has failed. */
-static void *pool_worker(void *arg)
+ * has failed, building them on the thread w. */
+static void pool_work(Pool *pool, Worker *w)
 {
-    Pool *pool = arg;
     Build *build = pool->build;
-    Worker w = { 0 };
     pthread_mutex_lock(&pool->lock);
     for (;;) {
         if (!pool->failed && pool->next_part < build->part_count) {
             Part *p = &build->parts[pool->part_order[pool->next_part++]];
             pool->parts_running++;
             pthread_mutex_unlock(&pool->lock);
-            const int built = build_part(build, &w, p);
+            const int built = build_part(build, w, p);
             pthread_mutex_lock(&pool->lock);
             pool->parts_running--;
             if (!built || !pool_add_ready(pool, &p->tasks))
@@ -471,7 +470,7 @@ static void *pool_worker(void *arg)
         Task *t = pool->failed ? NULL : pool_take_task(pool);
         if (t) {
             pthread_mutex_unlock(&pool->lock);
-            const int built = build_task(build, &w, t);
+            const int built = build_task(build, w, t);
             pthread_mutex_lock(&pool->lock);
             pool->failed |= !built;
             continue;
@@ -481,15 +480,27 @@ static void *pool_worker(void *arg)
         pthread_cond_wait(&pool->wake, &pool->lock);
     }
     pthread_mutex_unlock(&pool->lock);
-    free(w.scratch);
-    free(w.samples);
-    free(w.child);
+}
+
+static void worker_free(Worker *w)
+{
+    free(w->scratch);
+    free(w->samples);
+    bvh_sort_room_free(&w->sort);
+}
+
+/* A thread of the pool but the build's own. */
+static void *pool_thread(void *arg)
+{
+    Worker w = { 0 };
+    pool_work(arg, &w);
+    worker_free(&w);
     return NULL;
 }
 
 /* Builds the parts and every task, the root's and the parts', on all
- * threads from one pool (see Pool). */
-static PtrResult run_pool(Build *build, PtrError *err)
+ * threads from one pool (see Pool), w the build's own thread's. */
+static PtrResult run_pool(Build *build, Worker *w, PtrError *err)
 {
     Pool pool = { .build = build };
     for (size_t i = 0; i < build->part_count; i++) {
@@ -509,9 +520,9 @@ static PtrResult run_pool(Build *build, PtrError *err)
     pthread_mutex_init(&pool.lock, NULL);
     pthread_cond_init(&pool.wake, NULL);
     int started = 0;
-    while (started < build->threads - 1 && (ids[started] = ptr_thread_start(pool_worker, &pool)))
+    while (started < build->threads - 1 && (ids[started] = ptr_thread_start(pool_thread, &pool)))
         started++;
-    pool_worker(&pool);
+    pool_work(&pool, w);
     for (int i = 0; i < started; i++)
         ptr_thread_join(ids[i]);
     free(ids);
@@ -712,19 +723,19 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
 
 /* The root's children (see the head): its splits planned from PLAN_SAMPLES
  * of the tree's spheres, evenly spaced, or all of them where they are no
- * more. Fails only for memory. */
+ * more, on the thread w. Fails only for memory. */
 static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t *huge_index,
-                           size_t huge_count, BvhChildren *plan, PtrError *err)
+                           size_t huge_count, Worker *w, BvhChildren *plan, PtrError *err)
 {
     plan->count = 1;
-    BvhPrimSet samples = { .prims = malloc(PLAN_SAMPLES * sizeof *samples.prims) };
-    if (!samples.prims)
+    if (!worker_ready(w))
         return bvh_out_of_memory(err);
+    BvhPrimSet samples = { .prims = w->samples };
     const size_t n = ptr_bvh_samples(spheres, threads, huge_index, huge_count, samples.prims,
                                      PLAN_SAMPLES, &samples.magnitude);
     if (n > 0)
-        plan_children(&samples, n, 0, (double)(spheres->count - huge_count) / (double)n, plan);
-    free(samples.prims);
+        plan_children(&samples, n, 0, (double)(spheres->count - huge_count) / (double)n,
+                      w->scratch, plan);
     return PTR_OK;
 }
 
@@ -740,6 +751,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     BvhPrim huge[PTR_HUGE_MAX];
     size_t huge_index[PTR_HUGE_MAX];
     BvhChildren root;
+    Worker w = { 0 }; /* this thread's */
     PtrSpheres tree_part = *spheres;
     tree_part.count = count;
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
@@ -749,7 +761,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK)
         r = ptr_bvh_huge(&tree_part, build.threads, huge, huge_index, &bvh->huge_count, err);
     if (r == PTR_OK)
-        r = plan_root(&tree_part, build.threads, huge_index, bvh->huge_count, &root, err);
+        r = plan_root(&tree_part, build.threads, huge_index, bvh->huge_count, &w, &root, err);
     if (r == PTR_OK)
         r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
                           build.set.prims, &prim_count, &build.set.magnitude, err);
@@ -775,13 +787,13 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
         if (n == 1) {
             BvhCandidate range;
             bvh_candidate_init(&build.set, &range, 0, prim_count, root.lower[0], root.upper[0]);
-            grow_node(&build.set, NULL, &range, 0, 1.0, child, &n, NULL);
+            grow_node(&build.set, w.scratch, &range, 0, 1.0, child, &n, NULL);
         }
         size_t index;
         r = make_node(&build, NULL, &top, &build.root_tasks, child, n, NODE_ROOT, 0, &index,
                       &top.depth, err);
         if (r == PTR_OK)
-            r = run_pool(&build, err);
+            r = run_pool(&build, &w, err);
         if (r == PTR_OK)
             r = join_parts(&build, &top, err);
     }
@@ -803,6 +815,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
      * once the prims are gone. */
     if (r == PTR_OK && prim_count > 0)
         r = lay_out(&build, &top, bvh, err);
+    worker_free(&w);
     free_tasks(&build.tasks);
     for (size_t i = 0; i < build.part_count; i++) {
         free(build.parts[i].nodes.nodes);

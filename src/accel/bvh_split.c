@@ -1,9 +1,15 @@
 #include "accel/bvh_split.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
-enum { BINS = 32 };
+enum {
+    BINS = 32,
+    /* bvh_split_children's buffers, in blocks: a block and two of head for
+     * each child, and two to move blocks through (see sort_in_blocks). */
+    SORT_BLOCKS = 3 * PTR_BVH_WIDTH + 2,
+};
 
 static void bounds_empty(float lo[3], float hi[3])
 {
@@ -182,80 +188,19 @@ BvhSplitTest bvh_split_test(const BvhCandidate *c)
                            (float)(c->bins - 1) };
 }
 
-/* Moves the prims begin .. end - 1 that go left by test before those
- * that go right; returns the first right one. Hoare's partition. */
-static size_t partition_run(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test)
+/* Moves the prims of c that go left before those that go right, keeping
+ * each side's order (so that every partition of the build is stable, and a
+ * leaf holds its spheres in the arrays' order), through scratch; returns
+ * the first right one. No branch on the side a prim goes to, which for a
+ * random cloud is a coin toss the processor mispredicts half the time. */
+static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch)
 {
-    size_t i = begin, j = end;
-    for (;;) {
-        while (i < j && !bvh_goes_right(test, &p[i]))
-            i++;
-        while (i < j && bvh_goes_right(test, &p[j - 1]))
-            j--;
-        if (i >= j)
-            return i;
-        BvhPrim t = p[i];
-        p[i++] = p[j - 1];
-        p[--j] = t;
-    }
-}
-
-/* The same split as partition_run, without its unpredictable branches
- * (Edelkamp and Weiss's BlockQuicksort): blocks at each end are classified
- * into lists of the prims on the wrong side, without a branch, and the
- * lists swapped pairwise; the few prims left in the middle go to
- * partition_run. Everything before the left block belongs left, everything
- * after the right block right. */
-static size_t partition_blocks(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test)
-{
-    enum { BLOCK = 128 };
-    unsigned char wrong_left[BLOCK], wrong_right[BLOCK]; /* offsets in each block */
-    size_t l = begin, r = end, left_count = 0, right_count = 0, left_at = 0, right_at = 0;
-    while (r - l >= 2 * BLOCK) {
-        if (left_count == 0) {
-            left_at = 0;
-            for (size_t i = 0; i < BLOCK; i++) {
-                wrong_left[left_count] = (unsigned char)i;
-                left_count += (size_t)bvh_goes_right(test, &p[l + i]);
-            }
-        }
-        if (right_count == 0) {
-            right_at = 0;
-            for (size_t i = 0; i < BLOCK; i++) {
-                wrong_right[right_count] = (unsigned char)i;
-                right_count += 1 - (size_t)bvh_goes_right(test, &p[r - 1 - i]);
-            }
-        }
-        const size_t swaps = left_count < right_count ? left_count : right_count;
-        for (size_t k = 0; k < swaps; k++) {
-            BvhPrim *a = &p[l + wrong_left[left_at + k]], *b = &p[r - 1 - wrong_right[right_at + k]];
-            const BvhPrim t = *a;
-            *a = *b;
-            *b = t;
-        }
-        left_count -= swaps;
-        right_count -= swaps;
-        left_at += swaps;
-        right_at += swaps;
-        if (left_count == 0)
-            l += BLOCK;
-        if (right_count == 0)
-            r -= BLOCK;
-    }
-    return partition_run(p, l, r, test);
-}
-
-/* The same split as partition_run, keeping each side's order, through
- * scratch (room for the run): no branch on the side a prim goes to, which
- * for a random cloud is a coin toss the processor mispredicts half the
- * time. */
-static size_t partition_stable(BvhPrim *p, size_t begin, size_t end, const BvhSplitTest *test,
-                               BvhPrim *scratch)
-{
-    size_t left = begin, right = 0;
-    for (size_t i = begin; i < end; i++) {
+    const BvhSplitTest test = bvh_split_test(c);
+    BvhPrim *p = set->prims;
+    size_t left = c->begin, right = 0;
+    for (size_t i = c->begin; i < c->end; i++) {
         const BvhPrim prim = p[i];
-        const size_t goes_right = (size_t)bvh_goes_right(test, &prim);
+        const size_t goes_right = (size_t)bvh_goes_right(&test, &prim);
         p[left] = prim;
         scratch[right] = prim;
         left += 1 - goes_right;
@@ -263,17 +208,6 @@ static size_t partition_stable(BvhPrim *p, size_t begin, size_t end, const BvhSp
     }
     memcpy(p + left, scratch, right * sizeof *p);
     return left;
-}
-
-/* Moves the prims of c that go left before those that go right; returns
- * the first right one. With scratch, partition_stable, else
- * partition_blocks. */
-static size_t partition(const BvhPrimSet *set, const BvhCandidate *c, BvhPrim *scratch)
-{
-    const BvhSplitTest test = bvh_split_test(c);
-    if (scratch)
-        return partition_stable(set->prims, c->begin, c->end, &test, scratch);
-    return partition_blocks(set->prims, c->begin, c->end, &test);
 }
 
 void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
@@ -334,8 +268,109 @@ static void add_children4(const BvhChildLanes *lanes, float magnitude, const Bvh
     }
 }
 
+PtrResult bvh_sort_room_reserve(BvhSortRoom *room, size_t prims)
+{
+    if (!room->blocks && !(room->blocks = malloc(SORT_BLOCKS * BVH_SORT_BLOCK *
+                                                 sizeof *room->blocks)))
+        return PTR_ERR_NOMEM;
+    if (room->prims >= prims)
+        return PTR_OK;
+    free(room->child);
+    free(room->dest);
+    room->child = malloc(prims);
+    room->dest = malloc((prims / BVH_SORT_BLOCK + 1) * sizeof *room->dest);
+    room->prims = room->child && room->dest ? prims : 0;
+    return room->prims ? PTR_OK : PTR_ERR_NOMEM;
+}
+
+void bvh_sort_room_free(BvhSortRoom *room)
+{
+    free(room->child);
+    free(room->dest);
+    free(room->blocks);
+    *room = (BvhSortRoom){ 0 };
+}
+
+/* Sorts the n prims p, whose children are child[0 .. n - 1], into them,
+ * child k's prims to start[k] .. stop[k] - 1 in the order they come,
+ * blocks of BVH_SORT_BLOCK prims at a time (an American flag sort, which
+ * swaps one prim at a time, is not stable).
+ *
+ * Block slot t is prims t B .. t B + B - 1. A slot inside a child's places
+ * takes a whole block of its prims; the first prims of a child before its
+ * first such slot (its head) and the last after its last (its tail) are
+ * gathered aside. One pass reads the prims in order: a child's head to its
+ * head buffer, then its prims to its block buffer, which when full is
+ * written to the next slot, behind the pass (the slots written and the
+ * buffers hold every prim read), its child's the slot's tag. The full
+ * blocks then go to their slots, each moved once along the chains their
+ * slots make (a block whose slot holds another takes its place, that one
+ * moving on), and the heads and tails fill the slots the children share. */
+static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[],
+                           const size_t stop[], BvhSortRoom *room)
+{
+    enum { B = BVH_SORT_BLOCK, DONE = UINT32_MAX };
+    BvhPrim *fill = room->blocks, *head = fill + PTR_BVH_WIDTH * B,
+            *carry = head + PTR_BVH_WIDTH * 2 * B, *spare = carry + B;
+    size_t heads[PTR_BVH_WIDTH], first_slot[PTR_BVH_WIDTH], seen[PTR_BVH_WIDTH] = { 0 },
+           filled[PTR_BVH_WIDTH] = { 0 }, slots = 0;
+    for (int k = 0; k < count; k++) {
+        const size_t first = (start[k] + B - 1) / B, last = stop[k] / B;
+        /* Without a slot of its own a child is all head: fewer than 2 B
+         * prims, which lie in at most two slots. */
+        heads[k] = first < last ? first * B - start[k] : stop[k] - start[k];
+        first_slot[k] = first;
+    }
+    uint8_t *child = room->child;
+    for (size_t i = 0; i < n; i++) {
+        const int k = child[i];
+        if (seen[k] < heads[k]) {
+            head[k * 2 * B + seen[k]++] = p[i];
+            continue;
+        }
+        fill[k * B + filled[k]++] = p[i];
+        if (filled[k] == B) {
+            /* slots B + B <= i + 1: behind the pass, as is child[slots]. */
+            memcpy(&p[slots * B], &fill[k * B], B * sizeof *p);
+            child[slots++] = (uint8_t)k;
+            filled[k] = 0;
+        }
+    }
+    uint32_t *dest = room->dest;
+    size_t next[PTR_BVH_WIDTH];
+    memcpy(next, first_slot, sizeof next);
+    for (size_t t = 0; t < slots; t++)
+        dest[t] = (uint32_t)next[child[t]]++;
+    for (size_t t = 0; t < slots; t++) {
+        if (dest[t] == DONE)
+            continue;
+        size_t to = dest[t];
+        dest[t] = DONE;
+        if (to == t)
+            continue;
+        memcpy(carry, &p[t * B], B * sizeof *p);
+        /* A slot below slots not yet DONE holds its block still. */
+        while (to < slots && dest[to] != DONE) {
+            memcpy(spare, &p[to * B], B * sizeof *p);
+            memcpy(&p[to * B], carry, B * sizeof *p);
+            BvhPrim *moved = carry;
+            carry = spare;
+            spare = moved;
+            const size_t on = dest[to];
+            dest[to] = DONE;
+            to = on;
+        }
+        memcpy(&p[to * B], carry, B * sizeof *p);
+    }
+    for (int k = 0; k < count; k++) {
+        memcpy(&p[start[k]], &head[k * 2 * B], heads[k] * sizeof *p);
+        if (filled[k])
+            memcpy(&p[stop[k] - filled[k]], &fill[k * B], filled[k] * sizeof *p);
+    }
+}
+
 void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
-                        uint8_t *child)
+                        BvhSortRoom *room)
 {
     BvhChildLanes lanes;
     bvh_child_lanes(children, &lanes);
@@ -347,39 +382,20 @@ void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChil
         b.upper[k] = _mm_set1_ps(-INFINITY);
     }
     for (size_t i = 0; i < n; i += 4)
-        add_children4(&lanes, set->magnitude, &p[i], n - i < 4 ? n - i : 4, &child[i], &b);
-    /* Each child's place, and the next of its places to fill (head). */
+        add_children4(&lanes, set->magnitude, &p[i], n - i < 4 ? n - i : 4, &room->child[i], &b);
+    /* Each child's places, in bvh_children_order's order. */
     int order[PTR_BVH_WIDTH];
-    size_t head[PTR_BVH_WIDTH], stop[PTR_BVH_WIDTH], next = 0;
+    size_t start[PTR_BVH_WIDTH], stop[PTR_BVH_WIDTH], next = 0;
     bvh_children_order(children, order);
     for (int j = 0; j < children->count; j++) {
         const int k = order[j];
-        head[k] = next;
+        start[k] = next;
         next += b.count[k];
         stop[k] = next;
-        children->begin[k] = begin + head[k];
+        children->begin[k] = begin + start[k];
         children->end[k] = begin + next;
         bvh_store3(children->lower[k], b.lower[k]);
         bvh_store3(children->upper[k], b.upper[k]);
     }
-    /* Each child's places in turn, filled by swaps (American flag sort):
-     * a prim that belongs elsewhere goes to its child's next place, whose
-     * prim is looked at next. Each swap puts one prim in its child. */
-    for (int j = 0; j < children->count; j++) {
-        const int k = order[j];
-        while (head[k] < stop[k]) {
-            const size_t at = head[k];
-            const int to = child[at];
-            if (to == k) {
-                head[k]++;
-                continue;
-            }
-            const size_t there = head[to]++;
-            const BvhPrim moved = p[there];
-            p[there] = p[at];
-            p[at] = moved;
-            child[at] = child[there];
-            child[there] = (uint8_t)to;
-        }
-    }
+    sort_in_blocks(p, n, children->count, start, stop, room);
 }

@@ -52,16 +52,37 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
 /* c's best split (c->axis at least 0) as its prims are tested against it. */
 BvhSplitTest bvh_split_test(const BvhCandidate *c);
 
-/* Splits c in two (into *left and *right, which may be c): by its best split,
- * or in the middle of its order if it has none or middle is set. scratch
- * (room for c's prims, or NULL) makes the partition faster. */
+/* Splits c in two (into *left and *right, which may be c), keeping each
+ * half's order: by its best split, or in the middle of its order if it has
+ * none or middle is set. scratch: room for BVH_PLANNED_ABOVE prims (no
+ * range of more is partitioned, see bvh_candidate_init). */
 void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim *scratch,
                BvhCandidate *left, BvhCandidate *right);
 
+/* Prims a block of bvh_split_children's sort (32 at 10^8 spheres): a few
+ * pages, so that a block moves as a stream the prefetchers follow. */
+enum { BVH_SORT_BLOCK = 128 };
+
+/* What bvh_split_children works in, kept from one sort to the next: a
+ * byte a prim and a word a block of the largest range sorted, and its
+ * buffers. */
+typedef struct BvhSortRoom {
+    uint8_t *child;
+    uint32_t *dest;
+    BvhPrim *blocks;
+    size_t prims; /* room for */
+} BvhSortRoom;
+
+/* Makes room for sorting prims prims; fails only for memory
+ * (PTR_ERR_NOMEM, no message). */
+PtrResult bvh_sort_room_reserve(BvhSortRoom *room, size_t prims);
+void bvh_sort_room_free(BvhSortRoom *room);
+
 /* Sorts the prims begin .. end - 1 into children (its splits set, from
- * samples), in place, in bvh_children_order's order, and fills in each
- * child's range and box. child: room for a byte a prim. */
+ * samples), in place and stably (each child's prims in the order they
+ * came), in bvh_children_order's order, and fills in each child's range
+ * and box. room: reserved for end - begin prims. */
 void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
-                        uint8_t *child);
+                        BvhSortRoom *room);
 
 #endif /* PTR_BVH_SPLIT_H */

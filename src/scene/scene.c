@@ -259,13 +259,15 @@ PtrResult ptr_spheres_make_ids(PtrSpheres *s, PtrError *err)
     return ptr_spheres_make(s, (void **)&s->id, err);
 }
 
-PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t rgb[3],
                                        PtrError *err)
 {
     PtrSpheres *s = &scene->spheres;
     PtrResult res = create_optional(s, (void **)&s->color, 0, err);
-    if (res == PTR_OK)
-        memcpy(&s->color[4 * i], color, 4 * sizeof *color);
+    if (res == PTR_OK) {
+        memcpy(&s->color[4 * i], rgb, 3 * sizeof *rgb);
+        s->color[4 * i + 3] = UINT16_MAX;
+    }
     return res;
 }
 

@@ -36,8 +36,8 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
  *     word of the entry of a sphere that has none)
  *
  * color: the sphere's own colour, multiplying its material's base colour
- * (albedo or attenuation): r, g, b in units of 1/65535 and one unused
- * entry, 8 bytes a sphere; none is white. So a million colours are a
+ * (albedo or attenuation): r, g, b in units of 1/65535 and a fourth
+ * entry, always 65535 (as none's), 8 bytes a sphere; none is white. So a million colours are a
  * million of these, never a million materials. */
 #define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX)
 
@@ -227,8 +227,8 @@ int ptr_spheres_take_pages(PtrSpheres *spheres, PtrPageBank *bank, size_t begin,
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
                                      PtrError *err);
 
-/* The same with the colour as PtrSpheres.color stores it. */
-PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t color[4],
+/* The same with r, g and b as PtrSpheres.color stores them. */
+PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t rgb[3],
                                        PtrError *err);
 
 /* Creates array, one of the optional arrays of spheres (an attribute's, the
