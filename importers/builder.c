@@ -31,7 +31,7 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
  * that has one. The attributes' entries are the scene's (colours: 8 bytes,
  * not 12 floats'). */
 enum {
-#define OPTIONAL_INDEX(name, type, per_sphere, none) OPTIONAL_##name,
+#define OPTIONAL_INDEX(name, type, per_sphere, none, carried) OPTIONAL_##name,
     PTR_SPHERE_ATTRIBUTES(OPTIONAL_INDEX)
 #undef OPTIONAL_INDEX
     OPTIONAL_VALUES
@@ -41,7 +41,7 @@ static const struct {
     size_t words;
     uint32_t none;
 } optional_arrays[] = {
-#define OPTIONAL_ENTRY(name, type, per_sphere, none)                                       \
+#define OPTIONAL_ENTRY(name, type, per_sphere, none, carried)                              \
     [OPTIONAL_##name] = { offsetof(PtrSceneBuilder, name),                                 \
                           (per_sphere) * sizeof(type) / sizeof(uint32_t), (none) },
     PTR_SPHERE_ATTRIBUTES(OPTIONAL_ENTRY)
@@ -740,7 +740,7 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, const double d[4], siz
     ptr_sphere_set_material(s, at, ptr_sphere_material(&column, i));
     if (s->id)
         s->id[at] = (uint32_t)i;
-#define COPY_ATTRIBUTE(name, type, per_sphere, none)                                       \
+#define COPY_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
     if (b->name)                                                                           \
         memcpy(&s->name[(per_sphere) * at], &b->name[(per_sphere) * i],                    \
                (per_sphere) * sizeof(type));
@@ -810,7 +810,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
     const size_t huge_count = huge_in_double ? choose_huge(b, radii, origin, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
-#define MAKE_ATTRIBUTE(name, type, per_sphere, none)                                       \
+#define MAKE_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
     if (res == PTR_OK && b->name)                                                          \
         res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.name, err);
     PTR_SPHERE_ATTRIBUTES(MAKE_ATTRIBUTE)

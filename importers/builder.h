@@ -42,7 +42,7 @@ typedef struct PtrSceneBuilder {
     size_t material_size;
     /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
      * each NULL while no sphere has one. */
-#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried) type *name;
     PTR_SPHERE_ATTRIBUTES(PTR_BUILDER_ATTRIBUTE_ARRAY)
 #undef PTR_BUILDER_ATTRIBUTE_ARRAY
     float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */

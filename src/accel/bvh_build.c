@@ -280,7 +280,6 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
         node.upper_z[k] = c->upper[2];
         size_t count = c->end - c->begin;
         if (count <= PTR_BVH_LEAF_MAX) {
-            ptr_bvh_sort_leaf(build->set.prims + c->begin, count);
             node.child[k] = (uint32_t)(build->first_sphere + c->begin);
             node.leaf_count[k] = (uint32_t)count;
             continue;
@@ -683,14 +682,15 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
 typedef struct SphereWrite {
     PtrSpheres *spheres;
     const BvhPrim *prims;
-    size_t first; /* where prims[0] goes */
+    size_t first;              /* where prims[0] goes */
+    const PtrSpheres *aside; /* see bvh_prim_store */
 } SphereWrite;
 
 static void write_spheres(void *arg, size_t begin, size_t end)
 {
     const SphereWrite *w = arg;
     for (size_t i = begin; i < end; i++)
-        bvh_prim_store(&w->prims[i], w->spheres, w->first + i);
+        bvh_prim_store(&w->prims[i], w->spheres, w->first + i, w->aside);
 }
 
 /* Writes the tree's spheres back to the scene's arrays from the prims, in
@@ -700,9 +700,9 @@ static void write_spheres(void *arg, size_t begin, size_t end)
  * arrays' pages are not faulted in afresh. Frees the prims. Fails only for
  * memory, where the kernel lost pages it moved (ptr_pages_take). */
 static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
-                            int threads, PtrError *err)
+                            const PtrSpheres *aside, int threads, PtrError *err)
 {
-    SphereWrite w = { s, prims, first };
+    SphereWrite w = { s, prims, first, aside };
     PtrPageBank bank = { 0 };
     PtrResult r = PTR_OK;
     for (size_t begin = 0; begin < prim_count; begin += PTR_PAGE_STEP) {
@@ -752,12 +752,18 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     size_t huge_index[PTR_HUGE_MAX];
     BvhChildren root;
     Worker w = { 0 }; /* this thread's */
+    /* Where the prims cannot hold a sphere's material and attributes, the
+     * arrays of them stay whole. */
+    PtrSpheres aside = { 0 };
+    const int by_place = bvh_rest_by_place(spheres);
+    PtrResult r = by_place ? bvh_rest_aside(spheres, count, &aside, err) : PTR_OK;
     PtrSpheres tree_part = *spheres;
     tree_part.count = count;
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
     NodeArray top = { 0 };
     size_t prim_count = 0;
-    PtrResult r = build.set.prims ? PTR_OK : bvh_out_of_memory(err);
+    if (r == PTR_OK && !build.set.prims)
+        r = bvh_out_of_memory(err);
     if (r == PTR_OK)
         r = ptr_bvh_huge(&tree_part, build.threads, huge, huge_index, &bvh->huge_count, err);
     if (r == PTR_OK)
@@ -798,18 +804,19 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             r = join_parts(&build, &top, err);
     }
     if (r == PTR_OK) {
-        r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, build.threads,
-                       err);
+        r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count,
+                       by_place ? &aside : NULL, build.threads, err);
         build.set.prims = NULL;
     }
     if (r == PTR_OK) {
-        SphereWrite first = { spheres, huge, 0 };
+        SphereWrite first = { spheres, huge, 0, by_place ? &aside : NULL };
         write_spheres(&first, 0, bvh->huge_count);
-        /* The ids have done their work (the leaves' order): from here on a
-         * sphere's position decides a tie (see PtrSpheres). */
+        /* From here on a sphere's position decides a tie (see PtrSpheres),
+         * and the file's order is the leaves' (see BvhPrim). */
         free(spheres->id);
         spheres->id = NULL;
     }
+    bvh_rest_free(&aside);
     free(build.set.prims);
     /* Laying the tree out in one array needs memory of its own: it comes
      * once the prims are gone. */

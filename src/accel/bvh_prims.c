@@ -121,30 +121,135 @@ static void offer_huge(void *arg, size_t piece, size_t from, size_t to)
         ptr_huge_offer(&o->choice[piece], i, ptr_sphere_id(o->spheres, i), o->spheres->radius[i]);
 }
 
+int bvh_rest_by_place(const PtrSpheres *s)
+{
+    size_t bytes = s->material_size;
+#define REST_BYTES(name, type, per_sphere, none, carried)                                  \
+    _Static_assert((carried) > 0, #name ": an attribute varies");                          \
+    if (s->name)                                                                           \
+        bytes += (carried) * sizeof(type);
+    PTR_SPHERE_ATTRIBUTES(REST_BYTES)
+#undef REST_BYTES
+    return bytes > sizeof(uint64_t);
+}
+
+/* The material and attribute arrays of s, whether they exist or not, and
+ * the bytes of their entries. */
+enum { REST_ARRAYS_MAX = 8 };
+
+static int rest_arrays(PtrSpheres *s, void **array[REST_ARRAYS_MAX],
+                       size_t entry[REST_ARRAYS_MAX])
+{
+    int n = 0;
+    array[n] = &s->material;
+    entry[n++] = s->material_size;
+#define REST_ARRAY(name, type, per_sphere, none, carried)                                  \
+    array[n] = (void **)&s->name;                                                          \
+    entry[n++] = (per_sphere) * sizeof(type);
+    PTR_SPHERE_ATTRIBUTES(REST_ARRAY)
+#undef REST_ARRAY
+    return n;
+}
+
+PtrResult bvh_rest_aside(PtrSpheres *s, size_t count, PtrSpheres *aside, PtrError *err)
+{
+    *aside = (PtrSpheres){ .material_size = s->material_size };
+    void **from[REST_ARRAYS_MAX], **to[REST_ARRAYS_MAX];
+    size_t entry[REST_ARRAYS_MAX];
+    const int n = rest_arrays(s, from, entry);
+    rest_arrays(aside, to, entry);
+    PtrResult res = PTR_OK;
+    for (int k = 0; k < n && res == PTR_OK; k++) {
+        if (!*from[k])
+            continue;
+        *to[k] = *from[k];
+        *from[k] = NULL;
+        res = ptr_spheres_make(s, from[k], err);
+        if (res == PTR_OK)
+            memcpy((char *)*from[k] + count * entry[k], (char *)*to[k] + count * entry[k],
+                   (s->count - count) * entry[k]);
+    }
+    if (res != PTR_OK) {
+        for (int k = 0; k < n; k++)
+            if (*to[k]) {
+                free(*from[k]);
+                *from[k] = *to[k];
+            }
+        *aside = (PtrSpheres){ 0 };
+    }
+    return res;
+}
+
+void bvh_rest_free(PtrSpheres *aside)
+{
+    void **array[REST_ARRAYS_MAX];
+    size_t entry[REST_ARRAYS_MAX];
+    const int n = rest_arrays(aside, array, entry);
+    for (int k = 0; k < n; k++)
+        free(*array[k]);
+    *aside = (PtrSpheres){ 0 };
+}
+
+BvhPrim bvh_prim_geometry(const PtrSpheres *s, size_t i)
+{
+    return (BvhPrim){ .centre = { s->cx[i], s->cy[i], s->cz[i] }, .radius = s->radius[i] };
+}
+
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
 {
-    BvhPrim p = { .centre = { s->cx[i], s->cy[i], s->cz[i] }, .radius = s->radius[i],
-                  .id = ptr_sphere_id(s, i), .material = ptr_sphere_material(s, i) };
-#define COPY_IN(name, type, per_sphere, none)                                              \
-    if (s->name)                                                                           \
-        memcpy(p.name, &s->name[(per_sphere) * i], sizeof p.name);
-    PTR_SPHERE_ATTRIBUTES(COPY_IN)
-#undef COPY_IN
+    BvhPrim p = bvh_prim_geometry(s, i);
+    if (bvh_rest_by_place(s)) {
+        p.rest = i;
+        return p;
+    }
+    /* Each shift below 64: the bytes fit (bvh_rest_by_place), and each
+     * attribute has some. */
+    unsigned shift = 8 * (unsigned)s->material_size;
+    p.rest = ptr_sphere_material(s, i);
+#define PACK(name, type, per_sphere, none, carried)                                        \
+    if (s->name) {                                                                         \
+        uint64_t bits = 0;                                                                 \
+        memcpy(&bits, &s->name[(per_sphere) * i], (carried) * sizeof(type));               \
+        p.rest |= bits << shift;                                                           \
+        shift += 8 * (carried) * sizeof(type);                                             \
+    }
+    PTR_SPHERE_ATTRIBUTES(PACK)
+#undef PACK
     return p;
 }
 
-void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i)
+void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i, const PtrSpheres *aside)
 {
     s->cx[i] = p->centre[0];
     s->cy[i] = p->centre[1];
     s->cz[i] = p->centre[2];
     s->radius[i] = p->radius;
-    ptr_sphere_set_material(s, i, p->material);
-#define COPY_OUT(name, type, per_sphere, none)                                             \
+    if (aside) {
+        const size_t from = (size_t)p->rest;
+        ptr_sphere_set_material(s, i, ptr_sphere_material(aside, from));
+#define GATHER(name, type, per_sphere, none, carried)                                      \
     if (s->name)                                                                           \
-        memcpy(&s->name[(per_sphere) * i], p->name, sizeof p->name);
-    PTR_SPHERE_ATTRIBUTES(COPY_OUT)
-#undef COPY_OUT
+        memcpy(&s->name[(per_sphere) * i], &aside->name[(per_sphere) * from],              \
+               (per_sphere) * sizeof(type));
+        PTR_SPHERE_ATTRIBUTES(GATHER)
+#undef GATHER
+        return;
+    }
+    unsigned shift = 8 * (unsigned)s->material_size;
+    ptr_sphere_set_material(s, i, (uint32_t)(p->rest & ((UINT64_C(1) << shift) - 1)));
+    /* An entry is none's words, its varying elements then written over. */
+#define UNPACK(name, type, per_sphere, none, carried)                                      \
+    if (s->name) {                                                                         \
+        uint32_t entry[(per_sphere) * sizeof(type) / sizeof(uint32_t)];                    \
+        for (size_t w = 0; w < sizeof entry / sizeof *entry; w++)                          \
+            entry[w] = (none);                                                             \
+        const uint64_t bits = p->rest >> shift;                                            \
+        memcpy(entry, &bits, (carried) * sizeof(type));                                    \
+        memcpy(&s->name[(per_sphere) * i], entry, sizeof entry);                           \
+        shift += 8 * (carried) * sizeof(type);                                             \
+    }
+    PTR_SPHERE_ATTRIBUTES(UNPACK)
+#undef UNPACK
 }
 
 PtrResult ptr_bvh_huge(const PtrSpheres *s, int threads, BvhPrim *huge, size_t *huge_index,
@@ -216,14 +321,8 @@ static void copy_samples(void *arg, size_t begin, size_t end)
             _mm_prefetch((const char *)&s->cy[i], _MM_HINT_T0);
             _mm_prefetch((const char *)&s->cz[i], _MM_HINT_T0);
             _mm_prefetch((const char *)&s->radius[i], _MM_HINT_T0);
-            _mm_prefetch((const char *)s->material + i * s->material_size, _MM_HINT_T0);
-#define PREFETCH_ATTRIBUTE(name, type, per_sphere, none)                                   \
-    if (s->name)                                                                           \
-        _mm_prefetch((const char *)&s->name[(per_sphere) * i], _MM_HINT_T0);
-            PTR_SPHERE_ATTRIBUTES(PREFETCH_ATTRIBUTE)
-#undef PREFETCH_ATTRIBUTE
         }
-        c->samples[j] = bvh_prim_of(s, sample_sphere(c, j));
+        c->samples[j] = bvh_prim_geometry(s, sample_sphere(c, j));
     }
 }
 
@@ -455,16 +554,5 @@ void bvh_children_order(const BvhChildren *children, int order[PTR_BVH_WIDTH])
         for (; order[at - 1] != children->source[k]; at--)
             order[at] = order[at - 1];
         order[at] = k;
-    }
-}
-
-void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count)
-{
-    for (size_t i = 1; i < count; i++) {
-        BvhPrim v = prims[i];
-        size_t j = i;
-        for (; j > 0 && prims[j - 1].id > v.id; j--)
-            prims[j] = prims[j - 1];
-        prims[j] = v;
     }
 }

@@ -14,19 +14,24 @@
 #include "base/result.h"
 #include "scene/scene.h"
 
-/* A sphere as the build moves it, whole: 32 bytes with its colour. At 10^8
- * spheres the prims are the build's largest array, and the scene's arrays
- * give their pages up to them as they are filled; the tree's leaves are
- * written back to the arrays from the prims, in their final order. */
+/* A sphere as the build moves it, whole, in 24 bytes. At 10^8 spheres the
+ * prims are the build's largest array, and the scene's arrays give their
+ * pages up to them as they are filled; the tree's leaves are written back
+ * to the arrays from the prims, in their final order. No prim needs its
+ * place in the file: every split keeps the prims' order, so a leaf's come
+ * in the arrays' (see bvh_split). */
 typedef struct BvhPrim {
     float centre[3], radius;
-    uint32_t id; /* the sphere's in the file (ptr_sphere_id), which orders a leaf */
-    uint32_t material;
-    /* Those of PTR_SPHERE_ATTRIBUTES, unset where the scene has none. */
-#define BVH_PRIM_ATTRIBUTE(name, type, per_sphere, none) type name[per_sphere];
-    PTR_SPHERE_ATTRIBUTES(BVH_PRIM_ATTRIBUTE)
-#undef BVH_PRIM_ATTRIBUTE
+    /* The rest of the sphere, where it fits (bvh_rest_by_place): its
+     * material's index in material_size bytes, then the varying elements
+     * of each attribute it has (PTR_SPHERE_ATTRIBUTES), from the lowest
+     * byte up: so 2 for the material and 6 for the colour in a scene of up
+     * to 65,536 materials. Else its place in the arrays, where the build
+     * reads the rest back from (bvh_rest_aside). */
+    uint64_t rest;
 } BvhPrim;
+
+_Static_assert(sizeof(BvhPrim) == 24, "a prim is 24 bytes");
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
  * traversal's comment in bvh.c for why 2^-18. */
@@ -179,11 +184,26 @@ static inline PtrResult bvh_out_of_memory(PtrError *err)
     return PTR_ERR_NOMEM;
 }
 
-/* Sphere i of s as a prim, and back. */
-BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);
-void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i);
+/* Whether the rest of a sphere of s (its material and attributes) is too
+ * large for BvhPrim.rest, which then holds its place: where a scene of
+ * more than 65,536 materials gives its spheres colours. */
+int bvh_rest_by_place(const PtrSpheres *s);
 
-/* Sorts a leaf's prims by ascending sphere id. */
-void ptr_bvh_sort_leaf(BvhPrim *prims, size_t count);
+/* For a build where bvh_rest_by_place: moves s's material and attribute
+ * arrays to *aside and gives s fresh ones, whose entries from count on (the
+ * spheres the tree leaves in place) are copied, for the write-back to
+ * gather each sphere's from aside. Fails only for memory, s as it was. */
+PtrResult bvh_rest_aside(PtrSpheres *s, size_t count, PtrSpheres *aside, PtrError *err);
+
+/* Frees what bvh_rest_aside set aside (nothing if it set nothing). */
+void bvh_rest_free(PtrSpheres *aside);
+
+/* Sphere i of s as a prim; its centre and radius alone (rest 0). */
+BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);
+BvhPrim bvh_prim_geometry(const PtrSpheres *s, size_t i);
+
+/* Stores p as sphere i of s, the rest read from aside where it is set
+ * aside (bvh_rest_aside), else NULL. */
+void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i, const PtrSpheres *aside);
 
 #endif /* PTR_BVH_PRIMS_H */

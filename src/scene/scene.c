@@ -40,7 +40,7 @@ typedef struct SphereArray {
 
 enum { SPHERE_ARRAYS_MAX = 16 };
 
-#define WHOLE_WORDS(name, type, per_sphere, none)                                          \
+#define WHOLE_WORDS(name, type, per_sphere, none, carried)                                 \
     static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0,                     \
                   #name ": an attribute's entry is whole 4-byte words (see pad_array)");
 PTR_SPHERE_ATTRIBUTES(WHOLE_WORDS)
@@ -59,7 +59,7 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1, 1 }, /* never hit */
         { (void **)&s->material, s->material_size, 0, 0, 1, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1, 0 },
-#define ATTRIBUTE_ARRAY(name, type, per_sphere, none)                                      \
+#define ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried)                             \
     { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1, 1 },
         PTR_SPHERE_ATTRIBUTES(ATTRIBUTE_ARRAY)
 #undef ATTRIBUTE_ARRAY
@@ -464,7 +464,7 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     hash_in_file_order(&h, s->cz, sizeof *s->cz, by_id, s->count);
     hash_in_file_order(&h, s->radius, sizeof *s->radius, by_id, s->count);
     hash_materials(&h, s, by_id);
-#define HASH_ATTRIBUTE(name, type, per_sphere, none)                                       \
+#define HASH_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
     _Static_assert((per_sphere) * sizeof(type) <= GATHER_ENTRY, #name " is gathered whole"); \
     if (s->name)                                                                           \
         hash_in_file_order(&h, s->name, (per_sphere) * sizeof(type), by_id, s->count);

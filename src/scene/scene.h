@@ -33,13 +33,15 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
  * sphere has one, that moves with its sphere:
  *
  *   X(name, type of an element, elements a sphere, bits of each 4-byte
- *     word of the entry of a sphere that has none)
+ *     word of the entry of a sphere that has none, elements that vary:
+ *     the first ones, the others always holding none's bits)
  *
  * color: the sphere's own colour, multiplying its material's base colour
  * (albedo or attenuation): r, g, b in units of 1/65535 and a fourth
- * entry, always 65535 (as none's), 8 bytes a sphere; none is white. So a million colours are a
- * million of these, never a million materials. */
-#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX)
+ * entry, always 65535 (as none's), 8 bytes a sphere; none is white. So a
+ * million colours are a million of these, never a million materials. The
+ * tree's prims carry the varying elements only (accel/bvh_prims.h). */
+#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX, 3)
 
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
@@ -57,7 +59,7 @@ typedef struct PtrSpheres {
      * are in the file's order. */
     uint32_t *id;
     /* Those of PTR_SPHERE_ATTRIBUTES, in its order. */
-#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none) type *name;
+#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried) type *name;
     PTR_SPHERE_ATTRIBUTES(PTR_SPHERE_ATTRIBUTE_ARRAY)
 #undef PTR_SPHERE_ATTRIBUTE_ARRAY
     /* The value of the quantity --color-by names of the sphere of id i (NaN:

@@ -26,22 +26,33 @@ static void tag_file_order(PtrScene *s)
     }
 }
 
-/* The order the build keeps within a leaf: the file's, or with reversed ids
- * (see test_scenes) its reverse. */
-typedef struct FileOrder {
-    int reversed;
-} FileOrder;
-
-static uint32_t file_position(const PtrSpheres *s, size_t i, FileOrder order)
+/* The place in the file of sphere i, as tag_file_order tagged it. */
+static uint32_t file_position(const PtrSpheres *s, size_t i)
 {
-    const uint32_t tag = s->color[4 * i] | (uint32_t)s->color[4 * i + 1] << 16;
-    return order.reversed ? (uint32_t)s->count - 1 - tag : tag;
+    return s->color[4 * i] | (uint32_t)s->color[4 * i + 1] << 16;
+}
+
+/* The material give_materials gives the sphere at this place in the file. */
+static uint32_t material_at(uint32_t file, uint32_t materials)
+{
+    return (uint32_t)((uint64_t)file * 7919 % materials);
+}
+
+/* Gives s this many materials in all, each sphere one by its place. */
+static void give_materials(PtrScene *s, uint32_t materials)
+{
+    const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
+    uint32_t index = 0;
+    while (s->material_count < materials)
+        CHECK_INT(ptr_scene_add_material(s, &grey, &index, NULL), PTR_OK);
+    for (size_t i = 0; i < s->spheres.count; i++)
+        ptr_sphere_set_material(&s->spheres, i, material_at((uint32_t)i, materials));
 }
 
 /* Walks the tree: every sphere in the tree is in exactly one leaf, every
  * box contains its spheres and its subtree's boxes, leaves hold 1 to
- * PTR_BVH_LEAF_MAX spheres in ascending order, and the depth is as stated. */
-static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, uint32_t index,
+ * PTR_BVH_LEAF_MAX spheres in file order, and the depth is as stated. */
+static void check_node(const PtrBvh *bvh, const PtrSpheres *s, uint32_t index,
                        int level, const float parent_lo[3], const float parent_hi[3],
                        unsigned char *seen, int *ok)
 {
@@ -71,7 +82,7 @@ static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, 
             if (n->child[k] <= index || n->child[k] >= bvh->node_count)
                 *ok = 0;
             else
-                check_node(bvh, s, order, n->child[k], level + 1, box_lo, box_hi, seen, ok);
+                check_node(bvh, s, n->child[k], level + 1, box_lo, box_hi, seen, ok);
             continue;
         }
         uint32_t first = n->child[k];
@@ -81,7 +92,7 @@ static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, 
         }
         for (uint32_t i = first; i < first + count; i++) {
             seen[i]++;
-            if (i > first && file_position(s, i, order) <= file_position(s, i - 1, order))
+            if (i > first && file_position(s, i) <= file_position(s, i - 1))
                 *ok = 0;
             float c[3] = { s->cx[i], s->cy[i], s->cz[i] };
             for (int a = 0; a < 3; a++)
@@ -91,25 +102,32 @@ static void check_node(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order, 
     }
 }
 
-static void check_structure(const PtrBvh *bvh, const PtrSpheres *s, FileOrder order,
+/* The tree over s, whose spheres were given materials by give_materials
+ * (all 0: 1). */
+static void check_structure(const PtrBvh *bvh, const PtrSpheres *s, uint32_t materials,
                             const char *name)
 {
     unsigned char *seen = calloc(s->count + 1, 1);
     int ok = seen != NULL && s->id == NULL; /* the build frees the ids */
     for (size_t i = 0; ok && i < bvh->huge_count; i++) {
         seen[i]++;
-        if (i > 0 && file_position(s, i, order) <= file_position(s, i - 1, order))
+        if (i > 0 && file_position(s, i) <= file_position(s, i - 1))
             ok = 0;
     }
     if (ok && bvh->nodes)
-        check_node(bvh, s, order, 0, 0, NULL, NULL, seen, &ok);
+        check_node(bvh, s, 0, 0, NULL, NULL, seen, &ok);
     for (size_t i = 0; ok && i < s->count; i++)
         if (seen[i] != 1)
             ok = 0;
     /* The spheres are a permutation of the file's. */
     memset(seen, 0, s->count);
     for (size_t i = 0; ok && i < s->count; i++)
-        if (file_position(s, i, order) >= s->count || seen[file_position(s, i, order)]++)
+        if (file_position(s, i) >= s->count || seen[file_position(s, i)]++)
+            ok = 0;
+    /* The rest of each sphere went with it. */
+    for (size_t i = 0; ok && i < s->count; i++)
+        if (ptr_sphere_material(s, i) != material_at(file_position(s, i), materials) ||
+            s->color[4 * i + 2] != 0 || s->color[4 * i + 3] != UINT16_MAX)
             ok = 0;
     /* Padding: at least a block of NaN radii past the last sphere. */
     for (size_t i = s->count; ok && i < s->count + PTR_SPHERE_BLOCK; i++)
@@ -164,17 +182,21 @@ static void test_scenes(void)
             CHECK(bvh_scene_make(&a, (BvhSceneKind)kind, n, 1));
             CHECK(bvh_scene_make(&b, (BvhSceneKind)kind, n, 1));
             tag_file_order(&b);
-            /* Ids, where an importer gives them, are the order a leaf
-             * keeps: reversed here, for the larger sets. */
-            FileOrder order = { .reversed = size };
-            if (order.reversed) {
+            /* Materials in 2 bytes, which fit in a prim with the colours;
+             * in 4, which do not: then the prims hold their places. */
+            const uint32_t materials = size ? 70001 : 300;
+            give_materials(&b, materials);
+            CHECK_INT(bvh_rest_by_place(&b.spheres), size);
+            /* Ids, as an importer gives them (in file order), the build
+             * frees. */
+            if (size) {
                 CHECK_INT(ptr_spheres_make_ids(&b.spheres, NULL), PTR_OK);
                 for (size_t i = 0; i < b.spheres.count; i++)
-                    b.spheres.id[i] = (uint32_t)(b.spheres.count - 1 - i);
+                    b.spheres.id[i] = (uint32_t)i;
             }
             PtrBvh bvh;
             CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0, NULL), PTR_OK);
-            check_structure(&bvh, &b.spheres, order, bvh_scene_names[kind]);
+            check_structure(&bvh, &b.spheres, materials, bvh_scene_names[kind]);
             check_rays(&a, &b, &bvh, size ? 10000 : 20000, bvh_scene_names[kind]);
             ptr_bvh_free(&bvh);
             ptr_scene_free(&a);
@@ -222,7 +244,7 @@ static void test_huge(void)
         CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1, NULL), PTR_OK);
         CHECK_INT(bvh.huge_count, k < 2 ? 1 : 0);
         if (k < 2)
-            CHECK_INT(file_position(&s.spheres, 0, (FileOrder){ 0 }), 0);
+            CHECK_INT(file_position(&s.spheres, 0), 0);
         ptr_bvh_free(&bvh);
         ptr_scene_free(&s);
     }
@@ -264,7 +286,7 @@ static void check_huge_choice(const float *radius, int count)
         CHECK_INT(bvh.huge_count, rule.count);
         size_t wrong = 0;
         for (size_t k = 0; k < bvh.huge_count && k < rule.count; k++)
-            wrong += file_position(&s.spheres, k, (FileOrder){ 0 }) !=
+            wrong += file_position(&s.spheres, k) !=
                      rule.sphere[k].file_position;
         CHECK_INT(wrong, 0);
         ptr_bvh_free(&bvh);
@@ -370,7 +392,7 @@ static void test_root_sort(void)
         CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, t ? 3 : 1, NULL), PTR_OK);
         CHECK(bvh.huge_count == PTR_HUGE_MAX);
         if (t == 0) {
-            check_structure(&bvh, &s.spheres, (FileOrder){ 0 }, "root sort");
+            check_structure(&bvh, &s.spheres, 1, "root sort");
             check_rays(&file, &s, &bvh, 100, "root sort");
             first = bvh;
             first_scene = s;
@@ -399,7 +421,7 @@ static void test_plans_without_split(void)
     tag_file_order(&s);
     PtrBvh bvh;
     CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, NULL), PTR_OK);
-    check_structure(&bvh, &s.spheres, (FileOrder){ 0 }, "one centre, planned");
+    check_structure(&bvh, &s.spheres, 1, "one centre, planned");
     check_rays(&file, &s, &bvh, 100, "one centre, planned");
     ptr_bvh_free(&bvh);
     ptr_scene_free(&s);
@@ -424,7 +446,7 @@ static void test_split_children(void)
                                  { 5000, 5003 } };
     for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
         for (uint32_t i = 0; i < TOTAL; i++) {
-            prims[i] = (BvhPrim){ .id = i, .radius = bvh_uniform(&rng, 0.01f, 0.5f) };
+            prims[i] = (BvhPrim){ .rest = i, .radius = bvh_uniform(&rng, 0.01f, 0.5f) };
             for (int a = 0; a < 3; a++)
                 /* One in eight on the grid of the splits' bin edges. */
                 prims[i].centre[a] = ptr_rng_float(&rng) < 0.125f
@@ -454,14 +476,14 @@ static void test_split_children(void)
                   upper[3] = { -INFINITY, -INFINITY, -INFINITY };
             for (size_t i = plan.begin[k]; i < plan.end[k]; i++) {
                 /* In the order they came. */
-                CHECK(i == plan.begin[k] || prims[i].id > prims[i - 1].id);
+                CHECK(i == plan.begin[k] || prims[i].rest > prims[i - 1].rest);
                 int in = 0;
                 for (int s = 1; s < plan.count; s++)
                     if (in == plan.source[s] && bvh_goes_right(&plan.test[s], &prims[i]))
                         in = s;
                 CHECK_INT(in, k);
-                CHECK(prims[i].id >= begin && prims[i].id < end && !seen[prims[i].id]);
-                seen[prims[i].id] = 1;
+                CHECK(prims[i].rest >= begin && prims[i].rest < end && !seen[prims[i].rest]);
+                seen[prims[i].rest] = 1;
                 float lo[3], hi[3];
                 bvh_prim_box(&prims[i], set.magnitude, lo, hi);
                 for (int a = 0; a < 3; a++) {
@@ -475,7 +497,7 @@ static void test_split_children(void)
         CHECK_INT(next, end);
         for (size_t i = 0; i < TOTAL; i++)
             if (i < begin || i >= end)
-                CHECK_INT(prims[i].id, i);
+                CHECK_INT(prims[i].rest, i);
         free(seen);
     }
     free(prims);
