@@ -26,34 +26,33 @@ void ptr_builder_init(PtrSceneBuilder *builder, PtrScene *scene, const PtrImport
     }
 }
 
-/* The optional per-sphere arrays (words 4-byte words a sphere, and the bits
- * of each word of a sphere that has none): they exist from the first sphere
- * that has one. The attributes' entries are the scene's (colours: 8 bytes,
- * not 12 floats'). */
+/* The optional per-sphere arrays (bytes a sphere, and the bits of each
+ * 4-byte word of a sphere that has none: see ptr_entries_fill): they exist
+ * from the first sphere that has one. The attributes' entries are the
+ * scene's (colours: 6 bytes, not 12 floats'). */
 enum {
-#define OPTIONAL_INDEX(name, type, per_sphere, none, carried) OPTIONAL_##name,
+#define OPTIONAL_INDEX(name, type, per_sphere, none, hashed) OPTIONAL_##name,
     PTR_SPHERE_ATTRIBUTES(OPTIONAL_INDEX)
 #undef OPTIONAL_INDEX
     OPTIONAL_VALUES
 };
 static const struct {
     size_t offset;
-    size_t words;
+    size_t bytes;
     uint32_t none;
 } optional_arrays[] = {
-#define OPTIONAL_ENTRY(name, type, per_sphere, none, carried)                              \
-    [OPTIONAL_##name] = { offsetof(PtrSceneBuilder, name),                                 \
-                          (per_sphere) * sizeof(type) / sizeof(uint32_t), (none) },
+#define OPTIONAL_ENTRY(name, type, per_sphere, none, hashed)                               \
+    [OPTIONAL_##name] = { offsetof(PtrSceneBuilder, name), (per_sphere) * sizeof(type), (none) },
     PTR_SPHERE_ATTRIBUTES(OPTIONAL_ENTRY)
 #undef OPTIONAL_ENTRY
-    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), 1, 0x7fc00000u }, /* NaN */
+    [OPTIONAL_VALUES] = { offsetof(PtrSceneBuilder, values), sizeof(float), 0x7fc00000u }, /* NaN */
 };
 
 enum { OPTIONAL_ARRAYS = sizeof optional_arrays / sizeof optional_arrays[0] };
 
-static uint32_t **optional_array(PtrSceneBuilder *b, size_t k)
+static void **optional_array(PtrSceneBuilder *b, size_t k)
 {
-    return (uint32_t **)((char *)b + optional_arrays[k].offset);
+    return (void **)((char *)b + optional_arrays[k].offset);
 }
 
 void ptr_builder_free(PtrSceneBuilder *builder)
@@ -72,9 +71,8 @@ void ptr_builder_free(PtrSceneBuilder *builder)
 /* Entries from .. to - 1 of optional array k get its value for none. */
 static void fill_none(PtrSceneBuilder *b, size_t k, size_t from, size_t to)
 {
-    const size_t words = optional_arrays[k].words;
-    for (size_t i = from * words; i < to * words; i++)
-        (*optional_array(b, k))[i] = optional_arrays[k].none;
+    ptr_entries_fill(*optional_array(b, k), optional_arrays[k].bytes, optional_arrays[k].none,
+                     from, to);
 }
 
 static PtrResult no_room(size_t count, PtrError *err)
@@ -86,8 +84,8 @@ static PtrResult no_room(size_t count, PtrError *err)
  * spheres none (the others are the caller's to fill). */
 static PtrResult start_optional(PtrSceneBuilder *b, size_t k, size_t filled, PtrError *err)
 {
-    uint32_t **array = optional_array(b, k);
-    *array = malloc((b->capacity ? b->capacity : 1) * optional_arrays[k].words * sizeof **array);
+    void **array = optional_array(b, k);
+    *array = malloc((b->capacity ? b->capacity : 1) * optional_arrays[k].bytes);
     if (!*array)
         return no_room(b->capacity, err);
     fill_none(b, k, 0, filled);
@@ -139,10 +137,10 @@ static PtrResult resize(PtrSceneBuilder *b, size_t capacity, PtrError *err)
         return no_room(capacity, err);
     b->materials = materials;
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++) {
-        uint32_t **array = optional_array(b, k);
+        void **array = optional_array(b, k);
         if (!*array)
             continue;
-        uint32_t *resized = realloc(*array, entries * optional_arrays[k].words * sizeof *resized);
+        void *resized = realloc(*array, entries * optional_arrays[k].bytes);
         if (!resized)
             return no_room(capacity, err);
         *array = resized;
@@ -305,22 +303,22 @@ void ptr_builder_fill_sphere(PtrSceneBuilder *b, size_t n, const double centre[3
     PtrSpheres column = material_column(b);
     ptr_sphere_set_material(&column, n, material);
     if (rgb)
-        quantize_color(rgb, &b->color[4 * n]);
+        quantize_color(rgb, &b->color[3 * n]);
 }
 
 /* Optional array k's entry for the sphere added last, the array created if
  * it is the first. NULL if memory runs out. */
 static void *last_entry(PtrSceneBuilder *b, size_t k)
 {
-    uint32_t **array = optional_array(b, k);
-    const size_t words = optional_arrays[k].words;
+    void **array = optional_array(b, k);
+    const size_t bytes = optional_arrays[k].bytes;
     if (!*array) {
-        *array = malloc(b->capacity * words * sizeof **array);
+        *array = malloc(b->capacity * bytes);
         if (!*array)
             return NULL;
         fill_none(b, k, 0, b->capacity);
     }
-    return &(*array)[(b->count - 1) * words];
+    return (char *)*array + (b->count - 1) * bytes;
 }
 
 PtrResult ptr_builder_set_color(PtrSceneBuilder *b, const double rgb[3], PtrError *err)
@@ -740,7 +738,7 @@ static PtrResult add_sphere(PtrSceneBuilder *b, size_t i, const double d[4], siz
     ptr_sphere_set_material(s, at, ptr_sphere_material(&column, i));
     if (s->id)
         s->id[at] = (uint32_t)i;
-#define COPY_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
+#define COPY_ATTRIBUTE(name, type, per_sphere, none, hashed)                               \
     if (b->name)                                                                           \
         memcpy(&s->name[(per_sphere) * at], &b->name[(per_sphere) * i],                    \
                (per_sphere) * sizeof(type));
@@ -788,7 +786,7 @@ static void put_pages(PtrSceneBuilder *b, PtrPageBank *bank, size_t begin, size_
     ptr_pages_put(bank, b->materials, begin * b->material_size, end * b->material_size);
     for (size_t k = 0; k < OPTIONAL_ARRAYS; k++)
         if (*optional_array(b, k)) {
-            const size_t entry = optional_arrays[k].words * sizeof **optional_array(b, k);
+            const size_t entry = optional_arrays[k].bytes;
             ptr_pages_put(bank, *optional_array(b, k), begin * entry, end * entry);
         }
 }
@@ -810,7 +808,7 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
     const size_t huge_count = huge_in_double ? choose_huge(b, radii, origin, eye, huge) : 0;
     PtrResult res = ptr_spheres_resize(&scene->spheres, count, err);
     /* Made here, not by the first sphere's, so the threads only write them. */
-#define MAKE_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
+#define MAKE_ATTRIBUTE(name, type, per_sphere, none, hashed)                               \
     if (res == PTR_OK && b->name)                                                          \
         res = ptr_spheres_make(&scene->spheres, (void **)&scene->spheres.name, err);
     PTR_SPHERE_ATTRIBUTES(MAKE_ATTRIBUTE)

@@ -42,7 +42,7 @@ typedef struct PtrSceneBuilder {
     size_t material_size;
     /* Those of PTR_SPHERE_ATTRIBUTES (scene.h), as the scene stores them;
      * each NULL while no sphere has one. */
-#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried) type *name;
+#define PTR_BUILDER_ATTRIBUTE_ARRAY(name, type, per_sphere, none, hashed) type *name;
     PTR_SPHERE_ATTRIBUTES(PTR_BUILDER_ATTRIBUTE_ARRAY)
 #undef PTR_BUILDER_ATTRIBUTE_ARRAY
     float *values;    /* each sphere's --color-by value (NaN: none); NULL while none has one */
@@ -77,7 +77,7 @@ PtrResult ptr_builder_add_sphere(PtrSceneBuilder *builder, const double centre[3
 /* Adds count spheres at once for an importer that fills them itself, on as
  * many threads as it likes (ptr_builder_fill_sphere, then
  * ptr_builder_refill): for each sphere first + i, the centre and radius,
- * the material, and with with_colors the colour at color[4 * (first + i)]
+ * the material, and with with_colors the colour at color[3 * (first + i)]
  * (see ptr_color_quantize). */
 PtrResult ptr_builder_add_spheres(PtrSceneBuilder *builder, size_t count, int with_colors,
                                   size_t *first, PtrError *err);

@@ -124,10 +124,9 @@ static void offer_huge(void *arg, size_t piece, size_t from, size_t to)
 int bvh_rest_by_place(const PtrSpheres *s)
 {
     size_t bytes = s->material_size;
-#define REST_BYTES(name, type, per_sphere, none, carried)                                  \
-    _Static_assert((carried) > 0, #name ": an attribute varies");                          \
+#define REST_BYTES(name, type, per_sphere, none, hashed)                                   \
     if (s->name)                                                                           \
-        bytes += (carried) * sizeof(type);
+        bytes += (per_sphere) * sizeof(type);
     PTR_SPHERE_ATTRIBUTES(REST_BYTES)
 #undef REST_BYTES
     return bytes > sizeof(uint64_t);
@@ -143,7 +142,7 @@ static int rest_arrays(PtrSpheres *s, void **array[REST_ARRAYS_MAX],
     int n = 0;
     array[n] = &s->material;
     entry[n++] = s->material_size;
-#define REST_ARRAY(name, type, per_sphere, none, carried)                                  \
+#define REST_ARRAY(name, type, per_sphere, none, hashed)                                   \
     array[n] = (void **)&s->name;                                                          \
     entry[n++] = (per_sphere) * sizeof(type);
     PTR_SPHERE_ATTRIBUTES(REST_ARRAY)
@@ -202,16 +201,16 @@ BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i)
         p.rest = i;
         return p;
     }
-    /* Each shift below 64: the bytes fit (bvh_rest_by_place), and each
-     * attribute has some. */
+    /* Each shift below 64: the bytes fit (bvh_rest_by_place), and an
+     * entry has some. */
     unsigned shift = 8 * (unsigned)s->material_size;
     p.rest = ptr_sphere_material(s, i);
-#define PACK(name, type, per_sphere, none, carried)                                        \
+#define PACK(name, type, per_sphere, none, hashed)                                         \
     if (s->name) {                                                                         \
         uint64_t bits = 0;                                                                 \
-        memcpy(&bits, &s->name[(per_sphere) * i], (carried) * sizeof(type));               \
+        memcpy(&bits, &s->name[(per_sphere) * i], (per_sphere) * sizeof(type));            \
         p.rest |= bits << shift;                                                           \
-        shift += 8 * (carried) * sizeof(type);                                             \
+        shift += 8 * (per_sphere) * sizeof(type);                                          \
     }
     PTR_SPHERE_ATTRIBUTES(PACK)
 #undef PACK
@@ -227,7 +226,7 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i, const PtrSpheres 
     if (aside) {
         const size_t from = (size_t)p->rest;
         ptr_sphere_set_material(s, i, ptr_sphere_material(aside, from));
-#define GATHER(name, type, per_sphere, none, carried)                                      \
+#define GATHER(name, type, per_sphere, none, hashed)                                       \
     if (s->name)                                                                           \
         memcpy(&s->name[(per_sphere) * i], &aside->name[(per_sphere) * from],              \
                (per_sphere) * sizeof(type));
@@ -237,16 +236,11 @@ void bvh_prim_store(const BvhPrim *p, PtrSpheres *s, size_t i, const PtrSpheres 
     }
     unsigned shift = 8 * (unsigned)s->material_size;
     ptr_sphere_set_material(s, i, (uint32_t)(p->rest & ((UINT64_C(1) << shift) - 1)));
-    /* An entry is none's words, its varying elements then written over. */
-#define UNPACK(name, type, per_sphere, none, carried)                                      \
+#define UNPACK(name, type, per_sphere, none, hashed)                                       \
     if (s->name) {                                                                         \
-        uint32_t entry[(per_sphere) * sizeof(type) / sizeof(uint32_t)];                    \
-        for (size_t w = 0; w < sizeof entry / sizeof *entry; w++)                          \
-            entry[w] = (none);                                                             \
         const uint64_t bits = p->rest >> shift;                                            \
-        memcpy(entry, &bits, (carried) * sizeof(type));                                    \
-        memcpy(&s->name[(per_sphere) * i], entry, sizeof entry);                           \
-        shift += 8 * (carried) * sizeof(type);                                             \
+        memcpy(&s->name[(per_sphere) * i], &bits, (per_sphere) * sizeof(type));            \
+        shift += 8 * (per_sphere) * sizeof(type);                                          \
     }
     PTR_SPHERE_ATTRIBUTES(UNPACK)
 #undef UNPACK

@@ -23,10 +23,10 @@
 typedef struct BvhPrim {
     float centre[3], radius;
     /* The rest of the sphere, where it fits (bvh_rest_by_place): its
-     * material's index in material_size bytes, then the varying elements
-     * of each attribute it has (PTR_SPHERE_ATTRIBUTES), from the lowest
-     * byte up: so 2 for the material and 6 for the colour in a scene of up
-     * to 65,536 materials. Else its place in the arrays, where the build
+     * material's index in material_size bytes, then the entry of each
+     * attribute it has (PTR_SPHERE_ATTRIBUTES), from the lowest byte up:
+     * so 2 for the material and 6 for the colour in a scene of up to
+     * 65,536 materials. Else its place in the arrays, where the build
      * reads the rest back from (bvh_rest_aside). */
     uint64_t rest;
 } BvhPrim;

@@ -162,7 +162,7 @@ static inline void prefetch_surface(const PtrSpheres *spheres, uint32_t sphere)
         return;
     __builtin_prefetch((const char *)spheres->material + sphere * spheres->material_size);
     if (spheres->color)
-        __builtin_prefetch(&spheres->color[4 * (size_t)sphere]);
+        __builtin_prefetch(&spheres->color[3 * (size_t)sphere]);
 }
 
 /* A batch's camera rays through the tree as one packet: they leave one

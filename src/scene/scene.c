@@ -40,18 +40,20 @@ typedef struct SphereArray {
 
 enum { SPHERE_ARRAYS_MAX = 16 };
 
-#define WHOLE_WORDS(name, type, per_sphere, none, carried)                                 \
-    static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0,                     \
-                  #name ": an attribute's entry is whole 4-byte words (see pad_array)");
-PTR_SPHERE_ATTRIBUTES(WHOLE_WORDS)
-#undef WHOLE_WORDS
+#define PADDED(name, type, per_sphere, none, hashed)                                       \
+    static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0 ||                   \
+                      (uint32_t)(none) == ((none) & 0xffu) * 0x01010101u,                  \
+                  #name ": an entry is whole 4-byte words, or none's bytes are alike "     \
+                        "(see pad_array)");
+PTR_SPHERE_ATTRIBUTES(PADDED)
+#undef PADDED
 
 /* Fills a with s's arrays; returns how many there are. */
 static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
 {
     union { float f; uint32_t u; } nan_bits = { .f = NAN }, zero = { .f = 0.0f };
-    /* Entries are whole 4-byte words, or smaller ones padded with 0 (see
-     * pad_array). */
+    /* Entries are whole 4-byte words, or others whose padding's bytes are
+     * alike (see pad_array). */
     SphereArray list[] = {
         { (void **)&s->cx, sizeof *s->cx, zero.u, 0, 1, 1 },
         { (void **)&s->cy, sizeof *s->cy, zero.u, 0, 1, 1 },
@@ -59,7 +61,7 @@ static int sphere_arrays(PtrSpheres *s, SphereArray a[SPHERE_ARRAYS_MAX])
         { (void **)&s->radius, sizeof *s->radius, nan_bits.u, 0, 1, 1 }, /* never hit */
         { (void **)&s->material, s->material_size, 0, 0, 1, 1 },
         { (void **)&s->id, sizeof *s->id, UINT32_MAX, 1, 1, 0 },
-#define ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried)                             \
+#define ATTRIBUTE_ARRAY(name, type, per_sphere, none, hashed)                              \
     { (void **)&s->name, (per_sphere) * sizeof(type), (none), 1, 1, 1 },
         PTR_SPHERE_ATTRIBUTES(ATTRIBUTE_ARRAY)
 #undef ATTRIBUTE_ARRAY
@@ -96,19 +98,23 @@ void ptr_scene_free(PtrScene *scene)
     ptr_scene_init(scene);
 }
 
-/* Fills entries from .. to - 1 of array a with its padding. Entries are
- * 4-byte words (an entry of several words, such as a colour, is padded word
- * by word, the pattern repeated), or smaller ones whose padding is 0. */
-static void pad_array(const SphereArray *a, size_t from, size_t to)
+void ptr_entries_fill(void *array, size_t size, uint32_t bits, size_t from, size_t to)
 {
-    if (a->size < sizeof(uint32_t)) {
-        memset((char *)*a->data + from * a->size, 0, (to - from) * a->size);
+    if (size % sizeof(uint32_t)) {
+        memset((char *)array + from * size, (int)(bits & 0xff), (to - from) * size);
         return;
     }
-    uint32_t *words = *a->data;
-    const size_t per_entry = a->size / sizeof *words;
+    uint32_t *words = array;
+    const size_t per_entry = size / sizeof *words;
     for (size_t i = from * per_entry; i < to * per_entry; i++)
-        words[i] = a->padding;
+        words[i] = bits;
+}
+
+/* Fills entries from .. to - 1 of array a with its padding (a material
+ * index's 0, a colour's 0xff bytes). */
+static void pad_array(const SphereArray *a, size_t from, size_t to)
+{
+    ptr_entries_fill(*a->data, a->size, a->padding, from, to);
 }
 
 /* Fails for the memory of count spheres. */
@@ -223,12 +229,11 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     return PTR_OK;
 }
 
-void ptr_color_quantize(PtrVec3 color, uint16_t out[4])
+void ptr_color_quantize(PtrVec3 color, uint16_t out[3])
 {
     const float channels[3] = { color.x, color.y, color.z };
     for (int c = 0; c < 3; c++)
         out[c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
-    out[3] = UINT16_MAX;
 }
 
 /* Creates the optional array at data (one of s's) if absent, entries from
@@ -264,10 +269,8 @@ PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t
 {
     PtrSpheres *s = &scene->spheres;
     PtrResult res = create_optional(s, (void **)&s->color, 0, err);
-    if (res == PTR_OK) {
-        memcpy(&s->color[4 * i], rgb, 3 * sizeof *rgb);
-        s->color[4 * i + 3] = UINT16_MAX;
-    }
+    if (res == PTR_OK)
+        memcpy(&s->color[3 * i], rgb, 3 * sizeof *rgb);
     return res;
 }
 
@@ -424,6 +427,29 @@ static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
     }
 }
 
+/* The entries of an attribute's array as hash_in_file_order takes them,
+ * each widened from its stored bytes to the bytes the hash takes by none's
+ * (bytes alike: see PTR_SPHERE_ATTRIBUTES). Inlined, so that the copies'
+ * sizes are constants. */
+static inline __attribute__((always_inline)) void
+hash_attribute(XXH3_state_t *h, const void *array, size_t stored, size_t hashed, uint32_t none,
+               const uint32_t *by_id, size_t count)
+{
+    if (stored == hashed) {
+        hash_in_file_order(h, array, stored, by_id, count);
+        return;
+    }
+    const unsigned char *a = array;
+    unsigned char block[GATHER * GATHER_ENTRY];
+    memset(block, (int)(none & 0xff), sizeof block);
+    for (size_t k = 0; k < count; k += GATHER) {
+        const size_t n = count - k < GATHER ? count - k : GATHER;
+        for (size_t j = 0; j < n; j++)
+            memcpy(&block[j * hashed], a + (by_id ? by_id[k + j] : k + j) * stored, stored);
+        hash_bytes(h, block, n * hashed);
+    }
+}
+
 /* Each sphere's material in file order, as a 4-byte index whatever its
  * size in the arrays. */
 static void hash_materials(XXH3_state_t *h, const PtrSpheres *s, const uint32_t *by_id)
@@ -464,10 +490,14 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     hash_in_file_order(&h, s->cz, sizeof *s->cz, by_id, s->count);
     hash_in_file_order(&h, s->radius, sizeof *s->radius, by_id, s->count);
     hash_materials(&h, s, by_id);
-#define HASH_ATTRIBUTE(name, type, per_sphere, none, carried)                              \
-    _Static_assert((per_sphere) * sizeof(type) <= GATHER_ENTRY, #name " is gathered whole"); \
+#define HASH_ATTRIBUTE(name, type, per_sphere, none, hashed)                               \
+    _Static_assert((hashed) * sizeof(type) <= GATHER_ENTRY, #name " is gathered whole");   \
+    _Static_assert((hashed) == (per_sphere) ||                                             \
+                       (uint32_t)(none) == ((none) & 0xffu) * 0x01010101u,                 \
+                   #name " is widened by bytes alike");                                    \
     if (s->name)                                                                           \
-        hash_in_file_order(&h, s->name, (per_sphere) * sizeof(type), by_id, s->count);
+        hash_attribute(&h, s->name, (per_sphere) * sizeof(type), (hashed) * sizeof(type),  \
+                       (none), by_id, s->count);
     PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)
 #undef HASH_ATTRIBUTE
     free(by_id);

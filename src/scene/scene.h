@@ -33,15 +33,17 @@ enum { PTR_SPHERE_BLOCK = 16, PTR_SPHERE_ALIGN = 64 };
  * sphere has one, that moves with its sphere:
  *
  *   X(name, type of an element, elements a sphere, bits of each 4-byte
- *     word of the entry of a sphere that has none, elements that vary:
- *     the first ones, the others always holding none's bits)
+ *     word of the entry of a sphere that has none (bytes all alike where
+ *     an entry is not whole words), elements the hash takes: the sphere's,
+ *     then none's)
  *
  * color: the sphere's own colour, multiplying its material's base colour
- * (albedo or attenuation): r, g, b in units of 1/65535 and a fourth
- * entry, always 65535 (as none's), 8 bytes a sphere; none is white. So a
- * million colours are a million of these, never a million materials. The
- * tree's prims carry the varying elements only (accel/bvh_prims.h). */
-#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 4, UINT32_MAX, 3)
+ * (albedo or attenuation): r, g, b in units of 1/65535, 6 bytes a sphere;
+ * none is white. So a million colours are a million of these, never a
+ * million materials. The hash takes a fourth element, 65535, as the
+ * entries had when they were 8 bytes, so that a recorded hash keeps its
+ * value. */
+#define PTR_SPHERE_ATTRIBUTES(X) X(color, uint16_t, 3, UINT32_MAX, 4)
 
 typedef struct PtrSpheres {
     /* Kernels depend on this field order (see isect.h). */
@@ -59,7 +61,7 @@ typedef struct PtrSpheres {
      * are in the file's order. */
     uint32_t *id;
     /* Those of PTR_SPHERE_ATTRIBUTES, in its order. */
-#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none, carried) type *name;
+#define PTR_SPHERE_ATTRIBUTE_ARRAY(name, type, per_sphere, none, hashed) type *name;
     PTR_SPHERE_ATTRIBUTES(PTR_SPHERE_ATTRIBUTE_ARRAY)
 #undef PTR_SPHERE_ATTRIBUTE_ARRAY
     /* The value of the quantity --color-by names of the sphere of id i (NaN:
@@ -224,6 +226,11 @@ void ptr_spheres_release(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, s
  * caller fails for memory. */
 int ptr_spheres_take_pages(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
 
+/* Fills entries from .. to - 1 of an array of entries of size bytes with
+ * bits (as PTR_SPHERE_ATTRIBUTES gives none's): word by word where an entry
+ * is whole 4-byte words, else byte by byte, bits' bytes being alike. */
+void ptr_entries_fill(void *array, size_t size, uint32_t bits, size_t from, size_t to);
+
 /* Gives sphere i its own colour (each channel in [0, 1]); the first call
  * creates the colour array, white for every other sphere. */
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
@@ -244,7 +251,7 @@ PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
 PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
-void ptr_color_quantize(PtrVec3 color, uint16_t out[4]);
+void ptr_color_quantize(PtrVec3 color, uint16_t out[3]);
 
 /* Gives the sphere of id i a value (see PtrSpheres.value); the first call
  * creates the array, NaN for every other sphere. */
@@ -276,7 +283,7 @@ static inline void ptr_sphere_set_material(PtrSpheres *s, size_t i, uint32_t m)
 static inline PtrVec3 ptr_sphere_color(const PtrSpheres *s, size_t i)
 {
     const float unit = 1.0f / 65535.0f;
-    const uint16_t *c = &s->color[4 * i];
+    const uint16_t *c = &s->color[3 * i];
     return v3((float)c[0] * unit, (float)c[1] * unit, (float)c[2] * unit);
 }
 
