@@ -231,7 +231,7 @@ static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidat
 
 /* A node's children at this level as n samples of its prims split them,
  * each standing for per_prim prims (see grow_node), in plan: the prims are
- * then sorted into them in two passes (bvh_split_children), where splitting
+ * then sorted into them at once (bvh_split_children), where splitting
  * them one split at a time took a pass for each level of the node's splits,
  * about three, each moving every prim (docs/intersectors.md, "Nodes planned
  * from samples"). plan->count is 1 where the samples give no split (all at
@@ -695,10 +695,12 @@ static void write_spheres(void *arg, size_t begin, size_t end)
 
 /* Writes the tree's spheres back to the scene's arrays from the prims, in
  * the tree's order: a sequential write where a gather would read 10^8
- * scattered entries. Each step's spheres go on the pages of the prims the
- * step before read, so that the two copies are never both whole, and the
- * arrays' pages are not faulted in afresh. Frees the prims. Fails only for
- * memory, where the kernel lost pages it moved (ptr_pages_take). */
+ * scattered entries (but for the material and attributes of a scene whose
+ * prims hold places: see bvh_rest_aside). Each step's spheres go on the
+ * pages of the prims the step before read, so that the two copies are never
+ * both whole, and the arrays' pages are not faulted in afresh. Frees the
+ * prims. Fails only for memory, where the kernel lost pages it moved
+ * (ptr_pages_take). */
 static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
                             const PtrSpheres *aside, int threads, PtrError *err)
 {

@@ -135,6 +135,9 @@ int bvh_rest_by_place(const PtrSpheres *s)
 /* The material and attribute arrays of s, whether they exist or not, and
  * the bytes of their entries. */
 enum { REST_ARRAYS_MAX = 8 };
+#define ONE_MORE(name, type, per_sphere, none, hashed) +1
+_Static_assert(1 PTR_SPHERE_ATTRIBUTES(ONE_MORE) <= REST_ARRAYS_MAX, "room for every array");
+#undef ONE_MORE
 
 static int rest_arrays(PtrSpheres *s, void **array[REST_ARRAYS_MAX],
                        size_t entry[REST_ARRAYS_MAX])

@@ -32,6 +32,8 @@ typedef struct BvhPrim {
 } BvhPrim;
 
 _Static_assert(sizeof(BvhPrim) == 24, "a prim is 24 bytes");
+_Static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+               "rest's entries are copied in and out as the low bytes of a word");
 
 /* Box padding, relative to the magnitude of the numbers involved: see the
  * traversal's comment in bvh.c for why 2^-18. */
@@ -166,7 +168,9 @@ size_t ptr_bvh_samples(const PtrSpheres *spheres, int threads, const size_t *hug
  * camera sits at 0, other rays start on spheres) and so scales the boxes'
  * padding. Gives up the spheres' memory as it goes (ptr_spheres_release),
  * its pages moved under the next prims: on success the prims and the huge
- * spheres hold the only copy of spheres 0 .. count - 1 but their values.
+ * spheres hold the only copy of spheres 0 .. count - 1 but their values
+ * (and but their material and attributes where bvh_rest_aside set them
+ * aside).
  * Counts and copies on this many threads; the prims' order does not depend
  * on their number. Fails only for memory: the spheres untouched, but where
  * the kernel ran out of memory moving pages (ptr_pages_take), when some are
@@ -198,7 +202,8 @@ PtrResult bvh_rest_aside(PtrSpheres *s, size_t count, PtrSpheres *aside, PtrErro
 /* Frees what bvh_rest_aside set aside (nothing if it set nothing). */
 void bvh_rest_free(PtrSpheres *aside);
 
-/* Sphere i of s as a prim; its centre and radius alone (rest 0). */
+/* Sphere i of s as a prim, whole; and its centre and radius alone (rest
+ * 0), as samples need. */
 BvhPrim bvh_prim_of(const PtrSpheres *s, size_t i);
 BvhPrim bvh_prim_geometry(const PtrSpheres *s, size_t i);
 

@@ -293,8 +293,7 @@ void bvh_sort_room_free(BvhSortRoom *room)
 
 /* Sorts the n prims p, whose children are child[0 .. n - 1], into them,
  * child k's prims to start[k] .. stop[k] - 1 in the order they come,
- * blocks of BVH_SORT_BLOCK prims at a time (an American flag sort, which
- * swaps one prim at a time, is not stable).
+ * blocks of BVH_SORT_BLOCK prims at a time.
  *
  * Block slot t is prims t B .. t B + B - 1. A slot inside a child's places
  * takes a whole block of its prims; the first prims of a child before its
@@ -309,7 +308,8 @@ void bvh_sort_room_free(BvhSortRoom *room)
 static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[],
                            const size_t stop[], BvhSortRoom *room)
 {
-    enum { B = BVH_SORT_BLOCK, DONE = UINT32_MAX };
+    enum { B = BVH_SORT_BLOCK };
+    const uint32_t done = UINT32_MAX; /* a slot whose block has moved */
     BvhPrim *fill = room->blocks, *head = fill + PTR_BVH_WIDTH * B,
             *carry = head + PTR_BVH_WIDTH * 2 * B, *spare = carry + B;
     size_t heads[PTR_BVH_WIDTH], first_slot[PTR_BVH_WIDTH], seen[PTR_BVH_WIDTH] = { 0 },
@@ -338,26 +338,27 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
     }
     uint32_t *dest = room->dest;
     size_t next[PTR_BVH_WIDTH];
-    memcpy(next, first_slot, sizeof next);
+    for (int k = 0; k < count; k++)
+        next[k] = first_slot[k];
     for (size_t t = 0; t < slots; t++)
         dest[t] = (uint32_t)next[child[t]]++;
     for (size_t t = 0; t < slots; t++) {
-        if (dest[t] == DONE)
+        if (dest[t] == done)
             continue;
         size_t to = dest[t];
-        dest[t] = DONE;
+        dest[t] = done;
         if (to == t)
             continue;
         memcpy(carry, &p[t * B], B * sizeof *p);
-        /* A slot below slots not yet DONE holds its block still. */
-        while (to < slots && dest[to] != DONE) {
+        /* A slot below slots not yet done holds its block still. */
+        while (to < slots && dest[to] != done) {
             memcpy(spare, &p[to * B], B * sizeof *p);
             memcpy(&p[to * B], carry, B * sizeof *p);
             BvhPrim *moved = carry;
             carry = spare;
             spare = moved;
             const size_t on = dest[to];
-            dest[to] = DONE;
+            dest[to] = done;
             to = on;
         }
         memcpy(&p[to * B], carry, B * sizeof *p);

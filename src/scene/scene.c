@@ -41,10 +41,11 @@ typedef struct SphereArray {
 enum { SPHERE_ARRAYS_MAX = 16 };
 
 #define PADDED(name, type, per_sphere, none, hashed)                                       \
-    static_assert((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0 ||                   \
+    static_assert(((per_sphere) * sizeof(type) % sizeof(uint32_t) == 0 &&                  \
+                   (hashed) == (per_sphere)) ||                                            \
                       (uint32_t)(none) == ((none) & 0xffu) * 0x01010101u,                  \
-                  #name ": an entry is whole 4-byte words, or none's bytes are alike "     \
-                        "(see pad_array)");
+                  #name ": an entry is whole 4-byte words, as the hash takes it, or "      \
+                        "none's bytes are alike (see pad_array, hash_in_file_order)");
 PTR_SPHERE_ATTRIBUTES(PADDED)
 #undef PADDED
 
@@ -276,7 +277,7 @@ PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t
 
 PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color, PtrError *err)
 {
-    uint16_t quantized[4];
+    uint16_t quantized[3];
     ptr_color_quantize(color, quantized);
     return ptr_scene_set_sphere_color16(scene, i, quantized, err);
 }
@@ -406,42 +407,23 @@ static void hash_vec(XXH3_state_t *h, PtrVec3 v)
  * block, not one an entry, in 8 KB of the caller's stack. */
 enum { GATHER = 1024, GATHER_ENTRY = 8 };
 
-/* The entries (size bytes each) of a per-sphere array in file order:
+/* The entries (stored bytes each) of a per-sphere array in file order:
  * by_id[k] is the position of the sphere whose id is k (NULL: the arrays
- * are in file order). */
-static void hash_in_file_order(XXH3_state_t *h, const void *array, size_t size,
-                               const uint32_t *by_id, size_t count)
-{
-    assert(size <= GATHER_ENTRY);
-    const unsigned char *a = array;
-    if (!by_id) {
-        hash_bytes(h, a, count * size);
-        return;
-    }
-    unsigned char block[GATHER * GATHER_ENTRY];
-    for (size_t k = 0; k < count; k += GATHER) {
-        const size_t n = count - k < GATHER ? count - k : GATHER;
-        for (size_t j = 0; j < n; j++)
-            memcpy(&block[j * size], a + by_id[k + j] * size, size);
-        hash_bytes(h, block, n * size);
-    }
-}
-
-/* The entries of an attribute's array as hash_in_file_order takes them,
- * each widened from its stored bytes to the bytes the hash takes by none's
- * (bytes alike: see PTR_SPHERE_ATTRIBUTES). Inlined, so that the copies'
- * sizes are constants. */
+ * are in file order). Each entry is hashed as hashed bytes, those past the
+ * stored ones fill's (an attribute's none: see PTR_SPHERE_ATTRIBUTES).
+ * Inlined, so that the copies' sizes are constants. */
 static inline __attribute__((always_inline)) void
-hash_attribute(XXH3_state_t *h, const void *array, size_t stored, size_t hashed, uint32_t none,
-               const uint32_t *by_id, size_t count)
+hash_in_file_order(XXH3_state_t *h, const void *array, size_t stored, size_t hashed,
+                   unsigned char fill, const uint32_t *by_id, size_t count)
 {
-    if (stored == hashed) {
-        hash_in_file_order(h, array, stored, by_id, count);
+    assert(stored <= hashed && hashed <= GATHER_ENTRY);
+    const unsigned char *a = array;
+    if (!by_id && stored == hashed) {
+        hash_bytes(h, a, count * stored);
         return;
     }
-    const unsigned char *a = array;
     unsigned char block[GATHER * GATHER_ENTRY];
-    memset(block, (int)(none & 0xff), sizeof block);
+    memset(block, fill, sizeof block);
     for (size_t k = 0; k < count; k += GATHER) {
         const size_t n = count - k < GATHER ? count - k : GATHER;
         for (size_t j = 0; j < n; j++)
@@ -485,19 +467,16 @@ PtrResult ptr_scene_hash(const PtrScene *scene, uint64_t *hash, PtrError *err)
     (void)XXH3_64bits_reset(&h);
     hash_bytes(&h, scene->origin, sizeof scene->origin);
     hash_bytes(&h, &s->count, sizeof s->count);
-    hash_in_file_order(&h, s->cx, sizeof *s->cx, by_id, s->count);
-    hash_in_file_order(&h, s->cy, sizeof *s->cy, by_id, s->count);
-    hash_in_file_order(&h, s->cz, sizeof *s->cz, by_id, s->count);
-    hash_in_file_order(&h, s->radius, sizeof *s->radius, by_id, s->count);
+    hash_in_file_order(&h, s->cx, sizeof *s->cx, sizeof *s->cx, 0, by_id, s->count);
+    hash_in_file_order(&h, s->cy, sizeof *s->cy, sizeof *s->cy, 0, by_id, s->count);
+    hash_in_file_order(&h, s->cz, sizeof *s->cz, sizeof *s->cz, 0, by_id, s->count);
+    hash_in_file_order(&h, s->radius, sizeof *s->radius, sizeof *s->radius, 0, by_id, s->count);
     hash_materials(&h, s, by_id);
 #define HASH_ATTRIBUTE(name, type, per_sphere, none, hashed)                               \
     _Static_assert((hashed) * sizeof(type) <= GATHER_ENTRY, #name " is gathered whole");   \
-    _Static_assert((hashed) == (per_sphere) ||                                             \
-                       (uint32_t)(none) == ((none) & 0xffu) * 0x01010101u,                 \
-                   #name " is widened by bytes alike");                                    \
     if (s->name)                                                                           \
-        hash_attribute(&h, s->name, (per_sphere) * sizeof(type), (hashed) * sizeof(type),  \
-                       (none), by_id, s->count);
+        hash_in_file_order(&h, s->name, (per_sphere) * sizeof(type), (hashed) * sizeof(type), \
+                           (unsigned char)(none), by_id, s->count);
     PTR_SPHERE_ATTRIBUTES(HASH_ATTRIBUTE)
 #undef HASH_ATTRIBUTE
     free(by_id);

@@ -55,7 +55,8 @@ typedef struct PtrSpheres {
      * through ptr_sphere_set_material. */
     void *material;
     /* The sphere's position in the scene file's order (the importer puts
-     * the huge ones last), until the tree's build, which keeps that order
+     * the huge ones last, the others staying in that order, ascending),
+     * until the tree's build, which keeps the arrays' order, so the file's,
      * within a leaf (coincident spheres sharing one show the first in the
      * file) and frees the array: the renderer needs no ids. NULL: the arrays
      * are in the file's order. */
@@ -240,10 +241,11 @@ PtrResult ptr_scene_set_sphere_color(PtrScene *scene, size_t i, PtrVec3 color,
 PtrResult ptr_scene_set_sphere_color16(PtrScene *scene, size_t i, const uint16_t rgb[3],
                                        PtrError *err);
 
-/* Creates array, one of the optional arrays of spheres (an attribute's, the
- * values or the ids), if absent, for a caller that writes every sphere's
+/* Creates array, one of the arrays of spheres that may be NULL (an
+ * attribute's, the values or the ids; or the materials, which the tree's
+ * build sets aside), if absent, for a caller that writes every sphere's
  * entry: only the padding is set, so at 10^8 spheres memory is used as the
- * entries are written (800 MB of colours), not at once. */
+ * entries are written (600 MB of colours), not at once. */
 PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
 
 /* ptr_spheres_make for the ids (PtrSpheres.id), for an importer that puts

@@ -331,7 +331,7 @@ static void check_same_tree(const PtrBvh *a, const PtrScene *sa, const PtrBvh *b
           !memcmp(b->nodes, a->nodes, b->node_count * sizeof *b->nodes));
     CHECK(sb->spheres.count == sa->spheres.count &&
           !memcmp(sb->spheres.color, sa->spheres.color,
-                  sb->spheres.count * 4 * sizeof *sb->spheres.color));
+                  sb->spheres.count * 3 * sizeof *sb->spheres.color));
 }
 
 /* The same tree bytes and sphere order with 1, 2 and 7 threads, on a set
