@@ -146,6 +146,32 @@ def test_materials_and_save(tmp_path):
     assert not np.array_equal(turned, image)
 
 
+def test_colors_beside_many_materials():
+    """Colours in a scene of more than 65,536 materials, whose tree build
+    cannot pack a sphere's material and colour together and gathers them
+    from its place instead (src/accel/bvh_prims.h), give the image of the
+    same colours folded into the materials, which the build packs: white
+    times a colour is the colour, bit for bit."""
+    rng = np.random.default_rng(3)
+    count, kinds = 4000, 70001
+    centers = rng.uniform(-10, 10, (count, 3)).astype(np.float32)
+    radii = rng.uniform(0.2, 0.8, count).astype(np.float32)
+    channels = rng.integers(0, 65536, (count, 3))
+    indices = np.arange(count) * 7919 % kinds
+    white = ptr.Material("diffuse", (1.0, 1.0, 1.0))
+    colored = ptr.Scene.from_arrays(centers, radii, colors=channels / 65535.0,
+                                    materials=[white] * kinds, material_indices=indices)
+    # The renderer's colour: each channel as a float times 1/65535 in float.
+    folded = channels.astype(np.float32) * (np.float32(1) / np.float32(65535))
+    materials = [white] * kinds
+    for i in range(count):
+        materials[indices[i]] = ptr.Material("diffuse", tuple(float(v) for v in folded[i]))
+    plain = ptr.Scene.from_arrays(centers, radii, materials=materials, material_indices=indices)
+    image = colored.render(48, 32, samples=4, seed=1)
+    assert np.array_equal(image, plain.render(48, 32, samples=4, seed=1))
+    assert image.std() > 0.01  # spheres in view, in many colours
+
+
 def test_contexts_at_once():
     jobs = [(SEED, "none"), (FINAL, None)]
     alone = [ptr.load(path, context=ptr.Context(1, cap)).render(48, samples=2)
