@@ -682,7 +682,7 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
 typedef struct SphereWrite {
     PtrSpheres *spheres;
     const BvhPrim *prims;
-    size_t first;              /* where prims[0] goes */
+    size_t first;            /* where prims[0] goes */
     const PtrSpheres *aside; /* see bvh_prim_store */
 } SphereWrite;
 
@@ -757,8 +757,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     /* Where the prims cannot hold a sphere's material and attributes, the
      * arrays of them stay whole. */
     PtrSpheres aside = { 0 };
-    const int by_place = bvh_rest_by_place(spheres);
-    PtrResult r = by_place ? bvh_rest_aside(spheres, count, &aside, err) : PTR_OK;
+    const PtrSpheres *gather = bvh_rest_by_place(spheres) ? &aside : NULL;
+    PtrResult r = gather ? bvh_rest_aside(spheres, count, &aside, err) : PTR_OK;
     PtrSpheres tree_part = *spheres;
     tree_part.count = count;
     build.set.prims = malloc((count ? count : 1) * sizeof *build.set.prims);
@@ -806,12 +806,12 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             r = join_parts(&build, &top, err);
     }
     if (r == PTR_OK) {
-        r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count,
-                       by_place ? &aside : NULL, build.threads, err);
+        r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, gather,
+                       build.threads, err);
         build.set.prims = NULL;
     }
     if (r == PTR_OK) {
-        SphereWrite first = { spheres, huge, 0, by_place ? &aside : NULL };
+        SphereWrite first = { spheres, huge, 0, gather };
         write_spheres(&first, 0, bvh->huge_count);
         /* From here on a sphere's position decides a tie (see PtrSpheres),
          * and the file's order is the leaves' (see BvhPrim). */
