@@ -230,13 +230,6 @@ PtrResult ptr_scene_add_sphere(PtrScene *scene, PtrVec3 centre, float radius,
     return PTR_OK;
 }
 
-void ptr_color_quantize(PtrVec3 color, uint16_t out[3])
-{
-    const float channels[3] = { color.x, color.y, color.z };
-    for (int c = 0; c < 3; c++)
-        out[c] = (uint16_t)lrintf(ptr_minf(ptr_maxf(channels[c], 0.0f), 1.0f) * 65535.0f);
-}
-
 /* Creates the optional array at data (one of s's) if absent, entries from
  * pad_from on holding its value for none. */
 static PtrResult create_optional(PtrSpheres *s, void **data, size_t pad_from, PtrError *err)

@@ -18,6 +18,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <emmintrin.h> /* SSE2, which every x86-64 CPU has */
 
 #include "base/memory.h"
 #include "base/result.h"
@@ -252,8 +253,22 @@ PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
  * spheres out of the file's order. */
 PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
-/* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it. */
-void ptr_color_quantize(PtrVec3 color, uint16_t out[3]);
+/* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it.
+ * Inline and in SSE2, once a sphere of an import with colours: as a call
+ * whose clamps were branches it took a quarter of perf's samples in the
+ * conversion of an instanced cloud. _mm_max_ps(c, 0) and _mm_min_ps(c, 1) are
+ * ptr_maxf(c, 0) and ptr_minf(c, 1) lane by lane (NaN gives 0), and
+ * _mm_cvtps_epi32 rounds to nearest even, as lrintf does. */
+static inline void ptr_color_quantize(PtrVec3 color, uint16_t out[3])
+{
+    const __m128 c = _mm_min_ps(_mm_max_ps(_mm_setr_ps(color.x, color.y, color.z, 0.0f),
+                                           _mm_setzero_ps()),
+                                _mm_set1_ps(1.0f));
+    const __m128i q = _mm_cvtps_epi32(_mm_mul_ps(c, _mm_set1_ps(65535.0f)));
+    out[0] = (uint16_t)_mm_extract_epi16(q, 0);
+    out[1] = (uint16_t)_mm_extract_epi16(q, 2);
+    out[2] = (uint16_t)_mm_extract_epi16(q, 4);
+}
 
 /* Gives the sphere of id i a value (see PtrSpheres.value); the first call
  * creates the array, NaN for every other sphere. */
