@@ -40,11 +40,12 @@ typedef struct PtrPageBank {
     } run[PTR_PAGE_BANK_RUNS]; /* each one mapping of its own */
     size_t first, runs; /* those held: run[first .. runs - 1], oldest first */
     size_t bytes;
-    /* Moves the bank may still make (each may split a mapping), set at its
-     * first put or take: see mapping_room in memory.c. */
+    /* Moves the bank may make before it counts the mappings' room again
+     * (each may split a mapping): see bank_open in memory.c. */
     size_t moves_left;
-    int started;
-    int refused; /* the kernel would not move pages: the bank gives them back */
+    /* The kernel would not move pages, or the mappings' room is gone: the
+     * bank gives pages back. */
+    int refused;
 } PtrPageBank;
 
 /* Takes from base the pages that lie wholly inside base[0 .. to - 1] but
