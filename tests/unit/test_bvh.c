@@ -537,7 +537,10 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
  * split in the middle of its order (its centres all in one bin, or deep in
  * the tree) has other halves. All four changed when a colour's fourth
  * entry came to be always 65535, where the tags had 0: the build before
- * gave the random and sheet sets' values with such tags.) */
+ * gave the random and sheet sets' values with such tags. The 1,000,000
+ * clusters' value and depth changed when a planned node came to sample one
+ * prim in 16 where it sampled 32,768: its tree's surface area heuristic
+ * cost rose by 0.04%.) */
 static void test_tree_bytes(void)
 {
     const struct {
@@ -547,7 +550,7 @@ static void test_tree_bytes(void)
         int depth; /* the traversal's stack is sized by it */
     } sets[] = {
         { BVH_SCENE_CLUSTERS, 300000, UINT64_C(0x382d3ad9389d3640), 7 },
-        { BVH_SCENE_CLUSTERS, 1000000, UINT64_C(0xb14fdf25b4a41c90), 8 },
+        { BVH_SCENE_CLUSTERS, 1000000, UINT64_C(0x08ad6aa4f706257a), 7 },
         { BVH_SCENE_RANDOM, 5000, UINT64_C(0x132ed326d6e4f85b), 3 },
         { BVH_SCENE_SHEET, 20000, UINT64_C(0xf3d534216486cce2), 3 },
     };
