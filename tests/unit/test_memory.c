@@ -290,18 +290,33 @@ static void test_bank_runs_wrap(void)
     munmap(to, pages * page);
 }
 
+/* The process's mappings: the lines of /proc/self/maps. */
+static size_t mappings_held(void)
+{
+    FILE *f = fopen("/proc/self/maps", "r");
+    size_t lines = 0;
+    for (int c; f && (c = getc(f)) != EOF;)
+        lines += c == '\n';
+    if (f)
+        fclose(f);
+    return lines;
+}
+
 /* The bank of a process whose mappings have no room left: it moves
  * nothing and gives b's pages 1 .. 3 back. Run in a child (fork), which
  * maps pages one at a time, every other one read-only so that none joins
  * its neighbour, until the kernel refuses; returns the child's failed
- * checks. */
-static int bank_without_room(const Buffer *b)
+ * checks, or -1 where something else (an address space limit) stopped the
+ * mapping first. */
+static int bank_without_room(const Buffer *b, size_t max_maps)
 {
     const size_t page = page_size();
-    for (int flip = 0;; flip ^= 1)
-        if (mmap(NULL, page, flip ? PROT_READ : PROT_READ | PROT_WRITE,
+    for (size_t k = 0; k < max_maps; k++)
+        if (mmap(NULL, page, k % 2 ? PROT_READ : PROT_READ | PROT_WRITE,
                  MAP_PRIVATE | MAP_ANONYMOUS, -1, 0) == MAP_FAILED)
             break;
+    if (mappings_held() + 4 <= max_maps)
+        return -1;
     PtrPageBank bank = { 0 };
     ptr_pages_put(&bank, b->data, 0, 4 * page);
     int failed = !bank.refused + (bank.bytes != 0) + (bank.runs != 0);
@@ -341,14 +356,27 @@ static void test_bank_moves_limit(void)
     munmap(b.map, (PAGES + 2) * page);
     munmap(to.map, (PAGES + 2) * page);
 
+    /* Where a process may hold many more mappings than Debian's 65,530,
+     * using them up would take long and kernel memory. */
+    if (max_maps > (1u << 20)) {
+        fprintf(stderr, "vm.max_map_count is %lu: a bank without room not checked\n",
+                max_maps);
+        return;
+    }
     b = buffer_make();
     fflush(NULL);
     const pid_t child = fork();
-    if (child == 0)
-        _exit(bank_without_room(&b) ? 1 : 0);
+    if (child == 0) {
+        const int failed = bank_without_room(&b, max_maps);
+        _exit(failed < 0 ? 2 : failed > 0);
+    }
     int status = -1;
     CHECK(child > 0 && waitpid(child, &status, 0) == child);
-    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    CHECK(WIFEXITED(status));
+    if (WEXITSTATUS(status) == 2)
+        fprintf(stderr, "a child could not use up its mappings: a bank without room not "
+                        "checked\n");
+    CHECK(WEXITSTATUS(status) != 1);
     munmap(b.map, (PAGES + 2) * page);
 }
 
