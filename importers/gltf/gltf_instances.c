@@ -207,7 +207,8 @@ static int moved_and_scaled(const NodeRun *run, size_t i, Mat4 *world, double *s
 /* Instance i of the run, or why it gives no spheres. Always inline, as is
  * instance_spheres: in convert_slots' loop their calls and the stores and
  * loads of the Instance between them were a tenth of an instanced cloud's
- * conversion. */
+ * conversion. (slot_error and gltf_add_node_spheres get copies too, which
+ * run once a node.) */
 static inline __attribute__((always_inline)) Fault instance_at(const NodeRun *run, size_t i,
                                                                Instance *out)
 {

@@ -95,30 +95,40 @@ static size_t count_lines(const char *path)
     return lines;
 }
 
-/* The moves a bank may make from now. Each page run it moves can split a
- * mapping in two (the array's, or a run's), and a process holds at most
- * vm.max_map_count mappings (65,530 by default), past which most new
- * mappings (thread stacks, large blocks) fail: a bank takes at most a
- * quarter of the room left. */
-static size_t mapping_room(void)
+/* A quarter of the room for mappings left to a process holding `held`.
+ * Each page run a bank moves can split a mapping in two (the array's, or a
+ * run's), and a process holds at most vm.max_map_count mappings (65,530 by
+ * default), past which most new mappings (thread stacks, large blocks)
+ * fail. */
+static size_t mapping_room(size_t held)
 {
     const uint64_t max = read_number("/proc/sys/vm/max_map_count");
-    const size_t held = count_lines("/proc/self/maps");
     return max != UINT64_MAX && held > 0 && max > held ? (size_t)(max - held) / 4 : 0;
 }
 
-/* Whether bank may move pages now. Most moves split no mapping, since a
- * run moved next to the one before joins it: at 10^8 spheres the tree's
- * copy made 15,700 moves and the process held 2,900 mappings more. So the
- * room is counted again each time the moves it allowed are made, and the
- * bank stops only where none is left; the write-back, which made its
- * 15,300 and then faulted the rest of its pages in, took 1.2-1.4 s where
- * it now takes 0.5. */
+/* Whether bank may move pages now. A bank lets the process hold at most a
+ * quarter of the room left at its first count more mappings than it held
+ * then. Most moves split no mapping, since a run moved next to the one
+ * before joins it: at 10^8 spheres the tree's copy made 15,700 moves and
+ * the process held 2,900 mappings more. So each time the bank has made the
+ * moves its last count allowed, it counts the mappings again and may make
+ * as many more as keep them under its ceiling; within MOVES_MIN of it, it
+ * stops and gives its pages back. (Counted once, the room ran out halfway
+ * through the 10^8 write-back, which faulted the rest of its pages in: 1.2-
+ * 1.4 s where it now takes 0.5.) */
 static int bank_open(PtrPageBank *bank)
 {
+    enum { MOVES_MIN = 64 }; /* below this, a count every few moves */
     if (!bank->refused && bank->moves_left == 0) {
-        bank->moves_left = mapping_room();
-        bank->refused = bank->moves_left == 0;
+        const size_t held = count_lines("/proc/self/maps");
+        if (!bank->mappings_most)
+            bank->mappings_most = held + mapping_room(held);
+        bank->moves_left = bank->mappings_most >= held + MOVES_MIN
+                               ? bank->mappings_most - held : 0;
+        if (!bank->moves_left) {
+            bank->refused = 1;
+            ptr_pages_free(bank);
+        }
     }
     return !bank->refused && bank->moves_left > 0;
 }
@@ -190,9 +200,11 @@ int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
         /* The oldest run's first n bytes (the rest stays one mapping):
          * pages go out in the order they came in. Taken newest first, at
          * 10^8 spheres, where the tree's copy fills eight ranges a step
-         * (the root's children), the write-back ran out of moves early and
-         * the process faulted 1.94 million pages where it now faults 1.62
-         * (docs/intersectors.md, "The root chosen before the copy"). */
+         * (the root's children), they split more mappings: with a bank's
+         * room counted once, as it then was, the write-back ran out of
+         * moves earlier, and the process faulted 1.94 million pages where
+         * it faulted 1.62 (docs/intersectors.md, "The root chosen before
+         * the copy"). */
         if (mremap(run->at, n, n, MREMAP_MAYMOVE | MREMAP_FIXED, (void *)lo) == MAP_FAILED) {
             /* Some kernels unmap the destination before they move the
              * pages, and may then fail (out of memory): map it again, empty,

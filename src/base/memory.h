@@ -40,11 +40,12 @@ typedef struct PtrPageBank {
     } run[PTR_PAGE_BANK_RUNS]; /* each one mapping of its own */
     size_t first, runs; /* those held: run[first .. runs - 1], oldest first */
     size_t bytes;
-    /* Moves the bank may make before it counts the mappings' room again
-     * (each may split a mapping): see bank_open in memory.c. */
-    size_t moves_left;
-    /* The kernel would not move pages, or the mappings' room is gone: the
-     * bank gives pages back. */
+    /* The mappings the process may hold while the bank moves pages, set
+     * at its first count, and the moves it may make before it counts them
+     * again (each may split a mapping): see bank_open in memory.c. */
+    size_t mappings_most, moves_left;
+    /* The kernel would not move pages, or the mappings came near
+     * mappings_most: the bank holds no pages and gives back those put. */
     int refused;
 } PtrPageBank;
 

@@ -254,11 +254,13 @@ PtrResult ptr_spheres_make(PtrSpheres *spheres, void **array, PtrError *err);
 PtrResult ptr_spheres_make_ids(PtrSpheres *spheres, PtrError *err);
 
 /* A colour, each channel clamped to [0, 1], as PtrSpheres.color stores it.
- * Inline and in SSE2, once a sphere of an import with colours: as a call
- * whose clamps were branches it took a quarter of perf's samples in the
- * conversion of an instanced cloud. _mm_max_ps(c, 0) and _mm_min_ps(c, 1) are
- * ptr_maxf(c, 0) and ptr_minf(c, 1) lane by lane (NaN gives 0), and
- * _mm_cvtps_epi32 rounds to nearest even, as lrintf does. */
+ * Inline and in SSE2, since an import with colours calls it for every
+ * sphere: as a call whose clamps were branches it took a quarter of perf's
+ * samples in the conversion of an instanced cloud. _mm_max_ps(c, 0) and
+ * _mm_min_ps(c, 1) are ptr_maxf(c, 0) and ptr_minf(c, 1) lane by lane
+ * because each returns its second operand where the compare fails: so NaN
+ * gives 0 and -0 gives +0, which the operands the other way round would
+ * not. _mm_cvtps_epi32 rounds to nearest even, as lrintf does. */
 static inline void ptr_color_quantize(PtrVec3 color, uint16_t out[3])
 {
     const __m128 c = _mm_min_ps(_mm_max_ps(_mm_setr_ps(color.x, color.y, color.z, 0.0f),

@@ -2,7 +2,9 @@
  * its material through the builder's entries, which are as wide as the
  * scene's and widen with it, and its centre and radius through floats that
  * widen to doubles, whether a sphere is added alone or a batch is added and
- * filled. */
+ * filled; and its colour is quantised (ptr_color_quantize, which the
+ * builder calls for every coloured sphere) as the scalar clamp and lrintf
+ * would. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -162,19 +164,24 @@ static void test_float_until_not(void)
     ptr_scene_free(&scene);
 }
 
-/* Bit patterns for ptr_color_quantize: every tie and its neighbours (k +
- * 0.5 of 65535), the ends of [0, 1] and the values either side, zeros,
- * infinities, NaNs, subnormals, and xorshift's words as floats. */
+/* Bit patterns for ptr_color_quantize: the ends of [0, 1] and the values
+ * either side, zeros, infinities, NaNs and subnormals; every tie (k + 0.5
+ * of 65535) and its neighbours; then xorshift's words as floats. */
+static const float quantize_edges[] = { 0.0f, -0.0f, 1.0f, -1.0f, 0x1.fffffep-1f, 0x1.000002p0f,
+                                        0x1p-149f, -0x1p-149f, 0x1p-126f, 1e30f, -1e30f,
+                                        INFINITY, -INFINITY, NAN, -NAN };
+enum {
+    QUANTIZE_EDGES = sizeof quantize_edges / sizeof quantize_edges[0],
+    QUANTIZE_TIES = 3 * 65535,
+    QUANTIZE_INPUTS = QUANTIZE_EDGES + QUANTIZE_TIES + (1 << 20),
+};
+
 static float quantize_input(uint32_t i, uint32_t *state)
 {
-    static const float edges[] = { 0.0f, -0.0f, 1.0f, -1.0f, 0x1.fffffep-1f, 0x1.000002p0f,
-                                   0x1p-149f, -0x1p-149f, 0x1p-126f, 1e30f, -1e30f,
-                                   INFINITY, -INFINITY, NAN, -NAN };
-    enum { EDGES = sizeof edges / sizeof edges[0] };
-    if (i < EDGES)
-        return edges[i];
-    i -= EDGES;
-    if (i < 3 * 65535) {
+    if (i < QUANTIZE_EDGES)
+        return quantize_edges[i];
+    i -= QUANTIZE_EDGES;
+    if (i < QUANTIZE_TIES) {
         const float tie = ((float)(i / 3) + 0.5f) / 65535.0f;
         return i % 3 == 0 ? tie : i % 3 == 1 ? nextafterf(tie, 0.0f) : nextafterf(tie, 2.0f);
     }
@@ -187,23 +194,27 @@ static float quantize_input(uint32_t i, uint32_t *state)
 }
 
 /* ptr_color_quantize, inline in SSE2, gives the scalar clamp and lrintf's
- * rounding (ptr_maxf, ptr_minf: NaN gives 0) for every channel. */
+ * rounding (ptr_maxf, ptr_minf: NaN gives 0) for every channel, exact ties
+ * among its inputs (each tie's float times 65535 is k + 0.5 exactly). */
 static void test_color_quantize(void)
 {
-    enum { INPUTS = 15 + 3 * 65535 + (1 << 20) };
     uint32_t state = 0x9e3779b9u;
-    size_t wrong = 0;
-    for (uint32_t i = 0; i < INPUTS; i++) {
+    size_t wrong = 0, ties = 0;
+    for (uint32_t i = 0; i < QUANTIZE_INPUTS; i++) {
         const float c = quantize_input(i, &state);
+        const float scaled = c * 65535.0f;
+        ties += scaled - floorf(scaled) == 0.5f;
         for (int channel = 0; channel < 3; channel++) {
             float rgb[3] = { 0.25f, 0.5f, 0.75f };
             rgb[channel] = c;
             uint16_t out[3];
             ptr_color_quantize(v3(rgb[0], rgb[1], rgb[2]), out);
             for (int k = 0; k < 3; k++)
-                wrong += out[k] != (uint16_t)lrintf(ptr_minf(ptr_maxf(rgb[k], 0.0f), 1.0f) * 65535.0f);
+                wrong += out[k] != (uint16_t)lrintf(ptr_minf(ptr_maxf(rgb[k], 0.0f), 1.0f) *
+                                                    65535.0f);
         }
     }
+    CHECK(ties >= 65535);
     CHECK_INT(wrong, 0);
 }
 
