@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "base/threads.h"
-#include "grow.h"
+#include "base/grow.h"
 #include "mesh_component.h"
 
 enum {

@@ -16,7 +16,7 @@
 #include <sys/stat.h>
 
 #include "builder.h"
-#include "grow.h"
+#include "base/grow.h"
 #include "importer_internal.h"
 #include "mesh_spheres.h"
 

@@ -106,6 +106,15 @@ static size_t mapping_room(size_t held)
     return max != UINT64_MAX && held > 0 && max > held ? (size_t)(max - held) / 4 : 0;
 }
 
+/* Stops bank for good (the kernel would not move pages, or the mappings
+ * came near its ceiling): it gives back the pages it holds, and those put
+ * from now on. */
+static void bank_stop(PtrPageBank *bank)
+{
+    ptr_pages_free(bank);
+    bank->refused = 1;
+}
+
 /* Whether bank may move pages now. A bank lets the process hold at most a
  * quarter of the room left at its first count more mappings than it held
  * then. Most moves split no mapping, since a run moved next to the one
@@ -125,10 +134,8 @@ static int bank_open(PtrPageBank *bank)
             bank->mappings_most = held + mapping_room(held);
         bank->moves_left = bank->mappings_most >= held + MOVES_MIN
                                ? bank->mappings_most - held : 0;
-        if (!bank->moves_left) {
-            bank->refused = 1;
-            ptr_pages_free(bank);
-        }
+        if (!bank->moves_left)
+            bank_stop(bank);
     }
     return !bank->refused && bank->moves_left > 0;
 }
@@ -175,7 +182,7 @@ static void put_range(PtrPageBank *bank, uintptr_t lo, uintptr_t hi, uintptr_t p
                 put_range(bank, mid, hi, page);
                 return;
             }
-            bank->refused = 1;
+            bank_stop(bank);
         }
     }
     /* A hint: where refused, the memory is only given back later. */
@@ -215,8 +222,7 @@ int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
             const int kept = again != MAP_FAILED || errno == EEXIST;
             if (again != MAP_FAILED && again != (void *)lo)
                 munmap(again, n);
-            ptr_pages_free(bank);
-            bank->refused = 1;
+            bank_stop(bank);
             return kept;
         }
         bank->moves_left--;

@@ -14,6 +14,7 @@
 #error "ptr needs xxHash 0.8 or later: XXH3's values are fixed from 0.8 on"
 #endif
 
+#include "base/grow.h"
 #include "base/memory.h"
 
 void ptr_scene_init(PtrScene *scene)
@@ -322,15 +323,6 @@ const char *ptr_material_problem(const PtrMaterial *m)
     return NULL;
 }
 
-/* The materials scene->materials has room for while it holds count. */
-static size_t material_room(size_t count)
-{
-    size_t room = 1;
-    while (room < count)
-        room *= 2;
-    return room;
-}
-
 PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
                                  uint32_t *index, PtrError *err)
 {
@@ -343,15 +335,12 @@ PtrResult ptr_scene_add_material(PtrScene *scene, const PtrMaterial *material,
         if (r != PTR_OK)
             return r;
     }
-    /* Room for a power of two of them, so that a file of 10^5 materials
-     * is not copied 10^5 times (realloc copies where it cannot grow in
-     * place, as under AddressSanitizer it always does). */
-    if (!scene->materials || material_room(count) > material_room(scene->material_count)) {
-        PtrMaterial *grown = realloc(scene->materials, material_room(count) * sizeof *grown);
-        if (!grown)
-            return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu materials", count);
-        scene->materials = grown;
-    }
+    /* Grown by doubling, so that a file of 10^5 materials is not copied
+     * 10^5 times (realloc copies where it cannot grow in place, as under
+     * AddressSanitizer it always does). */
+    if (ptr_grow((void **)&scene->materials, &scene->material_capacity, count,
+                 sizeof *scene->materials) != PTR_OK)
+        return ptr_error_set(err, PTR_ERR_NOMEM, "out of memory for %zu materials", count);
     scene->materials[scene->material_count] = *material;
     *index = (uint32_t)scene->material_count++;
     return PTR_OK;

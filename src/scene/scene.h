@@ -189,7 +189,7 @@ typedef struct PtrScene {
     PtrSpheres spheres;
     PtrHugeSpheres huge;
     PtrMaterial *materials;
-    size_t material_count;
+    size_t material_count, material_capacity; /* see ptr_scene_add_material */
     PtrCamera camera;
     PtrSky sky;
     /* Image size the scene asks for (glTF scene extras.resolution); 0 if none. */

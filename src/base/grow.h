@@ -1,4 +1,5 @@
-/* An array grown by doubling, for the importers' lists of unknown length. */
+/* An array grown by doubling, for lists of unknown length: the importers',
+ * and the scene's materials. */
 #ifndef PTR_GROW_H
 #define PTR_GROW_H
 
