@@ -26,7 +26,8 @@
  * which streamed memory at 1.8x on two threads (docs/intersectors.md, "The
  * root chosen before the copy"). Every node of more than BVH_PLANNED_ABOVE
  * prims is grown so from samples of its prims, which are then sorted into
- * its children in place (plan_node).
+ * its children in place (plan_node), and into their children in the same
+ * pass where those are planned too (plan_below).
  *
  * Threads: each of the root's children of more than task_spheres spheres
  * (1/64 of all, at least TASK_SPHERES_MIN: a rule of the sphere count
@@ -81,6 +82,9 @@ typedef struct Task {
      * only (split_found 0): the task's thread finds theirs. */
     BvhCandidate range;
     int split_found;
+    /* Its prims sorted into its root's children where the node above
+     * planned them too (count above 1, see plan_below), else none. */
+    BvhChildren sorted;
     int level; /* of its root node */
     NodeArray nodes;
 } Task;
@@ -142,7 +146,7 @@ typedef struct Build {
  * memory for each would be cleared page by page. */
 typedef struct Worker {
     BvhPrim *scratch; /* room for BVH_PLANNED_ABOVE: see bvh_split */
-    BvhPrim *samples; /* room for PLAN_SAMPLES: see plan_node */
+    BvhPrim *samples; /* room for PTR_BVH_WIDTH PLAN_SAMPLES: see plan_below */
     BvhSortRoom sort; /* for the largest range planned */
 } Worker;
 
@@ -153,7 +157,7 @@ static int worker_ready(Worker *w)
     if (!w->scratch)
         w->scratch = malloc(BVH_PLANNED_ABOVE * sizeof *w->scratch);
     if (!w->samples)
-        w->samples = malloc(PLAN_SAMPLES * sizeof *w->samples);
+        w->samples = malloc(PTR_BVH_WIDTH * PLAN_SAMPLES * sizeof *w->samples);
     return w->scratch && w->samples;
 }
 
@@ -174,8 +178,8 @@ static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
     return PTR_OK;
 }
 
-static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_found, int level,
-                          uint32_t *task, PtrError *err)
+static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_found,
+                          const BvhChildren *sorted, int level, uint32_t *task, PtrError *err)
 {
     if (list->count == list->capacity) {
         size_t capacity = list->capacity ? list->capacity * 2 : 64;
@@ -186,8 +190,9 @@ static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_f
         list->capacity = capacity;
     }
     *task = (uint32_t)list->count;
-    list->tasks[list->count++] =
-        (Task){ .range = *range, .split_found = split_found, .level = level };
+    list->tasks[list->count++] = (Task){ .range = *range, .split_found = split_found,
+                                         .sorted = sorted ? *sorted : (BvhChildren){ 0 },
+                                         .level = level };
     return PTR_OK;
 }
 
@@ -231,32 +236,39 @@ static void grow_node(const BvhPrimSet *set, BvhPrim *scratch, const BvhCandidat
 }
 
 /* A node's children at this level as n samples of its prims split them,
- * each standing for per_prim prims (see grow_node), in plan: the prims are
- * then sorted into them at once (bvh_split_children), where splitting
- * them one split at a time took a pass for each level of the node's splits,
- * about three, each moving every prim (docs/intersectors.md, "Nodes planned
- * from samples"). plan->count is 1 where the samples give no split (all at
- * one centre). */
+ * each standing for per_prim prims (see grow_node), in plan, and the
+ * samples each child took in sampled (unless NULL): the prims are then
+ * sorted into them at once (bvh_split_children), where splitting them one
+ * split at a time took a pass for each level of the node's splits, about
+ * three, each moving every prim (docs/intersectors.md, "Nodes planned from
+ * samples"). plan->count is 1 where the samples give no split (all at one
+ * centre). */
 static void plan_children(const BvhPrimSet *samples, size_t n, int level, double per_prim,
-                          BvhPrim *scratch, BvhChildren *plan)
+                          BvhPrim *scratch, BvhChildren *plan, size_t sampled[PTR_BVH_WIDTH])
 {
     BvhCandidate range, child[PTR_BVH_WIDTH];
     bvh_candidate_init(samples, &range, 0, n, NULL, NULL);
     grow_node(samples, scratch, &range, level, per_prim, child, &plan->count, plan);
+    for (int k = 0; sampled && k < plan->count; k++)
+        sampled[k] = child[k].end - child[k].begin;
 }
 
 static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
-                            const BvhCandidate *range, NodeKind kind, int level,
-                            size_t *index, int *depth, PtrError *err);
+                            const BvhCandidate *range, const BvhChildren *sorted,
+                            NodeKind kind, int level, size_t *index, int *depth,
+                            PtrError *err);
 
 /* Makes the node of this kind at this level over the children child[0 .. n
  * - 1] in nodes (its index in *index), and its inner children below it that
  * are neither parts nor tasks, on the thread w (NULL for the root, which
  * has none); depth: levels below the node, not counting parts and tasks.
- * tasks: where a node of the top level puts its tasks. */
+ * tasks: where a node of the top level puts its tasks. below: NULL, or
+ * child k's prims sorted into its children, where below[k].count is above
+ * 1 (plan_below). */
 static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
-                           const BvhCandidate child[PTR_BVH_WIDTH], int n, NodeKind kind,
-                           int level, size_t *index, int *depth, PtrError *err)
+                           const BvhCandidate child[PTR_BVH_WIDTH],
+                           const BvhChildren *below, int n, NodeKind kind, int level,
+                           size_t *index, int *depth, PtrError *err)
 {
     PtrResult r;
     if ((r = node_array_add(nodes, index, err)) != PTR_OK)
@@ -288,7 +300,9 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
         node.leaf_count[k] = 0;
         if (kind != NODE_TASK && count <= build->task_spheres) {
             uint32_t task;
-            if ((r = add_task(tasks, c, kind != NODE_ROOT, level + 1, &task, err)) != PTR_OK)
+            r = add_task(tasks, c, kind != NODE_ROOT, below ? &below[k] : NULL, level + 1, &task,
+                         err);
+            if (r != PTR_OK)
                 return r;
             node.child[k] = TASK_FLAG | task;
             continue;
@@ -298,12 +312,13 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
             build->parts[build->part_count++] = (Part){ .range = *c, .level = level + 1 };
             continue;
         }
-        size_t below;
+        size_t inner;
         int below_depth;
-        r = build_node(build, w, nodes, tasks, c, kind, level + 1, &below, &below_depth, err);
+        r = build_node(build, w, nodes, tasks, c, below ? &below[k] : NULL, kind, level + 1,
+                       &inner, &below_depth, err);
         if (r != PTR_OK)
             return r;
-        node.child[k] = (uint32_t)below;
+        node.child[k] = (uint32_t)inner;
         if (below_depth + 1 > *depth)
             *depth = below_depth + 1;
     }
@@ -311,11 +326,72 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
     return PTR_OK;
 }
 
+/* m of the n prims, evenly spaced, in samples. */
+static void take_samples(const BvhPrim *prims, size_t n, size_t m, BvhPrim *samples)
+{
+    for (size_t j = 0; j < m; j++) {
+        /* Each a cache miss the prefetchers do not foresee: fetched ahead,
+         * they overlap. (j n is below 2^18 2^31: no overflow.) */
+        if (j + PLAN_AHEAD < m)
+            _mm_prefetch((const char *)&prims[(j + PLAN_AHEAD) * n / m], _MM_HINT_T0);
+        samples[j] = prims[j * n / m];
+    }
+}
+
+/* For each child k of plan over range at this level whose samples
+ * (sampled[k], each standing for per_prim prims) put it over
+ * BVH_PLANNED_ABOVE prims, its own children planned in below[k], from
+ * samples of range's prims, one in PLAN_SHARE up to PTR_BVH_WIDTH
+ * PLAN_SAMPLES, sorted into plan's children: up to PLAN_SAMPLES of those
+ * a child took, evenly spaced. below[k].count is 1 for the others. Returns
+ * whether any child has its children planned: the prims are then sorted
+ * into plan's children and theirs in one pass, where a pass for each level
+ * moved every prim twice as often (docs/intersectors.md, "Two levels
+ * planned at once"). Every child so planned holds a prim: it holds a
+ * sample, which is one of the prims, tested the same way. w->sort:
+ * reserved for range. */
+static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int level,
+                      const BvhChildren *plan, const size_t sampled[PTR_BVH_WIDTH],
+                      double per_prim, BvhChildren below[PTR_BVH_WIDTH])
+{
+    int planned[PTR_BVH_WIDTH], any = 0;
+    for (int k = 0; k < plan->count; k++) {
+        below[k].count = 1;
+        planned[k] = level + 1 < MIDDLE_SPLIT_LEVEL &&
+                     (double)sampled[k] * per_prim > BVH_PLANNED_ABOVE;
+        any |= planned[k];
+    }
+    if (!any)
+        return 0;
+    const size_t n = range->end - range->begin, most = PTR_BVH_WIDTH * PLAN_SAMPLES;
+    const size_t m = n / PLAN_SHARE < most ? n / PLAN_SHARE : most;
+    take_samples(build->set.prims + range->begin, n, m, w->samples);
+    const BvhPrimSet samples = { w->samples, build->set.magnitude };
+    BvhChildren split = *plan;
+    bvh_split_children(&samples, 0, m, &split, NULL, &w->sort);
+    for (int k = 0; k < plan->count; k++) {
+        const size_t took = split.end[k] - split.begin[k];
+        if (!planned[k] || took == 0)
+            continue;
+        BvhPrim *own = w->samples + split.begin[k];
+        const size_t used = took < PLAN_SAMPLES ? took : PLAN_SAMPLES;
+        for (size_t j = 0; j < used; j++) /* j took / used >= j: forwards is safe */
+            own[j] = own[j * took / used];
+        const BvhPrimSet child_samples = { own, build->set.magnitude };
+        const double child_per_prim = (double)n / (double)m * (double)took / (double)used;
+        plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch, &below[k],
+                      NULL);
+    }
+    return 1;
+}
+
 /* The node's children as samples of its prims, one in PLAN_SHARE up to
  * PLAN_SAMPLES, evenly spaced, split them, each sample standing for as many
  * prims as there are to a sample, in plan, and the prims sorted into them,
- * in child[0 .. *count - 1]. *count is 1 where the samples gave no split
- * (all at one centre): the prims as they were. Fails only for memory.
+ * in child[0 .. *count - 1], and into their children where they are
+ * planned too (below, see plan_below). *count is 1 where the samples gave
+ * no split (all at one centre): the prims as they were. Fails only for
+ * memory.
  *
  * Planned from PLAN_SAMPLES whatever its size, a node of 195,000 prims
  * (512 of them at 10^8 spheres) spent a third of its time on its samples,
@@ -323,30 +399,28 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
  * moved by 0.04% at most (docs/intersectors.md, "Fewer samples for smaller
  * nodes"). */
 static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, int level,
-                           BvhCandidate child[PTR_BVH_WIDTH], int *count, PtrError *err)
+                           BvhCandidate child[PTR_BVH_WIDTH], BvhChildren below[PTR_BVH_WIDTH],
+                           int *count, PtrError *err)
 {
     const size_t n = range->end - range->begin;
     const size_t m = n / PLAN_SHARE < PLAN_SAMPLES ? n / PLAN_SHARE : PLAN_SAMPLES;
     const BvhPrimSet samples = { w->samples, build->set.magnitude };
-    const BvhPrim *prims = build->set.prims + range->begin;
-    for (size_t j = 0; j < m; j++) {
-        /* Each a cache miss the prefetchers do not foresee: fetched ahead,
-         * they overlap. (j n is below 2^15 2^31: no overflow.) */
-        if (j + PLAN_AHEAD < m)
-            _mm_prefetch((const char *)&prims[(j + PLAN_AHEAD) * n / m], _MM_HINT_T0);
-        w->samples[j] = prims[j * n / m];
-    }
+    take_samples(build->set.prims + range->begin, n, m, w->samples);
     BvhChildren plan;
-    plan_children(&samples, m, level, (double)n / m, w->scratch, &plan);
+    size_t sampled[PTR_BVH_WIDTH];
+    const double per_prim = (double)n / (double)m;
+    plan_children(&samples, m, level, per_prim, w->scratch, &plan, sampled);
     *count = 1;
     child[0] = *range;
     if (plan.count == 1)
         return PTR_OK;
     if (bvh_sort_room_reserve(&w->sort, n) != PTR_OK)
         return bvh_out_of_memory(err);
+    const int two_levels = plan_below(build, w, range, level, &plan, sampled, per_prim, below);
     /* Every child holds a prim: each holds a sample (the heuristic makes
      * no empty side), which is one of the prims, tested the same way. */
-    bvh_split_children(&build->set, range->begin, range->end, &plan, &w->sort);
+    bvh_split_children(&build->set, range->begin, range->end, &plan, two_levels ? below : NULL,
+                       &w->sort);
     for (int k = 0; k < plan.count; k++)
         bvh_candidate_init(&build->set, &child[k], plan.begin[k], plan.end[k], plan.lower[k],
                            plan.upper[k]);
@@ -355,21 +429,39 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
 }
 
 /* Builds the node of this kind at this level over range (its split found,
- * where it has one: see bvh_candidate_init) into nodes: see make_node. */
+ * where it has one: see bvh_candidate_init) into nodes: see make_node.
+ * sorted: NULL, or range's prims sorted into the node's children where
+ * sorted->count is above 1 (plan_below). */
 static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
-                            const BvhCandidate *range, NodeKind kind, int level,
-                            size_t *index, int *depth, PtrError *err)
+                            const BvhCandidate *range, const BvhChildren *sorted,
+                            NodeKind kind, int level, size_t *index, int *depth,
+                            PtrError *err)
 {
     BvhCandidate child[PTR_BVH_WIDTH];
+    BvhChildren *below = NULL; /* planned with the children, where they are */
     int n = 1;
-    if (range->end - range->begin > BVH_PLANNED_ABOVE && level < MIDDLE_SPLIT_LEVEL) {
-        PtrResult r = plan_node(build, w, range, level, child, &n, err);
-        if (r != PTR_OK)
-            return r;
+    PtrResult r = PTR_OK;
+    if (sorted && sorted->count > 1) {
+        n = sorted->count;
+        for (int k = 0; k < n; k++)
+            bvh_candidate_init(&build->set, &child[k], sorted->begin[k], sorted->end[k],
+                               sorted->lower[k], sorted->upper[k]);
+    } else if (range->end - range->begin > BVH_PLANNED_ABOVE && level < MIDDLE_SPLIT_LEVEL) {
+        /* On the heap: the recursion holds a node's for as long as its
+         * children build. */
+        if (!(below = malloc(PTR_BVH_WIDTH * sizeof *below)))
+            return bvh_out_of_memory(err);
+        r = plan_node(build, w, range, level, child, below, &n, err);
     }
-    if (n == 1)
+    if (r == PTR_OK && n == 1) {
+        free(below); /* no plan: no children planned */
+        below = NULL;
         grow_node(&build->set, w->scratch, range, level, 1.0, child, &n, NULL);
-    return make_node(build, w, nodes, tasks, child, n, kind, level, index, depth, err);
+    }
+    if (r == PTR_OK)
+        r = make_node(build, w, nodes, tasks, child, below, n, kind, level, index, depth, err);
+    free(below);
+    return r;
 }
 
 static size_t part_size(const Part *p)
@@ -437,7 +529,7 @@ static int build_part(Build *build, Worker *w, Part *p)
     size_t root;
     bvh_candidate_init(&build->set, &range, p->range.begin, p->range.end, p->range.lower,
                        p->range.upper);
-    return build_node(build, w, &p->nodes, &p->tasks, &range, NODE_PART, p->level, &root,
+    return build_node(build, w, &p->nodes, &p->tasks, &range, NULL, NODE_PART, p->level, &root,
                       &p->nodes.depth, NULL) == PTR_OK;
 }
 
@@ -451,8 +543,8 @@ static int build_task(Build *build, Worker *w, Task *t)
     if (!t->split_found)
         bvh_candidate_init(&build->set, &range, range.begin, range.end, range.lower,
                            range.upper);
-    return build_node(build, w, &t->nodes, NULL, &range, NODE_TASK, t->level, &root,
-                      &t->nodes.depth, NULL) == PTR_OK;
+    return build_node(build, w, &t->nodes, NULL, &range, &t->sorted, NODE_TASK, t->level,
+                      &root, &t->nodes.depth, NULL) == PTR_OK;
 }
 
 /* Takes parts, then tasks, until none is left or will be, or the pool
@@ -745,7 +837,7 @@ static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t 
                                      PLAN_SAMPLES, &samples.magnitude);
     if (n > 0)
         plan_children(&samples, n, 0, (double)(spheres->count - huge_count) / (double)n,
-                      w->scratch, plan);
+                      w->scratch, plan, NULL);
     return PTR_OK;
 }
 
@@ -806,8 +898,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
             grow_node(&build.set, w.scratch, &range, 0, 1.0, child, &n, NULL);
         }
         size_t index;
-        r = make_node(&build, NULL, &top, &build.root_tasks, child, n, NODE_ROOT, 0, &index,
-                      &top.depth, err);
+        r = make_node(&build, NULL, &top, &build.root_tasks, child, NULL, n, NODE_ROOT, 0,
+                      &index, &top.depth, err);
         if (r == PTR_OK)
             r = run_pool(&build, &w, err);
         if (r == PTR_OK)

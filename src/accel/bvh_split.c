@@ -6,9 +6,12 @@
 
 enum {
     BINS = 32,
+    /* What bvh_split_children sorts into: a node's children, or their
+     * children, eight to a child (see sort_bucket). */
+    SORT_BUCKETS = PTR_BVH_WIDTH * PTR_BVH_WIDTH,
     /* bvh_split_children's buffers, in blocks: a block and two of head for
-     * each child, and two to move blocks through (see sort_in_blocks). */
-    SORT_BLOCKS = 3 * PTR_BVH_WIDTH + 2,
+     * each bucket, and two to move blocks through (see sort_in_blocks). */
+    SORT_BLOCKS = 3 * SORT_BUCKETS + 2,
 };
 
 static void bounds_empty(float lo[3], float hi[3])
@@ -236,16 +239,93 @@ static void prim_children4(const BvhChildLanes *lanes, const BvhPrim *p, uint8_t
     bvh_children4(lanes, centre, child);
 }
 
-/* The children's counts and boxes, growing with each prim. */
-typedef struct ChildBoxes {
-    size_t count[PTR_BVH_WIDTH];
-    __m128 lower[PTR_BVH_WIDTH], upper[PTR_BVH_WIDTH];
-} ChildBoxes;
+/* A child's own splits, to find which of its children a prim goes to:
+ * split s (1 to 7) in lane s - 1 of two registers, each lane reading its
+ * axis's coordinate through a mask, so that one prim meets all of them at
+ * once. The prims of a child meet its splits one prim at a time, where
+ * bvh_children4 takes four prims through one split at a time: four prims
+ * of one range go to different children, each with its own splits. The
+ * splits that send a prim right, as bits, give its child through a table
+ * of the chain of sources (BvhChildren). */
+typedef struct SplitRow {
+    __m128 on_x[2], on_y[2], on_z[2];
+    __m128 base[2], scale[2], last[2];
+    __m128i split_bin[2];
+    uint8_t child[1 << (PTR_BVH_WIDTH - 1)];
+} SplitRow;
 
-/* Finds the children of the first n (at most 4) of the prims p, in child,
- * and adds the prims to their children's counts and boxes. */
-static void add_children4(const BvhChildLanes *lanes, float magnitude, const BvhPrim *p,
-                          size_t n, uint8_t *child, ChildBoxes *b)
+static void split_row_init(const BvhChildren *children, SplitRow *row)
+{
+    memset(row, 0, sizeof *row);
+    float on[3][2 * 4] = { { 0 } }, base[2 * 4] = { 0 }, scale[2 * 4] = { 0 },
+          last[2 * 4] = { 0 };
+    int32_t split_bin[2 * 4] = { 0 };
+    for (int s = 1; s < children->count; s++) {
+        const BvhSplitTest *t = &children->test[s];
+        const uint32_t all = UINT32_MAX;
+        memcpy(&on[t->axis][s - 1], &all, sizeof all);
+        base[s - 1] = t->base;
+        scale[s - 1] = t->scale;
+        last[s - 1] = t->last;
+        split_bin[s - 1] = t->split_bin;
+    }
+    for (int h = 0; h < 2; h++) {
+        row->on_x[h] = _mm_loadu_ps(&on[0][4 * h]);
+        row->on_y[h] = _mm_loadu_ps(&on[1][4 * h]);
+        row->on_z[h] = _mm_loadu_ps(&on[2][4 * h]);
+        row->base[h] = _mm_loadu_ps(&base[4 * h]);
+        row->scale[h] = _mm_loadu_ps(&scale[4 * h]);
+        row->last[h] = _mm_loadu_ps(&last[4 * h]);
+        row->split_bin[h] = _mm_loadu_si128((const __m128i *)&split_bin[4 * h]);
+    }
+    /* The lanes of splits past count are never read: the table ignores
+     * their bits. */
+    for (unsigned right = 0; right < sizeof row->child; right++) {
+        int in = 0;
+        for (int s = 1; s < children->count; s++)
+            if (in == children->source[s] && (right >> (s - 1) & 1))
+                in = s;
+        row->child[right] = (uint8_t)in;
+    }
+}
+
+/* The child of row's node that prim p goes to: bvh_children4's arithmetic,
+ * on one prim in the lanes of all the splits. */
+static inline int split_row_child(const SplitRow *row, const BvhPrim *p)
+{
+    const __m128 c = _mm_loadu_ps(p->centre);
+    const __m128 x = _mm_shuffle_ps(c, c, _MM_SHUFFLE(0, 0, 0, 0)),
+                 y = _mm_shuffle_ps(c, c, _MM_SHUFFLE(1, 1, 1, 1)),
+                 z = _mm_shuffle_ps(c, c, _MM_SHUFFLE(2, 2, 2, 2));
+    int right = 0;
+    for (int h = 0; h < 2; h++) {
+        const __m128 at = _mm_or_ps(_mm_or_ps(_mm_and_ps(x, row->on_x[h]),
+                                              _mm_and_ps(y, row->on_y[h])),
+                                    _mm_and_ps(z, row->on_z[h]));
+        const __m128i bin = bvh_bins4(at, row->base[h], row->scale[h], row->last[h]);
+        right |= _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(bin, row->split_bin[h])))
+                 << 4 * h;
+    }
+    return row->child[right & (int)(sizeof row->child - 1)];
+}
+
+/* The bucket of child k's child g: each child's eight in turn. */
+static inline int sort_bucket(int k, int g)
+{
+    return k * PTR_BVH_WIDTH + g;
+}
+
+/* The buckets' counts and boxes, growing with each prim. */
+typedef struct BucketBoxes {
+    size_t count[SORT_BUCKETS];
+    __m128 lower[SORT_BUCKETS], upper[SORT_BUCKETS];
+} BucketBoxes;
+
+/* Finds the buckets of the first n (at most 4) of the prims p, in bucket
+ * (the children's, or with rows, the grandchildren's), and adds the prims
+ * to their buckets' counts and boxes. */
+static void add_buckets4(const BvhChildLanes *lanes, const SplitRow *rows, float magnitude,
+                         const BvhPrim *p, size_t n, uint8_t *bucket, BucketBoxes *b)
 {
     uint8_t four[4];
     if (n == 4) {
@@ -258,13 +338,14 @@ static void add_children4(const BvhChildLanes *lanes, float magnitude, const Bvh
         prim_children4(lanes, last, four);
     }
     for (size_t i = 0; i < n; i++) {
-        const int k = four[i];
+        const int k = rows ? sort_bucket(four[i], split_row_child(&rows[four[i]], &p[i]))
+                           : four[i];
         __m128 lower, upper;
         bvh_prim_box4(&p[i], magnitude, &lower, &upper);
         b->lower[k] = _mm_min_ps(b->lower[k], lower);
         b->upper[k] = _mm_max_ps(b->upper[k], upper);
         b->count[k]++;
-        child[i] = (uint8_t)k;
+        bucket[i] = (uint8_t)k;
     }
 }
 
@@ -291,9 +372,11 @@ void bvh_sort_room_free(BvhSortRoom *room)
     *room = (BvhSortRoom){ 0 };
 }
 
-/* Sorts the n prims p, whose children are child[0 .. n - 1], into them,
- * child k's prims to start[k] .. stop[k] - 1 in the order they come,
- * blocks of BVH_SORT_BLOCK prims at a time.
+/* Sorts the n prims p, whose buckets are room->child[0 .. n - 1], into them,
+ * bucket k's prims to start[k] .. stop[k] - 1 in the order they come,
+ * blocks of BVH_SORT_BLOCK prims at a time; count buckets, at most
+ * SORT_BUCKETS. (A bucket is called a child below: a node's child, or a
+ * child's child.)
  *
  * Block slot t is prims t B .. t B + B - 1. A slot inside a child's places
  * takes a whole block of its prims; the first prims of a child before its
@@ -310,10 +393,10 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
 {
     enum { B = BVH_SORT_BLOCK };
     const uint32_t done = UINT32_MAX; /* a slot whose block has moved */
-    BvhPrim *fill = room->blocks, *head = fill + PTR_BVH_WIDTH * B,
-            *carry = head + PTR_BVH_WIDTH * 2 * B, *spare = carry + B;
-    size_t heads[PTR_BVH_WIDTH], first_slot[PTR_BVH_WIDTH], seen[PTR_BVH_WIDTH] = { 0 },
-           filled[PTR_BVH_WIDTH] = { 0 }, slots = 0;
+    BvhPrim *fill = room->blocks, *head = fill + SORT_BUCKETS * B,
+            *carry = head + SORT_BUCKETS * 2 * B, *spare = carry + B;
+    size_t heads[SORT_BUCKETS], first_slot[SORT_BUCKETS], seen[SORT_BUCKETS] = { 0 },
+           filled[SORT_BUCKETS] = { 0 }, slots = 0;
     for (int k = 0; k < count; k++) {
         const size_t first = (start[k] + B - 1) / B, last = stop[k] / B;
         /* Without a slot of its own a child is all head: fewer than 2 B
@@ -337,7 +420,7 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
         }
     }
     uint32_t *dest = room->dest;
-    size_t next[PTR_BVH_WIDTH];
+    size_t next[SORT_BUCKETS];
     for (int k = 0; k < count; k++)
         next[k] = first_slot[k];
     for (size_t t = 0; t < slots; t++)
@@ -371,32 +454,53 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
 }
 
 void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
-                        BvhSortRoom *room)
+                        BvhChildren *below, BvhSortRoom *room)
 {
     BvhChildLanes lanes;
     bvh_child_lanes(children, &lanes);
+    SplitRow rows[PTR_BVH_WIDTH];
+    const int per_child = below ? PTR_BVH_WIDTH : 1; /* buckets */
+    for (int k = 0; below && k < children->count; k++)
+        split_row_init(&below[k], &rows[k]);
     BvhPrim *p = set->prims + begin;
     const size_t n = end - begin;
-    ChildBoxes b = { .count = { 0 } };
-    for (int k = 0; k < children->count; k++) {
+    BucketBoxes b = { .count = { 0 } };
+    for (int k = 0; k < children->count * per_child; k++) {
         b.lower[k] = _mm_set1_ps(INFINITY);
         b.upper[k] = _mm_set1_ps(-INFINITY);
     }
     for (size_t i = 0; i < n; i += 4)
-        add_children4(&lanes, set->magnitude, &p[i], n - i < 4 ? n - i : 4, &room->child[i], &b);
-    /* Each child's places, in bvh_children_order's order. */
+        add_buckets4(&lanes, below ? rows : NULL, set->magnitude, &p[i], n - i < 4 ? n - i : 4,
+                     &room->child[i], &b);
+    /* Each child's places, in bvh_children_order's order, and within it,
+     * each of its children's in the order of its own. */
     int order[PTR_BVH_WIDTH];
-    size_t start[PTR_BVH_WIDTH], stop[PTR_BVH_WIDTH], next = 0;
+    size_t start[SORT_BUCKETS] = { 0 }, stop[SORT_BUCKETS] = { 0 }, next = 0;
     bvh_children_order(children, order);
     for (int j = 0; j < children->count; j++) {
         const int k = order[j];
-        start[k] = next;
-        next += b.count[k];
-        stop[k] = next;
-        children->begin[k] = begin + start[k];
+        int below_order[PTR_BVH_WIDTH] = { 0 };
+        if (below)
+            bvh_children_order(&below[k], below_order);
+        __m128 lower = _mm_set1_ps(INFINITY), upper = _mm_set1_ps(-INFINITY);
+        children->begin[k] = begin + next;
+        for (int i = 0; i < (below ? below[k].count : 1); i++) {
+            const int g = below_order[i], at = below ? sort_bucket(k, g) : k;
+            start[at] = next;
+            next += b.count[at];
+            stop[at] = next;
+            lower = _mm_min_ps(lower, b.lower[at]);
+            upper = _mm_max_ps(upper, b.upper[at]);
+            if (below) {
+                below[k].begin[g] = begin + start[at];
+                below[k].end[g] = begin + next;
+                bvh_store3(below[k].lower[g], b.lower[at]);
+                bvh_store3(below[k].upper[g], b.upper[at]);
+            }
+        }
         children->end[k] = begin + next;
-        bvh_store3(children->lower[k], b.lower[k]);
-        bvh_store3(children->upper[k], b.upper[k]);
+        bvh_store3(children->lower[k], lower);
+        bvh_store3(children->upper[k], upper);
     }
-    sort_in_blocks(p, n, children->count, start, stop, room);
+    sort_in_blocks(p, n, children->count * per_child, start, stop, room);
 }

@@ -362,38 +362,31 @@ static void test_threads(void)
     ptr_scene_free(&first_scene);
 }
 
-/* The root's children, into which the prims are sorted as they are copied
- * (bvh_prims.c), over more spheres than a page step (PTR_PAGE_STEP), so
- * in several steps of several blocks (of 65,536) each, with spheres above
- * the huge limit at the edges of blocks and steps: 20 of them, so that the
- * tree keeps out the first PTR_HUGE_MAX and holds the other 4. On 1 and 3
- * threads the same tree, every sphere once, and brute force's answers. */
-static void test_root_sort(void)
+/* Makes a set of spheres in s (initialised, empty), the same each time. */
+typedef void (*SetMaker)(PtrScene *s);
+
+/* The set make makes, built on one thread: every sphere once (huge_count
+ * of them out of the tree), and brute force's answers to rays; and built
+ * on three threads, the same tree. */
+static void check_one_and_three_threads(SetMaker make, size_t huge_count, int rays,
+                                        const char *name)
 {
-    enum { COUNT = PTR_PAGE_STEP + (1 << 16) + 4099, BIG = 20 };
-    static const size_t big[BIG] = { 0, 1, 5, 65535, 65536, 65539, 131071, 500000, 1048573,
-                                     1048574, 1048575, 1048576, 1048577, 1048580, 1114111,
-                                     1114112, 1114113, COUNT - 3, COUNT - 2, COUNT - 1 };
     PtrScene file;
     ptr_scene_init(&file);
-    CHECK(bvh_scene_make(&file, BVH_SCENE_CLUSTERS, COUNT, 9));
-    for (size_t k = 0; k < BIG; k++)
-        file.spheres.radius[big[k]] = 100.0f; /* the limit: 100 x the median (about 0.85) */
+    make(&file);
     PtrBvh first = { 0 };
     PtrScene first_scene;
     for (int t = 0; t < 2; t++) {
         PtrScene s;
         ptr_scene_init(&s);
-        CHECK(bvh_scene_make(&s, BVH_SCENE_CLUSTERS, COUNT, 9));
-        for (size_t k = 0; k < BIG; k++)
-            s.spheres.radius[big[k]] = 100.0f;
+        make(&s);
         tag_file_order(&s);
         PtrBvh bvh;
         CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, t ? 3 : 1, NULL), PTR_OK);
-        CHECK(bvh.huge_count == PTR_HUGE_MAX);
+        CHECK(bvh.huge_count == huge_count);
         if (t == 0) {
-            check_structure(&bvh, &s.spheres, 1, "root sort");
-            check_rays(&file, &s, &bvh, 100, "root sort");
+            check_structure(&bvh, &s.spheres, 1, name);
+            check_rays(&file, &s, &bvh, rays, name);
             first = bvh;
             first_scene = s;
             continue;
@@ -405,6 +398,34 @@ static void test_root_sort(void)
     ptr_bvh_free(&first);
     ptr_scene_free(&first_scene);
     ptr_scene_free(&file);
+}
+
+enum { ROOT_SORT_COUNT = PTR_PAGE_STEP + (1 << 16) + 4099, ROOT_SORT_BIG = 20 };
+
+/* test_root_sort's set: clusters, with spheres above the huge limit (the
+ * limit: 100 x the median radius, about 0.85) at the edges of blocks and
+ * steps. */
+static void make_root_sort_set(PtrScene *s)
+{
+    static const size_t big[ROOT_SORT_BIG] = {
+        0,       1,       5,       65535,   65536,   65539,   131071,
+        500000,  1048573, 1048574, 1048575, 1048576, 1048577, 1048580,
+        1114111, 1114112, 1114113, ROOT_SORT_COUNT - 3, ROOT_SORT_COUNT - 2, ROOT_SORT_COUNT - 1
+    };
+    CHECK(bvh_scene_make(s, BVH_SCENE_CLUSTERS, ROOT_SORT_COUNT, 9));
+    for (size_t k = 0; k < ROOT_SORT_BIG; k++)
+        s->spheres.radius[big[k]] = 100.0f;
+}
+
+/* The root's children, into which the prims are sorted as they are copied
+ * (bvh_prims.c), over more spheres than a page step (PTR_PAGE_STEP), so
+ * in several steps of several blocks (of 65,536) each, with spheres above
+ * the huge limit at the edges of blocks and steps: 20 of them, so that the
+ * tree keeps out the first PTR_HUGE_MAX and holds the other 4. On 1 and 3
+ * threads the same tree, every sphere once, and brute force's answers. */
+static void test_root_sort(void)
+{
+    check_one_and_three_threads(make_root_sort_set, PTR_HUGE_MAX, 100, "root sort");
 }
 
 /* 600,000 spheres at one centre: the root's samples give no split, nor do
@@ -428,78 +449,130 @@ static void test_plans_without_split(void)
     ptr_scene_free(&file);
 }
 
+static void make_two_levels_set(PtrScene *s)
+{
+    CHECK(bvh_scene_make(s, BVH_SCENE_RANDOM, 5000000, 4));
+}
+
+/* 5,000,000 random spheres: the parts' children (planned, of some 78,000
+ * spheres each, over the 65,536 a node is planned above) are planned with
+ * them and sorted in the same pass (plan_below), both those built inline
+ * and the tasks (of at most 78,125 spheres), which then build on their
+ * sorted children. The tree is whole, answers as brute force does, and
+ * is the same on one thread and three. */
+static void test_two_levels_planned(void)
+{
+    check_one_and_three_threads(make_two_levels_set, 0, 10, "two levels planned");
+}
+
+/* Random splits for a plan of count children, each on a coordinate of
+ * -8 .. 8 in 32 bins. */
+static void random_plan(PtrRng *rng, int count, BvhChildren *plan)
+{
+    *plan = (BvhChildren){ .count = count };
+    for (int s = 1; s < count; s++) {
+        plan->source[s] = (int)(ptr_rng_float(rng) * (float)s);
+        plan->test[s] = (BvhSplitTest){ .axis = (s + count) % 3,
+                                        .split_bin = (int)(ptr_rng_float(rng) * 16.0f),
+                                        .base = -16.0f, .scale = 1.0f, .last = 31.0f };
+    }
+}
+
+/* The child of plan that p goes to, its splits made one at a time. */
+static int plan_child(const BvhChildren *plan, const BvhPrim *p)
+{
+    int in = 0;
+    for (int s = 1; s < plan->count; s++)
+        if (in == plan->source[s] && bvh_goes_right(&plan->test[s], p))
+            in = s;
+    return in;
+}
+
+/* Checks that plan's children tile begin .. end in bvh_children_order's
+ * order, that each holds the prims its splits send it, in the order they
+ * came if ordered (else sorted into its own children), and that each box is
+ * its prims' to the bit. With seen, that the prims are those of begin ..
+ * end (their rest), each once. */
+static void check_children(const BvhPrim *prims, float magnitude, size_t begin, size_t end,
+                           const BvhChildren *plan, int ordered, unsigned char *seen)
+{
+    int order[PTR_BVH_WIDTH];
+    bvh_children_order(plan, order);
+    size_t next = begin;
+    for (int j = 0; j < plan->count; j++) {
+        const int k = order[j];
+        CHECK_INT(plan->begin[k], next);
+        next = plan->end[k];
+        float lower[3] = { INFINITY, INFINITY, INFINITY },
+              upper[3] = { -INFINITY, -INFINITY, -INFINITY };
+        for (size_t i = plan->begin[k]; i < plan->end[k]; i++) {
+            /* In the order they came. */
+            CHECK(!ordered || i == plan->begin[k] || prims[i].rest > prims[i - 1].rest);
+            CHECK_INT(plan_child(plan, &prims[i]), k);
+            if (seen) {
+                CHECK(prims[i].rest >= begin && prims[i].rest < end && !seen[prims[i].rest]);
+                seen[prims[i].rest] = 1;
+            }
+            float lo[3], hi[3];
+            bvh_prim_box(&prims[i], magnitude, lo, hi);
+            for (int a = 0; a < 3; a++) {
+                lower[a] = ptr_minf(lower[a], lo[a]);
+                upper[a] = ptr_maxf(upper[a], hi[a]);
+            }
+        }
+        CHECK(!memcmp(lower, plan->lower[k], sizeof lower));
+        CHECK(!memcmp(upper, plan->upper[k], sizeof upper));
+    }
+    CHECK_INT(next, end);
+}
+
 /* bvh_split_children against the plan's splits made one at a time with
  * bvh_goes_right: every prim of a child goes there by the splits, in the
  * order it came, the children tile the range in bvh_children_order's order,
- * each box is its prims' to the bit, and no prim is lost or copied. The
- * ranges hold from under one to some 150 of its sort's blocks. The prims: random
- * centres, some on bin edges, in ranges whose length leaves 0 to 3 at the
- * end of the four-at-a-time pass, inside a larger array. */
+ * each box is its prims' to the bit, and no prim is lost or copied. With
+ * the children's own splits (below), each child's prims likewise go to its
+ * children, of 1 to 8 (one child: none), as a sort of the child's range by
+ * them would leave them. The ranges hold from under one to some 150 of its
+ * sort's blocks. The prims: random centres, some on bin edges, in ranges
+ * whose length leaves 0 to 3 at the end of the four-at-a-time pass, inside
+ * a larger array. */
 static void test_split_children(void)
 {
     enum { TOTAL = 20000 };
     BvhPrim *prims = malloc(TOTAL * sizeof *prims);
+    unsigned char *seen = malloc(TOTAL);
     BvhSortRoom room = { 0 };
-    CHECK(prims && bvh_sort_room_reserve(&room, TOTAL) == PTR_OK);
+    CHECK(prims && seen && bvh_sort_room_reserve(&room, TOTAL) == PTR_OK);
     PtrRng rng = ptr_rng_for_sample(11, 0, 0);
     const size_t ranges[][2] = { { 0, TOTAL }, { 3, 9001 }, { 100, 102 }, { 17, 18 },
                                  { 5000, 5003 } };
-    for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
-        for (uint32_t i = 0; i < TOTAL; i++) {
-            prims[i] = (BvhPrim){ .rest = i, .radius = bvh_uniform(&rng, 0.01f, 0.5f) };
-            for (int a = 0; a < 3; a++)
-                /* One in eight on the grid of the splits' bin edges. */
-                prims[i].centre[a] = ptr_rng_float(&rng) < 0.125f
-                                         ? (float)(int)bvh_uniform(&rng, -8, 8)
-                                         : bvh_uniform(&rng, -8, 8);
-        }
-        const BvhPrimSet set = { prims, 8.5f };
-        BvhChildren plan = { .count = r == 3 ? 1 : PTR_BVH_WIDTH };
-        for (int s = 1; s < plan.count; s++) {
-            plan.source[s] = (int)(ptr_rng_float(&rng) * (float)s);
-            plan.test[s] = (BvhSplitTest){ .axis = s % 3,
-                                           .split_bin = (int)(ptr_rng_float(&rng) * 16.0f),
-                                           .base = -16.0f, .scale = 1.0f, .last = 31.0f };
-        }
-        const size_t begin = ranges[r][0], end = ranges[r][1];
-        bvh_split_children(&set, begin, end, &plan, &room);
-        int order[PTR_BVH_WIDTH];
-        bvh_children_order(&plan, order);
-        size_t next = begin;
-        unsigned char *seen = calloc(TOTAL, 1);
-        CHECK(seen != NULL);
-        for (int j = 0; j < plan.count; j++) {
-            const int k = order[j];
-            CHECK_INT(plan.begin[k], next);
-            next = plan.end[k];
-            float lower[3] = { INFINITY, INFINITY, INFINITY },
-                  upper[3] = { -INFINITY, -INFINITY, -INFINITY };
-            for (size_t i = plan.begin[k]; i < plan.end[k]; i++) {
-                /* In the order they came. */
-                CHECK(i == plan.begin[k] || prims[i].rest > prims[i - 1].rest);
-                int in = 0;
-                for (int s = 1; s < plan.count; s++)
-                    if (in == plan.source[s] && bvh_goes_right(&plan.test[s], &prims[i]))
-                        in = s;
-                CHECK_INT(in, k);
-                CHECK(prims[i].rest >= begin && prims[i].rest < end && !seen[prims[i].rest]);
-                seen[prims[i].rest] = 1;
-                float lo[3], hi[3];
-                bvh_prim_box(&prims[i], set.magnitude, lo, hi);
-                for (int a = 0; a < 3; a++) {
-                    lower[a] = ptr_minf(lower[a], lo[a]);
-                    upper[a] = ptr_maxf(upper[a], hi[a]);
-                }
+    for (int two_levels = 0; two_levels < 2; two_levels++)
+        for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
+            for (uint32_t i = 0; i < TOTAL; i++) {
+                prims[i] = (BvhPrim){ .rest = i, .radius = bvh_uniform(&rng, 0.01f, 0.5f) };
+                for (int a = 0; a < 3; a++)
+                    /* One in eight on the grid of the splits' bin edges. */
+                    prims[i].centre[a] = ptr_rng_float(&rng) < 0.125f
+                                             ? (float)(int)bvh_uniform(&rng, -8, 8)
+                                             : bvh_uniform(&rng, -8, 8);
             }
-            CHECK(!memcmp(lower, plan.lower[k], sizeof lower));
-            CHECK(!memcmp(upper, plan.upper[k], sizeof upper));
+            const BvhPrimSet set = { prims, 8.5f };
+            BvhChildren plan, below[PTR_BVH_WIDTH];
+            random_plan(&rng, r == 3 ? 1 : PTR_BVH_WIDTH, &plan);
+            for (int k = 0; k < plan.count; k++)
+                random_plan(&rng, 1 + (k + (int)r) % PTR_BVH_WIDTH, &below[k]);
+            const size_t begin = ranges[r][0], end = ranges[r][1];
+            bvh_split_children(&set, begin, end, &plan, two_levels ? below : NULL, &room);
+            memset(seen, 0, TOTAL);
+            check_children(prims, set.magnitude, begin, end, &plan, !two_levels, seen);
+            for (int k = 0; two_levels && k < plan.count; k++)
+                check_children(prims, set.magnitude, plan.begin[k], plan.end[k], &below[k], 1,
+                               NULL);
+            for (size_t i = 0; i < TOTAL; i++)
+                if (i < begin || i >= end)
+                    CHECK_INT(prims[i].rest, i);
         }
-        CHECK_INT(next, end);
-        for (size_t i = 0; i < TOTAL; i++)
-            if (i < begin || i >= end)
-                CHECK_INT(prims[i].rest, i);
-        free(seen);
-    }
+    free(seen);
     free(prims);
     bvh_sort_room_free(&room);
 }
@@ -782,6 +855,7 @@ int main(void)
         TEST_CASE(test_root_sort),
         TEST_CASE(test_split_children),
         TEST_CASE(test_plans_without_split),
+        TEST_CASE(test_two_levels_planned),
         TEST_CASE(test_tree_bytes),
         TEST_CASE(test_auto),
         TEST_CASE(test_renders_files),
