@@ -26,8 +26,9 @@
  * which streamed memory at 1.8x on two threads (docs/intersectors.md, "The
  * root chosen before the copy"). Every node of more than BVH_PLANNED_ABOVE
  * prims is grown so from samples of its prims, which are then sorted into
- * its children in place (plan_node), and into their children in the same
- * pass where those are planned too (plan_below).
+ * its children in place (plan_node); a child that the node's samples put
+ * over BVH_PLANNED_ABOVE is planned with it, and the prims sorted into its
+ * children in the same pass (plan_below).
  *
  * Threads: each of the root's children of more than task_spheres spheres
  * (1/64 of all, at least TASK_SPHERES_MIN: a rule of the sphere count
@@ -67,7 +68,7 @@ enum {
     BOTTOM_SPHERES = 6 * PTR_BVH_LEAF_MAX,
     PLAN_SAMPLES = 1 << 15, /* see plan_children */
     PLAN_SHARE = 16,        /* a planned node samples one prim in this many: see plan_node */
-    PLAN_AHEAD = 64,        /* samples fetched ahead: see plan_node */
+    PLAN_AHEAD = 64,        /* samples fetched ahead: see take_samples */
     PRIMS_A_NODE = 32,      /* a task's first node array: see node_array_add */
 };
 
@@ -75,7 +76,7 @@ enum {
 typedef struct NodeArray {
     PtrBvhNode *nodes;
     size_t count, capacity;
-    size_t prims; /* under its nodes, where known (a task's): see node_array_add */
+    size_t prims_hint; /* under its nodes, for its first room (a task's): see node_array_add */
     int depth;
 } NodeArray;
 
@@ -87,7 +88,7 @@ typedef struct Task {
     int split_found;
     /* Its prims sorted into its root's children where the node above
      * planned them too (count above 1, see plan_below), else none. */
-    BvhChildren sorted;
+    BvhChildren presorted;
     int level; /* of its root node */
     NodeArray nodes;
 } Task;
@@ -175,8 +176,8 @@ static int worker_ready(Worker *w)
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 {
     if (a->count == a->capacity) {
-        const size_t first = a->prims / PRIMS_A_NODE > 64 ? a->prims / PRIMS_A_NODE : 64;
-        const size_t capacity = a->capacity ? a->capacity * 2 : first;
+        const size_t first = a->prims_hint / PRIMS_A_NODE;
+        const size_t capacity = a->capacity ? a->capacity * 2 : first > 64 ? first : 64;
         PtrBvhNode *grown = aligned_alloc(64, capacity * sizeof *grown);
         if (!grown)
             return bvh_out_of_memory(err);
@@ -191,7 +192,8 @@ static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 }
 
 static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_found,
-                          const BvhChildren *sorted, int level, uint32_t *task, PtrError *err)
+                          const BvhChildren *presorted, int level, uint32_t *task,
+                          PtrError *err)
 {
     if (list->count == list->capacity) {
         size_t capacity = list->capacity ? list->capacity * 2 : 64;
@@ -203,7 +205,8 @@ static PtrResult add_task(TaskList *list, const BvhCandidate *range, int split_f
     }
     *task = (uint32_t)list->count;
     list->tasks[list->count++] = (Task){ .range = *range, .split_found = split_found,
-                                         .sorted = sorted ? *sorted : (BvhChildren){ 0 },
+                                         .presorted = presorted ? *presorted
+                                                                : (BvhChildren){ 0 },
                                          .level = level };
     return PTR_OK;
 }
@@ -266,7 +269,7 @@ static void plan_children(const BvhPrimSet *samples, size_t n, int level, double
 }
 
 static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
-                            const BvhCandidate *range, const BvhChildren *sorted,
+                            const BvhCandidate *range, const BvhChildren *presorted,
                             NodeKind kind, int level, size_t *index, int *depth,
                             PtrError *err);
 
@@ -274,12 +277,12 @@ static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList 
  * - 1] in nodes (its index in *index), and its inner children below it that
  * are neither parts nor tasks, on the thread w (NULL for the root, which
  * has none); depth: levels below the node, not counting parts and tasks.
- * tasks: where a node of the top level puts its tasks. below: NULL, or
- * child k's prims sorted into its children, where below[k].count is above
- * 1 (plan_below). */
+ * tasks: where a node of the top level puts its tasks. grandchildren:
+ * NULL, or child k's prims sorted into its children, where
+ * grandchildren[k].count is above 1 (plan_below). */
 static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
                            const BvhCandidate child[PTR_BVH_WIDTH],
-                           const BvhChildren *below, int n, NodeKind kind, int level,
+                           const BvhChildren *grandchildren, int n, NodeKind kind, int level,
                            size_t *index, int *depth, PtrError *err)
 {
     PtrResult r;
@@ -312,8 +315,8 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
         node.leaf_count[k] = 0;
         if (kind != NODE_TASK && count <= build->task_spheres) {
             uint32_t task;
-            r = add_task(tasks, c, kind != NODE_ROOT, below ? &below[k] : NULL, level + 1, &task,
-                         err);
+            r = add_task(tasks, c, kind != NODE_ROOT, grandchildren ? &grandchildren[k] : NULL,
+                         level + 1, &task, err);
             if (r != PTR_OK)
                 return r;
             node.child[k] = TASK_FLAG | task;
@@ -326,8 +329,8 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
         }
         size_t inner;
         int below_depth;
-        r = build_node(build, w, nodes, tasks, c, below ? &below[k] : NULL, kind, level + 1,
-                       &inner, &below_depth, err);
+        r = build_node(build, w, nodes, tasks, c, grandchildren ? &grandchildren[k] : NULL, kind,
+                       level + 1, &inner, &below_depth, err);
         if (r != PTR_OK)
             return r;
         node.child[k] = (uint32_t)inner;
@@ -336,6 +339,16 @@ static PtrResult make_node(Build *build, Worker *w, NodeArray *nodes, TaskList *
     }
     nodes->nodes[self] = node; /* after the children: the array may have moved */
     return PTR_OK;
+}
+
+/* The candidates of children's ranges and boxes, child[0 .. count - 1]
+ * (see bvh_candidate_init). */
+static void candidates_of(const BvhPrimSet *set, const BvhChildren *children,
+                          BvhCandidate child[PTR_BVH_WIDTH])
+{
+    for (int k = 0; k < children->count; k++)
+        bvh_candidate_init(set, &child[k], children->begin[k], children->end[k],
+                           children->lower[k], children->upper[k]);
 }
 
 /* m of the n prims, evenly spaced, in samples. */
@@ -352,23 +365,25 @@ static void take_samples(const BvhPrim *prims, size_t n, size_t m, BvhPrim *samp
 
 /* For each child k of plan over range at this level whose samples
  * (sampled[k], each standing for per_prim prims) put it over
- * BVH_PLANNED_ABOVE prims, its own children planned in below[k], from
- * samples of range's prims, one in PLAN_SHARE up to PTR_BVH_WIDTH
+ * BVH_PLANNED_ABOVE prims, its own children planned in grandchildren[k],
+ * from samples of range's prims, one in PLAN_SHARE up to PTR_BVH_WIDTH
  * PLAN_SAMPLES, sorted into plan's children: up to PLAN_SAMPLES of those
- * a child took, evenly spaced. below[k].count is 1 for the others. Returns
- * whether any child has its children planned: the prims are then sorted
- * into plan's children and theirs in one pass, where a pass for each level
- * moved every prim twice as often (docs/intersectors.md, "Two levels
- * planned at once"). Every child so planned holds a prim: it holds a
- * sample, which is one of the prims, tested the same way. w->sort:
- * reserved for range. */
+ * a child took, evenly spaced. grandchildren[k].count is 1 for the others.
+ * Returns whether any child has its children planned: the prims are then
+ * sorted into plan's children and theirs in one pass, where a pass for
+ * each level moved every prim twice as often (docs/intersectors.md, "Two
+ * levels planned at once"). Every grandchild so planned holds a prim: it
+ * holds a sample, which is one of the prims, tested the same way. A child
+ * planned so may hold no more than BVH_PLANNED_ABOVE prims in the end:
+ * then its plan stands, where it would have been split by the binned
+ * split of all its prims. w->sort: reserved for range. */
 static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int level,
                       const BvhChildren *plan, const size_t sampled[PTR_BVH_WIDTH],
-                      double per_prim, BvhChildren below[PTR_BVH_WIDTH])
+                      double per_prim, BvhChildren grandchildren[PTR_BVH_WIDTH])
 {
     int planned[PTR_BVH_WIDTH], any = 0;
     for (int k = 0; k < plan->count; k++) {
-        below[k].count = 1;
+        grandchildren[k].count = 1;
         planned[k] = level + 1 < MIDDLE_SPLIT_LEVEL &&
                      (double)sampled[k] * per_prim > BVH_PLANNED_ABOVE;
         any |= planned[k];
@@ -391,8 +406,8 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
             own[j] = own[j * took / used];
         const BvhPrimSet child_samples = { own, build->set.magnitude };
         const double child_per_prim = (double)n / (double)m * (double)took / (double)used;
-        plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch, &below[k],
-                      NULL);
+        plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch,
+                      &grandchildren[k], NULL);
     }
     return 1;
 }
@@ -401,7 +416,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
  * PLAN_SAMPLES, evenly spaced, split them, each sample standing for as many
  * prims as there are to a sample, in plan, and the prims sorted into them,
  * in child[0 .. *count - 1], and into their children where they are
- * planned too (below, see plan_below). *count is 1 where the samples gave
+ * planned too (grandchildren, see plan_below). *count is 1 where the samples gave
  * no split (all at one centre): the prims as they were. Fails only for
  * memory.
  *
@@ -411,8 +426,8 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
  * moved by 0.04% at most (docs/intersectors.md, "Fewer samples for smaller
  * nodes"). */
 static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, int level,
-                           BvhCandidate child[PTR_BVH_WIDTH], BvhChildren below[PTR_BVH_WIDTH],
-                           int *count, PtrError *err)
+                           BvhCandidate child[PTR_BVH_WIDTH],
+                           BvhChildren grandchildren[PTR_BVH_WIDTH], int *count, PtrError *err)
 {
     const size_t n = range->end - range->begin;
     const size_t m = n / PLAN_SHARE < PLAN_SAMPLES ? n / PLAN_SHARE : PLAN_SAMPLES;
@@ -428,51 +443,49 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
         return PTR_OK;
     if (bvh_sort_room_reserve(&w->sort, n) != PTR_OK)
         return bvh_out_of_memory(err);
-    const int two_levels = plan_below(build, w, range, level, &plan, sampled, per_prim, below);
+    const int two_levels =
+        plan_below(build, w, range, level, &plan, sampled, per_prim, grandchildren);
     /* Every child holds a prim: each holds a sample (the heuristic makes
      * no empty side), which is one of the prims, tested the same way. */
-    bvh_split_children(&build->set, range->begin, range->end, &plan, two_levels ? below : NULL,
-                       &w->sort);
-    for (int k = 0; k < plan.count; k++)
-        bvh_candidate_init(&build->set, &child[k], plan.begin[k], plan.end[k], plan.lower[k],
-                           plan.upper[k]);
+    bvh_split_children(&build->set, range->begin, range->end, &plan,
+                       two_levels ? grandchildren : NULL, &w->sort);
+    candidates_of(&build->set, &plan, child);
     *count = plan.count;
     return PTR_OK;
 }
 
 /* Builds the node of this kind at this level over range (its split found,
  * where it has one: see bvh_candidate_init) into nodes: see make_node.
- * sorted: NULL, or range's prims sorted into the node's children where
- * sorted->count is above 1 (plan_below). */
+ * presorted: NULL, or range's prims sorted into the node's children
+ * where presorted->count is above 1 (plan_below). */
 static PtrResult build_node(Build *build, Worker *w, NodeArray *nodes, TaskList *tasks,
-                            const BvhCandidate *range, const BvhChildren *sorted,
+                            const BvhCandidate *range, const BvhChildren *presorted,
                             NodeKind kind, int level, size_t *index, int *depth,
                             PtrError *err)
 {
     BvhCandidate child[PTR_BVH_WIDTH];
-    BvhChildren *below = NULL; /* planned with the children, where they are */
+    BvhChildren *grandchildren = NULL; /* planned with the children, where they are */
     int n = 1;
     PtrResult r = PTR_OK;
-    if (sorted && sorted->count > 1) {
-        n = sorted->count;
-        for (int k = 0; k < n; k++)
-            bvh_candidate_init(&build->set, &child[k], sorted->begin[k], sorted->end[k],
-                               sorted->lower[k], sorted->upper[k]);
+    if (presorted && presorted->count > 1) {
+        n = presorted->count;
+        candidates_of(&build->set, presorted, child);
     } else if (range->end - range->begin > BVH_PLANNED_ABOVE && level < MIDDLE_SPLIT_LEVEL) {
         /* On the heap: the recursion holds a node's for as long as its
          * children build. */
-        if (!(below = malloc(PTR_BVH_WIDTH * sizeof *below)))
+        if (!(grandchildren = malloc(PTR_BVH_WIDTH * sizeof *grandchildren)))
             return bvh_out_of_memory(err);
-        r = plan_node(build, w, range, level, child, below, &n, err);
+        r = plan_node(build, w, range, level, child, grandchildren, &n, err);
     }
     if (r == PTR_OK && n == 1) {
-        free(below); /* no plan: no children planned */
-        below = NULL;
+        free(grandchildren); /* no plan: no children planned */
+        grandchildren = NULL;
         grow_node(&build->set, w->scratch, range, level, 1.0, child, &n, NULL);
     }
     if (r == PTR_OK)
-        r = make_node(build, w, nodes, tasks, child, below, n, kind, level, index, depth, err);
-    free(below);
+        r = make_node(build, w, nodes, tasks, child, grandchildren, n, kind, level, index, depth,
+                      err);
+    free(grandchildren);
     return r;
 }
 
@@ -552,11 +565,11 @@ static int build_task(Build *build, Worker *w, Task *t)
         return 0;
     BvhCandidate range = t->range;
     size_t root;
-    t->nodes.prims = task_size(t);
+    t->nodes.prims_hint = task_size(t);
     if (!t->split_found)
         bvh_candidate_init(&build->set, &range, range.begin, range.end, range.lower,
                            range.upper);
-    return build_node(build, w, &t->nodes, NULL, &range, &t->sorted, NODE_TASK, t->level,
+    return build_node(build, w, &t->nodes, NULL, &range, &t->presorted, NODE_TASK, t->level,
                       &root, &t->nodes.depth, NULL) == PTR_OK;
 }
 
@@ -733,8 +746,9 @@ static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
  * safe where another allocator serves malloc, as under AddressSanitizer.)
  * A batch's nodes go on the pages of the arrays the batch before copied
  * (a page bank, as in write_back): faulted in afresh, the tree's 500 MB at
- * 10^8 spheres took 122,000 faults. */
-enum { TRIM_BYTES = 32 << 20 };
+ * 10^8 spheres took 122,000 faults. (Batches of 32 MB laid out 10^8
+ * spheres' nodes in no less time.) */
+enum { TRIM_BYTES = 8 << 20 };
 
 typedef struct LayOut {
     Build *build;

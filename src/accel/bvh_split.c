@@ -247,16 +247,18 @@ static void prim_children4(const BvhChildLanes *lanes, const BvhPrim *p, uint8_t
  * of one range go to different children, each with its own splits. The
  * splits that send a prim right, as bits, give its child through a table
  * of the chain of sources (BvhChildren). */
-typedef struct SplitRow {
+typedef struct SplitLanes {
     __m128 on_x[2], on_y[2], on_z[2];
     __m128 base[2], scale[2], last[2];
     __m128i split_bin[2];
     uint8_t child[1 << (PTR_BVH_WIDTH - 1)];
-} SplitRow;
+} SplitLanes;
 
-static void split_row_init(const BvhChildren *children, SplitRow *row)
+_Static_assert(PTR_BVH_WIDTH - 1 <= 2 * 4, "a node's splits fit two registers' lanes");
+_Static_assert(SORT_BUCKETS <= 256, "a bucket's number fits BvhSortRoom's byte");
+
+static void split_lanes_init(const BvhChildren *children, SplitLanes *lanes)
 {
-    memset(row, 0, sizeof *row);
     float on[3][2 * 4] = { { 0 } }, base[2 * 4] = { 0 }, scale[2 * 4] = { 0 },
           last[2 * 4] = { 0 };
     int32_t split_bin[2 * 4] = { 0 };
@@ -270,28 +272,30 @@ static void split_row_init(const BvhChildren *children, SplitRow *row)
         split_bin[s - 1] = t->split_bin;
     }
     for (int h = 0; h < 2; h++) {
-        row->on_x[h] = _mm_loadu_ps(&on[0][4 * h]);
-        row->on_y[h] = _mm_loadu_ps(&on[1][4 * h]);
-        row->on_z[h] = _mm_loadu_ps(&on[2][4 * h]);
-        row->base[h] = _mm_loadu_ps(&base[4 * h]);
-        row->scale[h] = _mm_loadu_ps(&scale[4 * h]);
-        row->last[h] = _mm_loadu_ps(&last[4 * h]);
-        row->split_bin[h] = _mm_loadu_si128((const __m128i *)&split_bin[4 * h]);
+        lanes->on_x[h] = _mm_loadu_ps(&on[0][4 * h]);
+        lanes->on_y[h] = _mm_loadu_ps(&on[1][4 * h]);
+        lanes->on_z[h] = _mm_loadu_ps(&on[2][4 * h]);
+        lanes->base[h] = _mm_loadu_ps(&base[4 * h]);
+        lanes->scale[h] = _mm_loadu_ps(&scale[4 * h]);
+        lanes->last[h] = _mm_loadu_ps(&last[4 * h]);
+        lanes->split_bin[h] = _mm_loadu_si128((const __m128i *)&split_bin[4 * h]);
     }
-    /* The lanes of splits past count are never read: the table ignores
-     * their bits. */
-    for (unsigned right = 0; right < sizeof row->child; right++) {
+    /* The lanes past count's splits (all 0: bin 0, never past split_bin
+     * 0) give bits the table ignores. */
+    for (unsigned right = 0; right < sizeof lanes->child; right++) {
         int in = 0;
         for (int s = 1; s < children->count; s++)
             if (in == children->source[s] && (right >> (s - 1) & 1))
                 in = s;
-        row->child[right] = (uint8_t)in;
+        lanes->child[right] = (uint8_t)in;
     }
 }
 
-/* The child of row's node that prim p goes to: bvh_children4's arithmetic,
- * on one prim in the lanes of all the splits. */
-static inline int split_row_child(const SplitRow *row, const BvhPrim *p)
+/* The child of lanes' node that prim p goes to: bvh_children4's
+ * arithmetic, on one prim in the lanes of all the splits. The eighth lane
+ * holds no split (all 0), so its bit is 0 and the table's 128 entries
+ * take every outcome. */
+static inline int split_lanes_child(const SplitLanes *lanes, const BvhPrim *p)
 {
     const __m128 c = _mm_loadu_ps(p->centre);
     const __m128 x = _mm_shuffle_ps(c, c, _MM_SHUFFLE(0, 0, 0, 0)),
@@ -299,14 +303,14 @@ static inline int split_row_child(const SplitRow *row, const BvhPrim *p)
                  z = _mm_shuffle_ps(c, c, _MM_SHUFFLE(2, 2, 2, 2));
     int right = 0;
     for (int h = 0; h < 2; h++) {
-        const __m128 at = _mm_or_ps(_mm_or_ps(_mm_and_ps(x, row->on_x[h]),
-                                              _mm_and_ps(y, row->on_y[h])),
-                                    _mm_and_ps(z, row->on_z[h]));
-        const __m128i bin = bvh_bins4(at, row->base[h], row->scale[h], row->last[h]);
-        right |= _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(bin, row->split_bin[h])))
+        const __m128 at = _mm_or_ps(_mm_or_ps(_mm_and_ps(x, lanes->on_x[h]),
+                                              _mm_and_ps(y, lanes->on_y[h])),
+                                    _mm_and_ps(z, lanes->on_z[h]));
+        const __m128i bin = bvh_bins4(at, lanes->base[h], lanes->scale[h], lanes->last[h]);
+        right |= _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(bin, lanes->split_bin[h])))
                  << 4 * h;
     }
-    return row->child[right & (int)(sizeof row->child - 1)];
+    return lanes->child[right];
 }
 
 /* The bucket of child k's child g: each child's eight in turn. */
@@ -322,9 +326,10 @@ typedef struct BucketBoxes {
 } BucketBoxes;
 
 /* Finds the buckets of the first n (at most 4) of the prims p, in bucket
- * (the children's, or with rows, the grandchildren's), and adds the prims
- * to their buckets' counts and boxes. */
-static void add_buckets4(const BvhChildLanes *lanes, const SplitRow *rows, float magnitude,
+ * (the children's, or with each child's own splits, own, the
+ * grandchildren's), and adds the prims to their buckets' counts and
+ * boxes. */
+static void add_buckets4(const BvhChildLanes *lanes, const SplitLanes *own, float magnitude,
                          const BvhPrim *p, size_t n, uint8_t *bucket, BucketBoxes *b)
 {
     uint8_t four[4];
@@ -338,8 +343,8 @@ static void add_buckets4(const BvhChildLanes *lanes, const SplitRow *rows, float
         prim_children4(lanes, last, four);
     }
     for (size_t i = 0; i < n; i++) {
-        const int k = rows ? sort_bucket(four[i], split_row_child(&rows[four[i]], &p[i]))
-                           : four[i];
+        const int k = own ? sort_bucket(four[i], split_lanes_child(&own[four[i]], &p[i]))
+                          : four[i];
         __m128 lower, upper;
         bvh_prim_box4(&p[i], magnitude, &lower, &upper);
         b->lower[k] = _mm_min_ps(b->lower[k], lower);
@@ -356,25 +361,25 @@ PtrResult bvh_sort_room_reserve(BvhSortRoom *room, size_t prims)
         return PTR_ERR_NOMEM;
     if (room->prims >= prims)
         return PTR_OK;
-    free(room->child);
+    free(room->bucket);
     free(room->dest);
-    room->child = malloc(prims);
+    room->bucket = malloc(prims);
     room->dest = malloc((prims / BVH_SORT_BLOCK + 1) * sizeof *room->dest);
-    room->prims = room->child && room->dest ? prims : 0;
+    room->prims = room->bucket && room->dest ? prims : 0;
     return room->prims ? PTR_OK : PTR_ERR_NOMEM;
 }
 
 void bvh_sort_room_free(BvhSortRoom *room)
 {
-    free(room->child);
+    free(room->bucket);
     free(room->dest);
     free(room->blocks);
     *room = (BvhSortRoom){ 0 };
 }
 
-/* Sorts the n prims p, whose buckets are room->child[0 .. n - 1], into them,
- * bucket k's prims to start[k] .. stop[k] - 1 in the order they come,
- * blocks of BVH_SORT_BLOCK prims at a time; count buckets, at most
+/* Sorts the n prims p, whose buckets are room->bucket[0 .. n - 1], into
+ * them, bucket k's prims to start[k] .. stop[k] - 1 in the order they
+ * come, blocks of BVH_SORT_BLOCK prims at a time; count buckets, at most
  * SORT_BUCKETS. (A bucket is called a child below: a node's child, or a
  * child's child.)
  *
@@ -404,7 +409,7 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
         heads[k] = first < last ? first * B - start[k] : stop[k] - start[k];
         first_slot[k] = first;
     }
-    uint8_t *child = room->child;
+    uint8_t *child = room->bucket;
     for (size_t i = 0; i < n; i++) {
         const int k = child[i];
         if (seen[k] < heads[k]) {
@@ -454,14 +459,14 @@ static void sort_in_blocks(BvhPrim *p, size_t n, int count, const size_t start[]
 }
 
 void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
-                        BvhChildren *below, BvhSortRoom *room)
+                        BvhChildren *grandchildren, BvhSortRoom *room)
 {
     BvhChildLanes lanes;
     bvh_child_lanes(children, &lanes);
-    SplitRow rows[PTR_BVH_WIDTH];
-    const int per_child = below ? PTR_BVH_WIDTH : 1; /* buckets */
-    for (int k = 0; below && k < children->count; k++)
-        split_row_init(&below[k], &rows[k]);
+    SplitLanes own[PTR_BVH_WIDTH]; /* each child's splits */
+    const int per_child = grandchildren ? PTR_BVH_WIDTH : 1; /* buckets */
+    for (int k = 0; grandchildren && k < children->count; k++)
+        split_lanes_init(&grandchildren[k], &own[k]);
     BvhPrim *p = set->prims + begin;
     const size_t n = end - begin;
     BucketBoxes b = { .count = { 0 } };
@@ -470,8 +475,8 @@ void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChil
         b.upper[k] = _mm_set1_ps(-INFINITY);
     }
     for (size_t i = 0; i < n; i += 4)
-        add_buckets4(&lanes, below ? rows : NULL, set->magnitude, &p[i], n - i < 4 ? n - i : 4,
-                     &room->child[i], &b);
+        add_buckets4(&lanes, grandchildren ? own : NULL, set->magnitude, &p[i],
+                     n - i < 4 ? n - i : 4, &room->bucket[i], &b);
     /* Each child's places, in bvh_children_order's order, and within it,
      * each of its children's in the order of its own. */
     int order[PTR_BVH_WIDTH];
@@ -479,23 +484,24 @@ void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChil
     bvh_children_order(children, order);
     for (int j = 0; j < children->count; j++) {
         const int k = order[j];
-        int below_order[PTR_BVH_WIDTH] = { 0 };
-        if (below)
-            bvh_children_order(&below[k], below_order);
+        BvhChildren *own_children = grandchildren ? &grandchildren[k] : NULL;
+        int own_order[PTR_BVH_WIDTH] = { 0 };
+        if (own_children)
+            bvh_children_order(own_children, own_order);
         __m128 lower = _mm_set1_ps(INFINITY), upper = _mm_set1_ps(-INFINITY);
         children->begin[k] = begin + next;
-        for (int i = 0; i < (below ? below[k].count : 1); i++) {
-            const int g = below_order[i], at = below ? sort_bucket(k, g) : k;
+        for (int i = 0; i < (own_children ? own_children->count : 1); i++) {
+            const int g = own_order[i], at = own_children ? sort_bucket(k, g) : k;
             start[at] = next;
             next += b.count[at];
             stop[at] = next;
             lower = _mm_min_ps(lower, b.lower[at]);
             upper = _mm_max_ps(upper, b.upper[at]);
-            if (below) {
-                below[k].begin[g] = begin + start[at];
-                below[k].end[g] = begin + next;
-                bvh_store3(below[k].lower[g], b.lower[at]);
-                bvh_store3(below[k].upper[g], b.upper[at]);
+            if (own_children) {
+                own_children->begin[g] = begin + start[at];
+                own_children->end[g] = begin + next;
+                bvh_store3(own_children->lower[g], b.lower[at]);
+                bvh_store3(own_children->upper[g], b.upper[at]);
             }
         }
         children->end[k] = begin + next;

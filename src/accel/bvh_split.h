@@ -60,15 +60,17 @@ void bvh_split(const BvhPrimSet *set, const BvhCandidate *c, int middle, BvhPrim
                BvhCandidate *left, BvhCandidate *right);
 
 /* Prims a block of bvh_split_children's sort: 3 KB, which moves as a stream
- * the prefetchers follow; the blocks being filled, one a child (at most
- * 64 of a node's grandchildren, 192 KB), stay in the level-2 cache. */
+ * the prefetchers follow. The blocks being filled, one a bucket (8 for a
+ * node's children, 24 KB; up to 64 for their children, 192 KB), stay in a
+ * level-2 cache of 512 KB or more; a worker's sort room keeps 194 blocks
+ * (582 KB) of buffers. */
 enum { BVH_SORT_BLOCK = 128 };
 
 /* What bvh_split_children works in, kept from one sort to the next: a
- * byte a prim and a word a block of the largest range sorted, and its
- * buffers. */
+ * byte a prim (its bucket) and a word a block of the largest range sorted,
+ * and its buffers. */
 typedef struct BvhSortRoom {
-    uint8_t *child;
+    uint8_t *bucket;
     uint32_t *dest;
     BvhPrim *blocks;
     size_t prims; /* room for */
@@ -82,11 +84,12 @@ void bvh_sort_room_free(BvhSortRoom *room);
 /* Sorts the prims begin .. end - 1 into children (its splits set, from
  * samples), in place and stably (each child's prims in the order they
  * came), in bvh_children_order's order, and fills in each child's range
- * and box. With below (else NULL), each child k's prims are sorted in the
- * same pass into its own children by below[k]'s splits (a count of 1: none),
- * as a second call on the child's range would sort them, and below[k]'s
- * ranges and boxes are filled in too. room: reserved for end - begin prims. */
+ * and box. With grandchildren (else NULL), each child k's prims are sorted
+ * in the same pass into its own children by grandchildren[k]'s splits (a
+ * count of 1: none), as a second call on the child's range would sort them
+ * (stably within each of its children), and grandchildren[k]'s ranges and
+ * boxes are filled in too. room: reserved for end - begin prims. */
 void bvh_split_children(const BvhPrimSet *set, size_t begin, size_t end, BvhChildren *children,
-                        BvhChildren *below, BvhSortRoom *room);
+                        BvhChildren *grandchildren, BvhSortRoom *room);
 
 #endif /* PTR_BVH_SPLIT_H */

@@ -362,15 +362,46 @@ static void test_threads(void)
     ptr_scene_free(&first_scene);
 }
 
+/* FNV-1a over bytes, for test_tree_bytes. */
+static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++)
+        h = (h ^ p[i]) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+/* The tree's bytes, for test_tree_bytes: its nodes, and the spheres in the
+ * order the build leaves them (centres, radii and the tags of their places
+ * in the file). */
+static uint64_t tree_hash(const PtrBvh *bvh, const PtrSpheres *sp)
+{
+    uint64_t h = fnv1a(UINT64_C(0xcbf29ce484222325), bvh->nodes,
+                       bvh->node_count * sizeof *bvh->nodes);
+    h = fnv1a(h, sp->cx, sp->count * sizeof *sp->cx);
+    h = fnv1a(h, sp->cy, sp->count * sizeof *sp->cy);
+    h = fnv1a(h, sp->cz, sp->count * sizeof *sp->cz);
+    h = fnv1a(h, sp->radius, sp->count * sizeof *sp->radius);
+    /* Each colour as the 8 bytes it was stored in when the values were
+     * set, 65535 the fourth. */
+    for (size_t i = 0; i < sp->count; i++) {
+        const uint16_t entry[4] = { sp->color[3 * i], sp->color[3 * i + 1], sp->color[3 * i + 2],
+                                    UINT16_MAX };
+        h = fnv1a(h, entry, sizeof entry);
+    }
+    return h;
+}
+
 /* Makes a set of spheres in s (initialised, empty), the same each time. */
 typedef void (*SetMaker)(PtrScene *s);
 
 /* The set make makes, built on one thread: every sphere once (huge_count
  * of them out of the tree), and brute force's answers to rays; and built
- * on three threads, the same tree. */
-static void check_one_and_three_threads(SetMaker make, size_t huge_count, int rays,
-                                        const char *name)
+ * on three threads, the same tree. Returns its tree_hash. */
+static uint64_t check_one_and_three_threads(SetMaker make, size_t huge_count, int rays,
+                                            const char *name)
 {
+    uint64_t hash = 0;
     PtrScene file;
     ptr_scene_init(&file);
     make(&file);
@@ -387,6 +418,7 @@ static void check_one_and_three_threads(SetMaker make, size_t huge_count, int ra
         if (t == 0) {
             check_structure(&bvh, &s.spheres, 1, name);
             check_rays(&file, &s, &bvh, rays, name);
+            hash = tree_hash(&bvh, &s.spheres);
             first = bvh;
             first_scene = s;
             continue;
@@ -398,6 +430,7 @@ static void check_one_and_three_threads(SetMaker make, size_t huge_count, int ra
     ptr_bvh_free(&first);
     ptr_scene_free(&first_scene);
     ptr_scene_free(&file);
+    return hash;
 }
 
 enum { ROOT_SORT_COUNT = PTR_PAGE_STEP + (1 << 16) + 4099, ROOT_SORT_BIG = 20 };
@@ -425,7 +458,7 @@ static void make_root_sort_set(PtrScene *s)
  * threads the same tree, every sphere once, and brute force's answers. */
 static void test_root_sort(void)
 {
-    check_one_and_three_threads(make_root_sort_set, PTR_HUGE_MAX, 100, "root sort");
+    (void)check_one_and_three_threads(make_root_sort_set, PTR_HUGE_MAX, 100, "root sort");
 }
 
 /* 600,000 spheres at one centre: the root's samples give no split, nor do
@@ -457,24 +490,39 @@ static void make_two_levels_set(PtrScene *s)
 /* 5,000,000 random spheres: the parts' children (planned, of some 78,000
  * spheres each, over the 65,536 a node is planned above) are planned with
  * them and sorted in the same pass (plan_below), both those built inline
- * and the tasks (of at most 78,125 spheres), which then build on their
- * sorted children. The tree is whole, answers as brute force does, and
- * is the same on one thread and three. */
+ * (31 of them) and the tasks (of at most 78,125 spheres; 33), which then
+ * build on their sorted children. The tree is whole, answers as brute
+ * force does, is the same on one thread and three, and has the bytes it
+ * had when this path was made (as test_tree_bytes' sets: a build that
+ * planned no grandchildren, or planned them otherwise, shows here). Its
+ * layout takes its nodes' pages from the page bank, in five batches. */
 static void test_two_levels_planned(void)
 {
-    check_one_and_three_threads(make_two_levels_set, 0, 10, "two levels planned");
+    const uint64_t hash =
+        check_one_and_three_threads(make_two_levels_set, 0, 10, "two levels planned");
+    if (hash != UINT64_C(0x9461fc828aba9779))
+        fprintf(stderr, "two levels planned: the tree's bytes hash to %016llx\n",
+                (unsigned long long)hash);
+    CHECK(hash == UINT64_C(0x9461fc828aba9779));
 }
 
 /* Random splits for a plan of count children, each on a coordinate of
- * -8 .. 8 in 32 bins. */
+ * about -8 .. 8 in 4 to 32 bins of its own (a scale of 0, as a flat box's
+ * axis has, in one split of eight). */
 static void random_plan(PtrRng *rng, int count, BvhChildren *plan)
 {
     *plan = (BvhChildren){ .count = count };
     for (int s = 1; s < count; s++) {
+        const int bins = 4 + (int)(ptr_rng_float(rng) * 29.0f);
+        const float base = bvh_uniform(rng, -17.0f, -15.0f);
         plan->source[s] = (int)(ptr_rng_float(rng) * (float)s);
-        plan->test[s] = (BvhSplitTest){ .axis = (s + count) % 3,
-                                        .split_bin = (int)(ptr_rng_float(rng) * 16.0f),
-                                        .base = -16.0f, .scale = 1.0f, .last = 31.0f };
+        plan->test[s] = (BvhSplitTest){
+            .axis = (s + count) % 3,
+            .split_bin = (int)(ptr_rng_float(rng) * (float)(bins - 1)),
+            .base = base,
+            .scale = ptr_rng_float(rng) < 0.125f ? 0.0f : (float)bins * 0.99999f / (-2.0f * base),
+            .last = (float)(bins - 1),
+        };
     }
 }
 
@@ -577,14 +625,6 @@ static void test_split_children(void)
     bvh_sort_room_free(&room);
 }
 
-/* FNV-1a over bytes, for test_tree_bytes. */
-static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < size; i++)
-        h = (h ^ p[i]) * UINT64_C(0x100000001b3);
-    return h;
-}
 
 /* The trees of two fixed sets, to the byte: their nodes, and the spheres
  * in the order the build leaves them (centres, radii and the tags of their
@@ -634,20 +674,7 @@ static void test_tree_bytes(void)
         tag_file_order(&s);
         PtrBvh bvh;
         CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, NULL), PTR_OK);
-        const PtrSpheres *sp = &s.spheres;
-        uint64_t h = fnv1a(UINT64_C(0xcbf29ce484222325), bvh.nodes,
-                           bvh.node_count * sizeof *bvh.nodes);
-        h = fnv1a(h, sp->cx, sp->count * sizeof *sp->cx);
-        h = fnv1a(h, sp->cy, sp->count * sizeof *sp->cy);
-        h = fnv1a(h, sp->cz, sp->count * sizeof *sp->cz);
-        h = fnv1a(h, sp->radius, sp->count * sizeof *sp->radius);
-        /* Each colour as the 8 bytes it was stored in when the values
-         * were set, 65535 the fourth. */
-        for (size_t i = 0; i < sp->count; i++) {
-            const uint16_t entry[4] = { sp->color[3 * i], sp->color[3 * i + 1],
-                                        sp->color[3 * i + 2], UINT16_MAX };
-            h = fnv1a(h, entry, sizeof entry);
-        }
+        const uint64_t h = tree_hash(&bvh, &s.spheres);
         if (h != sets[k].hash)
             fprintf(stderr, "%s, %d spheres: the tree's bytes hash to %016llx, not %016llx\n",
                     bvh_scene_names[sets[k].kind], sets[k].count, (unsigned long long)h,
