@@ -69,14 +69,13 @@ enum {
     PLAN_SAMPLES = 1 << 15, /* see plan_children */
     PLAN_SHARE = 16,        /* a planned node samples one prim in this many: see plan_node */
     PLAN_AHEAD = 64,        /* samples fetched ahead: see take_samples */
-    PRIMS_A_NODE = 32,      /* a task's first node array: see node_array_add */
+    PRIMS_A_NODE = 32,      /* a task's first node array: see build_task */
 };
 
 /* Node arrays: the root's, one per part and one per task. */
 typedef struct NodeArray {
     PtrBvhNode *nodes;
     size_t count, capacity;
-    size_t prims_hint; /* under its nodes, for its first room (a task's): see node_array_add */
     int depth;
 } NodeArray;
 
@@ -165,28 +164,26 @@ static int worker_ready(Worker *w)
     return w->scratch && w->samples;
 }
 
-/* A new node at the end of a, its index in *index. The first array has
- * room for a node to PRIMS_A_NODE of a's prims (or 64 nodes): a tree has
- * about one node to 50 prims (1.96 million over 10^8 random spheres), so a
- * task's array seldom grows, where growing from 64 nodes copied its nodes
- * and faulted in fresh pages for them at each doubling (at 10^8 a task's
- * 8 MB of nodes: 3.6% of the build's and import's time in the kernel's
- * page clearing under make_node); the end it does not use is never faulted
- * in. */
+/* Gives a room for capacity nodes, its nodes kept; whether there was
+ * memory. */
+static int node_array_grow(NodeArray *a, size_t capacity)
+{
+    PtrBvhNode *grown = aligned_alloc(64, capacity * sizeof *grown);
+    if (!grown)
+        return 0;
+    if (a->count)
+        memcpy(grown, a->nodes, a->count * sizeof *grown);
+    free(a->nodes);
+    a->nodes = grown;
+    a->capacity = capacity;
+    return 1;
+}
+
+/* A new node at the end of a, its index in *index. */
 static PtrResult node_array_add(NodeArray *a, size_t *index, PtrError *err)
 {
-    if (a->count == a->capacity) {
-        const size_t first = a->prims_hint / PRIMS_A_NODE;
-        const size_t capacity = a->capacity ? a->capacity * 2 : first > 64 ? first : 64;
-        PtrBvhNode *grown = aligned_alloc(64, capacity * sizeof *grown);
-        if (!grown)
-            return bvh_out_of_memory(err);
-        if (a->count)
-            memcpy(grown, a->nodes, a->count * sizeof *grown);
-        free(a->nodes);
-        a->nodes = grown;
-        a->capacity = capacity;
-    }
+    if (a->count == a->capacity && !node_array_grow(a, a->capacity ? a->capacity * 2 : 64))
+        return bvh_out_of_memory(err);
     *index = a->count++;
     return PTR_OK;
 }
@@ -351,7 +348,8 @@ static void candidates_of(const BvhPrimSet *set, const BvhChildren *children,
                            children->lower[k], children->upper[k]);
 }
 
-/* m of the n prims, evenly spaced, in samples. */
+/* m of the n prims, evenly spaced, in samples, which may be prims itself
+ * (sample j is prim j n / m, never one before it). */
 static void take_samples(const BvhPrim *prims, size_t n, size_t m, BvhPrim *samples)
 {
     for (size_t j = 0; j < m; j++) {
@@ -402,8 +400,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
             continue;
         BvhPrim *own = w->samples + split.begin[k];
         const size_t used = took < PLAN_SAMPLES ? took : PLAN_SAMPLES;
-        for (size_t j = 0; j < used; j++) /* j took / used >= j: forwards is safe */
-            own[j] = own[j * took / used];
+        take_samples(own, took, used, own); /* in place: sample j is at j or after */
         const BvhPrimSet child_samples = { own, build->set.magnitude };
         const double child_per_prim = (double)n / (double)m * (double)took / (double)used;
         plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch,
@@ -565,7 +562,16 @@ static int build_task(Build *build, Worker *w, Task *t)
         return 0;
     BvhCandidate range = t->range;
     size_t root;
-    t->nodes.prims_hint = task_size(t);
+    /* Room for a node to PRIMS_A_NODE of its prims: a tree has about one
+     * node to 50 prims (1.96 million over 10^8 random spheres), so a task's
+     * array seldom grows, where growing from 64 nodes copied its nodes and
+     * faulted in fresh pages for them at each doubling (at 10^8 a task's
+     * 8 MB of nodes: 3.6% of the build's and import's time in the kernel's
+     * page clearing under make_node); the end it does not use is never
+     * faulted in. */
+    const size_t room = task_size(t) / PRIMS_A_NODE;
+    if (!node_array_grow(&t->nodes, room > 64 ? room : 64))
+        return 0;
     if (!t->split_found)
         bvh_candidate_init(&build->set, &range, range.begin, range.end, range.lower,
                            range.upper);

@@ -103,7 +103,7 @@ static size_t count_lines(const char *path)
 static size_t mapping_room(size_t held)
 {
     const uint64_t max = read_number("/proc/sys/vm/max_map_count");
-    return max != UINT64_MAX && held > 0 && max > held ? (size_t)(max - held) / 4 : 0;
+    return max != UINT64_MAX && max > held ? (size_t)(max - held) / 4 : 0;
 }
 
 /* Stops bank for good (the kernel would not move pages, or the mappings
@@ -115,14 +115,15 @@ static void bank_stop(PtrPageBank *bank)
     bank->refused = 1;
 }
 
-/* Whether bank may move pages now. A bank lets the process hold at most a
- * quarter of the room left at its first count more mappings than it held
- * then. Most moves split no mapping, since a run moved next to the one
- * before joins it: at 10^8 spheres the tree's copy made 15,700 moves and
- * the process held 2,900 mappings more. So each time the bank has made the
- * moves its last count allowed, it counts the mappings again and may make
- * as many more as keep them under its ceiling; within MOVES_MIN of it, it
- * stops and gives its pages back. (Counted once, the room ran out halfway
+/* Whether bank may move pages now. At its first count a bank sets its
+ * ceiling: the mappings the process held then and a quarter of the room
+ * left. At each count it may make as many moves as there are mappings left
+ * under the ceiling (a move splits at most one mapping in two). Most moves
+ * split none, since a run moved next to the one before joins it: at 10^8
+ * spheres the tree's copy made 15,700 moves and the process held 2,900
+ * mappings more. So each time the bank has made the moves its last count
+ * allowed, it counts again; within MOVES_MIN of the ceiling, or where the
+ * mappings cannot be counted, it stops and gives its pages back. (Counted once, the room ran out halfway
  * through the 10^8 write-back, which faulted the rest of its pages in: 1.2-
  * 1.4 s where it now takes 0.5.) */
 static int bank_open(PtrPageBank *bank)
@@ -130,6 +131,10 @@ static int bank_open(PtrPageBank *bank)
     enum { MOVES_MIN = 64 }; /* below this, a count every few moves */
     if (!bank->refused && bank->moves_left == 0) {
         const size_t held = count_lines("/proc/self/maps");
+        if (!held) { /* unreadable: no count to keep under a ceiling */
+            bank_stop(bank);
+            return 0;
+        }
         if (!bank->mappings_most)
             bank->mappings_most = held + mapping_room(held);
         bank->moves_left = bank->mappings_most >= held + MOVES_MIN
@@ -137,7 +142,7 @@ static int bank_open(PtrPageBank *bank)
         if (!bank->moves_left)
             bank_stop(bank);
     }
-    return !bank->refused && bank->moves_left > 0;
+    return !bank->refused; /* moves_left is above 0 unless the bank stopped */
 }
 
 /* Moves the pages of [lo, hi) into bank, the range left mapped and empty;

@@ -340,10 +340,13 @@ static int bank_without_room(const Buffer *b, size_t max_maps)
     return failed ? CHILD_FAILED : CHILD_PASSED;
 }
 
-/* A bank lets the process hold at most a quarter of the mappings' room
- * more than at its first count, counts them again each time it has made
- * the moves its last count allowed (a put's or a take's, one a run), and
- * gives its pages back when it comes near that ceiling. */
+/* A bank sets a ceiling at its first count (the mappings held and a
+ * quarter of the room left), counts the mappings again each time it has
+ * made the moves its last count allowed (a put's or a take's, one a run:
+ * as many as there were mappings left under the ceiling), and gives its
+ * pages back when it comes near that ceiling. The child below uses up the
+ * kernel's own room, not just the ceiling's, so that the count runs where
+ * mapping anything more fails. */
 static void test_bank_moves_limit(void)
 {
     const size_t page = page_size();
