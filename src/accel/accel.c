@@ -18,7 +18,8 @@ PtrResult ptr_accel_init(PtrAccel *accel, PtrAccelChoice choice, const PtrIsectT
     /* Built for brute force too, for its order: on equal t the sphere first
      * in the arrays wins, so both must search the same arrays (PtrSpheres). */
     double start = ptr_now_seconds();
-    PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads, err);
+    PtrResult r = ptr_bvh_build(&accel->bvh, &scene->spheres, accel->searched, threads,
+                                isect->level, err);
     if (r != PTR_OK)
         return r;
     accel->build_seconds = ptr_now_seconds() - start;

@@ -20,6 +20,7 @@
 #include <stdint.h>
 
 #include "accel/ray.h"
+#include "base/cpu.h"
 #include "base/result.h"
 #include "scene/scene.h"
 
@@ -66,12 +67,16 @@ typedef struct PtrBvh {
 /* Builds the tree over the first count spheres, reordering them (see
  * bvh.h's head) and leaving the rest in place after them (the scene's
  * huge spheres, which accel/huge.h tests); threads 0 means one per CPU the
- * process may run on. The tree's bytes depend only on the spheres, never
- * on the thread count. On failure (out of memory) *bvh
+ * process may run on, and level is the caller's CPU level (ptr_cpu_level,
+ * or lower), which chooses the binning's code. The tree's bytes depend
+ * only on the spheres, never on the thread count or the level. On failure (out of memory) *bvh
  * is empty and the spheres may be part reordered: the scene can only be
  * freed; err (which may be NULL) says so. */
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
-                        PtrError *err);
+                        PtrCpuLevel level, PtrError *err);
+
+/* The binning a build at this level uses: "c" or "avx2" (--print-dispatch). */
+const char *ptr_bvh_bin_name(PtrCpuLevel level);
 
 void ptr_bvh_free(PtrBvh *bvh);
 

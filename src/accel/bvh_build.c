@@ -391,7 +391,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
     const size_t n = range->end - range->begin, most = PTR_BVH_WIDTH * PLAN_SAMPLES;
     const size_t m = n / PLAN_SHARE < most ? n / PLAN_SHARE : most;
     take_samples(build->set.prims + range->begin, n, m, w->samples);
-    const BvhPrimSet samples = { w->samples, build->set.magnitude };
+    const BvhPrimSet samples = { w->samples, build->set.magnitude, build->set.bin };
     BvhChildren split = *plan;
     bvh_split_children(&samples, 0, m, &split, NULL, &w->sort);
     for (int k = 0; k < plan->count; k++) {
@@ -401,7 +401,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
         BvhPrim *own = w->samples + split.begin[k];
         const size_t used = took < PLAN_SAMPLES ? took : PLAN_SAMPLES;
         take_samples(own, took, used, own); /* in place: sample j is at j or after */
-        const BvhPrimSet child_samples = { own, build->set.magnitude };
+        const BvhPrimSet child_samples = { own, build->set.magnitude, build->set.bin };
         const double child_per_prim = (double)n / (double)m * (double)took / (double)used;
         plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch,
                       &grandchildren[k], NULL);
@@ -428,7 +428,7 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
 {
     const size_t n = range->end - range->begin;
     const size_t m = n / PLAN_SHARE < PLAN_SAMPLES ? n / PLAN_SHARE : PLAN_SAMPLES;
-    const BvhPrimSet samples = { w->samples, build->set.magnitude };
+    const BvhPrimSet samples = { w->samples, build->set.magnitude, build->set.bin };
     take_samples(build->set.prims + range->begin, n, m, w->samples);
     BvhChildren plan;
     size_t sampled[PTR_BVH_WIDTH];
@@ -878,14 +878,15 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
 
 /* The root's children (see the head): its splits planned from PLAN_SAMPLES
  * of the tree's spheres, evenly spaced, or all of them where they are no
- * more, on the thread w. Fails only for memory. */
+ * more, binned by bin, on the thread w. Fails only for memory. */
 static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t *huge_index,
-                           size_t huge_count, Worker *w, BvhChildren *plan, PtrError *err)
+                           size_t huge_count, BvhBinFn bin, Worker *w, BvhChildren *plan,
+                           PtrError *err)
 {
     plan->count = 1;
     if (!worker_ready(w))
         return bvh_out_of_memory(err);
-    BvhPrimSet samples = { .prims = w->samples };
+    BvhPrimSet samples = { .prims = w->samples, .bin = bin };
     const size_t n = ptr_bvh_samples(spheres, threads, huge_index, huge_count, samples.prims,
                                      PLAN_SAMPLES, &samples.magnitude);
     if (n > 0)
@@ -895,12 +896,13 @@ static PtrResult plan_root(const PtrSpheres *spheres, int threads, const size_t 
 }
 
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
-                        PtrError *err)
+                        PtrCpuLevel level, PtrError *err)
 {
     memset(bvh, 0, sizeof *bvh);
     if (spheres->count >= TASK_FLAG)
         return bvh_out_of_memory(err);
-    Build build = { .threads = ptr_thread_count(threads) };
+    Build build = { .threads = ptr_thread_count(threads),
+                    .set.bin = bvh_bin_for_level(level).bin };
     /* The prims and huge take the tree's spheres, whose pages the scene's
      * arrays give up meanwhile; the spheres after them stay. */
     BvhPrim huge[PTR_HUGE_MAX];
@@ -922,7 +924,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     if (r == PTR_OK)
         r = ptr_bvh_huge(&tree_part, build.threads, huge, huge_index, &bvh->huge_count, err);
     if (r == PTR_OK)
-        r = plan_root(&tree_part, build.threads, huge_index, bvh->huge_count, &w, &root, err);
+        r = plan_root(&tree_part, build.threads, huge_index, bvh->huge_count, build.set.bin, &w,
+                      &root, err);
     if (r == PTR_OK)
         r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
                           build.set.prims, &prim_count, &build.set.magnitude, err);

@@ -5,7 +5,6 @@
 #include <string.h>
 
 enum {
-    BINS = 32,
     /* What bvh_split_children sorts into: a node's children, or their
      * children, eight to a child (see sort_bucket). */
     SORT_BUCKETS = PTR_BVH_WIDTH * PTR_BVH_WIDTH,
@@ -30,108 +29,126 @@ static void bounds_grow(float lo[3], float hi[3], const float plo[3], const floa
     }
 }
 
-/* The bins of one run of prims: boxes and counts per axis, plus the run's
- * box. A bin's box is x, y, z and a fourth lane in one SSE register, so
- * that growing it is one minimum and one maximum, where three scalar lanes
- * took six (binning is most of a build). _mm_min_ps(a, b) and
- * _mm_max_ps(a, b) are ptr_minf(a, b) and ptr_maxf(a, b) lane by lane, so
- * the boxes have the bits the scalar code gives. The bin's count is the
- * upper box's fourth lane, a float (exact: a range binned has at most
- * BVH_PLANNED_ABOVE prims), so that counting a prim is no load and store of
- * its own. */
-typedef struct Bins {
-    __m128 lower[3][BINS], upper[3][BINS];
-    float box_lo[3], box_hi[3];
-} Bins;
-
-static void bins_clear(Bins *b, int bins)
+/* The box of the prims begin .. end - 1 (of a plan's samples, or of the
+ * halves of a split in the middle). */
+static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, float lo[3], float hi[3])
 {
-    for (int a = 0; a < 3; a++)
-        for (int k = 0; k < bins; k++) {
-            b->lower[a][k] = _mm_set1_ps(INFINITY);
-            b->upper[a][k] = _mm_setr_ps(-INFINITY, -INFINITY, -INFINITY, 0.0f);
-        }
-    bounds_empty(b->box_lo, b->box_hi);
+    bounds_empty(lo, hi);
+    for (size_t i = begin; i < end; i++) {
+        float lower[3], upper[3];
+        bvh_prim_box(&set->prims[i], set->magnitude, lower, upper);
+        bounds_grow(lo, hi, lower, upper);
+    }
 }
 
-/* bvh_half_area of the box in the x, y and z lanes of lo and hi: its
- * arithmetic in its order, (dx dy + dy dz) + dz dx, without storing the
- * lanes (the sweep over a candidate's bins asks it twice a bin). */
-static inline float half_area4(__m128 lo, __m128 hi)
+PTR_DECL_BVH_BIN(bvh_bin_c)
 {
-    const __m128 d = _mm_sub_ps(hi, lo);
+    const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
+    const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
+    const __m128 last = _mm_set1_ps((float)(c->bins - 1));
+    const __m128 none = _mm_set1_ps(-INFINITY),
+                 no_prims = _mm_setr_ps(-INFINITY, -INFINITY, -INFINITY, 0.0f),
+                 one_more = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < c->bins; k++) {
+            _mm_store_ps(bins->box[a][k], none);
+            _mm_store_ps(bins->box[a][k] + 4, no_prims);
+        }
+    for (size_t i = 0; i < count; i++) {
+        __m128 neg_lower, upper;
+        bvh_bin_box(&prims[i], magnitude, &neg_lower, &upper);
+        /* Its bins on the three axes at once (the radius lane, scaled by
+         * 0, gives bin 0). */
+        int k[4];
+        _mm_storeu_si128((__m128i *)k, bvh_bins4(_mm_loadu_ps(prims[i].centre), base, scale, last));
+        for (int a = 0; a < 3; a++) {
+            float *box = bins->box[a][k[a]];
+            _mm_store_ps(box, _mm_max_ps(_mm_load_ps(box), neg_lower));
+            /* One more on the count, 0 on the box (x + 0 is x but for
+             * x = -0, and no box has a -0: the extent is never -0, so
+             * centre + extent is -0 only for a centre of -0 and an extent
+             * of -0). */
+            _mm_store_ps(box + 4, _mm_add_ps(_mm_max_ps(_mm_load_ps(box + 4), upper), one_more));
+        }
+    }
+}
+
+BvhBinKernel bvh_bin_for_level(PtrCpuLevel level)
+{
+#if PTR_HAVE_BVH_BIN_AVX2
+    if (level >= PTR_CPU_AVX2)
+        return (BvhBinKernel){ bvh_bin_avx2, "avx2" };
+#else
+    (void)level;
+#endif
+    return (BvhBinKernel){ bvh_bin_c, "c" };
+}
+
+const char *ptr_bvh_bin_name(PtrCpuLevel level)
+{
+    return bvh_bin_for_level(level).name;
+}
+
+/* A run of bins merged: the box in the lanes of BvhBins (negated lower
+ * corner, upper corner; upper's last lane, the largest count, is no
+ * box's), and in the last lane of counts the count. */
+typedef struct BinSum {
+    __m128 neg_lower, upper, counts;
+} BinSum;
+
+static inline BinSum bin_sum_empty(void)
+{
+    return (BinSum){ _mm_set1_ps(-INFINITY), _mm_set1_ps(-INFINITY), _mm_setzero_ps() };
+}
+
+static inline BinSum bin_sum_add(BinSum s, const float box[8])
+{
+    const __m128 upper = _mm_load_ps(box + 4);
+    return (BinSum){ _mm_max_ps(s.neg_lower, _mm_load_ps(box)), _mm_max_ps(s.upper, upper),
+                     _mm_add_ps(s.counts, upper) };
+}
+
+static inline float bin_sum_count(BinSum s)
+{
+    return _mm_cvtss_f32(_mm_shuffle_ps(s.counts, s.counts, _MM_SHUFFLE(3, 3, 3, 3)));
+}
+
+/* bvh_half_area of the box: its arithmetic in its order, (dx dy + dy dz)
+ * + dz dx, without storing the lanes (the sweep over a candidate's bins
+ * asks it twice a bin). */
+static inline float bin_sum_half_area(BinSum s)
+{
+    const __m128 d = _mm_add_ps(s.upper, s.neg_lower);
     const __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));
     return _mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1))) +
            _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2)));
 }
 
-/* A bin's count, or a sum of them: the fourth lane (see Bins). */
-static inline float count_lane(__m128 upper)
+static void bin_sum_store(BinSum s, float lower[3], float upper[3])
 {
-    return _mm_cvtss_f32(_mm_shuffle_ps(upper, upper, _MM_SHUFFLE(3, 3, 3, 3)));
-}
-
-/* The box only (of a plan's samples, or of the halves of a split in the
- * middle). */
-static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, Bins *b)
-{
-    for (size_t i = begin; i < end; i++) {
-        float lower[3], upper[3];
-        bvh_prim_box(&set->prims[i], set->magnitude, lower, upper);
-        bounds_grow(b->box_lo, b->box_hi, lower, upper);
-    }
-}
-
-static void bin_run(const BvhPrimSet *set, size_t begin, size_t end, const BvhCandidate *c,
-                    Bins *b)
-{
-    const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
-    const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
-    const __m128 last = _mm_set1_ps((float)(c->bins - 1));
-    /* The box's upper x, y and z, and 0 under the count; then one more on
-     * the count, 0 on the box (x + 0 is x but for x = -0, and no box has a
-     * -0: the extent is never -0, so centre + extent is -0 only for a
-     * centre of -0 and an extent of -0). */
-    const __m128 box_lanes = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)),
-                 one_more = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
-    for (size_t i = begin; i < end; i++) {
-        const BvhPrim *p = &set->prims[i];
-        __m128 lower, upper;
-        bvh_prim_box4(p, set->magnitude, &lower, &upper);
-        upper = _mm_and_ps(upper, box_lanes);
-        /* Its bins on the three axes at once (the radius lane, scaled by
-         * 0, gives bin 0). */
-        int k[4];
-        _mm_storeu_si128((__m128i *)k, bvh_bins4(_mm_loadu_ps(p->centre), base, scale, last));
-        for (int a = 0; a < 3; a++) {
-            b->lower[a][k[a]] = _mm_min_ps(b->lower[a][k[a]], lower);
-            b->upper[a][k[a]] = _mm_add_ps(_mm_max_ps(b->upper[a][k[a]], upper), one_more);
-        }
-    }
+    bvh_store3(lower, _mm_xor_ps(s.neg_lower, _mm_set1_ps(-0.0f)));
+    bvh_store3(upper, s.upper);
 }
 
 void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, size_t end,
                         const float lower[3], const float upper[3])
 {
-    Bins bins;
     c->begin = begin;
     c->end = end;
     c->axis = -1;
-    if (!lower) {
-        bins_clear(&bins, 0);
-        bound_run(set, begin, end, &bins);
-        lower = bins.box_lo;
-        upper = bins.box_hi;
+    if (lower) {
+        memcpy(c->lower, lower, sizeof c->lower);
+        memcpy(c->upper, upper, sizeof c->upper);
+    } else {
+        bound_run(set, begin, end, c->lower, c->upper);
     }
-    memcpy(c->lower, lower, sizeof c->lower);
-    memcpy(c->upper, upper, sizeof c->upper);
     if (end - begin <= PTR_BVH_LEAF_MAX || end - begin > BVH_PLANNED_ABOVE)
         return;
     /* Embree's rule: few bins for few prims, where more would mostly be
      * empty and only cost time. */
     c->bins = 4 + (int)((end - begin) / 20);
-    if (c->bins > BINS)
-        c->bins = BINS;
+    if (c->bins > BVH_BINS)
+        c->bins = BVH_BINS;
     int spread = 0;
     for (int a = 0; a < 3; a++) {
         float extent = 2.0f * (c->upper[a] - c->lower[a]);
@@ -142,44 +159,26 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     }
     if (!spread)
         return;
-    bins_clear(&bins, c->bins);
-    bin_run(set, begin, end, c, &bins);
+    BvhBins bins;
+    set->bin(set->prims + begin, end - begin, set->magnitude, c, &bins);
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
-        /* The boxes of the bins from each end, and their counts summed in
-         * the fourth lane of sum (hi4's fourth lane, their largest count,
-         * is no box's). */
-        __m128 right_lo[BINS], right_hi[BINS];
-        float right_count[BINS];
-        __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY), sum = _mm_setzero_ps();
-        for (int k = c->bins - 1; k > 0; k--) {
-            lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
-            hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
-            sum = _mm_add_ps(sum, bins.upper[a][k]);
-            right_lo[k] = lo4;
-            right_hi[k] = hi4;
-            right_count[k] = count_lane(sum);
-        }
-        lo4 = _mm_set1_ps(INFINITY);
-        hi4 = _mm_set1_ps(-INFINITY);
-        sum = _mm_setzero_ps();
+        /* The bins from each end merged. */
+        BinSum right[BVH_BINS], left = bin_sum_empty(), sum = bin_sum_empty();
+        for (int k = c->bins - 1; k > 0; k--)
+            right[k] = sum = bin_sum_add(sum, bins.box[a][k]);
         for (int k = 0; k < c->bins - 1; k++) {
-            lo4 = _mm_min_ps(lo4, bins.lower[a][k]);
-            hi4 = _mm_max_ps(hi4, bins.upper[a][k]);
-            sum = _mm_add_ps(sum, bins.upper[a][k]);
-            const float n = count_lane(sum);
-            if (n == 0 || right_count[k + 1] == 0)
+            left = bin_sum_add(left, bins.box[a][k]);
+            const float n = bin_sum_count(left), right_n = bin_sum_count(right[k + 1]);
+            if (n == 0 || right_n == 0)
                 continue;
-            float cost = half_area4(lo4, hi4) * n +
-                         half_area4(right_lo[k + 1], right_hi[k + 1]) * right_count[k + 1];
+            float cost = bin_sum_half_area(left) * n + bin_sum_half_area(right[k + 1]) * right_n;
             if (cost < best) {
                 best = cost;
                 c->axis = a;
                 c->split_bin = k;
-                bvh_store3(c->left_lower, lo4);
-                bvh_store3(c->left_upper, hi4);
-                bvh_store3(c->right_lower, right_lo[k + 1]);
-                bvh_store3(c->right_upper, right_hi[k + 1]);
+                bin_sum_store(left, c->left_lower, c->left_upper);
+                bin_sum_store(right[k + 1], c->right_lower, c->right_upper);
             }
         }
     }

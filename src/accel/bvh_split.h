@@ -8,12 +8,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh_prims.h"
-
-/* The prims being built over. */
-typedef struct BvhPrimSet {
-    BvhPrim *prims;
-    float magnitude; /* of the coordinates, for the boxes (see ptr_bvh_prims) */
-} BvhPrimSet;
+#include "base/cpu.h"
 
 /* A range of prims being split into a node's children: its box, and the
  * best binned split found for it with the boxes of its two halves. */
@@ -21,7 +16,7 @@ typedef struct BvhCandidate {
     size_t begin, end;
     float lower[3], upper[3];
     int axis;         /* of the best split; -1: split in the middle of the range */
-    int bins;         /* BINS, fewer for small ranges */
+    int bins;         /* BVH_BINS, fewer for small ranges */
     int split_bin;    /* prims in bins <= split_bin go left */
     float left_lower[3], left_upper[3], right_lower[3], right_upper[3];
     /* Binning: a prim's bin on axis a is (lower + upper - bin_base) * bin_scale,
@@ -29,6 +24,70 @@ typedef struct BvhCandidate {
      * would need a pass of its own, and as good for spheres of similar size). */
     float bin_base[3], bin_scale[3];
 } BvhCandidate;
+
+enum { BVH_BINS = 32 }; /* BvhCandidate.bins at most */
+
+/* A candidate's bins: for each axis and bin, the box of the prims whose
+ * centres fall in it and their count, in eight floats: the box's lower x,
+ * y and z negated and a lane no one reads, then its upper x, y and z and
+ * the count (exact: a range binned has at most BVH_PLANNED_ABOVE prims).
+ * With the lower corner negated, a prim grows its bin by maxima alone: one
+ * 256-bit maximum (bvh_bin_avx2) or two 128-bit ones (bvh_bin_c), where
+ * separate lower and upper corners took a minimum and a maximum, each a
+ * load and a store of its own. max(-a, -b) is -min(a, b) bit for bit, ties
+ * and zeros' signs included (_mm_max_ps(x, y) is x > y ? x : y, and
+ * _mm_min_ps(a, b) is a < b ? a : b), and upper - lower is upper + (-lower)
+ * exactly, so the boxes and areas are the same bits as before. */
+typedef struct BvhBins {
+    _Alignas(32) float box[3][BVH_BINS][8];
+} BvhBins;
+
+/* Clears c->bins bins an axis and grows them by the count prims (c's
+ * range), each in its bin on each axis (bvh_bins4 of its centre over c's
+ * bin_base and bin_scale). Every version leaves the same bits in every
+ * lane but the unread one. */
+#define PTR_DECL_BVH_BIN(name)                                                \
+    void name(const BvhPrim *prims, size_t count, float magnitude,            \
+              const BvhCandidate *c, BvhBins *bins)
+
+typedef PTR_DECL_BVH_BIN((*BvhBinFn));
+
+/* The reference, in SSE2. */
+PTR_DECL_BVH_BIN(bvh_bin_c);
+#if PTR_HAVE_BVH_BIN_AVX2
+/* One 256-bit maximum a bin (bvh_bin_avx2.c, built for AVX2). */
+PTR_DECL_BVH_BIN(bvh_bin_avx2);
+#endif
+
+/* The binning at a CPU level (the caller's, as ptr_bvh_build's). */
+typedef struct BvhBinKernel {
+    BvhBinFn bin;
+    const char *name; /* "c", "avx2" */
+} BvhBinKernel;
+
+BvhBinKernel bvh_bin_for_level(PtrCpuLevel level);
+
+/* What prim p grows its bins by: its padded box's lower corner negated
+ * and its upper corner (bvh_prim_box4's), with 0 for the count lane in
+ * upper (the radius lanes are unread but the count's, which is the
+ * caller's to add to). */
+static inline void bvh_bin_box(const BvhPrim *p, float magnitude, __m128 *neg_lower,
+                               __m128 *upper)
+{
+    const __m128 centre = _mm_loadu_ps(p->centre),
+                 extent = _mm_set1_ps(bvh_prim_extent(p, magnitude));
+    /* extent - centre is -(centre - extent) exactly: rounding is symmetric. */
+    *neg_lower = _mm_sub_ps(extent, centre);
+    *upper = _mm_and_ps(_mm_add_ps(centre, extent),
+                        _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
+
+/* The prims being built over, and how they are binned. */
+typedef struct BvhPrimSet {
+    BvhPrim *prims;
+    float magnitude; /* of the coordinates, for the boxes (see ptr_bvh_prims) */
+    BvhBinFn bin;    /* bvh_bin_for_level's, at the build's CPU level */
+} BvhPrimSet;
 
 /* Half the surface area of a box: what the heuristic weighs. */
 static inline float bvh_half_area(const float lo[3], const float hi[3])

@@ -106,8 +106,9 @@ static void print_dispatch(PtrCpuLevel level)
         PtrConvTable conv;
         ptr_isect_init_level(&table, (PtrCpuLevel)l);
         ptr_conv_init_level(&conv, (PtrCpuLevel)l);
-        printf("%-7s %-7s %-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
+        printf("%-7s %-7s %-7s %-7s %-7s%s%s\n", ptr_cpu_level_name((PtrCpuLevel)l), table.name,
                ptr_integrator_name(ptr_integrator_for_level((PtrCpuLevel)l)), conv.name,
+               ptr_bvh_bin_name((PtrCpuLevel)l),
                l > (int)detected ? "  (not on this CPU)" : "",
                l == (int)level ? "  <- in use" : "");
     }

@@ -72,7 +72,8 @@ int check_bvh_closest_hit(uint64_t seed, int *passed)
                 ptr_scene_free(&tree_scene);
                 continue;
             }
-            if (ptr_bvh_build(&bvh, &tree_scene.spheres, tree_scene.spheres.count, 0, NULL) != PTR_OK) {
+            if (ptr_bvh_build(&bvh, &tree_scene.spheres, tree_scene.spheres.count, 0,
+                              ptr_cpu_level(), NULL) != PTR_OK) {
                 fprintf(stderr, "check_bvh: cannot build %s %d\n", bvh_scene_names[kind], sizes[z]);
                 return 1;
             }
@@ -185,7 +186,8 @@ void bench_bvh_closest_hit(void)
             ptr_scene_add_sphere(&scene, v3(bvh_uniform(&rng, -10, 10), bvh_uniform(&rng, r, 6),
                                             bvh_uniform(&rng, -10, 10)), r, 0, NULL);
         PtrBvh bvh;
-        if (ptr_bvh_build(&bvh, &scene.spheres, scene.spheres.count, 0, NULL) != PTR_OK)
+        if (ptr_bvh_build(&bvh, &scene.spheres, scene.spheres.count, 0, ptr_cpu_level(),
+                          NULL) != PTR_OK)
             return;
         for (int i = 0; i < RAYS; i++) {
             PtrVec3 o = v3(0, 9, 26);

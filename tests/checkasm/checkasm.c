@@ -193,6 +193,7 @@ static int check(uint64_t rays, uint64_t seed)
                    &packets.status[l]) ? passed++ : failed++;
     failed += check_bvh_closest_hit(seed, &passed);
     failed += check_conv3x3(seed, &passed);
+    failed += check_bvh_bin(seed, &passed);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

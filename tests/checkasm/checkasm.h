@@ -2,7 +2,8 @@
  * cases, the run and the report. Each field of the kernel tables
  * (accel/isect.h, denoise/conv.h) is checked in the file named after it:
  * closest_hit.c, closest_hit_packet.c, bvh_closest_hit.c,
- * bvh_closest_hit_packet.c, conv3x3.c. */
+ * bvh_closest_hit_packet.c, conv3x3.c; and the build's binning
+ * (accel/bvh_split.h) in bvh_bin.c. */
 #ifndef PTR_CHECKASM_H
 #define PTR_CHECKASM_H
 
@@ -111,5 +112,10 @@ void bench_bvh_closest_hit(void);
  * the output's surroundings guarded; returns the number of levels that
  * failed. */
 int check_conv3x3(uint64_t seed, int *passed);
+
+/* bvh_bin.c: every level's binning for the tree's build against
+ * bvh_bin_c, bit for bit, with the bins past a candidate's guarded;
+ * returns the number of kernels that failed. */
+int check_bvh_bin(uint64_t seed, int *passed);
 
 #endif

@@ -18,6 +18,13 @@
 
 /* Gives every sphere of s a colour that is its position in the file (the
  * colours move with the spheres), for the checks below to read back. */
+/* A tree over all of s's spheres on this many threads (0: one per CPU),
+ * at the CPU level the suite runs at (PTR_CPUMASK: CI runs it at each). */
+static void build_tree(PtrBvh *bvh, PtrSpheres *s, int threads)
+{
+    CHECK_INT(ptr_bvh_build(bvh, s, s->count, threads, ptr_cpu_level(), NULL), PTR_OK);
+}
+
 static void tag_file_order(PtrScene *s)
 {
     for (size_t i = 0; i < s->spheres.count; i++) {
@@ -195,7 +202,7 @@ static void test_scenes(void)
                     b.spheres.id[i] = (uint32_t)i;
             }
             PtrBvh bvh;
-            CHECK_INT(ptr_bvh_build(&bvh, &b.spheres, b.spheres.count, 0, NULL), PTR_OK);
+            build_tree(&bvh, &b.spheres, 0);
             check_structure(&bvh, &b.spheres, materials, bvh_scene_names[kind]);
             check_rays(&a, &b, &bvh, size ? 10000 : 20000, bvh_scene_names[kind]);
             ptr_bvh_free(&bvh);
@@ -241,7 +248,7 @@ static void test_huge(void)
         CHECK(bvh_scene_make(&s, kinds[k], 500, 2));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 1, NULL), PTR_OK);
+        build_tree(&bvh, &s.spheres, 1);
         CHECK_INT(bvh.huge_count, k < 2 ? 1 : 0);
         if (k < 2)
             CHECK_INT(file_position(&s.spheres, 0), 0);
@@ -282,7 +289,7 @@ static void check_huge_choice(const float *radius, int count)
                       PTR_OK);
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t], NULL), PTR_OK);
+        build_tree(&bvh, &s.spheres, threads[t]);
         CHECK_INT(bvh.huge_count, rule.count);
         size_t wrong = 0;
         for (size_t k = 0; k < bvh.huge_count && k < rule.count; k++)
@@ -347,7 +354,7 @@ static void test_threads(void)
         CHECK(bvh_scene_make(&s, BVH_SCENE_CLUSTERS, 150000, 3));
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, threads[t], NULL), PTR_OK);
+        build_tree(&bvh, &s.spheres, threads[t]);
         if (t == 0) {
             first = bvh;
             first_scene = s;
@@ -413,7 +420,7 @@ static uint64_t check_one_and_three_threads(SetMaker make, size_t huge_count, in
         make(&s);
         tag_file_order(&s);
         PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, t ? 3 : 1, NULL), PTR_OK);
+        build_tree(&bvh, &s.spheres, t ? 3 : 1);
         CHECK(bvh.huge_count == huge_count);
         if (t == 0) {
             check_structure(&bvh, &s.spheres, 1, name);
@@ -474,7 +481,7 @@ static void test_plans_without_split(void)
     CHECK(bvh_scene_make(&s, BVH_SCENE_SAME_CENTRE, 600000, 3));
     tag_file_order(&s);
     PtrBvh bvh;
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, NULL), PTR_OK);
+    build_tree(&bvh, &s.spheres, 2);
     check_structure(&bvh, &s.spheres, 1, "one centre, planned");
     check_rays(&file, &s, &bvh, 100, "one centre, planned");
     ptr_bvh_free(&bvh);
@@ -604,7 +611,7 @@ static void test_split_children(void)
                                              ? (float)(int)bvh_uniform(&rng, -8, 8)
                                              : bvh_uniform(&rng, -8, 8);
             }
-            const BvhPrimSet set = { prims, 8.5f };
+            const BvhPrimSet set = { prims, 8.5f, bvh_bin_c };
             BvhChildren plan, below[PTR_BVH_WIDTH];
             random_plan(&rng, r == 3 ? 1 : PTR_BVH_WIDTH, &plan);
             for (int k = 0; k < plan.count; k++)
@@ -626,34 +633,33 @@ static void test_split_children(void)
 }
 
 
-/* The trees of two fixed sets, to the byte: their nodes, and the spheres
- * in the order the build leaves them (centres, radii and the tags of their
- * places in the file), as the build has made them since it was last meant
- * to change them. Images depend on the tree where two spheres tie, and are
- * promised the same from one build to the next: a change that moves any
- * split shows here, and one meant to updates these values and says why. The
- * sets take every path of the build: the clusters' 300,000 spheres a root
- * chosen from samples, its parts and the tasks; the clusters' 1,000,000
- * the nodes of its parts planned from samples; the random 5,000 a root
- * chosen from all of them and the binning of every prim; the sheet's
- * 19,881 centres on a regular grid the same. The
- * root's split tests, made four spheres at once where the partitions test
- * one, must agree with them to leave the last two as the build made them
- * when it split the root in place. (The random set's value is that of the
- * build before the binning moved into SSE registers, which left it
- * unchanged; the sheet's that of the build just before the root was chosen
- * before the copy. The clusters' changed with that: the root's splits came
- * from samples of each range, and now of the whole. The 300,000 clusters'
- * value held when the nodes of more than 65,536 spheres came to be planned
- * from samples, since none of its nodes has so many. Both clusters' values
- * changed when every partition came to keep each side's order: a range
- * split in the middle of its order (its centres all in one bin, or deep in
- * the tree) has other halves. All four changed when a colour's fourth
- * entry came to be always 65535, where the tags had 0: the build before
- * gave the random and sheet sets' values with such tags. The 1,000,000
- * clusters' value and depth changed when a planned node came to sample one
- * prim in 16 where it sampled 32,768: its tree's surface area heuristic
- * cost rose by 0.04%.) */
+/* The trees of four fixed sets, to the byte, at every CPU level: their nodes,
+ * and the spheres in the order the build leaves them (centres, radii and the
+ * tags of their places in the file), as the build has made them since it was
+ * last meant to change them. Images depend on the tree where two spheres tie,
+ * and are promised the same from one build to the next: a change that moves
+ * any split shows here, and one meant to updates these values and says why.
+ * The sets take every path of the build: the clusters' 300,000 spheres a root
+ * chosen from samples, its parts and the tasks; the clusters' 1,000,000 the
+ * nodes of its parts planned from samples; the random 5,000 a root chosen from
+ * all of them and the binning of every prim; the sheet's 19,881 centres on a
+ * regular grid the same. The root's split tests, made four spheres at once
+ * where the partitions test one, must agree with them to leave the last two as
+ * the build made them when it split the root in place.
+ * (The random set's value is that of the build before the binning moved into
+ * SSE registers, which left it unchanged, as did the bins' negated lower
+ * corners and the AVX2 binning; the sheet's that of the build just before the
+ * root was chosen before the copy. The clusters' changed with that: the root's
+ * splits came from samples of each range, and now of the whole. The 300,000
+ * clusters' value held when the nodes of more than 65,536 spheres came to be
+ * planned from samples, since none of its nodes has so many. Both clusters'
+ * values changed when every partition came to keep each side's order: a range
+ * split in the middle of its order (its centres all in one bin, or deep in the
+ * tree) has other halves. All four changed when a colour's fourth entry came
+ * to be always 65535, where the tags had 0: the build before gave the random
+ * and sheet sets' values with such tags. The 1,000,000 clusters' value and
+ * depth changed when a planned node came to sample one prim in 16 where it
+ * sampled 32,768: its tree's surface area heuristic cost rose by 0.04%.) */
 static void test_tree_bytes(void)
 {
     const struct {
@@ -667,23 +673,29 @@ static void test_tree_bytes(void)
         { BVH_SCENE_RANDOM, 5000, UINT64_C(0x132ed326d6e4f85b), 3 },
         { BVH_SCENE_SHEET, 20000, UINT64_C(0xf3d534216486cce2), 3 },
     };
-    for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
-        PtrScene s;
-        ptr_scene_init(&s);
-        CHECK(bvh_scene_make(&s, sets[k].kind, sets[k].count, 5));
-        tag_file_order(&s);
-        PtrBvh bvh;
-        CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, NULL), PTR_OK);
-        const uint64_t h = tree_hash(&bvh, &s.spheres);
-        if (h != sets[k].hash)
-            fprintf(stderr, "%s, %d spheres: the tree's bytes hash to %016llx, not %016llx\n",
-                    bvh_scene_names[sets[k].kind], sets[k].count, (unsigned long long)h,
-                    (unsigned long long)sets[k].hash);
-        CHECK(h == sets[k].hash);
-        CHECK_INT(bvh.depth, sets[k].depth);
-        ptr_bvh_free(&bvh);
-        ptr_scene_free(&s);
-    }
+    /* At every CPU level this one reaches: the binning's code is the
+     * level's (bvh_bin_for_level), the tree the same. */
+    for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++)
+        for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
+            PtrScene s;
+            ptr_scene_init(&s);
+            CHECK(bvh_scene_make(&s, sets[k].kind, sets[k].count, 5));
+            tag_file_order(&s);
+            PtrBvh bvh;
+            CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 2, (PtrCpuLevel)level,
+                                    NULL), PTR_OK);
+            const uint64_t h = tree_hash(&bvh, &s.spheres);
+            if (h != sets[k].hash)
+                fprintf(stderr,
+                        "%s, %d spheres, CPU level %s: the tree's bytes hash to %016llx, "
+                        "not %016llx\n", bvh_scene_names[sets[k].kind], sets[k].count,
+                        ptr_cpu_level_name((PtrCpuLevel)level), (unsigned long long)h,
+                        (unsigned long long)sets[k].hash);
+            CHECK(h == sets[k].hash);
+            CHECK_INT(bvh.depth, sets[k].depth);
+            ptr_bvh_free(&bvh);
+            ptr_scene_free(&s);
+        }
 }
 
 /* No spheres, one sphere: nothing to build, and the traversal still answers. */
@@ -692,7 +704,7 @@ static void test_small(void)
     PtrScene s;
     ptr_scene_init(&s);
     PtrBvh bvh;
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
+    build_tree(&bvh, &s.spheres, 0);
     CHECK(bvh.nodes == NULL);
     PtrRay ray = { { 0, 0, 0 }, 0.0f, { 0, 0, -1 }, INFINITY };
     PtrHit hit;
@@ -700,7 +712,7 @@ static void test_small(void)
     CHECK_INT(hit.sphere, PTR_NO_HIT);
     CHECK_FLOAT_EQ(hit.t, INFINITY);
     CHECK_INT(ptr_scene_add_sphere(&s, v3(0, 0, -5), 1.0f, 0, NULL), PTR_OK);
-    CHECK_INT(ptr_bvh_build(&bvh, &s.spheres, s.spheres.count, 0, NULL), PTR_OK);
+    build_tree(&bvh, &s.spheres, 0);
     CHECK(ptr_bvh_closest_hit_c(&ray, &bvh, &s.spheres, &hit));
     CHECK_FLOAT_EQ(hit.t, 4.0f);
     CHECK_INT(hit.sphere, 0);
