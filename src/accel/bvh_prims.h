@@ -75,11 +75,17 @@ typedef struct BvhSplitTest {
     float base, scale, last; /* last: the bins less 1 */
 } BvhSplitTest;
 
-static inline int bvh_goes_right(const BvhSplitTest *t, const BvhPrim *p)
+/* Whether a prim whose centre on the split's axis is x goes right. */
+static inline int bvh_goes_right_at(const BvhSplitTest *t, float x)
 {
     /* Clamped as a float, then converted: no branch, and a NaN-free range. */
-    const float k = (2.0f * p->centre[t->axis] - t->base) * t->scale;
+    const float k = (2.0f * x - t->base) * t->scale;
     return (int)ptr_minf(ptr_maxf(k, 0.0f), t->last) > t->split_bin;
+}
+
+static inline int bvh_goes_right(const BvhSplitTest *t, const BvhPrim *p)
+{
+    return bvh_goes_right_at(t, p->centre[t->axis]);
 }
 
 /* Four bins at once, bvh_goes_right's arithmetic lane by lane: centre +

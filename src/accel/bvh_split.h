@@ -111,6 +111,14 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
 /* c's best split (c->axis at least 0) as its prims are tested against it. */
 BvhSplitTest bvh_split_test(const BvhCandidate *c);
 
+/* The least centre on the axis of c's best split that goes right by it:
+ * bvh_goes_right's arithmetic is monotone in the centre (doubling,
+ * subtracting the base, multiplying by a scale above 0, clamping and
+ * truncating each are), so a prim of c goes right exactly when its centre
+ * is at least this. A float past c's box where all go left (or all right),
+ * which holds every centre. */
+float bvh_least_right(const BvhCandidate *c);
+
 /* Splits c in two (into *left and *right, which may be c), keeping each
  * half's order: by its best split, or in the middle of its order if it has
  * none or middle is set. scratch: room for BVH_PLANNED_ABOVE prims (no

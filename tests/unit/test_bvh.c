@@ -1,5 +1,6 @@
 /* The tree: its structure, its determinism, and its traversal against brute
  * force on hard sphere sets, bit for bit. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -581,6 +582,77 @@ static void check_children(const BvhPrim *prims, float magnitude, size_t begin, 
     CHECK_INT(next, end);
 }
 
+/* Whether bvh_least_right(c) splits x as c's split does, x in c's box. */
+static int splits_as_test(const BvhCandidate *c, float least_right, float x)
+{
+    const BvhSplitTest t = bvh_split_test(c);
+    return x < c->lower[c->axis] || x > c->upper[c->axis] ||
+           (x >= least_right) == bvh_goes_right_at(&t, x);
+}
+
+/* bvh_least_right, with which the partitions test a prim by one
+ * comparison, against bvh_goes_right_at's arithmetic: on splits of boxes
+ * from 1e-30 to 1e30 wide, up to 1e30 from the origin on either side or
+ * across it, a few floats wide, and up to FLT_MAX (whose doubled centres
+ * overflow), of 4 to 32 bins and each of their split bins, the 64 floats
+ * either side of the least right centre and random ones in the box go the
+ * same way by both. */
+static void test_least_right(void)
+{
+    PtrRng rng = ptr_rng_for_sample(7, 0, 0);
+    int differ = 0;
+    for (int n = 0; n < 4000; n++) {
+        BvhCandidate c = { .axis = (int)(ptr_rng_next(&rng) % 3) };
+        const int a = c.axis;
+        const float width = powf(10.0f, bvh_uniform(&rng, -30.0f, 30.0f));
+        const float centre = powf(10.0f, bvh_uniform(&rng, -30.0f, 30.0f)) *
+                             (ptr_rng_next(&rng) & 1 ? -1.0f : 1.0f);
+        switch (n % 5) {
+        case 0: /* near the origin or across it */
+            c.lower[a] = -width * bvh_uniform(&rng, 0.0f, 1.0f);
+            c.upper[a] = c.lower[a] + width;
+            break;
+        case 1: /* a few floats wide */
+            c.lower[a] = centre;
+            c.upper[a] = centre;
+            for (int k = 1 + (int)(ptr_rng_next(&rng) % 8); k > 0; k--)
+                c.upper[a] = nextafterf(c.upper[a], INFINITY);
+            break;
+        case 2: /* up to FLT_MAX */
+            c.lower[a] = ptr_rng_next(&rng) & 1 ? -FLT_MAX : 0.5f * FLT_MAX;
+            c.upper[a] = FLT_MAX;
+            break;
+        default:
+            c.lower[a] = ptr_minf(centre, centre + width);
+            c.upper[a] = ptr_maxf(centre, centre + width);
+            break;
+        }
+        const float extent = 2.0f * (c.upper[a] - c.lower[a]);
+        if (!(extent > 0.0f) || !isfinite(extent))
+            continue; /* no split on this axis, as bvh_candidate_init finds */
+        c.bins = 4 + (int)(ptr_rng_next(&rng) % 29);
+        c.split_bin = (int)(ptr_rng_next(&rng) % (uint64_t)(c.bins - 1));
+        c.bin_base[a] = 2.0f * c.lower[a];
+        c.bin_scale[a] = (float)c.bins * 0.99999f / extent;
+        const float least_right = bvh_least_right(&c);
+        int ok = 1;
+        float x = least_right, y = least_right;
+        for (int k = 0; k < 64; k++) {
+            ok &= splits_as_test(&c, least_right, x) && splits_as_test(&c, least_right, y);
+            x = nextafterf(x, -INFINITY);
+            y = nextafterf(y, INFINITY);
+        }
+        for (int k = 0; k < 64; k++)
+            ok &= splits_as_test(&c, least_right,
+                                 c.lower[a] + (c.upper[a] - c.lower[a]) * ptr_rng_float(&rng));
+        if (!ok && differ++ < 5)
+            fprintf(stderr, "least right %a of [%a, %a], %d bins, split bin %d: splits "
+                    "otherwise than the bins\n", least_right, c.lower[a], c.upper[a], c.bins,
+                    c.split_bin);
+        CHECK(ok);
+    }
+}
+
 /* bvh_split_children against the plan's splits made one at a time with
  * bvh_goes_right: every prim of a child goes there by the splits, in the
  * order it came, the children tile the range in bvh_children_order's order,
@@ -892,6 +964,7 @@ int main(void)
         TEST_CASE(test_scenes),
         TEST_CASE(test_threads),
         TEST_CASE(test_root_sort),
+        TEST_CASE(test_least_right),
         TEST_CASE(test_split_children),
         TEST_CASE(test_plans_without_split),
         TEST_CASE(test_two_levels_planned),
