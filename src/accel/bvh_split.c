@@ -1,5 +1,6 @@
 #include "accel/bvh_split.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,19 +42,24 @@ static void bound_run(const BvhPrimSet *set, size_t begin, size_t end, float lo[
     }
 }
 
-PTR_DECL_BVH_BIN(bvh_bin_c)
+void bvh_bins_clear(const BvhCandidate *c, BvhBins *bins)
 {
-    const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
-    const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
-    const __m128 last = _mm_set1_ps((float)(c->bins - 1));
     const __m128 none = _mm_set1_ps(-INFINITY),
-                 no_prims = _mm_setr_ps(-INFINITY, -INFINITY, -INFINITY, 0.0f),
-                 one_more = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
+                 no_prims = _mm_setr_ps(-INFINITY, -INFINITY, -INFINITY, 0.0f);
     for (int a = 0; a < 3; a++)
         for (int k = 0; k < c->bins; k++) {
             _mm_store_ps(bins->box[a][k], none);
             _mm_store_ps(bins->box[a][k] + 4, no_prims);
         }
+}
+
+PTR_DECL_BVH_BIN(bvh_bin_c)
+{
+    const __m128 base = _mm_setr_ps(c->bin_base[0], c->bin_base[1], c->bin_base[2], 0.0f);
+    const __m128 scale = _mm_setr_ps(c->bin_scale[0], c->bin_scale[1], c->bin_scale[2], 0.0f);
+    const __m128 last = _mm_set1_ps((float)(c->bins - 1));
+    const float one_more_lanes[8] = { BVH_BIN_ONE_MORE };
+    const __m128 one_more = _mm_loadu_ps(one_more_lanes + 4);
     for (size_t i = 0; i < count; i++) {
         __m128 neg_lower, upper;
         bvh_bin_box(&prims[i], magnitude, &neg_lower, &upper);
@@ -63,11 +69,9 @@ PTR_DECL_BVH_BIN(bvh_bin_c)
         _mm_storeu_si128((__m128i *)k, bvh_bins4(_mm_loadu_ps(prims[i].centre), base, scale, last));
         for (int a = 0; a < 3; a++) {
             float *box = bins->box[a][k[a]];
+            /* The negated lower corner needs no -0 added: adding it
+             * changes nothing. */
             _mm_store_ps(box, _mm_max_ps(_mm_load_ps(box), neg_lower));
-            /* One more on the count, 0 on the box (x + 0 is x but for
-             * x = -0, and no box has a -0: the extent is never -0, so
-             * centre + extent is -0 only for a centre of -0 and an extent
-             * of -0). */
             _mm_store_ps(box + 4, _mm_add_ps(_mm_max_ps(_mm_load_ps(box + 4), upper), one_more));
         }
     }
@@ -160,6 +164,7 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
     if (!spread)
         return;
     BvhBins bins;
+    bvh_bins_clear(c, &bins);
     set->bin(set->prims + begin, end - begin, set->magnitude, c, &bins);
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
@@ -215,6 +220,7 @@ static int goes_right_at(const BvhSplitTest *t, int64_t order)
 float bvh_least_right(const BvhCandidate *c)
 {
     const BvhSplitTest t = bvh_split_test(c);
+    assert(t.scale > 0.0f); /* a split's axis has an extent */
     /* Orders taken to go left (lo) and right (hi), beyond the box, which
      * holds every centre. */
     int64_t lo = float_order(c->lower[t.axis]) - 1, hi = float_order(c->upper[t.axis]) + 1;
@@ -224,26 +230,15 @@ float bvh_least_right(const BvhCandidate *c)
     const float edge = 0.5f * ((float)(t.split_bin + 1) / t.scale + t.base);
     int64_t guess = isnan(edge) ? lo + 1 : float_order(edge);
     guess = guess <= lo ? lo + 1 : guess >= hi ? hi - 1 : guess;
-    if (goes_right_at(&t, guess)) {
-        for (hi = guess; hi - 1 > lo;) {
-            const int64_t step = (guess - hi) + 1;
-            const int64_t next = hi - step > lo ? hi - step : lo + 1;
-            if (!goes_right_at(&t, next)) {
-                lo = next;
-                break;
-            }
-            hi = next;
-        }
-    } else {
-        for (lo = guess; lo + 1 < hi;) {
-            const int64_t step = (lo - guess) + 1;
-            const int64_t next = lo + step < hi ? lo + step : hi - 1;
-            if (goes_right_at(&t, next)) {
-                hi = next;
-                break;
-            }
-            lo = next;
-        }
+    const int up = !goes_right_at(&t, guess); /* the least right is above guess */
+    *(up ? &lo : &hi) = guess;
+    for (int64_t step = 1; hi - lo > 1; step *= 2) {
+        const int64_t next = up ? (lo + step < hi ? lo + step : hi - 1)
+                                : (hi - step > lo ? hi - step : lo + 1);
+        const int right = goes_right_at(&t, next);
+        *(right ? &hi : &lo) = next;
+        if (right == up) /* past it: it lies between lo and hi */
+            break;
     }
     while (hi - lo > 1) {
         const int64_t mid = lo + (hi - lo) / 2;

@@ -34,18 +34,23 @@ enum { BVH_BINS = 32 }; /* BvhCandidate.bins at most */
  * With the lower corner negated, a prim grows its bin by maxima alone: one
  * 256-bit maximum (bvh_bin_avx2) or two 128-bit ones (bvh_bin_c), where
  * separate lower and upper corners took a minimum and a maximum, each a
- * load and a store of its own. max(-a, -b) is -min(a, b) bit for bit, ties
- * and zeros' signs included (_mm_max_ps(x, y) is x > y ? x : y, and
- * _mm_min_ps(a, b) is a < b ? a : b), and upper - lower is upper + (-lower)
- * exactly, so the boxes and areas are the same bits as before. */
+ * load and a store of its own. Negated exactly (the sign flipped, so a +0
+ * corner is -0), max(-a, -b) is -min(a, b) bit for bit, ties and zeros'
+ * signs included (_mm_max_ps(x, y) is x > y ? x : y, and _mm_min_ps(a, b)
+ * is a < b ? a : b), and upper - lower is upper + (-lower) exactly, so the
+ * boxes and areas are the same bits as before. */
 typedef struct BvhBins {
     _Alignas(32) float box[3][BVH_BINS][8];
 } BvhBins;
 
-/* Clears c->bins bins an axis and grows them by the count prims (c's
- * range), each in its bin on each axis (bvh_bins4 of its centre over c's
- * bin_base and bin_scale). Every version leaves the same bits in every
- * lane but the unread one. */
+/* Empties c->bins bins an axis: corners of -infinity (a maximum's
+ * identity), no prims. */
+void bvh_bins_clear(const BvhCandidate *c, BvhBins *bins);
+
+/* Grows c->bins bins an axis, emptied by bvh_bins_clear, by the count
+ * prims (c's range), each in its bin on each axis (bvh_bins4 of its centre
+ * over c's bin_base and bin_scale), and touches no other bin. Every
+ * version leaves the same bits in every lane but the unread one. */
 #define PTR_DECL_BVH_BIN(name)                                                \
     void name(const BvhPrim *prims, size_t count, float magnitude,            \
               const BvhCandidate *c, BvhBins *bins)
@@ -68,19 +73,23 @@ typedef struct BvhBinKernel {
 BvhBinKernel bvh_bin_for_level(PtrCpuLevel level);
 
 /* What prim p grows its bins by: its padded box's lower corner negated
- * and its upper corner (bvh_prim_box4's), with 0 for the count lane in
- * upper (the radius lanes are unread but the count's, which is the
- * caller's to add to). */
+ * and its upper corner (bvh_prim_box4's), 0 in the upper's fourth lane
+ * for the count (the lower's fourth lane is unread). */
 static inline void bvh_bin_box(const BvhPrim *p, float magnitude, __m128 *neg_lower,
                                __m128 *upper)
 {
-    const __m128 centre = _mm_loadu_ps(p->centre),
-                 extent = _mm_set1_ps(bvh_prim_extent(p, magnitude));
-    /* extent - centre is -(centre - extent) exactly: rounding is symmetric. */
-    *neg_lower = _mm_sub_ps(extent, centre);
-    *upper = _mm_and_ps(_mm_add_ps(centre, extent),
-                        _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+    __m128 lower;
+    bvh_prim_box4(p, magnitude, &lower, upper);
+    /* The sign flipped, not extent - centre: that is +0 where centre -
+     * extent is +0, whose negation is -0. */
+    *neg_lower = _mm_xor_ps(lower, _mm_set1_ps(-0.0f));
+    *upper = _mm_and_ps(*upper, _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
 }
+
+/* What a bin's eight lanes grow by after their maximum: one on the count,
+ * and -0 on the rest, which leaves every float as it is (x + -0 is x, -0
+ * included). */
+#define BVH_BIN_ONE_MORE -0.0f, -0.0f, -0.0f, -0.0f, -0.0f, -0.0f, -0.0f, 1.0f
 
 /* The prims being built over, and how they are binned. */
 typedef struct BvhPrimSet {
@@ -115,8 +124,10 @@ BvhSplitTest bvh_split_test(const BvhCandidate *c);
  * bvh_goes_right's arithmetic is monotone in the centre (doubling,
  * subtracting the base, multiplying by a scale above 0, clamping and
  * truncating each are), so a prim of c goes right exactly when its centre
- * is at least this. A float past c's box where all go left (or all right),
- * which holds every centre. */
+ * is at least this. c's box must hold every centre of its prims (a prim's
+ * padded box holds its centre), as it does for a candidate the build
+ * makes; the float found is one of the box's, or the one just above it
+ * where no centre in the box goes right. */
 float bvh_least_right(const BvhCandidate *c);
 
 /* Splits c in two (into *left and *right, which may be c), keeping each

@@ -97,7 +97,8 @@ static void print_version(PtrCpuLevel level)
     printf("ptr %s (intersector: %s)\n", PTR_VERSION, table.name);
 }
 
-/* Each level: the intersectors, the integrator, the denoiser's convolution. */
+/* Each level: the intersectors, the integrator, the denoiser's convolution,
+ * the tree build's binning. */
 static void print_dispatch(PtrCpuLevel level)
 {
     PtrCpuLevel detected = ptr_cpu_detected();

@@ -3,10 +3,10 @@
  * lane a build reads, on ranges of 0 to 2,000 prims with 4 to 32 bins,
  * random ones and adversarial ones: every prim at one centre (one bin's
  * chain of maxima), centres on the bins' edges, signed zeros with extents
- * of 0, coordinates near FLT_MAX (whose doubled centres overflow to
- * infinity), a few centres repeated, and bins over a box the prims are
- * not in. The bins past the candidate's count hold a guard that must
- * survive. The kernel is C built for AVX2, so no checked call: its calls
+ * of 0, corners exactly 0 (a centre equal to its extent or to minus it),
+ * coordinates near FLT_MAX (whose doubled centres overflow to infinity), a
+ * few centres repeated, and bins over a box the prims are not in. The bins
+ * past the candidate's count hold a guard that must survive. The kernel is C built for AVX2, so no checked call: its calls
  * keep the ABI as the compiler makes them. */
 #include <inttypes.h>
 #include <math.h>
@@ -23,6 +23,7 @@ typedef enum Kind {
     KIND_ONE_CENTRE,
     KIND_EDGES,
     KIND_ZEROS,
+    KIND_ZERO_CORNERS,
     KIND_HUGE,
     KIND_REPEATED,
     KIND_OUTSIDE,
@@ -30,7 +31,7 @@ typedef enum Kind {
 } Kind;
 
 static const char *const kind_names[KIND_COUNT] = {
-    "random", "one centre", "edges", "zeros", "huge", "repeated", "outside",
+    "random", "one centre", "edges", "zeros", "zero corners", "huge", "repeated", "outside",
 };
 
 static const uint32_t guard_bits = 0x7fbadbadu; /* a signalling NaN */
@@ -59,6 +60,12 @@ static void make_range(Kind kind, PtrRng *rng, BvhPrim *prims, size_t *count, fl
             case KIND_ONE_CENTRE: x = repeated[0][a]; break;
             case KIND_REPEATED: x = repeated[ptr_rng_next(rng) % 4][a]; break;
             case KIND_ZEROS: x = ptr_rng_next(rng) & 1 ? -0.0f : 0.0f; break;
+            case KIND_ZERO_CORNERS: {
+                const float extent = bvh_prim_extent(&(BvhPrim){ .radius = radius }, *magnitude);
+                const uint64_t corner = ptr_rng_next(rng) % 3;
+                x = corner == 0 ? extent : corner == 1 ? -extent : x;
+                break;
+            }
             case KIND_EDGES: /* on the edges of bins over [-scale, scale] */
                 x = -scale + 2.0f * scale * (float)(ptr_rng_next(rng) % (c->bins + 1)) /
                                  (float)c->bins;
@@ -132,11 +139,13 @@ int check_bvh_bin(uint64_t seed, int *passed)
         float magnitude;
         make_range(kind, &rng, prims, &count, &magnitude, &c);
         guard(&ref);
+        bvh_bins_clear(&c, &ref);
         bvh_bin_c(prims, count, magnitude, &c, &ref);
         for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
             if (kernels[l].bin == bvh_bin_c || kernels[l].bin == kernels[l - 1].bin)
                 continue;
             guard(&got);
+            bvh_bins_clear(&c, &got);
             kernels[l].bin(prims, count, magnitude, &c, &got);
             if (!same_bins(&ref, &got, c.bins) && differ[l][kind]++ == 0)
                 printf("bvh_bin %s: %s range %d (%zu prims, %d bins) differs from c\n",

@@ -17,15 +17,16 @@
 #include "render/render.h"
 #include "test.h"
 
-/* Gives every sphere of s a colour that is its position in the file (the
- * colours move with the spheres), for the checks below to read back. */
 /* A tree over all of s's spheres on this many threads (0: one per CPU),
- * at the CPU level the suite runs at (PTR_CPUMASK: CI runs it at each). */
+ * at the CPU level in force (PTR_CPUMASK caps it; test_tree_bytes builds
+ * at every level). */
 static void build_tree(PtrBvh *bvh, PtrSpheres *s, int threads)
 {
     CHECK_INT(ptr_bvh_build(bvh, s, s->count, threads, ptr_cpu_level(), NULL), PTR_OK);
 }
 
+/* Gives every sphere of s a colour that is its position in the file (the
+ * colours move with the spheres), for the checks below to read back. */
 static void tag_file_order(PtrScene *s)
 {
     for (size_t i = 0; i < s->spheres.count; i++) {
@@ -618,9 +619,13 @@ static void test_least_right(void)
             for (int k = 1 + (int)(ptr_rng_next(&rng) % 8); k > 0; k--)
                 c.upper[a] = nextafterf(c.upper[a], INFINITY);
             break;
-        case 2: /* up to FLT_MAX */
-            c.lower[a] = ptr_rng_next(&rng) & 1 ? -FLT_MAX : 0.5f * FLT_MAX;
+        case 2: /* out to FLT_MAX, where doubled centres overflow */
+            c.lower[a] = 0.5f * FLT_MAX;
             c.upper[a] = FLT_MAX;
+            if (ptr_rng_next(&rng) & 1) {
+                c.lower[a] = -FLT_MAX;
+                c.upper[a] = -0.5f * FLT_MAX;
+            }
             break;
         default:
             c.lower[a] = ptr_minf(centre, centre + width);
@@ -651,6 +656,59 @@ static void test_least_right(void)
                     c.split_bin);
         CHECK(ok);
     }
+}
+
+/* The boxes a binned split gives its halves, the bins', against the boxes
+ * of the prims the partition sends each way, bit for bit, with each
+ * binning: on ranges of 17 to 3,000 prims, some of whose corners are
+ * exactly 0 (a centre equal to its extent, or to minus it: a lower corner
+ * of +0, negated to -0 in the bins, or an upper one of +0), some on one
+ * centre. */
+static void test_split_boxes(void)
+{
+    enum { MAX = 3000 };
+    const float magnitude = 4.0f;
+    BvhPrim *prims = malloc(MAX * sizeof *prims),
+            *scratch = malloc(BVH_PLANNED_ABOVE * sizeof *scratch);
+    CHECK(prims && scratch);
+    PtrRng rng = ptr_rng_for_sample(11, 0, 0);
+    int splits = 0;
+    for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
+        const BvhPrimSet set = { prims, magnitude, bvh_bin_for_level((PtrCpuLevel)level).bin };
+        if (level > PTR_CPU_NONE && set.bin == bvh_bin_for_level((PtrCpuLevel)(level - 1)).bin)
+            continue;
+        for (int n = 0; n < 300; n++) {
+            const size_t count = 17 + ptr_rng_next(&rng) % (MAX - 16);
+            for (size_t i = 0; i < count; i++) {
+                BvhPrim *p = &prims[i];
+                p->radius = bvh_uniform(&rng, 0.01f, 0.3f);
+                p->rest = i;
+                const float extent = bvh_prim_extent(p, magnitude);
+                for (int a = 0; a < 3; a++) {
+                    const uint64_t kind = ptr_rng_next(&rng) % 8;
+                    p->centre[a] = kind == 0 ? extent
+                                   : kind == 1 ? -extent
+                                   : kind == 2 ? 1.5f
+                                               : bvh_uniform(&rng, -2.0f, 2.0f);
+                }
+            }
+            BvhCandidate c, left, right, bound;
+            bvh_candidate_init(&set, &c, 0, count, NULL, NULL);
+            if (c.axis < 0)
+                continue;
+            bvh_split(&set, &c, 0, scratch, &left, &right);
+            splits++;
+            const BvhCandidate *half[2] = { &left, &right };
+            for (int h = 0; h < 2; h++) {
+                bvh_candidate_init(&set, &bound, half[h]->begin, half[h]->end, NULL, NULL);
+                CHECK(!memcmp(half[h]->lower, bound.lower, sizeof bound.lower));
+                CHECK(!memcmp(half[h]->upper, bound.upper, sizeof bound.upper));
+            }
+        }
+    }
+    CHECK(splits > 250);
+    free(prims);
+    free(scratch);
 }
 
 /* bvh_split_children against the plan's splits made one at a time with
@@ -705,7 +763,7 @@ static void test_split_children(void)
 }
 
 
-/* The trees of four fixed sets, to the byte, at every CPU level: their nodes,
+/* The trees of four fixed sets, to the byte, with every binning: their nodes,
  * and the spheres in the order the build leaves them (centres, radii and the
  * tags of their places in the file), as the build has made them since it was
  * last meant to change them. Images depend on the tree where two spheres tie,
@@ -745,10 +803,13 @@ static void test_tree_bytes(void)
         { BVH_SCENE_RANDOM, 5000, UINT64_C(0x132ed326d6e4f85b), 3 },
         { BVH_SCENE_SHEET, 20000, UINT64_C(0xf3d534216486cce2), 3 },
     };
-    /* At every CPU level this one reaches: the binning's code is the
-     * level's (bvh_bin_for_level), the tree the same. */
+    /* With each binning this CPU reaches (bvh_bin_for_level's, once a
+     * kernel), the tree the same. */
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++)
         for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
+            if (level > PTR_CPU_NONE && bvh_bin_for_level((PtrCpuLevel)level).bin ==
+                                            bvh_bin_for_level((PtrCpuLevel)(level - 1)).bin)
+                break;
             PtrScene s;
             ptr_scene_init(&s);
             CHECK(bvh_scene_make(&s, sets[k].kind, sets[k].count, 5));
@@ -965,6 +1026,7 @@ int main(void)
         TEST_CASE(test_threads),
         TEST_CASE(test_root_sort),
         TEST_CASE(test_least_right),
+        TEST_CASE(test_split_boxes),
         TEST_CASE(test_split_children),
         TEST_CASE(test_plans_without_split),
         TEST_CASE(test_two_levels_planned),
