@@ -64,14 +64,14 @@ typedef struct PtrBvh {
     int depth; /* levels below the root at most, for the traversal stack */
 } PtrBvh;
 
-/* Builds the tree over the first count spheres, reordering them (see
- * bvh.h's head) and leaving the rest in place after them (the scene's
- * huge spheres, which accel/huge.h tests); threads 0 means one per CPU the
- * process may run on, and level is the caller's CPU level (ptr_cpu_level,
- * or lower), which chooses the binning's code. The tree's bytes depend
- * only on the spheres, never on the thread count or the level. On failure (out of memory) *bvh
- * is empty and the spheres may be part reordered: the scene can only be
- * freed; err (which may be NULL) says so. */
+/* Builds the tree over the first count spheres, reordering them (see bvh.h's
+ * head) and leaving the rest in place after them (the scene's huge spheres,
+ * which accel/huge.h tests); threads 0 means one per CPU the process may run
+ * on, and level is the caller's CPU level (ptr_cpu_level, or lower), which
+ * chooses the binning's code. The tree's bytes depend only on the spheres,
+ * never on the thread count or the level. On failure (out of memory) *bvh is
+ * empty and the spheres may be part reordered: the scene can only be freed;
+ * err (which may be NULL) says so. */
 PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int threads,
                         PtrCpuLevel level, PtrError *err);
 

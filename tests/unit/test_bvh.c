@@ -18,8 +18,8 @@
 #include "test.h"
 
 /* A tree over all of s's spheres on this many threads (0: one per CPU),
- * at the CPU level in force (PTR_CPUMASK caps it; test_tree_bytes builds
- * at every level). */
+ * at the CPU level in force (PTR_CPUMASK caps it; test_tree_bytes and
+ * test_split_boxes build with each binning). */
 static void build_tree(PtrBvh *bvh, PtrSpheres *s, int threads)
 {
     CHECK_INT(ptr_bvh_build(bvh, s, s->count, threads, ptr_cpu_level(), NULL), PTR_OK);
