@@ -153,6 +153,15 @@ typedef struct Worker {
     BvhSortRoom sort; /* for the largest range planned */
 } Worker;
 
+/* The build's prims set, over other prims (a node's samples): the same
+ * magnitude and binning. */
+static BvhPrimSet set_over(const Build *build, BvhPrim *prims)
+{
+    BvhPrimSet set = build->set;
+    set.prims = prims;
+    return set;
+}
+
 /* A thread's scratch and samples, made for its first node: whether there
  * is memory for them. */
 static int worker_ready(Worker *w)
@@ -391,7 +400,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
     const size_t n = range->end - range->begin, most = PTR_BVH_WIDTH * PLAN_SAMPLES;
     const size_t m = n / PLAN_SHARE < most ? n / PLAN_SHARE : most;
     take_samples(build->set.prims + range->begin, n, m, w->samples);
-    const BvhPrimSet samples = { w->samples, build->set.magnitude, build->set.bin };
+    const BvhPrimSet samples = set_over(build, w->samples);
     BvhChildren split = *plan;
     bvh_split_children(&samples, 0, m, &split, NULL, &w->sort);
     for (int k = 0; k < plan->count; k++) {
@@ -401,7 +410,7 @@ static int plan_below(Build *build, Worker *w, const BvhCandidate *range, int le
         BvhPrim *own = w->samples + split.begin[k];
         const size_t used = took < PLAN_SAMPLES ? took : PLAN_SAMPLES;
         take_samples(own, took, used, own); /* in place: sample j is at j or after */
-        const BvhPrimSet child_samples = { own, build->set.magnitude, build->set.bin };
+        const BvhPrimSet child_samples = set_over(build, own);
         const double child_per_prim = (double)n / (double)m * (double)took / (double)used;
         plan_children(&child_samples, used, level + 1, child_per_prim, w->scratch,
                       &grandchildren[k], NULL);
@@ -428,7 +437,7 @@ static PtrResult plan_node(Build *build, Worker *w, const BvhCandidate *range, i
 {
     const size_t n = range->end - range->begin;
     const size_t m = n / PLAN_SHARE < PLAN_SAMPLES ? n / PLAN_SHARE : PLAN_SAMPLES;
-    const BvhPrimSet samples = { w->samples, build->set.magnitude, build->set.bin };
+    const BvhPrimSet samples = set_over(build, w->samples);
     take_samples(build->set.prims + range->begin, n, m, w->samples);
     BvhChildren plan;
     size_t sampled[PTR_BVH_WIDTH];

@@ -119,10 +119,14 @@ int check_bvh_bin(uint64_t seed, int *passed)
     const PtrCpuLevel top = ptr_cpu_level();
     BvhBinKernel kernels[PTR_CPU_LEVEL_COUNT];
     uint64_t differ[PTR_CPU_LEVEL_COUNT][KIND_COUNT] = { { 0 } };
-    int any = 0;
+    /* The levels checked: those whose kernel is neither c nor the one
+     * below's. */
+    int checked[PTR_CPU_LEVEL_COUNT] = { 0 }, any = 0;
     for (int l = PTR_CPU_NONE; l <= (int)top; l++) {
         kernels[l] = bvh_bin_for_level((PtrCpuLevel)l);
-        any |= kernels[l].bin != bvh_bin_c;
+        checked[l] = kernels[l].bin != bvh_bin_c &&
+                     (l == PTR_CPU_NONE || kernels[l].bin != kernels[l - 1].bin);
+        any |= checked[l];
     }
     if (!any) {
         printf("bvh_bin: no kernel but c at CPU level %s\n", ptr_cpu_level_name(top));
@@ -130,7 +134,6 @@ int check_bvh_bin(uint64_t seed, int *passed)
     }
     static BvhPrim prims[PRIMS_MAX];
     static BvhBins ref, got;
-    /* A level whose kernel is the one below's is not checked again. */
     PtrRng rng = ptr_rng_for_sample(seed, 0, 34);
     for (int r = 0; r < RANGES; r++) {
         const Kind kind = (Kind)(r % KIND_COUNT);
@@ -142,7 +145,7 @@ int check_bvh_bin(uint64_t seed, int *passed)
         bvh_bins_clear(&c, &ref);
         bvh_bin_c(prims, count, magnitude, &c, &ref);
         for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-            if (kernels[l].bin == bvh_bin_c || kernels[l].bin == kernels[l - 1].bin)
+            if (!checked[l])
                 continue;
             guard(&got);
             bvh_bins_clear(&c, &got);
@@ -154,7 +157,7 @@ int check_bvh_bin(uint64_t seed, int *passed)
     }
     int failed = 0;
     for (int l = PTR_CPU_SSE41; l <= (int)top; l++) {
-        if (kernels[l].bin == bvh_bin_c || kernels[l].bin == kernels[l - 1].bin)
+        if (!checked[l])
             continue;
         uint64_t total = 0;
         for (int k = 0; k < KIND_COUNT; k++)

@@ -25,6 +25,15 @@ static void build_tree(PtrBvh *bvh, PtrSpheres *s, int threads)
     CHECK_INT(ptr_bvh_build(bvh, s, s->count, threads, ptr_cpu_level(), NULL), PTR_OK);
 }
 
+/* Whether the build's binning at this CPU level is another kernel than the
+ * level below's: the tests that build with each binning build once a
+ * kernel. */
+static int binning_is_new(int level)
+{
+    return level == PTR_CPU_NONE || bvh_bin_for_level((PtrCpuLevel)level).bin !=
+                                        bvh_bin_for_level((PtrCpuLevel)(level - 1)).bin;
+}
+
 /* Gives every sphere of s a colour that is its position in the file (the
  * colours move with the spheres), for the checks below to read back. */
 static void tag_file_order(PtrScene *s)
@@ -674,9 +683,9 @@ static void test_split_boxes(void)
     PtrRng rng = ptr_rng_for_sample(11, 0, 0);
     int splits = 0;
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
-        const BvhPrimSet set = { prims, magnitude, bvh_bin_for_level((PtrCpuLevel)level).bin };
-        if (level > PTR_CPU_NONE && set.bin == bvh_bin_for_level((PtrCpuLevel)(level - 1)).bin)
+        if (!binning_is_new(level))
             continue;
+        const BvhPrimSet set = { prims, magnitude, bvh_bin_for_level((PtrCpuLevel)level).bin };
         for (int n = 0; n < 300; n++) {
             const size_t count = 17 + ptr_rng_next(&rng) % (MAX - 16);
             for (size_t i = 0; i < count; i++) {
@@ -807,8 +816,7 @@ static void test_tree_bytes(void)
      * kernel), the tree the same. */
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++)
         for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
-            if (level > PTR_CPU_NONE && bvh_bin_for_level((PtrCpuLevel)level).bin ==
-                                            bvh_bin_for_level((PtrCpuLevel)(level - 1)).bin)
+            if (!binning_is_new(level))
                 break;
             PtrScene s;
             ptr_scene_init(&s);
