@@ -760,9 +760,10 @@ static PtrResult join_parts(Build *build, NodeArray *top, PtrError *err)
  * on the calling thread: glibc's malloc_trim on two threads at once is not
  * safe where another allocator serves malloc, as under AddressSanitizer.)
  * A batch's nodes go on the pages of the arrays the batch before copied
- * (a page bank, as in write_back): faulted in afresh, the tree's 500 MB at
- * 10^8 spheres took 122,000 faults. (Batches of 32 MB laid out 10^8
- * spheres' nodes in no less time.) */
+ * (the first batch's on those of the prims, which the write-back left in the
+ * bank): faulted in afresh, the tree's 500 MB at 10^8 spheres took 122,000
+ * faults. (Batches of 32 MB laid out 10^8 spheres' nodes in no less
+ * time.) */
 enum { TRIM_BYTES = 8 << 20 };
 
 typedef struct LayOut {
@@ -781,8 +782,10 @@ static void lay_out_tasks(void *arg, size_t begin, size_t end)
 }
 
 /* One node array: the top level's first, then each task's, with every task
- * reference and every inner child index moved to its final place. */
-static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *err)
+ * reference and every inner child index moved to its final place, on pages
+ * from bank (see TRIM_BYTES). */
+static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrPageBank *bank,
+                         PtrError *err)
 {
     size_t *start = malloc((build->tasks.count + 1) * sizeof *start);
     if (!start)
@@ -799,23 +802,25 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
     }
     memcpy(nodes, top->nodes, top->count * sizeof *nodes);
     LayOut l = { build, nodes, start };
-    PtrPageBank bank = { 0 };
     Task *tasks = build->tasks.tasks;
     const size_t count = build->tasks.count;
     for (size_t first = 0; first < count;) {
         size_t last = first, bytes = 0;
         while (last < count && bytes < TRIM_BYTES)
             bytes += tasks[last++].nodes.count * sizeof *nodes;
-        if (!ptr_pages_take(&bank, nodes, start[first] * sizeof *nodes,
+        if (!ptr_pages_take(bank, nodes, start[first] * sizeof *nodes,
                             (start[last - 1] + tasks[last - 1].nodes.count) * sizeof *nodes)) {
-            ptr_pages_free(&bank);
             free(start);
             free(nodes);
             return bvh_out_of_memory(err);
         }
+        /* Of the prims' pages (write_back), those the first batch did not
+         * take go back: the tree is not to be in memory more than once. */
+        if (first == 0)
+            ptr_pages_free(bank);
         ptr_parallel_ranges(build->threads, first, last, lay_out_tasks, &l);
         for (size_t i = first; i < last; i++) {
-            ptr_pages_put(last < count ? &bank : NULL, tasks[i].nodes.nodes, 0,
+            ptr_pages_put(last < count ? bank : NULL, tasks[i].nodes.nodes, 0,
                           tasks[i].nodes.count * sizeof *nodes);
             free(tasks[i].nodes.nodes);
             tasks[i].nodes.nodes = NULL;
@@ -823,7 +828,6 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrError *er
         malloc_trim(0);
         first = last;
     }
-    ptr_pages_free(&bank);
     /* The depth of the top level counts a task as one level; add the rest. */
     int depth = 0;
     for (size_t j = 0; j < top->count; j++)
@@ -859,28 +863,29 @@ static void write_spheres(void *arg, size_t begin, size_t end)
  * the tree's order: a sequential write where a gather would read 10^8
  * scattered entries (but for the material and attributes of a scene whose
  * prims hold places: see bvh_rest_aside). Each step's spheres go on the
- * pages of the prims the step before read, so that the two copies are never
- * both whole, and the arrays' pages are not faulted in afresh. Frees the
- * prims. Fails only for memory, where the kernel lost pages it moved
- * (ptr_pages_take). */
+ * pages of the prims the step before read (the first step's on those of the
+ * spheres ptr_bvh_prims copied last), so that the two copies are never both
+ * whole, and the arrays' pages are not faulted in afresh; bank keeps the
+ * last prims' pages for the nodes. Frees the prims. Fails only for memory,
+ * where the kernel lost pages it moved (ptr_pages_take). */
 static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, size_t first,
-                            const PtrSpheres *aside, int threads, PtrError *err)
+                            const PtrSpheres *aside, int threads, PtrPageBank *bank,
+                            PtrError *err)
 {
     SphereWrite w = { s, prims, first, aside };
-    PtrPageBank bank = { 0 };
     PtrResult r = PTR_OK;
     for (size_t begin = 0; begin < prim_count; begin += PTR_PAGE_STEP) {
         const size_t end = prim_count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP
                                                               : prim_count;
-        if (!ptr_spheres_take_pages(s, &bank, first + begin, first + end)) {
+        if (!ptr_spheres_take_pages(s, bank, first + begin, first + end)) {
             r = bvh_out_of_memory(err);
             break;
         }
         ptr_parallel_ranges(threads, begin, end, write_spheres, &w);
-        ptr_pages_put(end < prim_count ? &bank : NULL, prims, begin * sizeof *prims,
-                      end * sizeof *prims);
+        if (end == prim_count) /* as in ptr_bvh_prims */
+            ptr_pages_free(bank);
+        ptr_pages_put(bank, prims, begin * sizeof *prims, end * sizeof *prims);
     }
-    ptr_pages_free(&bank);
     free(prims);
     return r;
 }
@@ -913,7 +918,11 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     Build build = { .threads = ptr_thread_count(threads),
                     .set.bin = bvh_bin_for_level(level).bin };
     /* The prims and huge take the tree's spheres, whose pages the scene's
-     * arrays give up meanwhile; the spheres after them stay. */
+     * arrays give up meanwhile; the spheres after them stay. Pages go from
+     * one stage's arrays to the next's through the spheres' spare pages:
+     * the import's last to the prims, the spheres' to the arrays written
+     * back, the prims' to the nodes. */
+    PtrPageBank *pages = ptr_spheres_spare_pages(spheres);
     BvhPrim huge[PTR_HUGE_MAX];
     size_t huge_index[PTR_HUGE_MAX];
     BvhChildren root;
@@ -937,7 +946,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
                       &root, err);
     if (r == PTR_OK)
         r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
-                          build.set.prims, &prim_count, &build.set.magnitude, err);
+                          build.set.prims, &prim_count, &build.set.magnitude, pages, err);
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
@@ -972,7 +981,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     }
     if (r == PTR_OK) {
         r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, gather,
-                       build.threads, err);
+                       build.threads, pages, err);
         build.set.prims = NULL;
     }
     if (r == PTR_OK) {
@@ -988,7 +997,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     /* Laying the tree out in one array needs memory of its own: it comes
      * once the prims are gone. */
     if (r == PTR_OK && prim_count > 0)
-        r = lay_out(&build, &top, bvh, err);
+        r = lay_out(&build, &top, bvh, pages, err);
+    ptr_spheres_spare_free(spheres);
     worker_free(&w);
     free_tasks(&build.tasks);
     for (size_t i = 0; i < build.part_count; i++) {

@@ -456,7 +456,8 @@ static void copy_blocks(void *arg, size_t begin, size_t end)
 
 PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
                         size_t huge_count, BvhChildren *children, BvhPrim *prims,
-                        size_t *prim_count, float *magnitude_out, PtrError *err)
+                        size_t *prim_count, float *magnitude_out, PtrPageBank *bank,
+                        PtrError *err)
 {
     *prim_count = s->count - huge_count;
     *magnitude_out = 0.0f;
@@ -493,22 +494,24 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
         for (size_t b = 0; b < blocks; b++)
             r.tree_magnitude = ptr_maxf(r.magnitude[b], r.tree_magnitude);
         /* Each step's prims on the pages of the spheres the step before
-         * copied. */
-        PtrPageBank bank = { 0 };
+         * copied (the first's on those bank holds). */
         const size_t step_blocks = PTR_PAGE_STEP / BLOCK;
         for (size_t first = 0; first < blocks && res == PTR_OK; first += step_blocks) {
             const size_t last = blocks - first > step_blocks ? first + step_blocks : blocks;
             for (int k = 0; k < children->count && res == PTR_OK; k++)
-                if (!ptr_pages_take(&bank, prims, r.place[first][k] * sizeof *prims,
+                if (!ptr_pages_take(bank, prims, r.place[first][k] * sizeof *prims,
                                     r.place[last][k] * sizeof *prims))
                     res = bvh_out_of_memory(err);
             if (res != PTR_OK)
                 break;
             ptr_parallel_ranges(threads, first, last, copy_blocks, &r);
             const size_t end = last * (size_t)BLOCK < s->count ? last * (size_t)BLOCK : s->count;
-            ptr_spheres_release(s, end < s->count ? &bank : NULL, first * (size_t)BLOCK, end);
+            /* The write-back's first step takes no more than the last
+             * step's pages: what the steps before left goes back. */
+            if (end == s->count)
+                ptr_pages_free(bank);
+            ptr_spheres_release(s, bank, first * (size_t)BLOCK, end);
         }
-        ptr_pages_free(&bank);
     }
     if (res == PTR_OK) {
         for (int k = 0; k < children->count; k++) {

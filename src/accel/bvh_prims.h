@@ -173,17 +173,19 @@ size_t ptr_bvh_samples(const PtrSpheres *spheres, int threads, const size_t *hug
  * in the tree, which bounds both the spheres' and the rays' origins (the
  * camera sits at 0, other rays start on spheres) and so scales the boxes'
  * padding. Gives up the spheres' memory as it goes (ptr_spheres_release),
- * its pages moved under the next prims: on success the prims and the huge
- * spheres hold the only copy of spheres 0 .. count - 1 but their values
- * (and but their material and attributes where bvh_rest_aside set them
- * aside).
+ * through bank: the first prims go on pages it holds, the next on those of
+ * the spheres copied before them, and it keeps the last spheres' for the
+ * write-back. On success the prims and the huge spheres hold the only copy
+ * of spheres 0 .. count - 1 but their values (and but their material and
+ * attributes where bvh_rest_aside set them aside).
  * Counts and copies on this many threads; the prims' order does not depend
  * on their number. Fails only for memory: the spheres untouched, but where
  * the kernel ran out of memory moving pages (ptr_pages_take), when some are
  * already given up, as they are where the build fails after this. */
 PtrResult ptr_bvh_prims(PtrSpheres *spheres, int threads, const size_t *huge_index,
                         size_t huge_count, BvhChildren *children, BvhPrim *prims,
-                        size_t *prim_count, float *magnitude, PtrError *err);
+                        size_t *prim_count, float *magnitude, PtrPageBank *bank,
+                        PtrError *err);
 
 /* Fails for memory the tree's build cannot have: every failure of the
  * build's functions is this one. (The code returned as a constant, so the

@@ -62,13 +62,15 @@ void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to);
  * base[from .. to - 1], as many as it has and while it may still move them,
  * for a caller that writes every byte of the range before reading any: a
  * page taken from the bank holds what its last array left there. The rest
- * stay as they were. A move the kernel refuses gives the bank's pages back
- * and stops it. Returns 0 only where the kernel ran out of memory in the
- * middle of a move and the range could not be mapped again: then the caller
- * must not write it, and fails for memory. */
+ * stay as they were (all of them where bank is NULL). A move the kernel
+ * refuses gives the bank's pages back and stops it. Returns 0 only where the
+ * kernel ran out of memory in the middle of a move and the range could not
+ * be mapped again: then the caller must not write it, and fails for
+ * memory. */
 int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to);
 
-/* Gives back the pages bank still holds; it is empty afterwards. */
+/* Gives back the pages bank still holds (none where it is NULL); it is
+ * empty afterwards. */
 void ptr_pages_free(PtrPageBank *bank);
 
 #endif /* PTR_MEMORY_H */

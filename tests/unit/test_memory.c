@@ -182,6 +182,18 @@ static void test_bank_moves_pages(void)
     munmap(to.map, (PAGES + 2) * page);
 }
 
+/* No bank (NULL, as where the spheres' could not be made): a take leaves
+ * its range as it was, every page and byte, and a free does nothing. */
+static void test_no_bank(void)
+{
+    const size_t page = page_size();
+    Buffer b = buffer_make();
+    CHECK_INT(ptr_pages_take(NULL, b.data, 0, b.bytes), 1);
+    check_released(&b, 0, 0, 0, "taken from no bank");
+    ptr_pages_free(NULL);
+    munmap(b.map, (PAGES + 2) * page);
+}
+
 /* An array filled from a bank is one mapping for each run it took: putting
  * a range across them banks every page still, and the pages travel on. */
 static void test_bank_across_mappings(void)
@@ -654,6 +666,7 @@ int main(void)
         TEST_CASE(test_release_whole_pages_only),
         TEST_CASE(test_release_in_steps),
         TEST_CASE(test_bank_moves_pages),
+        TEST_CASE(test_no_bank),
         TEST_CASE(test_bank_across_mappings),
         TEST_CASE(test_bank_limit),
         TEST_CASE(test_bank_moves_limit),
