@@ -833,11 +833,11 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
     SphereMove move = { .builder = b, .origin = origin, .huge = huge, .huge_count = huge_count };
     atomic_init(&move.invalid, 0);
     const int threads = ptr_usable_cpus();
-    /* Each step's spheres on the pages of those the step before moved. */
-    PtrPageBank *bank = ptr_spheres_spare_pages(&scene->spheres);
+    PtrPageBank bank = { 0 };
     for (size_t begin = 0; begin < count && res == PTR_OK; begin += PTR_PAGE_STEP) {
         const size_t end = count - begin > PTR_PAGE_STEP ? begin + PTR_PAGE_STEP : count;
-        if (!ptr_spheres_take_pages(&scene->spheres, bank,
+        /* Each step's spheres on the pages of those the step before moved. */
+        if (!ptr_spheres_take_pages(&scene->spheres, &bank,
                                     begin - ptr_huge_before(huge, huge_count, begin),
                                     end - ptr_huge_before(huge, huge_count, end))) {
             res = ptr_error_set(err, PTR_ERR_NOMEM, "out of memory moving the spheres");
@@ -847,13 +847,9 @@ static PtrResult add_spheres(PtrSceneBuilder *b, Radii radii, const double origi
         if (atomic_load(&move.invalid))
             res = ptr_error_set(err, PTR_ERR_SCENE_INVALID,
                                 "a sphere lies too far from the camera for single precision");
-        /* The last step's pages stay for the tree's build (see
-         * PtrSpheres.spare_pages), whose first step takes no more; what the
-         * steps before left goes back now. */
-        if (end == count)
-            ptr_pages_free(bank);
-        put_pages(b, bank, begin, end);
+        put_pages(b, end < count ? &bank : NULL, begin, end);
     }
+    ptr_pages_free(&bank);
     if (res == PTR_OK)
         scene->huge.count = huge_count;
     return res;

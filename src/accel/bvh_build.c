@@ -814,8 +814,8 @@ static PtrResult lay_out(Build *build, NodeArray *top, PtrBvh *bvh, PtrPageBank 
             free(nodes);
             return bvh_out_of_memory(err);
         }
-        /* Of the prims' pages (write_back), those the first batch did not
-         * take go back: the tree is not to be in memory more than once. */
+        /* The prims' pages (write_back) the first batch did not take go
+         * back: the layout holds no more than its batch beyond the tree. */
         if (first == 0)
             ptr_pages_free(bank);
         ptr_parallel_ranges(build->threads, first, last, lay_out_tasks, &l);
@@ -882,7 +882,7 @@ static PtrResult write_back(PtrSpheres *s, BvhPrim *prims, size_t prim_count, si
             break;
         }
         ptr_parallel_ranges(threads, begin, end, write_spheres, &w);
-        if (end == prim_count) /* as in ptr_bvh_prims */
+        if (end == prim_count) /* the layout gets one step's pages, as this did */
             ptr_pages_free(bank);
         ptr_pages_put(bank, prims, begin * sizeof *prims, end * sizeof *prims);
     }
@@ -918,11 +918,11 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     Build build = { .threads = ptr_thread_count(threads),
                     .set.bin = bvh_bin_for_level(level).bin };
     /* The prims and huge take the tree's spheres, whose pages the scene's
-     * arrays give up meanwhile; the spheres after them stay. Pages go from
-     * one stage's arrays to the next's through the spheres' spare pages:
-     * the import's last to the prims, the spheres' to the arrays written
-     * back, the prims' to the nodes. */
-    PtrPageBank *pages = ptr_spheres_spare_pages(spheres);
+     * arrays give up meanwhile; the spheres after them stay. One bank of
+     * pages goes from stage to stage: the spheres' pages under the prims and
+     * then under the arrays written back, the prims' under those arrays and
+     * then under the nodes. */
+    PtrPageBank bank = { 0 };
     BvhPrim huge[PTR_HUGE_MAX];
     size_t huge_index[PTR_HUGE_MAX];
     BvhChildren root;
@@ -946,7 +946,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
                       &root, err);
     if (r == PTR_OK)
         r = ptr_bvh_prims(&tree_part, build.threads, huge_index, bvh->huge_count, &root,
-                          build.set.prims, &prim_count, &build.set.magnitude, pages, err);
+                          build.set.prims, &prim_count, &build.set.magnitude, &bank, err);
     build.first_sphere = bvh->huge_count;
     build.task_spheres = prim_count / TASKS_PER_TREE > TASK_SPHERES_MIN
                              ? prim_count / TASKS_PER_TREE : TASK_SPHERES_MIN;
@@ -981,7 +981,7 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     }
     if (r == PTR_OK) {
         r = write_back(spheres, build.set.prims, prim_count, bvh->huge_count, gather,
-                       build.threads, pages, err);
+                       build.threads, &bank, err);
         build.set.prims = NULL;
     }
     if (r == PTR_OK) {
@@ -997,8 +997,8 @@ PtrResult ptr_bvh_build(PtrBvh *bvh, PtrSpheres *spheres, size_t count, int thre
     /* Laying the tree out in one array needs memory of its own: it comes
      * once the prims are gone. */
     if (r == PTR_OK && prim_count > 0)
-        r = lay_out(&build, &top, bvh, pages, err);
-    ptr_spheres_spare_free(spheres);
+        r = lay_out(&build, &top, bvh, &bank, err);
+    ptr_pages_free(&bank);
     worker_free(&w);
     free_tasks(&build.tasks);
     for (size_t i = 0; i < build.part_count; i++) {

@@ -494,7 +494,7 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
         for (size_t b = 0; b < blocks; b++)
             r.tree_magnitude = ptr_maxf(r.magnitude[b], r.tree_magnitude);
         /* Each step's prims on the pages of the spheres the step before
-         * copied (the first's on those bank holds). */
+         * copied. */
         const size_t step_blocks = PTR_PAGE_STEP / BLOCK;
         for (size_t first = 0; first < blocks && res == PTR_OK; first += step_blocks) {
             const size_t last = blocks - first > step_blocks ? first + step_blocks : blocks;
@@ -506,8 +506,10 @@ PtrResult ptr_bvh_prims(PtrSpheres *s, int threads, const size_t *huge_index,
                 break;
             ptr_parallel_ranges(threads, first, last, copy_blocks, &r);
             const size_t end = last * (size_t)BLOCK < s->count ? last * (size_t)BLOCK : s->count;
-            /* The write-back's first step takes no more than the last
-             * step's pages: what the steps before left goes back. */
+            /* The last step's pages stay in the bank, for the write-back's
+             * first step, which would fault in as many; what the steps
+             * before left goes back, so that the bank holds no more than
+             * that while the tree is built. */
             if (end == s->count)
                 ptr_pages_free(bank);
             ptr_spheres_release(s, bank, first * (size_t)BLOCK, end);

@@ -173,11 +173,11 @@ size_t ptr_bvh_samples(const PtrSpheres *spheres, int threads, const size_t *hug
  * in the tree, which bounds both the spheres' and the rays' origins (the
  * camera sits at 0, other rays start on spheres) and so scales the boxes'
  * padding. Gives up the spheres' memory as it goes (ptr_spheres_release),
- * through bank: the first prims go on pages it holds, the next on those of
- * the spheres copied before them, and it keeps the last spheres' for the
- * write-back. On success the prims and the huge spheres hold the only copy
- * of spheres 0 .. count - 1 but their values (and but their material and
- * attributes where bvh_rest_aside set them aside).
+ * through bank (empty when called): each step's prims go on the pages of
+ * the spheres copied the step before, and the last step's stay in bank for
+ * the write-back. On success the prims and the huge spheres hold the only
+ * copy of spheres 0 .. count - 1 but their values (and but their material
+ * and attributes where bvh_rest_aside set them aside).
  * Counts and copies on this many threads; the prims' order does not depend
  * on their number. Fails only for memory: the spheres untouched, but where
  * the kernel ran out of memory moving pages (ptr_pages_take), when some are

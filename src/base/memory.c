@@ -206,7 +206,7 @@ int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
 {
     uintptr_t lo, hi;
     pages_in(base, from, to, 0, &lo, &hi);
-    while (bank && lo < hi && bank->first < bank->runs && bank_open(bank)) {
+    while (lo < hi && bank->first < bank->runs && bank_open(bank)) {
         struct PtrPageRun *run = &bank->run[bank->first];
         const size_t n = run->bytes < hi - lo ? run->bytes : hi - lo;
         /* The oldest run's first n bytes (the rest stays one mapping):
@@ -243,9 +243,7 @@ int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to)
 
 void ptr_pages_free(PtrPageBank *bank)
 {
-    if (!bank)
-        return;
     for (size_t k = bank->first; k < bank->runs; k++)
         munmap(bank->run[k].at, bank->run[k].bytes);
-    bank->first = bank->runs = bank->bytes = 0;
+    *bank = (PtrPageBank){ 0 };
 }

@@ -62,15 +62,16 @@ void ptr_pages_put(PtrPageBank *bank, void *base, size_t from, size_t to);
  * base[from .. to - 1], as many as it has and while it may still move them,
  * for a caller that writes every byte of the range before reading any: a
  * page taken from the bank holds what its last array left there. The rest
- * stay as they were (all of them where bank is NULL). A move the kernel
- * refuses gives the bank's pages back and stops it. Returns 0 only where the
- * kernel ran out of memory in the middle of a move and the range could not
- * be mapped again: then the caller must not write it, and fails for
- * memory. */
+ * stay as they were. A move the kernel refuses gives the bank's pages back
+ * and stops it. Returns 0 only where the kernel ran out of memory in the
+ * middle of a move and the range could not be mapped again: then the caller
+ * must not write it, and fails for memory. */
 int ptr_pages_take(PtrPageBank *bank, void *base, size_t from, size_t to);
 
-/* Gives back the pages bank still holds (none where it is NULL); it is
- * empty afterwards. */
+/* Gives back the pages bank still holds; it is then as a new one, and
+ * sets its ceiling of mappings afresh at its next count (see bank_open in
+ * memory.c): a bank carried from one stage to the next, given back between
+ * them, allows each stage what a bank of its own would. */
 void ptr_pages_free(PtrPageBank *bank);
 
 #endif /* PTR_MEMORY_H */

@@ -80,7 +80,6 @@ static void spheres_free(PtrSpheres *s)
     int arrays = sphere_arrays(s, a);
     for (int k = 0; k < arrays; k++)
         free(*a[k].data);
-    ptr_spheres_spare_free(s);
     *s = (PtrSpheres){ .material_size = s->material_size };
 }
 
@@ -170,8 +169,6 @@ static PtrResult spheres_grow(PtrSpheres *s, size_t count, size_t pad_from, PtrE
     PtrResult r = spheres_copy(s, capacity_for(count), pad_from, &grown, err);
     if (r != PTR_OK)
         return r;
-    grown.spare_pages = s->spare_pages;
-    s->spare_pages = NULL;
     spheres_free(s);
     *s = grown;
     return PTR_OK;
@@ -201,20 +198,6 @@ void ptr_spheres_release(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t 
     for (int k = 0; k < arrays; k++)
         if (a[k].moves && *a[k].data)
             ptr_pages_put(bank, *a[k].data, begin * a[k].size, end * a[k].size);
-}
-
-PtrPageBank *ptr_spheres_spare_pages(PtrSpheres *s)
-{
-    if (!s->spare_pages)
-        s->spare_pages = calloc(1, sizeof *s->spare_pages);
-    return s->spare_pages;
-}
-
-void ptr_spheres_spare_free(PtrSpheres *s)
-{
-    ptr_pages_free(s->spare_pages);
-    free(s->spare_pages);
-    s->spare_pages = NULL;
 }
 
 int ptr_spheres_take_pages(PtrSpheres *s, PtrPageBank *bank, size_t begin, size_t end)

@@ -74,15 +74,6 @@ typedef struct PtrSpheres {
     size_t count;        /* spheres in use */
     size_t capacity;     /* allocated, a multiple of PTR_SPHERE_BLOCK */
     size_t material_size; /* 1, 2 or 4 (see material) */
-    /* Pages the arrays these spheres were last copied between gave up,
-     * for the next ones written from them: the import's builder leaves its
-     * last step's here (PTR_PAGE_STEP spheres' at most) for the tree's
-     * prims, whose build moves the spheres' under the arrays in the tree's
-     * order and the prims' under the nodes (ptr_pages_take), where each
-     * stage would give them back and fault fresh ones in (at 10^6 spheres,
-     * 12,500 of the run's 27,200 faults). Given back by the tree's build,
-     * or with the arrays. NULL: none (see ptr_spheres_spare_pages). */
-    PtrPageBank *spare_pages;
 } PtrSpheres;
 
 typedef enum PtrMaterialKind {
@@ -229,14 +220,6 @@ PtrResult ptr_spheres_resize(PtrSpheres *spheres, size_t count, PtrError *err);
  * itself). Called as the copy grows, each begin the last call's end; the
  * entries read as zero until written again. */
 void ptr_spheres_release(PtrSpheres *spheres, PtrPageBank *bank, size_t begin, size_t end);
-
-/* The spheres' spare pages (spare_pages), the bank made if they have none:
- * NULL only where it cannot be (out of memory), which the ptr_pages_
- * functions take as no bank. */
-PtrPageBank *ptr_spheres_spare_pages(PtrSpheres *spheres);
-
-/* Gives the spheres' spare pages back to the machine. */
-void ptr_spheres_spare_free(PtrSpheres *spheres);
 
 /* Puts pages from bank under the entries of spheres begin .. end - 1 in the
  * arrays every store of a sphere writes (all but id and value; see

@@ -6,15 +6,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include "accel/accel.h"
 #include "accel/bvh.h"
 #include "accel/bvh_split.h"
 #include "accel/isect.h"
 #include "base/memory.h"
-#include "builder.h"
 #include "bvh_scenes.h"
 #include "importer.h"
 #include "render/render.h"
@@ -900,114 +897,6 @@ static void check_same_render(PtrScene *brute, PtrScene *tree, int width, int he
     free(y);
 }
 
-/* A cloud of n spheres through the builder, as an importer makes one. */
-static void import_cloud(PtrScene *scene, size_t n)
-{
-    ptr_scene_init(scene);
-    const PtrMaterial grey = { .kind = PTR_MATERIAL_DIFFUSE, .albedo = { 0.5f, 0.5f, 0.5f } };
-    uint32_t material;
-    CHECK_INT(ptr_scene_add_material(scene, &grey, &material, NULL), PTR_OK);
-    PtrSceneBuilder b;
-    ptr_builder_init(&b, scene, NULL);
-    CHECK_INT(ptr_builder_reserve(&b, n, NULL), PTR_OK);
-    PtrRng rng = ptr_rng_for_sample(11, 0, 0);
-    for (size_t i = 0; i < n; i++) {
-        const double centre[3] = { bvh_uniform(&rng, -50.0f, 50.0f),
-                                   bvh_uniform(&rng, -50.0f, 50.0f),
-                                   bvh_uniform(&rng, -50.0f, 50.0f) };
-        CHECK_INT(ptr_builder_add_sphere(&b, centre, bvh_uniform(&rng, 0.05f, 0.2f), material,
-                                         NULL), PTR_OK);
-    }
-    CHECK_INT(ptr_builder_finish(&b, PTR_BUILD_DEFAULT, NULL), PTR_OK);
-}
-
-enum { SPARE_TEST_SPHERES = 300000 };
-
-/* This program run as "test_bvh --build-faults KEEP": prints the minor
- * faults of a build of the cloud of SPARE_TEST_SPHERES, the import's spare
- * pages kept (KEEP 1) or given back first (0), in a process of its own so
- * that what the heap kept of other cases counts for neither. */
-static int print_build_faults(int keep_spare)
-{
-    PtrScene scene;
-    import_cloud(&scene, SPARE_TEST_SPHERES);
-    if (!keep_spare)
-        ptr_spheres_spare_free(&scene.spheres);
-    PtrBvh bvh;
-    struct rusage before, after;
-    getrusage(RUSAGE_SELF, &before);
-    if (ptr_bvh_build(&bvh, &scene.spheres, SPARE_TEST_SPHERES, 2, ptr_cpu_level(), NULL) !=
-        PTR_OK)
-        return 1;
-    getrusage(RUSAGE_SELF, &after);
-    printf("%ld\n", after.ru_minflt - before.ru_minflt);
-    ptr_bvh_free(&bvh);
-    ptr_scene_free(&scene);
-    return 0;
-}
-
-/* What print_build_faults prints, run by this program; -1 if it failed. */
-static long build_faults(int keep_spare)
-{
-    char command[64];
-    snprintf(command, sizeof command, "/proc/%ld/exe --build-faults %d", (long)getpid(),
-             keep_spare);
-    FILE *p = popen(command, "r");
-    long faults = -1;
-    if (!p || fscanf(p, "%ld", &faults) != 1)
-        faults = -1;
-    if (p && pclose(p) != 0)
-        faults = -1;
-    return faults;
-}
-
-/* The import leaves its last pages to the spheres (spare_pages), and the
- * build moves them and its own from stage to stage, then gives them back:
- * the same tree and arrays as a build without the import's, and the prims
- * take the import's pages where they would fault in as many fresh ones.
- * (Where pages fault in more than one at a time, as transparent huge pages
- * do, the faults are not counted.) */
-static void test_spare_pages(void)
-{
-    enum { N = SPARE_TEST_SPHERES };
-    PtrScene with, without;
-    import_cloud(&with, N);
-    import_cloud(&without, N);
-    const PtrPageBank *spare = with.spheres.spare_pages;
-    CHECK(spare && spare->bytes > 0 && spare->bytes <= PTR_PAGE_BANK_BYTES);
-    const long page = sysconf(_SC_PAGESIZE);
-    const long spare_pages = spare ? (long)(spare->bytes / (size_t)page) : 0;
-    ptr_spheres_spare_free(&without.spheres);
-    CHECK(!without.spheres.spare_pages);
-    PtrBvh a, b;
-    CHECK_INT(ptr_bvh_build(&a, &with.spheres, N, 2, ptr_cpu_level(), NULL), PTR_OK);
-    CHECK_INT(ptr_bvh_build(&b, &without.spheres, N, 2, ptr_cpu_level(), NULL), PTR_OK);
-    CHECK(!with.spheres.spare_pages && !without.spheres.spare_pages);
-    CHECK(a.node_count == b.node_count && a.depth == b.depth &&
-          !memcmp(a.nodes, b.nodes, a.node_count * sizeof *a.nodes));
-    const PtrSpheres *x = &with.spheres, *y = &without.spheres;
-    CHECK(!memcmp(x->cx, y->cx, N * sizeof *x->cx) && !memcmp(x->cy, y->cy, N * sizeof *x->cy) &&
-          !memcmp(x->cz, y->cz, N * sizeof *x->cz) &&
-          !memcmp(x->radius, y->radius, N * sizeof *x->radius) &&
-          !memcmp(x->material, y->material, N * x->material_size));
-    ptr_bvh_free(&a);
-    ptr_bvh_free(&b);
-    ptr_scene_free(&with);
-    ptr_scene_free(&without);
-
-    /* The prims (24 bytes a sphere) outweigh the import's last pages (the
-     * builder's 17 here), so the build takes every one of them. */
-    const long prim_pages = N * (long)sizeof(BvhPrim) / page;
-    CHECK(spare_pages < prim_pages);
-    const long kept = build_faults(1), given_back = build_faults(0);
-    CHECK(kept >= 0 && given_back >= 0);
-    if (given_back > prim_pages)
-        CHECK(kept + spare_pages * 9 / 10 < given_back);
-    else
-        printf("spare pages: faults not counted one page at a time (%ld and %ld)\n", kept,
-               given_back);
-}
-
 static void test_renders_files(void)
 {
     const char *files[] = { PTR_SOURCE_DIR "/scenes/seed.gltf", PTR_SOURCE_DIR "/scenes/final.gltf" };
@@ -1133,10 +1022,8 @@ static void test_coincident(void)
     }
 }
 
-int main(int argc, char **argv)
+int main(void)
 {
-    if (argc == 3 && !strcmp(argv[1], "--build-faults"))
-        return print_build_faults(atoi(argv[2]));
     const TestCase cases[] = {
         TEST_CASE(test_small),
         TEST_CASE(test_coincident),
@@ -1153,7 +1040,6 @@ int main(int argc, char **argv)
         TEST_CASE(test_two_levels_planned),
         TEST_CASE(test_tree_bytes),
         TEST_CASE(test_auto),
-        TEST_CASE(test_spare_pages),
         TEST_CASE(test_renders_files),
         TEST_CASE(test_renders_hard),
     };
