@@ -83,12 +83,7 @@ static inline int bvh_goes_right_at(const BvhSplitTest *t, float x)
     return (int)ptr_minf(ptr_maxf(k, 0.0f), t->last) > t->split_bin;
 }
 
-static inline int bvh_goes_right(const BvhSplitTest *t, const BvhPrim *p)
-{
-    return bvh_goes_right_at(t, p->centre[t->axis]);
-}
-
-/* Four bins at once, bvh_goes_right's arithmetic lane by lane: centre +
+/* Four bins at once, bvh_goes_right_at's arithmetic lane by lane: centre +
  * centre is 2 centre, and _mm_min_ps(a, b) and _mm_max_ps(a, b) are
  * ptr_minf(a, b) and ptr_maxf(a, b). */
 static inline __m128i bvh_bins4(__m128 centre, __m128 base, __m128 scale, __m128 last)
@@ -132,7 +127,7 @@ void bvh_child_lanes(const BvhChildren *children, BvhChildLanes *lanes);
 
 /* The children of four prims whose centres' x, y and z are centre[0], [1]
  * and [2], in child[0 .. 3]: each split moves the lanes in its source that
- * go right (bvh_goes_right's arithmetic, bvh_bins4). */
+ * go right (bvh_goes_right_at's arithmetic, bvh_bins4). */
 static inline void bvh_children4(const BvhChildLanes *l, const __m128 centre[3], uint8_t child[4])
 {
     __m128i in = _mm_setzero_si128();

@@ -121,7 +121,7 @@ void bvh_candidate_init(const BvhPrimSet *set, BvhCandidate *c, size_t begin, si
 BvhSplitTest bvh_split_test(const BvhCandidate *c);
 
 /* The least centre on the axis of c's best split that goes right by it:
- * bvh_goes_right's arithmetic is monotone in the centre (doubling,
+ * bvh_goes_right_at's arithmetic is monotone in the centre (doubling,
  * subtracting the base, multiplying by a scale above 0, clamping and
  * truncating each are), so a prim of c goes right exactly when its centre
  * is at least this. c's box must hold every centre of its prims (a prim's

@@ -6,8 +6,9 @@
  * of 0, corners exactly 0 (a centre equal to its extent or to minus it),
  * coordinates near FLT_MAX (whose doubled centres overflow to infinity), a
  * few centres repeated, and bins over a box the prims are not in. The bins
- * past the candidate's count hold a guard that must survive. The kernel is C built for AVX2, so no checked call: its calls
- * keep the ABI as the compiler makes them. */
+ * past the candidate's count hold a guard that must survive. The kernel is
+ * C built for AVX2, so no checked call: its calls keep the ABI as the
+ * compiler makes them. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>

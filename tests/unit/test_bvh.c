@@ -549,7 +549,8 @@ static int plan_child(const BvhChildren *plan, const BvhPrim *p)
 {
     int in = 0;
     for (int s = 1; s < plan->count; s++)
-        if (in == plan->source[s] && bvh_goes_right(&plan->test[s], p))
+        if (in == plan->source[s] &&
+            bvh_goes_right_at(&plan->test[s], p->centre[plan->test[s].axis]))
             in = s;
     return in;
 }
@@ -721,7 +722,7 @@ static void test_split_boxes(void)
 }
 
 /* bvh_split_children against the plan's splits made one at a time with
- * bvh_goes_right: every prim of a child goes there by the splits, in the
+ * bvh_goes_right_at: every prim of a child goes there by the splits, in the
  * order it came, the children tile the range in bvh_children_order's order,
  * each box is its prims' to the bit, and no prim is lost or copied. With
  * the children's own splits (below), each child's prims likewise go to its
