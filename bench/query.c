@@ -16,7 +16,17 @@
  * few grazing rays may disagree, and their count is printed.
  *
  * METHOD (a name of the table, "avx512", "embree user 16"...) times that one
- * alone, for a profile (bench/stages.sh).
+ * alone, for a profile (bench/stages.sh); Embree's trees are built only for
+ * its own methods (at 10^8 spheres they take gigabytes).
+ *
+ * METHOD "warmed" splits the one-ray traversal of this CPU's table three
+ * ways instead, each ray timed alone (fenced rdtsc, whose own cost is in
+ * all three): cold, as the renderer meets it; right after the C reference
+ * answered the same ray (its nodes and spheres in the cache, but this
+ * traversal's branches not trained on its path); and right after this
+ * traversal itself answered it (cache and branches warm). Cold minus the
+ * second is about the wait on memory; the second minus the third about
+ * the mispredicted branches; the third is the steps' work.
  *
  * Embree's geometries: its own spheres (RTC_GEOMETRY_TYPE_SPHERE_POINT, what
  * ../shared/peers/embree_pt.c traces with -m 1), and user geometry whose
@@ -159,6 +169,44 @@ static void time_ptr_as_asked(Method *m, const PtrAccel *accel, const PtrIsectTa
     keep_best(m, thread_seconds() - t0, sum);
 }
 
+/* "warmed" (see the head): nanoseconds a ray of the table's one-ray
+ * traversal cold, after the C reference answered the ray, and after the
+ * traversal itself did, each the best of runs. */
+static void print_warmed(const PtrAccel *accel, PtrBvhClosestHitFn reference,
+                         PtrBvhClosestHitFn traversal, int runs, double hz)
+{
+    static const char *const before[3] = { "cold", "after the C reference",
+                                           "after itself" };
+    uint64_t best[3] = { UINT64_MAX, UINT64_MAX, UINT64_MAX };
+    double sum = 0;
+    for (int run = 0; run < runs; run++) {
+        for (int way = 0; way < 3; way++) {
+            uint64_t ticks = 0;
+            for (size_t i = 0; i < recorded_count; i++) {
+                PtrHit hit;
+                if (way > 0)
+                    sum += (way == 1 ? reference : traversal)(&recorded[i], &accel->bvh,
+                                                              accel->spheres, &hit);
+                _mm_lfence();
+                const uint64_t t0 = __rdtsc();
+                _mm_lfence();
+                if (traversal(&recorded[i], &accel->bvh, accel->spheres, &hit))
+                    sum += hit.t;
+                _mm_lfence();
+                ticks += __rdtsc() - t0;
+            }
+            if (ticks < best[way])
+                best[way] = ticks;
+        }
+    }
+    printf("%-22s %9s %11s (checksum %.9g)\n", "one ray, timed alone", "ns/ray", "cycles/ray",
+           sum);
+    for (int way = 0; way < 3; way++)
+        printf("%-22s %9.1f %11.0f\n", before[way],
+               (double)best[way] / hz / (double)recorded_count * 1e9,
+               (double)best[way] / (double)recorded_count);
+}
+
 static void to_embree(const PtrRay *r, RTCRayHit *rh)
 {
     memset(rh, 0, sizeof *rh);
@@ -279,6 +327,88 @@ static RTCScene embree_scene(RTCDevice device, const PtrSpheres *s, size_t count
     return scene;
 }
 
+/* Every method (or the one named only), best of runs, against Embree's
+ * best, and how often Embree's answers differ from the C reference's. */
+static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const char *only,
+                    int runs)
+{
+    const int embree = !only || !strncmp(only, "embree", 6);
+    RTCDevice device = embree ? rtcNewDevice("threads=1") : NULL;
+    RTCScene points = embree ? embree_scene(device, accel->spheres, accel->spheres->count, 0) : NULL;
+    RTCScene user = embree ? embree_scene(device, accel->spheres, accel->spheres->count, 1) : NULL;
+
+    /* Every one-ray traversal of the ladder (a level that keeps the level
+     * below's is left out), the table as asked, and Embree's four ways. */
+    Method methods[PTR_CPU_LEVEL_COUNT + 5];
+    int n = 0;
+    PtrBvhClosestHitFn last = NULL;
+    for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
+        PtrIsectTable table;
+        ptr_isect_init_level(&table, (PtrCpuLevel)level);
+        if (table.bvh_closest_hit != last)
+            methods[n++] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level),
+                                     .kind = PTR_ONE_RAY, .traversal = last = table.bvh_closest_hit };
+    }
+    methods[n++] = (Method){ .name = "as asked", .kind = PTR_AS_ASKED };
+    methods[n++] = (Method){ .name = "embree point 1", .kind = EMBREE_POINT_1 };
+    methods[n++] = (Method){ .name = "embree point 16", .kind = EMBREE_POINT_16 };
+    methods[n++] = (Method){ .name = "embree user 1", .kind = EMBREE_USER_1 };
+    methods[n++] = (Method){ .name = "embree user 16", .kind = EMBREE_USER_16 };
+
+    float *embree_t = malloc(recorded_count * sizeof *embree_t);
+    for (int run = 0; run < runs; run++) {
+        for (int k = 0; k < n; k++) {
+            Method *m = &methods[k];
+            if (only && strcmp(only, m->name))
+                continue;
+            switch (m->kind) {
+            case PTR_ONE_RAY: time_ptr(m, accel, m->traversal); break;
+            case PTR_AS_ASKED: time_ptr_as_asked(m, accel, &recorded_table); break;
+            case EMBREE_POINT_1: time_embree1(m, points, NULL); break;
+            case EMBREE_POINT_16: time_embree16(m, points); break;
+            case EMBREE_USER_1: time_embree1(m, user, run == 0 ? embree_t : NULL); break;
+            case EMBREE_USER_16: time_embree16(m, user); break;
+            }
+        }
+    }
+
+    size_t disagree = 0;
+    for (size_t i = 0; !only && i < recorded_count; i++) {
+        PtrHit hit;
+        const int found = reference(&recorded[i], &accel->bvh, accel->spheres, &hit);
+        if (found != !isnan(embree_t[i]) ||
+            (found && fabsf(hit.t - embree_t[i]) > 1e-4f * hit.t))
+            disagree++;
+    }
+    const double hz = tsc_hz();
+    double embree_best = INFINITY;
+    for (int k = 0; k < n; k++)
+        if (methods[k].kind >= EMBREE_POINT_1 && methods[k].seconds > 0)
+            embree_best = fmin(embree_best, methods[k].seconds);
+    printf("%-16s %9s %9s %11s %13s\n", "method", "Mrays/s", "ns/ray", "cycles/ray",
+           "Embree best /");
+    for (int k = 0; k < n; k++) {
+        const Method *m = &methods[k];
+        if (m->seconds == 0)
+            continue;
+        printf("%-16s %9.2f %9.1f %11.0f", m->name, (double)recorded_count / m->seconds * 1e-6,
+               m->seconds / (double)recorded_count * 1e9, m->seconds * hz / (double)recorded_count);
+        if (isinf(embree_best)) /* Embree not timed */
+            printf("%13s\n", "-");
+        else
+            printf("%12.2fx\n", embree_best / m->seconds);
+    }
+    if (!only)
+        printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t "
+               "to 1e-4)\n", disagree, recorded_count);
+    if (embree) {
+        rtcReleaseScene(points);
+        rtcReleaseScene(user);
+        rtcReleaseDevice(device);
+    }
+    free(embree_t);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -328,76 +458,14 @@ int main(int argc, char **argv)
            ptr_integrator_name(ptr_render_integrator(&settings)), recorded_count,
            recorded_count == RAYS_MAX ? " (the first ones: the buffer is full)" : "");
 
-    RTCDevice device = rtcNewDevice("threads=1");
-    RTCScene points = embree_scene(device, accel.spheres, accel.spheres->count, 0);
-    RTCScene user = embree_scene(device, accel.spheres, accel.spheres->count, 1);
-
-    /* Every one-ray traversal of the ladder (a level that keeps the level
-     * below's is left out), the table as asked, and Embree's four ways. */
-    Method methods[PTR_CPU_LEVEL_COUNT + 5];
-    int n = 0;
-    PtrBvhClosestHitFn last = NULL;
-    for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
-        PtrIsectTable table;
-        ptr_isect_init_level(&table, (PtrCpuLevel)level);
-        if (table.bvh_closest_hit != last)
-            methods[n++] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level),
-                                     .kind = PTR_ONE_RAY, .traversal = last = table.bvh_closest_hit };
+    if (only && !strcmp(only, "warmed")) {
+        PtrIsectTable own;
+        ptr_isect_init_level(&own, ptr_cpu_level());
+        printf("%s traversal:\n", ptr_cpu_level_name(ptr_cpu_level()));
+        print_warmed(&accel, c.bvh_closest_hit, own.bvh_closest_hit, runs, tsc_hz());
+    } else {
+        compare(&accel, c.bvh_closest_hit, only, runs);
     }
-    methods[n++] = (Method){ .name = "as asked", .kind = PTR_AS_ASKED };
-    methods[n++] = (Method){ .name = "embree point 1", .kind = EMBREE_POINT_1 };
-    methods[n++] = (Method){ .name = "embree point 16", .kind = EMBREE_POINT_16 };
-    methods[n++] = (Method){ .name = "embree user 1", .kind = EMBREE_USER_1 };
-    methods[n++] = (Method){ .name = "embree user 16", .kind = EMBREE_USER_16 };
-
-    float *embree_t = malloc(recorded_count * sizeof *embree_t);
-    for (int run = 0; run < runs; run++) {
-        for (int k = 0; k < n; k++) {
-            Method *m = &methods[k];
-            if (only && strcmp(only, m->name))
-                continue;
-            switch (m->kind) {
-            case PTR_ONE_RAY: time_ptr(m, &accel, m->traversal); break;
-            case PTR_AS_ASKED: time_ptr_as_asked(m, &accel, &recorded_table); break;
-            case EMBREE_POINT_1: time_embree1(m, points, NULL); break;
-            case EMBREE_POINT_16: time_embree16(m, points); break;
-            case EMBREE_USER_1: time_embree1(m, user, run == 0 ? embree_t : NULL); break;
-            case EMBREE_USER_16: time_embree16(m, user); break;
-            }
-        }
-    }
-
-    size_t disagree = 0;
-    for (size_t i = 0; !only && i < recorded_count; i++) {
-        PtrHit hit;
-        const int found = c.bvh_closest_hit(&recorded[i], &accel.bvh, accel.spheres, &hit);
-        if (found != !isnan(embree_t[i]) ||
-            (found && fabsf(hit.t - embree_t[i]) > 1e-4f * hit.t))
-            disagree++;
-    }
-    const double hz = tsc_hz();
-    double embree_best = INFINITY;
-    for (int k = 0; k < n; k++)
-        if (methods[k].kind >= EMBREE_POINT_1 && methods[k].seconds > 0)
-            embree_best = fmin(embree_best, methods[k].seconds);
-    printf("%-16s %9s %9s %11s %13s\n", "method", "Mrays/s", "ns/ray", "cycles/ray",
-           "Embree best /");
-    for (int k = 0; k < n; k++) {
-        const Method *m = &methods[k];
-        if (m->seconds > 0)
-            printf("%-16s %9.2f %9.1f %11.0f %12.2fx\n", m->name,
-                   (double)recorded_count / m->seconds * 1e-6,
-                   m->seconds / (double)recorded_count * 1e9,
-                   m->seconds * hz / (double)recorded_count,
-                   isinf(embree_best) ? NAN : embree_best / m->seconds);
-    }
-    if (!only)
-        printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t "
-               "to 1e-4)\n", disagree, recorded_count);
-    rtcReleaseScene(points);
-    rtcReleaseScene(user);
-    rtcReleaseDevice(device);
-    free(embree_t);
     free(rgb);
     free(recorded);
     free(packet_start);
