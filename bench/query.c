@@ -26,7 +26,9 @@
  * traversal's branches not trained on its path); and right after this
  * traversal itself answered it (cache and branches warm). Cold minus the
  * second is about the wait on memory; the second minus the third about
- * the mispredicted branches; the third is the steps' work.
+ * the mispredicted branches; the third is the steps' work. About: the C
+ * reference may visit a few other nodes, in another order, and its own
+ * branches move the predictor's history.
  *
  * Embree's geometries: its own spheres (RTC_GEOMETRY_TYPE_SPHERE_POINT, what
  * ../shared/peers/embree_pt.c traces with -m 1), and user geometry whose
@@ -169,24 +171,25 @@ static void time_ptr_as_asked(Method *m, const PtrAccel *accel, const PtrIsectTa
     keep_best(m, thread_seconds() - t0, sum);
 }
 
-/* "warmed" (see the head): nanoseconds a ray of the table's one-ray
- * traversal cold, after the C reference answered the ray, and after the
- * traversal itself did, each the best of runs. */
+/* "warmed" (see the head): nanoseconds a ray of traversal cold, after the
+ * C reference answered the ray, and after the traversal itself did, each
+ * the best of runs. */
 static void print_warmed(const PtrAccel *accel, PtrBvhClosestHitFn reference,
                          PtrBvhClosestHitFn traversal, int runs, double hz)
 {
-    static const char *const before[3] = { "cold", "after the C reference",
-                                           "after itself" };
-    uint64_t best[3] = { UINT64_MAX, UINT64_MAX, UINT64_MAX };
-    double sum = 0;
+    enum { WAYS = 3 };
+    static const char *const way_name[WAYS] = { "cold", "after the C reference",
+                                                "after itself" };
+    const PtrBvhClosestHitFn warm_with[WAYS] = { NULL, reference, traversal };
+    uint64_t best[WAYS] = { UINT64_MAX, UINT64_MAX, UINT64_MAX };
+    double sum = 0; /* of the timed answers' t, printed: the answers are used */
     for (int run = 0; run < runs; run++) {
-        for (int way = 0; way < 3; way++) {
+        for (int way = 0; way < WAYS; way++) {
             uint64_t ticks = 0;
             for (size_t i = 0; i < recorded_count; i++) {
                 PtrHit hit;
-                if (way > 0)
-                    sum += (way == 1 ? reference : traversal)(&recorded[i], &accel->bvh,
-                                                              accel->spheres, &hit);
+                if (warm_with[way])
+                    (void)warm_with[way](&recorded[i], &accel->bvh, accel->spheres, &hit);
                 _mm_lfence();
                 const uint64_t t0 = __rdtsc();
                 _mm_lfence();
@@ -201,8 +204,8 @@ static void print_warmed(const PtrAccel *accel, PtrBvhClosestHitFn reference,
     }
     printf("%-22s %9s %11s (checksum %.9g)\n", "one ray, timed alone", "ns/ray", "cycles/ray",
            sum);
-    for (int way = 0; way < 3; way++)
-        printf("%-22s %9.1f %11.0f\n", before[way],
+    for (int way = 0; way < WAYS; way++)
+        printf("%-22s %9.1f %11.0f\n", way_name[way],
                (double)best[way] / hz / (double)recorded_count * 1e9,
                (double)best[way] / (double)recorded_count);
 }
@@ -332,11 +335,6 @@ static RTCScene embree_scene(RTCDevice device, const PtrSpheres *s, size_t count
 static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const char *only,
                     int runs)
 {
-    const int embree = !only || !strncmp(only, "embree", 6);
-    RTCDevice device = embree ? rtcNewDevice("threads=1") : NULL;
-    RTCScene points = embree ? embree_scene(device, accel->spheres, accel->spheres->count, 0) : NULL;
-    RTCScene user = embree ? embree_scene(device, accel->spheres, accel->spheres->count, 1) : NULL;
-
     /* Every one-ray traversal of the ladder (a level that keeps the level
      * below's is left out), the table as asked, and Embree's four ways. */
     Method methods[PTR_CPU_LEVEL_COUNT + 5];
@@ -355,7 +353,21 @@ static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const c
     methods[n++] = (Method){ .name = "embree user 1", .kind = EMBREE_USER_1 };
     methods[n++] = (Method){ .name = "embree user 16", .kind = EMBREE_USER_16 };
 
-    float *embree_t = malloc(recorded_count * sizeof *embree_t);
+    /* Embree's trees only where an Embree method is timed: at 10^8 spheres
+     * they take gigabytes. */
+    int embree_timed = 0;
+    for (int k = 0; k < n; k++)
+        embree_timed |= methods[k].kind >= EMBREE_POINT_1 &&
+                        (!only || !strcmp(only, methods[k].name));
+    const PtrSpheres *s = accel->spheres;
+    RTCDevice device = embree_timed ? rtcNewDevice("threads=1") : NULL;
+    RTCScene points = embree_timed ? embree_scene(device, s, s->count, 0) : NULL;
+    RTCScene user = embree_timed ? embree_scene(device, s, s->count, 1) : NULL;
+    float *embree_t = embree_timed ? malloc(recorded_count * sizeof *embree_t) : NULL;
+    if (embree_timed && !embree_t) {
+        fprintf(stderr, "query: out of memory\n");
+        exit(6);
+    }
     for (int run = 0; run < runs; run++) {
         for (int k = 0; k < n; k++) {
             Method *m = &methods[k];
@@ -401,7 +413,7 @@ static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const c
     if (!only)
         printf("Embree's tree (user geometry) and ptr's disagree on %zu of %zu rays (hit or t "
                "to 1e-4)\n", disagree, recorded_count);
-    if (embree) {
+    if (embree_timed) {
         rtcReleaseScene(points);
         rtcReleaseScene(user);
         rtcReleaseDevice(device);
@@ -418,6 +430,10 @@ int main(int argc, char **argv)
     const uint32_t spp = (uint32_t)atoi(argv[2]);
     const int runs = argc > 3 ? atoi(argv[3]) : 3;
     const char *only = argc > 4 ? argv[4] : NULL;
+    if (runs < 1) {
+        fprintf(stderr, "query: RUNS must be at least 1\n");
+        return 2;
+    }
     PtrScene scene;
     PtrStrings warnings = { 0 };
     PtrError err = { 0 };
@@ -459,9 +475,15 @@ int main(int argc, char **argv)
            recorded_count == RAYS_MAX ? " (the first ones: the buffer is full)" : "");
 
     if (only && !strcmp(only, "warmed")) {
-        PtrIsectTable own;
+        /* This CPU's traversal, named by the lowest level that has it, as
+         * compare's rows name it. */
+        PtrIsectTable own, lower;
         ptr_isect_init_level(&own, ptr_cpu_level());
-        printf("%s traversal:\n", ptr_cpu_level_name(ptr_cpu_level()));
+        int named = PTR_CPU_NONE - 1;
+        do
+            ptr_isect_init_level(&lower, (PtrCpuLevel)++named);
+        while (lower.bvh_closest_hit != own.bvh_closest_hit);
+        printf("%s traversal:\n", ptr_cpu_level_name((PtrCpuLevel)named));
         print_warmed(&accel, c.bvh_closest_hit, own.bvh_closest_hit, runs, tsc_hz());
     } else {
         compare(&accel, c.bvh_closest_hit, only, runs);
