@@ -330,23 +330,33 @@ static RTCScene embree_scene(RTCDevice device, const PtrSpheres *s, size_t count
     return scene;
 }
 
-/* Every method (or the one named only), best of runs, against Embree's
- * best, and how often Embree's answers differ from the C reference's. */
-static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const char *only,
-                    int runs)
+/* Every one-ray traversal of the ladder up to this CPU's level, each named
+ * by the lowest level that has it (a level that keeps the level below's is
+ * left out), into methods; returns their count, this CPU's traversal last. */
+static int ladder_methods(Method *methods)
 {
-    /* Every one-ray traversal of the ladder (a level that keeps the level
-     * below's is left out), the table as asked, and Embree's four ways. */
-    Method methods[PTR_CPU_LEVEL_COUNT + 5];
     int n = 0;
     PtrBvhClosestHitFn last = NULL;
     for (int level = PTR_CPU_NONE; level <= (int)ptr_cpu_level(); level++) {
         PtrIsectTable table;
         ptr_isect_init_level(&table, (PtrCpuLevel)level);
-        if (table.bvh_closest_hit != last)
+        if (table.bvh_closest_hit != last) {
+            last = table.bvh_closest_hit;
             methods[n++] = (Method){ .name = ptr_cpu_level_name((PtrCpuLevel)level),
-                                     .kind = PTR_ONE_RAY, .traversal = last = table.bvh_closest_hit };
+                                     .kind = PTR_ONE_RAY, .traversal = last };
+        }
     }
+    return n;
+}
+
+/* Every method (or the one named only), best of runs, against Embree's
+ * best, and how often Embree's answers differ from the C reference's. */
+static void compare(const PtrAccel *accel, PtrBvhClosestHitFn reference, const char *only,
+                    int runs)
+{
+    /* The ladder's traversals, the table as asked, and Embree's four ways. */
+    Method methods[PTR_CPU_LEVEL_COUNT + 5];
+    int n = ladder_methods(methods);
     methods[n++] = (Method){ .name = "as asked", .kind = PTR_AS_ASKED };
     methods[n++] = (Method){ .name = "embree point 1", .kind = EMBREE_POINT_1 };
     methods[n++] = (Method){ .name = "embree point 16", .kind = EMBREE_POINT_16 };
@@ -475,16 +485,10 @@ int main(int argc, char **argv)
            recorded_count == RAYS_MAX ? " (the first ones: the buffer is full)" : "");
 
     if (only && !strcmp(only, "warmed")) {
-        /* This CPU's traversal, named by the lowest level that has it, as
-         * compare's rows name it. */
-        PtrIsectTable own, lower;
-        ptr_isect_init_level(&own, ptr_cpu_level());
-        int named = PTR_CPU_NONE - 1;
-        do
-            ptr_isect_init_level(&lower, (PtrCpuLevel)++named);
-        while (lower.bvh_closest_hit != own.bvh_closest_hit);
-        printf("%s traversal:\n", ptr_cpu_level_name((PtrCpuLevel)named));
-        print_warmed(&accel, c.bvh_closest_hit, own.bvh_closest_hit, runs, tsc_hz());
+        Method ladder[PTR_CPU_LEVEL_COUNT];
+        const Method *own = &ladder[ladder_methods(ladder) - 1];
+        printf("%s traversal:\n", own->name);
+        print_warmed(&accel, c.bvh_closest_hit, own->traversal, runs, tsc_hz());
     } else {
         compare(&accel, c.bvh_closest_hit, only, runs);
     }
